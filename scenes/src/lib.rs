@@ -1,0 +1,1 @@
+//! The scene registry (filled in by the scenes issue).
