@@ -22,10 +22,10 @@
 // pub mod effect;
 pub mod element;
 // pub mod energy;
-// pub mod geometry;
+pub mod geometry;
 // pub mod mass;
 // pub mod material;
-// pub mod mesh;
+pub mod mesh;
 pub mod quadrature;
 // pub mod solver;
 

@@ -325,4 +325,4 @@ pub(crate) fn build_faces(shape: ReferenceShape, order: usize, nodes: &[[f64; 3]
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

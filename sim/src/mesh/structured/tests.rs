@@ -1,0 +1,81 @@
+use super::*;
+
+pub(crate) fn beam(element: &str, cells: [usize; 3], split: TetSplit, refine: usize, length_m: f64) -> Mesh {
+    BoxMeshSpec {
+        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(length_m, 0.5, 0.5), cells },
+        element_type: ElementType::from_name(element).unwrap(),
+        split,
+        refine,
+    }
+    .build()
+    .unwrap()
+}
+
+/// The element and node counts of the paper's meshes (ERRATA.md table).
+#[test]
+fn the_paper_meshes_have_the_paper_counts() {
+    use TetSplit::*;
+    let cases: &[(&str, [usize; 3], TetSplit, usize, f64, usize, usize)] = &[
+        ("p1", [16, 4, 4], Five, 0, 2.0, 1_280, 425),
+        ("p1", [16, 4, 4], Five, 1, 2.0, 10_240, 2_417),
+        ("p1", [16, 4, 4], Five, 2, 2.0, 81_920, 16_225),
+        ("q1", [64, 16, 16], Five, 0, 2.0, 16_384, 18_785),
+        ("p2", [8, 2, 2], Five, 0, 2.0, 160, 393),
+        ("p3", [4, 2, 2], Five, 0, 2.0, 80, 573),
+        ("p1", [12, 6, 6], Six, 0, 1.0, 2_592, 637),
+        ("p2", [6, 3, 3], Six, 0, 1.0, 324, 637),
+        ("p3", [4, 2, 2], Six, 0, 1.0, 96, 637),
+    ];
+    for &(e, cells, split, refine, len, elements, nodes) in cases {
+        let m = beam(e, cells, split, refine, len);
+        assert_eq!((m.num_elements(), m.num_nodes()), (elements, nodes), "{e} {cells:?} {split:?} refine {refine}");
+    }
+}
+
+#[test]
+fn no_two_nodes_share_a_position() {
+    for e in ["p1", "p2", "p3", "q1", "q2", "prism", "pyramid"] {
+        let m = beam(e, [3, 2, 2], TetSplit::Five, 0, 1.5);
+        let mut keys: Vec<[i64; 3]> =
+            m.rest_positions.iter().map(|p| [p.x, p.y, p.z].map(|c| (c * 1e9).round() as i64)).collect();
+        keys.sort_unstable();
+        let n = keys.len();
+        keys.dedup();
+        assert_eq!(keys.len(), n, "{e}: duplicate node coordinates");
+    }
+}
+
+#[test]
+fn high_order_meshes_are_conforming_every_interior_face_is_shared_by_two_elements() {
+    for e in ["p1", "p2", "p3", "q1", "q2", "prism", "pyramid"] {
+        for split in [TetSplit::Five, TetSplit::Six] {
+            let m = beam(e, [3, 2, 2], split, 0, 1.5);
+            // A conforming box mesh has boundary faces only on the box surface.
+            let (lo, hi) = m.bounding_box();
+            for (b, el, f) in m.boundary_faces() {
+                let block = &m.blocks[b];
+                let face = &block.element_type.faces()[f];
+                let pts: Vec<Vec3> = face.nodes.iter().map(|&l| m.rest_positions[block.element(el)[l] as usize]).collect();
+                let on_box = (0..3).any(|d| {
+                    pts.iter().all(|p| (p[d] - lo[d]).abs() < 1e-12) || pts.iter().all(|p| (p[d] - hi[d]).abs() < 1e-12)
+                });
+                assert!(on_box, "{e} {split:?}: unmatched interior face {:?}", face.nodes);
+            }
+        }
+    }
+}
+
+#[test]
+fn bad_requests_are_errors() {
+    let spec = |cells, e: &str, refine| BoxMeshSpec {
+        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 1.0, 1.0), cells },
+        element_type: ElementType::from_name(e).unwrap(),
+        split: TetSplit::Five,
+        refine,
+    };
+    assert!(spec([0, 1, 1], "p1", 0).build().unwrap_err().to_string().contains("empty direction"));
+    assert!(spec([1, 1, 1], "q1", 1).build().unwrap_err().to_string().contains("tetrahedra only"));
+    let mut flat = spec([1, 1, 1], "p1", 0);
+    flat.grid.max_m.z = 0.0;
+    assert!(flat.build().unwrap_err().to_string().contains("positive finite size"));
+}
