@@ -159,4 +159,4 @@ pub fn total_volume_m3(geometry: &[BlockGeometry]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

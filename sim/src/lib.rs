@@ -18,16 +18,16 @@
 //! - [`constraint`]: pure XPBD constraint kernels (energy and split formulations).
 //! - [`solver`]: the stateful XPBD solver and the opt-in [`effect`]s it runs.
 
-// pub mod constraint;
-// pub mod effect;
+pub mod constraint;
+pub mod effect;
 pub mod element;
-// pub mod energy;
+pub mod energy;
 pub mod geometry;
-// pub mod mass;
-// pub mod material;
+pub mod mass;
+pub mod material;
 pub mod mesh;
 pub mod quadrature;
-// pub mod solver;
+pub mod solver;
 
 pub use nalgebra;
 

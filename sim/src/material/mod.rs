@@ -1,0 +1,591 @@
+//! Hyperelastic material models for the finite-element / XPBD solvers.
+//!
+//! Implements the constitutive laws used by Saillant et al., *High-Order
+//! Elements in Position Based Dynamics*, plus two Neo-Hookean variants:
+//!
+//! | [`MaterialModel`] | short name | energy density ψ(F) | module |
+//! | --- | --- | --- | --- |
+//! | [`MaterialModel::StVenantKirchhoff`] | `stvk` | μ E:E + λ/2 (tr E)², E = ½(FᵀF − I) | [`stvk`] |
+//! | [`MaterialModel::StableNeoHookean`] | `snh` | μ/2 (I_C − 3) + λ̂/2 (J − α)² − μ²/(2λ̂) | [`stable_neo_hookean`] |
+//! | [`MaterialModel::NeoHookean`] | `nh` | μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)² | [`neo_hookean`] |
+//!
+//! Conventions shared by every model:
+//!
+//! * ψ is an energy per unit reference volume (J/m³ = Pa) and is exactly `0.0`
+//!   at F = I; the first Piola–Kirchhoff stress P = ∂ψ/∂F is exactly zero there.
+//! * The Lamé parameters come from Young's modulus E and Poisson ratio ν:
+//!   μ = E / (2(1 + ν)), λ = Eν / ((1 + ν)(1 − 2ν)), and every model's
+//!   linearisation at rest equals the linear-elasticity tensor
+//!   μ(δ_ik δ_jl + δ_il δ_jk) + λ δ_ij δ_kl for those μ, λ.
+//! * Fourth-order tensors are 9×9 matrices acting on vec(F) in nalgebra's
+//!   column-major order: index = row + 3·col, so
+//!   `dpdf[(row_p + 3*col_p, row_f + 3*col_f)] = ∂P[row_p,col_p] / ∂F[row_f,col_f]`.
+//! * [`Material::split_terms`] exposes the two constraints of the "split" XPBD
+//!   formulation (Macklin & Müller 2021, *A Constraint-based Formulation of
+//!   Stable Neo-Hookean Materials*), `[deviatoric, hydrostatic]`, with
+//!   ψ(F) = Σ_t k_t/2 · C_t(F)² + [`Material::split_energy_offset`], where the
+//!   stiffnesses k_t are [`Material::split_stiffness_pa`]. The XPBD compliance
+//!   of term t at a quadrature point of reference volume V_q is 1/(k_t · V_q).
+
+use nalgebra::{Matrix3, SMatrix, SymmetricEigen, Vector3};
+
+// Declared first so its test macro is in textual scope in the model modules.
+#[cfg(test)]
+#[macro_use]
+mod testing;
+
+pub mod neo_hookean;
+pub mod stable_neo_hookean;
+pub mod stvk;
+
+pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
+
+/// 3×3 matrix of `f64` (deformation gradients, stresses).
+pub type Mat3 = Matrix3<f64>;
+/// 9×9 matrix of `f64` acting on column-major vec(F) (index = row + 3·col).
+pub type Mat9 = SMatrix<f64, 9, 9>;
+
+/// The available hyperelastic constitutive models.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MaterialModel {
+    /// Saint-Venant–Kirchhoff (the model used in Saillant et al.). See [`stvk`].
+    StVenantKirchhoff,
+    /// Stable Neo-Hookean (Smith, de Goes & Kim 2018). See [`stable_neo_hookean`].
+    StableNeoHookean,
+    /// Classic compressible Neo-Hookean with a ln J floor. See [`neo_hookean`].
+    NeoHookean,
+}
+
+impl MaterialModel {
+    /// Every model, in declaration order.
+    pub const ALL: [MaterialModel; 3] = [
+        MaterialModel::StVenantKirchhoff,
+        MaterialModel::StableNeoHookean,
+        MaterialModel::NeoHookean,
+    ];
+
+    /// Short, stable identifier: `"stvk"`, `"snh"` or `"nh"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            MaterialModel::StVenantKirchhoff => "stvk",
+            MaterialModel::StableNeoHookean => "snh",
+            MaterialModel::NeoHookean => "nh",
+        }
+    }
+
+    /// Human-readable name.
+    pub fn long_name(self) -> &'static str {
+        match self {
+            MaterialModel::StVenantKirchhoff => "Saint-Venant–Kirchhoff",
+            MaterialModel::StableNeoHookean => "stable Neo-Hookean",
+            MaterialModel::NeoHookean => "compressible Neo-Hookean",
+        }
+    }
+
+    /// Parses a short name (`stvk`, `snh`, `nh`), ignoring ASCII case and
+    /// surrounding whitespace. The long names are accepted as well.
+    pub fn from_name(s: &str) -> Option<Self> {
+        let s = s.trim();
+        Self::ALL
+            .into_iter()
+            .find(|m| s.eq_ignore_ascii_case(m.name()) || s.eq_ignore_ascii_case(m.long_name()))
+    }
+}
+
+impl std::fmt::Display for MaterialModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Lamé parameters, in pascals.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lame {
+    /// Shear modulus μ (Pa).
+    pub mu_pa: f64,
+    /// First Lamé parameter λ (Pa). Negative for ν < 0.
+    pub lambda_pa: f64,
+}
+
+impl Lame {
+    /// μ = E / (2(1 + ν)), λ = Eν / ((1 + ν)(1 − 2ν)).
+    ///
+    /// Pure formula, no validation: use [`Material::new`] for checked input.
+    pub fn from_youngs_poisson(youngs_modulus_pa: f64, poisson_ratio: f64) -> Lame {
+        let e = youngs_modulus_pa;
+        let nu = poisson_ratio;
+        Lame {
+            mu_pa: e / (2.0 * (1.0 + nu)),
+            lambda_pa: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+        }
+    }
+}
+
+/// Invalid material parameters.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum MaterialError {
+    /// E is not a finite number > 0.
+    #[error("Young's modulus must be a finite positive number of pascals, got {youngs_modulus_pa}")]
+    YoungsModulus { youngs_modulus_pa: f64 },
+    /// ν is not a finite number in the open interval (−1, 0.5).
+    #[error("Poisson ratio must lie in (-1, 0.5) for {model} (λ → ∞ at 0.5), got {poisson_ratio}")]
+    PoissonRatio {
+        model: MaterialModel,
+        poisson_ratio: f64,
+    },
+    /// ρ is not a finite number > 0.
+    #[error("density must be a finite positive number of kg/m³, got {density_kg_m3}")]
+    Density { density_kg_m3: f64 },
+    /// E and ν are individually valid but μ or λ overflows `f64`.
+    #[error(
+        "Young's modulus {youngs_modulus_pa} Pa with Poisson ratio {poisson_ratio} gives \
+         non-finite Lamé parameters (μ = {mu_pa} Pa, λ = {lambda_pa} Pa)"
+    )]
+    NonFiniteLame {
+        youngs_modulus_pa: f64,
+        poisson_ratio: f64,
+        mu_pa: f64,
+        lambda_pa: f64,
+    },
+}
+
+/// A validated hyperelastic material.
+///
+/// Construct with [`Material::new`]. The Lamé parameters are derived from the
+/// public fields on every call (a few flops), so they can never go stale; if
+/// you mutate the public fields yourself you bypass validation.
+// `#[non_exhaustive]` would not stop struct-literal construction inside this
+// crate; the private field does (outside this module).
+#[allow(clippy::manual_non_exhaustive)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    pub model: MaterialModel,
+    pub youngs_modulus_pa: f64,
+    pub poisson_ratio: f64,
+    pub density_kg_m3: f64,
+    /// Forces construction through [`Material::new`].
+    _validated: (),
+}
+
+/// One split constraint at a quadrature point.
+///
+/// `grad_f_scaled` = `scale` · ∂C/∂F. For constraints of the form C = sqrt(g) ≥ 0
+/// (whose gradient is 0/0 at C = 0) `scale` = C and `grad_f_scaled` = ∂(C²/2)/∂F,
+/// which stays finite; for the others `scale` = 1 and `grad_f_scaled` = ∂C/∂F.
+/// Where `scale` ≠ 0, ∂C/∂F = `grad_f_scaled` / `scale`.
+#[derive(Clone, Copy, Debug)]
+pub struct SplitTerm {
+    /// C(F).
+    pub value: f64,
+    /// The factor folded into `grad_f_scaled` (C for sqrt forms, else 1).
+    pub scale: f64,
+    /// `scale` · ∂C/∂F.
+    pub grad_f_scaled: Mat3,
+}
+
+impl Material {
+    /// Validates E > 0, ν ∈ (−1, 0.5), ρ > 0 (all finite) and that μ, λ are finite.
+    pub fn new(
+        model: MaterialModel,
+        youngs_modulus_pa: f64,
+        poisson_ratio: f64,
+        density_kg_m3: f64,
+    ) -> Result<Material, MaterialError> {
+        if !(youngs_modulus_pa.is_finite() && youngs_modulus_pa > 0.0) {
+            return Err(MaterialError::YoungsModulus { youngs_modulus_pa });
+        }
+        // Every model needs a finite λ, hence the open upper bound 0.5.
+        if !(poisson_ratio.is_finite() && poisson_ratio > -1.0 && poisson_ratio < 0.5) {
+            return Err(MaterialError::PoissonRatio {
+                model,
+                poisson_ratio,
+            });
+        }
+        if !(density_kg_m3.is_finite() && density_kg_m3 > 0.0) {
+            return Err(MaterialError::Density { density_kg_m3 });
+        }
+        let lame = Lame::from_youngs_poisson(youngs_modulus_pa, poisson_ratio);
+        // λ + μ = E / (2(1+ν)(1−2ν)) is what stable Neo-Hookean divides by.
+        if !(lame.mu_pa.is_finite()
+            && lame.lambda_pa.is_finite()
+            && (lame.mu_pa + lame.lambda_pa).is_finite())
+        {
+            return Err(MaterialError::NonFiniteLame {
+                youngs_modulus_pa,
+                poisson_ratio,
+                mu_pa: lame.mu_pa,
+                lambda_pa: lame.lambda_pa,
+            });
+        }
+        Ok(Material {
+            model,
+            youngs_modulus_pa,
+            poisson_ratio,
+            density_kg_m3,
+            _validated: (),
+        })
+    }
+
+    /// Lamé parameters μ, λ of this material.
+    pub fn lame(&self) -> Lame {
+        Lame::from_youngs_poisson(self.youngs_modulus_pa, self.poisson_ratio)
+    }
+
+    /// ψ(F) in J/m³, exactly 0 at F = I for every model.
+    pub fn energy_density(&self, f: &Mat3) -> f64 {
+        let l = self.lame();
+        match self.model {
+            MaterialModel::StVenantKirchhoff => stvk::energy_density(l, f),
+            MaterialModel::StableNeoHookean => stable_neo_hookean::energy_density(l, f),
+            MaterialModel::NeoHookean => neo_hookean::energy_density(l, f),
+        }
+    }
+
+    /// First Piola–Kirchhoff stress P = ∂ψ/∂F (Pa).
+    pub fn pk1(&self, f: &Mat3) -> Mat3 {
+        self.energy_density_and_pk1(f).1
+    }
+
+    /// (ψ(F), P(F)), sharing the common work.
+    pub fn energy_density_and_pk1(&self, f: &Mat3) -> (f64, Mat3) {
+        let l = self.lame();
+        match self.model {
+            MaterialModel::StVenantKirchhoff => stvk::energy_density_and_pk1(l, f),
+            MaterialModel::StableNeoHookean => stable_neo_hookean::energy_density_and_pk1(l, f),
+            MaterialModel::NeoHookean => neo_hookean::energy_density_and_pk1(l, f),
+        }
+    }
+
+    /// dP/dF as a 9×9 matrix on column-major vec(F) (index = row + 3·col):
+    /// `dpdf[(row_p + 3*col_p, row_f + 3*col_f)] = ∂P[row_p,col_p] / ∂F[row_f,col_f]`.
+    /// Exactly symmetric (it is the Hessian of ψ).
+    pub fn dpdf(&self, f: &Mat3) -> Mat9 {
+        let l = self.lame();
+        match self.model {
+            MaterialModel::StVenantKirchhoff => stvk::dpdf(l, f),
+            MaterialModel::StableNeoHookean => stable_neo_hookean::dpdf(l, f),
+            MaterialModel::NeoHookean => neo_hookean::dpdf(l, f),
+        }
+    }
+
+    /// [`Material::dpdf`] projected to the nearest (Frobenius) positive
+    /// semi-definite matrix: symmetric eigen-decomposition with negative
+    /// eigenvalues clamped to 0. Returned unchanged when already PSD.
+    /// Non-finite input is returned as is.
+    pub fn dpdf_projected(&self, f: &Mat3) -> Mat9 {
+        project_psd(&self.dpdf(f))
+    }
+
+    /// The two split constraints `[deviatoric, hydrostatic]` at F
+    /// (see each model's module doc for their definitions).
+    pub fn split_terms(&self, f: &Mat3) -> [SplitTerm; 2] {
+        let l = self.lame();
+        match self.model {
+            MaterialModel::StVenantKirchhoff => stvk::split_terms(f),
+            MaterialModel::StableNeoHookean => stable_neo_hookean::split_terms(l, f),
+            MaterialModel::NeoHookean => neo_hookean::split_terms(f),
+        }
+    }
+
+    /// Stiffness k_t (Pa) of each split term, so that
+    /// ψ(F) = Σ_t k_t/2 · C_t(F)² + [`Material::split_energy_offset`].
+    /// XPBD compliance is 1/(k_t · V_q).
+    ///
+    /// The hydrostatic stiffness of `stvk` and `nh` is λ, which is negative
+    /// for ν < 0 (and 0 for ν = 0); `snh` uses λ̂ = λ + μ > 0.
+    pub fn split_stiffness_pa(&self) -> [f64; 2] {
+        let l = self.lame();
+        match self.model {
+            MaterialModel::StVenantKirchhoff => stvk::split_stiffness_pa(l),
+            MaterialModel::StableNeoHookean => stable_neo_hookean::split_stiffness_pa(l),
+            MaterialModel::NeoHookean => neo_hookean::split_stiffness_pa(l),
+        }
+    }
+
+    /// The constant c (J/m³) with ψ(F) = Σ_t k_t/2 · C_t(F)² + c:
+    /// 0 for `stvk` and `nh`, −3μ/2 − μ²/(2λ̂) for `snh`.
+    pub fn split_energy_offset(&self) -> f64 {
+        let l = self.lame();
+        match self.model {
+            MaterialModel::StVenantKirchhoff => stvk::split_energy_offset(l),
+            MaterialModel::StableNeoHookean => stable_neo_hookean::split_energy_offset(l),
+            MaterialModel::NeoHookean => neo_hookean::split_energy_offset(l),
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Shared kinematics helpers.
+
+/// cof F = det(F) F⁻ᵀ, built from cross products of the columns f0, f1, f2:
+/// cof F = [f1×f2, f2×f0, f0×f1]. Defined (and smooth) for singular F too.
+fn cofactor(f: &Mat3) -> Mat3 {
+    let a: Vector3<f64> = f.column(0).into_owned();
+    let b: Vector3<f64> = f.column(1).into_owned();
+    let c: Vector3<f64> = f.column(2).into_owned();
+    Mat3::from_columns(&[b.cross(&c), c.cross(&a), a.cross(&b)])
+}
+
+/// Directional derivative of [`cofactor`] at F along dF:
+/// d cof = [df1×f2 + f1×df2, df2×f0 + f2×df0, df0×f1 + f0×df1].
+fn cofactor_directional(f: &Mat3, df: &Mat3) -> Mat3 {
+    let a: Vector3<f64> = f.column(0).into_owned();
+    let b: Vector3<f64> = f.column(1).into_owned();
+    let c: Vector3<f64> = f.column(2).into_owned();
+    let da: Vector3<f64> = df.column(0).into_owned();
+    let db: Vector3<f64> = df.column(1).into_owned();
+    let dc: Vector3<f64> = df.column(2).into_owned();
+    Mat3::from_columns(&[
+        db.cross(&c) + b.cross(&dc),
+        dc.cross(&a) + c.cross(&da),
+        da.cross(&b) + a.cross(&db),
+    ])
+}
+
+/// J − 1 = det(F) − 1 without the cancellation of `det(F) - 1.0` near rest:
+/// with H = F − I, det(I + H) = 1 + tr H + ½((tr H)² − tr(H²)) + det H.
+fn det_minus_one(f: &Mat3) -> f64 {
+    let h = f - Mat3::identity();
+    let tr = h.trace();
+    tr + 0.5 * (tr * tr - (h * h).trace()) + h.determinant()
+}
+
+/// I_C − 3 = ‖F‖²_F − 3, computed as 2 tr H + ‖H‖² (H = F − I) to stay exact at rest.
+fn first_invariant_minus_three(f: &Mat3) -> f64 {
+    let h = f - Mat3::identity();
+    2.0 * h.trace() + h.norm_squared()
+}
+
+/// Assembles the 9×9 tangent from a directional derivative dP(F; dF) applied
+/// to the 9 unit matrices (column j ↔ vec index j = row + 3·col), and
+/// symmetrises it (the exact tangent is a Hessian, so this only removes rounding).
+fn dpdf_from_directional(dp: impl Fn(&Mat3) -> Mat3) -> Mat9 {
+    let mut out = Mat9::zeros();
+    for j in 0..9 {
+        let mut df = Mat3::zeros();
+        df[j] = 1.0;
+        let col = dp(&df);
+        for i in 0..9 {
+            out[(i, j)] = col[i];
+        }
+    }
+    (out + out.transpose()) * 0.5
+}
+
+/// Nearest PSD matrix (Frobenius norm) to the symmetric part of `m`.
+fn project_psd(m: &Mat9) -> Mat9 {
+    if !m.iter().all(|x| x.is_finite()) {
+        return *m;
+    }
+    let sym = (m + m.transpose()) * 0.5;
+    match SymmetricEigen::try_new(sym, f64::EPSILON, 10_000) {
+        Some(eig) => {
+            if eig.eigenvalues.iter().all(|&l| l >= 0.0) {
+                return sym;
+            }
+            let clamped = eig.eigenvalues.map(|l| l.max(0.0));
+            let q = &eig.eigenvectors;
+            let out = q * Mat9::from_diagonal(&clamped) * q.transpose();
+            (out + out.transpose()) * 0.5
+        }
+        // Not expected for finite symmetric input; fall back to a PSD
+        // (diagonal, clamped) approximation rather than failing.
+        None => Mat9::from_diagonal(&sym.diagonal().map(|d| d.max(0.0))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::testing;
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn names_round_trip() {
+        for m in MaterialModel::ALL {
+            assert_eq!(MaterialModel::from_name(m.name()), Some(m));
+            assert_eq!(MaterialModel::from_name(&m.name().to_uppercase()), Some(m));
+            assert_eq!(MaterialModel::from_name(m.long_name()), Some(m));
+            assert_eq!(m.to_string(), m.name());
+        }
+        assert_eq!(
+            MaterialModel::ALL.map(MaterialModel::name),
+            ["stvk", "snh", "nh"]
+        );
+        assert_eq!(
+            MaterialModel::from_name(" StVK "),
+            Some(MaterialModel::StVenantKirchhoff)
+        );
+        assert_eq!(
+            MaterialModel::from_name("NH"),
+            Some(MaterialModel::NeoHookean)
+        );
+        assert_eq!(
+            MaterialModel::from_name("Snh"),
+            Some(MaterialModel::StableNeoHookean)
+        );
+        assert_eq!(MaterialModel::from_name("neo"), None);
+        assert_eq!(MaterialModel::from_name(""), None);
+        assert_eq!(
+            MaterialModel::StVenantKirchhoff.long_name(),
+            "Saint-Venant–Kirchhoff"
+        );
+    }
+
+    #[test]
+    fn lame_from_youngs_poisson() {
+        let l = Lame::from_youngs_poisson(1.0, 0.25);
+        assert!((l.mu_pa - 0.4).abs() < 1e-15);
+        assert!((l.lambda_pa - 0.4).abs() < 1e-15);
+        let l = Lame::from_youngs_poisson(2.0e6, 0.0);
+        assert_eq!(l.lambda_pa, 0.0);
+        assert!((l.mu_pa - 1.0e6).abs() < 1e-9);
+        let m = Material::new(MaterialModel::NeoHookean, 1.0e5, 0.3, 1000.0).expect("valid");
+        assert_eq!(m.lame(), Lame::from_youngs_poisson(1.0e5, 0.3));
+    }
+
+    #[test]
+    fn new_accepts_valid_parameters() {
+        for model in MaterialModel::ALL {
+            for nu in [-0.99, -0.5, 0.0, 0.3, 0.49, 0.4999] {
+                let m = Material::new(model, 1.0e6, nu, 1100.0).expect("valid parameters");
+                assert_eq!(m.model, model);
+                assert_eq!(m.youngs_modulus_pa, 1.0e6);
+                assert_eq!(m.poisson_ratio, nu);
+                assert_eq!(m.density_kg_m3, 1100.0);
+            }
+        }
+    }
+
+    fn err(model: MaterialModel, e: f64, nu: f64, rho: f64) -> String {
+        match Material::new(model, e, nu, rho) {
+            Ok(m) => panic!("accepted invalid parameters: {m:?}"),
+            Err(err) => err.to_string(),
+        }
+    }
+
+    #[test]
+    fn new_rejects_invalid_parameters_with_named_messages() {
+        for model in MaterialModel::ALL {
+            for nu in [
+                0.5,
+                0.7,
+                -1.0,
+                -1.5,
+                f64::NAN,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+            ] {
+                let msg = err(model, 1.0e6, nu, 1000.0);
+                assert!(msg.contains("Poisson ratio"), "{msg}");
+                assert!(msg.contains(model.name()), "{msg}");
+            }
+            for e in [0.0, -0.0, -3.0, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                let msg = err(model, e, 0.3, 1000.0);
+                assert!(msg.contains("Young's modulus"), "{msg}");
+            }
+            for rho in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+                let msg = err(model, 1.0e6, 0.3, rho);
+                assert!(msg.contains("density"), "{msg}");
+            }
+        }
+        assert_eq!(
+            err(MaterialModel::StVenantKirchhoff, -3.0, 0.3, 1000.0),
+            "Young's modulus must be a finite positive number of pascals, got -3"
+        );
+        assert_eq!(
+            err(MaterialModel::StVenantKirchhoff, 1.0e6, 0.5, 1000.0),
+            "Poisson ratio must lie in (-1, 0.5) for stvk (λ → ∞ at 0.5), got 0.5"
+        );
+        assert_eq!(
+            err(MaterialModel::NeoHookean, 1.0e6, 0.3, -2.5),
+            "density must be a finite positive number of kg/m³, got -2.5"
+        );
+        assert!(err(MaterialModel::NeoHookean, f64::NAN, 0.3, 1.0).ends_with("got NaN"));
+        assert_eq!(
+            Material::new(MaterialModel::NeoHookean, 1.0e6, 0.7, 1.0),
+            Err(MaterialError::PoissonRatio {
+                model: MaterialModel::NeoHookean,
+                poisson_ratio: 0.7
+            })
+        );
+        // Valid-looking E and ν whose Lamé parameters overflow.
+        let msg = err(MaterialModel::StableNeoHookean, 1.0e308, 0.5 - 1.0e-12, 1.0);
+        assert!(msg.contains("Lamé"), "{msg}");
+    }
+
+    #[test]
+    fn cofactor_is_det_times_inverse_transpose() {
+        testing::run(testing::general_matrix(1.5), |f| {
+            prop_assume!(f.determinant().abs() > 1e-3);
+            let inv_t = f.try_inverse().expect("invertible").transpose();
+            let expected = inv_t * f.determinant();
+            let cof = cofactor(&f);
+            prop_assert!((cof - expected).norm() <= 1e-9 * (1.0 + expected.norm()));
+            prop_assert!(
+                (det_minus_one(&f) - (f.determinant() - 1.0)).abs()
+                    <= 1e-12 * (1.0 + f.norm().powi(3))
+            );
+            Ok(())
+        });
+    }
+
+    #[test]
+    fn cofactor_directional_matches_finite_differences() {
+        testing::run(
+            (testing::general_matrix(1.5), testing::general_matrix(1.0)),
+            |(f, df)| {
+                let h = 1e-6;
+                let fd = (cofactor(&(f + df * h)) - cofactor(&(f - df * h))) / (2.0 * h);
+                let an = cofactor_directional(&f, &df);
+                prop_assert!((fd - an).norm() <= 1e-7 * (1.0 + an.norm()));
+                Ok(())
+            },
+        );
+    }
+
+    #[test]
+    fn projection_of_known_matrix() {
+        let mut d = Mat9::zeros();
+        for i in 0..9 {
+            d[(i, i)] = i as f64 - 4.0; // eigenvalues -4..4
+        }
+        let r = testing::random_orthogonal9(7);
+        let m = r * d * r.transpose();
+        let p = project_psd(&m);
+        let mut expected = Mat9::zeros();
+        for i in 0..9 {
+            expected[(i, i)] = (i as f64 - 4.0).max(0.0);
+        }
+        let expected = r * expected * r.transpose();
+        assert!(
+            (p - expected).norm() < 1e-12 * expected.norm().max(1.0),
+            "{p}"
+        );
+        // Already positive definite: returned unchanged (bit for bit).
+        let mut pd = Mat9::zeros();
+        for i in 0..9 {
+            pd[(i, i)] = i as f64 + 1.0;
+        }
+        let pd = r * pd * r.transpose();
+        let pd = (pd + pd.transpose()) * 0.5;
+        assert_eq!(project_psd(&pd), pd);
+        // Non-finite input passes through instead of looping.
+        let mut bad = m;
+        bad[(3, 4)] = f64::NAN;
+        assert!(project_psd(&bad)[(3, 4)].is_nan());
+    }
+
+    #[test]
+    fn split_stiffness_is_positive_for_nonnegative_poisson_ratio() {
+        testing::run((0.0f64..0.49, 3.0f64..9.0), |(nu, log_e)| {
+            for model in MaterialModel::ALL {
+                let m = Material::new(model, 10f64.powf(log_e), nu, 1000.0).expect("valid");
+                let k = m.split_stiffness_pa();
+                prop_assert!(k[0] > 0.0);
+                prop_assert!(k[1] >= 0.0);
+            }
+            Ok(())
+        });
+    }
+}
