@@ -10,7 +10,7 @@ fn the_update_zeroes_a_linear_hard_constraint_in_one_step() {
     let (x0, x1) = (2.5, 0.5);
     let c = x0 - x1 - 1.0;
     let (d_lambda, step) = xpbd_step(c, 1.0, 1.0 + 3.0, 0.0, 0.0).unwrap();
-    let (y0, y1) = (x0 + step * 1.0 * 1.0, x1 + step * 3.0 * -1.0);
+    let (y0, y1) = (x0 + step * 1.0 * 1.0, x1 - step * 3.0);
     assert!((y0 - y1 - 1.0).abs() < 1e-15);
     assert_eq!(d_lambda, step);
     // compliant: Δλ = −C/(Σw|∇C|² + α̃)
