@@ -1,1 +1,103 @@
-//! The scene registry (filled in by the scenes issue).
+//! The scene registry: the one list of scenes the CLI, the app, tests and benchmarks read.
+//!
+//! Each built-in scene is a TOML file in `assets/scenes/` (embedded in the binary, so `hox`
+//! runs from anywhere); [`scene`] documents the format. [`Instance`] builds a scene into a
+//! running simulation with its probes, and [`run`] advances it for a time or until it settles.
+
+pub mod run;
+pub mod scene;
+
+pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, run};
+pub use scene::{Scene, SceneFile, SceneOverrides};
+
+use hox_sim::probe::Probe;
+use hox_sim::solver::Simulation;
+
+/// The built-in scenes: (name, TOML text). Adding a scene: its file plus one line here.
+pub const BUILTIN: &[(&str, &str)] = &[
+    ("bending", include_str!("../../assets/scenes/bending.toml")),
+    ("tension", include_str!("../../assets/scenes/tension.toml")),
+    ("torsion", include_str!("../../assets/scenes/torsion.toml")),
+    ("drop", include_str!("../../assets/scenes/drop.toml")),
+    ("twist", include_str!("../../assets/scenes/twist.toml")),
+    ("squash", include_str!("../../assets/scenes/squash.toml")),
+];
+
+/// The paper's three scenes.
+pub const PAPER_SCENES: [&str; 3] = ["bending", "tension", "torsion"];
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    #[error("unknown scene '{name}' (available: {available})")]
+    Unknown { name: String, available: String },
+    #[error("{source_name}: {message}")]
+    Parse { source_name: String, message: String },
+    #[error("{source_name}: {key} = {value}: {reason}")]
+    Invalid { source_name: String, key: String, value: String, reason: String },
+    #[error("cannot read scene file {path}: {message}")]
+    Io { path: String, message: String },
+    #[error("{source_name}: cannot build the mesh: {message}")]
+    Mesh { source_name: String, message: String },
+    #[error("{source_name}: {message}")]
+    Simulation { source_name: String, message: String },
+    #[error("{source_name}: {message}")]
+    Probe { source_name: String, message: String },
+}
+
+/// Names of the built-in scenes, comma-separated.
+pub fn names() -> String {
+    BUILTIN.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+}
+
+/// Every built-in scene, parsed and validated.
+pub fn registry() -> Result<Vec<Scene>, SceneError> {
+    BUILTIN.iter().map(|(n, text)| Scene::from_toml(text, &format!("builtin:{n}"))).collect()
+}
+
+/// A built-in scene by name.
+pub fn by_name(name: &str) -> Result<Scene, SceneError> {
+    let (n, text) = BUILTIN
+        .iter()
+        .find(|(n, _)| *n == name)
+        .ok_or_else(|| SceneError::Unknown { name: name.to_string(), available: names() })?;
+    Scene::from_toml(text, &format!("builtin:{n}"))
+}
+
+/// A scene built into a running simulation.
+pub struct Instance {
+    pub scene: Scene,
+    pub sim: Simulation,
+    pub probes: Vec<Probe>,
+}
+
+impl Instance {
+    /// Builds the mesh, effects, simulation and probes of `scene`.
+    pub fn new(scene: Scene) -> Result<Instance, SceneError> {
+        let mesh = scene.build_mesh()?;
+        let effects = scene.build_effects(&mesh)?;
+        let probes = scene
+            .file
+            .probes
+            .iter()
+            .map(|p| Probe::locate(&mesh, &p.name, hox_sim::Vec3::from(p.point_m)))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| SceneError::Probe { source_name: scene.source.clone(), message: e.to_string() })?;
+        let sim = Simulation::new(mesh, scene.material, scene.settings, effects)
+            .map_err(|e| SceneError::Simulation { source_name: scene.source.clone(), message: e.to_string() })?;
+        Ok(Instance { scene, sim, probes })
+    }
+
+    /// Current displacement of every probe, metres.
+    pub fn probe_displacements(&self) -> Vec<(String, [f64; 3])> {
+        self.probes
+            .iter()
+            .map(|p| {
+                let u = p.displacement(&self.sim.positions, &self.sim.mesh().rest_positions);
+                (p.name.clone(), [u.x, u.y, u.z])
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -14,6 +14,7 @@
 //! - [`mesh`]: meshes (blocks of one element type), structured beams, high-order nodes.
 //! - [`geometry`]: per-element, per-quadrature-point precomputed gradients and volumes.
 //! - [`mass`]: lumped nodal masses (HRZ).
+//! - [`probe`]: material points located in the rest mesh, followed through the deformation.
 //! - [`energy`]: total elastic energy, gradient and Hessian of a mesh.
 //! - [`constraint`]: pure XPBD constraint kernels (energy and split formulations).
 //! - [`solver`]: the stateful XPBD solver and the opt-in [`effect`]s it runs.
@@ -26,6 +27,7 @@ pub mod geometry;
 pub mod mass;
 pub mod material;
 pub mod mesh;
+pub mod probe;
 pub mod quadrature;
 pub mod solver;
 

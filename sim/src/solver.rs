@@ -113,21 +113,11 @@ impl Simulation {
         settings.validate()?;
         let geometry = precompute(&mesh, settings.quadrature_degree)?;
         let masses_kg = lumped_masses_kg(&mesh, material.density_kg_m3)?;
-        let mut inv_mass: Vec<f64> = masses_kg.iter().map(|m| 1.0 / m).collect();
-        for e in &effects {
-            for node in e.pinned_nodes(&mesh) {
-                let slot = inv_mass.get_mut(node as usize).ok_or(SimError::EffectNode {
-                    effect: e.name(),
-                    node,
-                    num_nodes: mesh.num_nodes(),
-                })?;
-                *slot = 0.0;
-            }
-        }
+        let inv_mass: Vec<f64> = masses_kg.iter().map(|m| 1.0 / m).collect();
         let positions = mesh.rest_positions.clone();
         let n = positions.len();
         let lambdas = Self::multipliers(&geometry, settings.formulation);
-        Ok(Self {
+        let mut sim = Self {
             mesh,
             geometry,
             material,
@@ -138,11 +128,15 @@ impl Simulation {
             masses_kg,
             inv_mass,
             lambdas,
-            effects,
+            effects: Vec::with_capacity(effects.len()),
             time_secs: 0.0,
             frames: 0,
             counters: SolverCounters::default(),
-        })
+        };
+        for e in effects {
+            sim.add_effect(e)?;
+        }
+        Ok(sim)
     }
 
     fn multipliers(geometry: &[BlockGeometry], formulation: Formulation) -> Vec<Vec<f64>> {
@@ -185,6 +179,37 @@ impl Simulation {
     /// Number of XPBD constraints per solver iteration.
     pub fn num_constraints(&self) -> usize {
         self.lambdas.iter().map(Vec::len).sum()
+    }
+
+    /// Adds an effect to the running simulation (pinning the nodes it positions).
+    pub fn add_effect(&mut self, effect: Box<dyn Effect>) -> Result<(), SimError> {
+        for node in effect.pinned_nodes(&self.mesh) {
+            let slot = self.inv_mass.get_mut(node as usize).ok_or(SimError::EffectNode {
+                effect: effect.name(),
+                node,
+                num_nodes: self.mesh.num_nodes(),
+            })?;
+            *slot = 0.0;
+        }
+        self.effects.push(effect);
+        Ok(())
+    }
+
+    /// Removes the effects named `name` (for example the attachment that exists only while a
+    /// node is dragged); nodes they pinned get their mass back. Returns how many were removed.
+    pub fn remove_effects_named(&mut self, name: &str) -> usize {
+        let before = self.effects.len();
+        let (removed, kept): (Vec<_>, Vec<_>) = std::mem::take(&mut self.effects).into_iter().partition(|e| e.name() == name);
+        self.effects = kept;
+        let still_pinned: std::collections::HashSet<u32> = self.effects.iter().flat_map(|e| e.pinned_nodes(&self.mesh)).collect();
+        for e in &removed {
+            for node in e.pinned_nodes(&self.mesh) {
+                if !still_pinned.contains(&node) {
+                    self.inv_mass[node as usize] = 1.0 / self.masses_kg[node as usize];
+                }
+            }
+        }
+        before - self.effects.len()
     }
 
     /// Changes the material, keeping positions and velocities (masses follow the density).

@@ -1,0 +1,107 @@
+//! Running a scene: for a given simulated time, or until it settles.
+//!
+//! **Settling** (`RunMode::Settle`): velocity damping `v ← v e^{−c h}` with the scene's
+//! `settle_damping_per_sec` is added, and the run stops once every node has moved less than
+//! `SETTLE_TOLERANCE_REL` × the body's bounding-box diagonal per frame for `SETTLE_FRAMES`
+//! consecutive frames, after all prescribed ramps and moving planes have stopped; or at
+//! `SETTLE_CAP_SECS` simulated seconds, reported as not settled.
+
+use crate::{Instance, SceneError};
+use crate::scene::EffectSpec;
+use hox_sim::effect::Damping;
+use std::time::Instant;
+
+/// Consecutive quiet frames that count as settled.
+pub const SETTLE_FRAMES: usize = 30;
+/// Largest per-frame node motion that counts as quiet, relative to the body's diagonal.
+pub const SETTLE_TOLERANCE_REL: f64 = 1e-7;
+/// Simulated time after which settling gives up.
+pub const SETTLE_CAP_SECS: f64 = 120.0;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RunMode {
+    Seconds(f64),
+    Settle,
+}
+
+/// What a run produced (the CLI prints it as JSON).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct RunReport {
+    pub probes: std::collections::BTreeMap<String, [f64; 3]>,
+    pub frames: u64,
+    pub sim_seconds: f64,
+    pub ms_per_frame: f64,
+    pub settled: bool,
+    pub kinetic_energy_j: f64,
+    pub elastic_energy_j: f64,
+}
+
+/// Runs `instance` and reports. `progress(sim_seconds, fraction)` is called after every frame
+/// (`fraction` is None when settling, whose length is not known in advance).
+pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64, Option<f64>)) -> Result<RunReport, SceneError> {
+    let frame_secs = 1.0 / instance.scene.settings.frames_per_second;
+    let source = instance.scene.source.clone();
+    let fail = |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: source.clone(), message: e.to_string() };
+    let mut settled = false;
+    let mut stepping_secs = 0.0;
+    let start_frames = instance.sim.frames();
+    match mode {
+        RunMode::Seconds(t) => {
+            let frames = (t / frame_secs).round().max(0.0) as u64;
+            for f in 0..frames {
+                let clock = Instant::now();
+                instance.sim.step_frame().map_err(fail)?;
+                stepping_secs += clock.elapsed().as_secs_f64();
+                progress(instance.sim.time_secs(), Some((f + 1) as f64 / frames as f64));
+            }
+        }
+        RunMode::Settle => {
+            let damping = instance.scene.file.solver.settle_damping_per_sec;
+            if damping > 0.0 {
+                instance.sim.add_effect(Box::new(Damping { rate_per_sec: damping })).map_err(fail)?;
+            }
+            let driven_until = driven_until_secs(&instance.scene.file.effects);
+            let (lo, hi) = instance.sim.mesh().bounding_box();
+            let tolerance_m = SETTLE_TOLERANCE_REL * (hi - lo).norm();
+            let mut quiet = 0;
+            let mut before = instance.sim.positions.clone();
+            while instance.sim.time_secs() < SETTLE_CAP_SECS {
+                let clock = Instant::now();
+                instance.sim.step_frame().map_err(fail)?;
+                stepping_secs += clock.elapsed().as_secs_f64();
+                let moved = instance.sim.positions.iter().zip(&before).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+                before.copy_from_slice(&instance.sim.positions);
+                quiet = if moved < tolerance_m && instance.sim.time_secs() >= driven_until { quiet + 1 } else { 0 };
+                progress(instance.sim.time_secs(), None);
+                if quiet >= SETTLE_FRAMES {
+                    settled = true;
+                    break;
+                }
+            }
+        }
+    }
+    let frames = instance.sim.frames() - start_frames;
+    Ok(RunReport {
+        probes: instance.probe_displacements().into_iter().collect(),
+        frames,
+        sim_seconds: instance.sim.time_secs(),
+        ms_per_frame: if frames > 0 { 1e3 * stepping_secs / frames as f64 } else { 0.0 },
+        settled,
+        kinetic_energy_j: instance.sim.kinetic_energy_j(),
+        elastic_energy_j: instance.sim.elastic_energy_j(),
+    })
+}
+
+/// Time after which no listed effect drives motion any more (ramps done, planes stopped).
+fn driven_until_secs(effects: &[EffectSpec]) -> f64 {
+    effects
+        .iter()
+        .map(|e| match e {
+            EffectSpec::Prescribed { ramp_secs, .. } => *ramp_secs,
+            EffectSpec::Contact { velocity_m_s, move_secs, .. } if velocity_m_s.iter().any(|v| *v != 0.0) => {
+                move_secs.unwrap_or(f64::INFINITY).min(SETTLE_CAP_SECS)
+            }
+            _ => 0.0,
+        })
+        .fold(0.0, f64::max)
+}

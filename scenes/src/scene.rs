@@ -1,0 +1,519 @@
+//! Scene files: a scene is data, a TOML file (`assets/scenes/*.toml`) naming its mesh,
+//! material, solver settings, the effects it needs and its probes.
+//!
+//! ```toml
+//! name = "bending"
+//! description = "…"
+//! [mesh]        # a structured box (see hox_sim::mesh::structured)
+//! box_min_m = [0, 0, 0]
+//! box_max_m = [2, 0.5, 0.5]
+//! element = "p2"          # p1 p2 p3 q1 q2 prism pyramid
+//! grid = [8, 2, 2]        # hexahedral cells per direction
+//! split = "five"          # five (unbiased) | six (biased): tetrahedra per cell
+//! refine = 0              # 1-to-8 refinements of the tetrahedra
+//! [material]
+//! model = "stvk"          # stvk | snh | nh
+//! youngs_modulus_pa = 3e6
+//! poisson_ratio = 0.35
+//! density_kg_m3 = 1000
+//! [solver]                # all optional; defaults are the paper's
+//! substeps = 50
+//! iterations = 1
+//! frames_per_second = 60
+//! formulation = "energy"  # energy | split
+//! quadrature_degree = 2   # omit for each element type's default
+//! duration_secs = 3       # default run length
+//! settle_damping_per_sec = 10  # velocity damping used by --settle
+//! [[effects]]             # only the effects listed are simulated
+//! type = "gravity"        # gravity | clamp | prescribed | damping | contact
+//! acceleration_m_s2 = [0, 0, -9.81]
+//! [[effects]]
+//! type = "clamp"
+//! nodes = { plane = "x", at_m = 0 }   # or { box_min_m = [...], box_max_m = [...] }
+//! [[effects]]
+//! type = "prescribed"     # translation and/or rotation, ramped smoothly then held
+//! nodes = { plane = "x", at_m = 1 }
+//! translation_m = [0.5, 0, 0]
+//! rotation_axis = [1, 0, 0]
+//! rotation_origin_m = [1, 0.25, 0.25]
+//! rotation_deg = 90
+//! ramp_secs = 1
+//! [[effects]]
+//! type = "damping"
+//! rate_per_sec = 1
+//! [[effects]]
+//! type = "contact"        # half-space contact with a (moving) plane
+//! point_m = [0, 0, 0]
+//! normal = [0, 0, 1]      # points into the allowed side
+//! velocity_m_s = [0, 0, 0]
+//! move_secs = 2           # the plane stops after this long (default: never)
+//! friction = 0.5
+//! [[probes]]
+//! name = "tip"
+//! point_m = [2, 0.25, 0.25]
+//! ```
+//!
+//! Unknown keys, missing fields, wrong types, negative or non-finite values and probes outside
+//! the body are errors naming the file, the key and the value.
+
+use hox_sim::Vec3;
+use hox_sim::constraint::Formulation;
+use hox_sim::effect::{AxisRotation, Clamp, ContactPlane, Damping, Effect, Gravity, Prescribed};
+use hox_sim::element::ElementType;
+use hox_sim::material::{Material, MaterialModel};
+use hox_sim::mesh::Mesh;
+use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+use hox_sim::solver::SolverSettings;
+use serde::{Deserialize, Serialize};
+
+use crate::SceneError;
+
+/// A scene file as written (see the module docs).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    pub mesh: MeshSpec,
+    pub material: MaterialSpec,
+    #[serde(default)]
+    pub solver: SolverSpec,
+    #[serde(default)]
+    pub effects: Vec<EffectSpec>,
+    #[serde(default)]
+    pub probes: Vec<ProbeSpec>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    pub box_min_m: [f64; 3],
+    pub box_max_m: [f64; 3],
+    pub element: String,
+    pub grid: [usize; 3],
+    #[serde(default = "default_split")]
+    pub split: String,
+    #[serde(default)]
+    pub refine: usize,
+}
+
+fn default_split() -> String {
+    "five".into()
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    pub model: String,
+    pub youngs_modulus_pa: f64,
+    pub poisson_ratio: f64,
+    pub density_kg_m3: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSpec {
+    pub substeps: u32,
+    pub iterations: u32,
+    pub frames_per_second: f64,
+    pub formulation: String,
+    pub quadrature_degree: Option<usize>,
+    pub duration_secs: f64,
+    pub settle_damping_per_sec: f64,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        Self {
+            substeps: 50,
+            iterations: 1,
+            frames_per_second: 60.0,
+            formulation: "energy".into(),
+            quadrature_degree: None,
+            duration_secs: 3.0,
+            settle_damping_per_sec: 10.0,
+        }
+    }
+}
+
+/// Which nodes an effect acts on: those on an axis-aligned plane, or inside a box.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodeSelector {
+    pub plane: Option<String>,
+    pub at_m: Option<f64>,
+    pub box_min_m: Option<[f64; 3]>,
+    pub box_max_m: Option<[f64; 3]>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum EffectSpec {
+    Gravity {
+        acceleration_m_s2: [f64; 3],
+    },
+    Clamp {
+        nodes: NodeSelector,
+    },
+    Prescribed {
+        nodes: NodeSelector,
+        #[serde(default)]
+        translation_m: [f64; 3],
+        #[serde(default)]
+        rotation_axis: Option<[f64; 3]>,
+        #[serde(default)]
+        rotation_origin_m: Option<[f64; 3]>,
+        #[serde(default)]
+        rotation_deg: f64,
+        #[serde(default)]
+        ramp_secs: f64,
+    },
+    Damping {
+        rate_per_sec: f64,
+    },
+    Contact {
+        point_m: [f64; 3],
+        normal: [f64; 3],
+        #[serde(default)]
+        velocity_m_s: [f64; 3],
+        #[serde(default)]
+        move_secs: Option<f64>,
+        #[serde(default)]
+        friction: f64,
+    },
+}
+
+impl EffectSpec {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Gravity { .. } => "gravity",
+            Self::Clamp { .. } => "clamp",
+            Self::Prescribed { .. } => "prescribed",
+            Self::Damping { .. } => "damping",
+            Self::Contact { .. } => "contact",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    pub name: String,
+    pub point_m: [f64; 3],
+}
+
+/// A validated scene: typed settings ready to build a simulation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Where the scene came from (a file path or `builtin:NAME`), for error messages.
+    pub source: String,
+    pub file: SceneFile,
+    pub mesh: BoxMeshSpec,
+    pub material: Material,
+    pub settings: SolverSettings,
+}
+
+/// Command-line (or app) changes to a scene, applied before validation.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneOverrides {
+    pub element: Option<String>,
+    pub grid: Option<[usize; 3]>,
+    pub split: Option<String>,
+    pub refine: Option<usize>,
+    pub material: Option<String>,
+    pub youngs_modulus_pa: Option<f64>,
+    pub poisson_ratio: Option<f64>,
+    pub density_kg_m3: Option<f64>,
+    pub formulation: Option<String>,
+    pub quadrature_degree: Option<usize>,
+    pub substeps: Option<u32>,
+    pub iterations: Option<u32>,
+    pub frames_per_second: Option<f64>,
+}
+
+impl Scene {
+    /// Parses and validates a scene file's text. `source` names it in errors.
+    pub fn from_toml(text: &str, source: &str) -> Result<Scene, SceneError> {
+        let file: SceneFile = toml::from_str(text)
+            .map_err(|e| SceneError::Parse { source_name: source.to_string(), message: e.to_string() })?;
+        Scene::from_file(file, source)
+    }
+
+    /// Reads a scene file from disk.
+    pub fn load(path: &std::path::Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SceneError::Io { path: path.display().to_string(), message: e.to_string() })?;
+        Scene::from_toml(&text, &path.display().to_string())
+    }
+
+    /// Validates a parsed scene file.
+    pub fn from_file(file: SceneFile, source: &str) -> Result<Scene, SceneError> {
+        let invalid = |key: &str, value: String, reason: &str| SceneError::Invalid {
+            source_name: source.to_string(),
+            key: key.to_string(),
+            value,
+            reason: reason.to_string(),
+        };
+        let m = &file.mesh;
+        let element_type = ElementType::from_name(&m.element)
+            .ok_or_else(|| invalid("mesh.element", format!("{:?}", m.element), &format!("expected one of {}", ElementType::names())))?;
+        let split = TetSplit::from_name(&m.split)
+            .ok_or_else(|| invalid("mesh.split", format!("{:?}", m.split), "expected \"five\" or \"six\""))?;
+        finite3("mesh.box_min_m", &m.box_min_m, &invalid)?;
+        finite3("mesh.box_max_m", &m.box_max_m, &invalid)?;
+        for d in 0..3 {
+            if m.box_max_m[d] <= m.box_min_m[d] {
+                return Err(invalid("mesh.box_max_m", format!("{:?}", m.box_max_m), "must exceed box_min_m in every direction"));
+            }
+            if m.grid[d] == 0 {
+                return Err(invalid("mesh.grid", format!("{:?}", m.grid), "needs at least one cell per direction"));
+            }
+        }
+        let mesh = BoxMeshSpec {
+            grid: BoxGrid { min_m: Vec3::from(m.box_min_m), max_m: Vec3::from(m.box_max_m), cells: m.grid },
+            element_type,
+            split,
+            refine: m.refine,
+        };
+        let mm = &file.material;
+        let model = MaterialModel::from_name(&mm.model)
+            .ok_or_else(|| invalid("material.model", format!("{:?}", mm.model), "expected stvk, snh or nh"))?;
+        let material = Material::new(model, mm.youngs_modulus_pa, mm.poisson_ratio, mm.density_kg_m3)
+            .map_err(|e| invalid("material", format!("{mm:?}"), &e.to_string()))?;
+        let s = &file.solver;
+        let formulation = Formulation::from_name(&s.formulation)
+            .ok_or_else(|| invalid("solver.formulation", format!("{:?}", s.formulation), "expected \"energy\" or \"split\""))?;
+        if s.substeps == 0 {
+            return Err(invalid("solver.substeps", "0".into(), "must be at least 1"));
+        }
+        if s.iterations == 0 {
+            return Err(invalid("solver.iterations", "0".into(), "must be at least 1"));
+        }
+        positive("solver.frames_per_second", s.frames_per_second, &invalid)?;
+        positive("solver.duration_secs", s.duration_secs, &invalid)?;
+        non_negative("solver.settle_damping_per_sec", s.settle_damping_per_sec, &invalid)?;
+        if let Some(d) = s.quadrature_degree {
+            let max = hox_sim::quadrature::max_degree(element_type.shape());
+            if d == 0 || d > max {
+                return Err(invalid("solver.quadrature_degree", d.to_string(), &format!("must lie in 1..={max} for {element_type}")));
+            }
+        }
+        if formulation == Formulation::Split && material.split_stiffness_pa().iter().any(|k| !(*k > 0.0)) {
+            return Err(invalid(
+                "material.poisson_ratio",
+                mm.poisson_ratio.to_string(),
+                "the split formulation needs positive Lamé parameters (ν ≥ 0); use the energy formulation",
+            ));
+        }
+        let settings = SolverSettings {
+            substeps: s.substeps,
+            iterations: s.iterations,
+            frames_per_second: s.frames_per_second,
+            formulation,
+            quadrature_degree: s.quadrature_degree,
+        };
+        for (k, e) in file.effects.iter().enumerate() {
+            validate_effect(k, e, &invalid)?;
+        }
+        let mut names = std::collections::HashSet::new();
+        for (k, p) in file.probes.iter().enumerate() {
+            finite3(&format!("probes[{k}].point_m"), &p.point_m, &invalid)?;
+            if !names.insert(p.name.as_str()) {
+                return Err(invalid(&format!("probes[{k}].name"), format!("{:?}", p.name), "is used twice"));
+            }
+        }
+        Ok(Scene { source: source.to_string(), file, mesh, material, settings })
+    }
+
+    pub fn name(&self) -> &str {
+        &self.file.name
+    }
+
+    /// The scene with `overrides` applied, validated again.
+    pub fn with_overrides(&self, o: &SceneOverrides) -> Result<Scene, SceneError> {
+        let mut f = self.file.clone();
+        if let Some(v) = &o.element {
+            f.mesh.element = v.clone();
+        }
+        if let Some(v) = o.grid {
+            f.mesh.grid = v;
+        }
+        if let Some(v) = &o.split {
+            f.mesh.split = v.clone();
+        }
+        if let Some(v) = o.refine {
+            f.mesh.refine = v;
+        }
+        if let Some(v) = &o.material {
+            f.material.model = v.clone();
+        }
+        if let Some(v) = o.youngs_modulus_pa {
+            f.material.youngs_modulus_pa = v;
+        }
+        if let Some(v) = o.poisson_ratio {
+            f.material.poisson_ratio = v;
+        }
+        if let Some(v) = o.density_kg_m3 {
+            f.material.density_kg_m3 = v;
+        }
+        if let Some(v) = &o.formulation {
+            f.solver.formulation = v.clone();
+        }
+        if o.quadrature_degree.is_some() {
+            f.solver.quadrature_degree = o.quadrature_degree;
+        }
+        if let Some(v) = o.substeps {
+            f.solver.substeps = v;
+        }
+        if let Some(v) = o.iterations {
+            f.solver.iterations = v;
+        }
+        if let Some(v) = o.frames_per_second {
+            f.solver.frames_per_second = v;
+        }
+        Scene::from_file(f, &self.source)
+    }
+
+    /// Builds the mesh.
+    pub fn build_mesh(&self) -> Result<Mesh, SceneError> {
+        self.mesh.build().map_err(|e| SceneError::Mesh { source_name: self.source.clone(), message: e.to_string() })
+    }
+
+    /// The effects the scene lists, bound to `mesh`'s nodes.
+    pub fn build_effects(&self, mesh: &Mesh) -> Result<Vec<Box<dyn Effect>>, SceneError> {
+        let mut effects: Vec<Box<dyn Effect>> = Vec::new();
+        for (k, e) in self.file.effects.iter().enumerate() {
+            let select = |sel: &NodeSelector| -> Result<Vec<u32>, SceneError> {
+                let nodes = select_nodes(mesh, sel);
+                if nodes.is_empty() {
+                    return Err(SceneError::Invalid {
+                        source_name: self.source.clone(),
+                        key: format!("effects[{k}].nodes"),
+                        value: format!("{sel:?}"),
+                        reason: "selects no node of the mesh".into(),
+                    });
+                }
+                Ok(nodes)
+            };
+            effects.push(match e {
+                EffectSpec::Gravity { acceleration_m_s2 } => Box::new(Gravity::new(Vec3::from(*acceleration_m_s2))),
+                EffectSpec::Clamp { nodes } => Box::new(Clamp { nodes: select(nodes)? }),
+                EffectSpec::Prescribed { nodes, translation_m, rotation_axis, rotation_origin_m, rotation_deg, ramp_secs } => {
+                    let rotation = rotation_axis.map(|axis| AxisRotation {
+                        axis: Vec3::from(axis).normalize(),
+                        origin_m: Vec3::from(rotation_origin_m.unwrap_or([0.0; 3])),
+                        angle_rad: rotation_deg.to_radians(),
+                    });
+                    Box::new(Prescribed { nodes: select(nodes)?, translation_m: Vec3::from(*translation_m), rotation, ramp_secs: *ramp_secs })
+                }
+                EffectSpec::Damping { rate_per_sec } => Box::new(Damping { rate_per_sec: *rate_per_sec }),
+                EffectSpec::Contact { point_m, normal, velocity_m_s, move_secs, friction } => Box::new(ContactPlane::new(
+                    Vec3::from(*point_m),
+                    Vec3::from(*normal),
+                    Vec3::from(*velocity_m_s),
+                    move_secs.unwrap_or(f64::INFINITY),
+                    *friction,
+                )),
+            });
+        }
+        Ok(effects)
+    }
+}
+
+/// Nodes picked by a selector. Plane selection uses a tolerance of 1e-9 × the body's size.
+pub fn select_nodes(mesh: &Mesh, sel: &NodeSelector) -> Vec<u32> {
+    let (lo, hi) = mesh.bounding_box();
+    let tol = 1e-9 * (hi - lo).norm().max(1e-300);
+    if let (Some(plane), Some(at)) = (&sel.plane, sel.at_m) {
+        let d = axis_index(plane).unwrap_or(0);
+        return mesh.nodes_where(|p| (p[d] - at).abs() <= tol);
+    }
+    if let (Some(a), Some(b)) = (sel.box_min_m, sel.box_max_m) {
+        return mesh.nodes_where(|p| (0..3).all(|d| p[d] >= a[d] - tol && p[d] <= b[d] + tol));
+    }
+    Vec::new()
+}
+
+fn axis_index(name: &str) -> Option<usize> {
+    match name.to_ascii_lowercase().as_str() {
+        "x" => Some(0),
+        "y" => Some(1),
+        "z" => Some(2),
+        _ => None,
+    }
+}
+
+type Invalid<'a> = dyn Fn(&str, String, &str) -> SceneError + 'a;
+
+fn finite3(key: &str, v: &[f64; 3], invalid: &Invalid<'_>) -> Result<(), SceneError> {
+    if v.iter().all(|c| c.is_finite()) { Ok(()) } else { Err(invalid(key, format!("{v:?}"), "must be finite")) }
+}
+
+fn positive(key: &str, v: f64, invalid: &Invalid<'_>) -> Result<(), SceneError> {
+    if v.is_finite() && v > 0.0 { Ok(()) } else { Err(invalid(key, v.to_string(), "must be a finite positive number")) }
+}
+
+fn non_negative(key: &str, v: f64, invalid: &Invalid<'_>) -> Result<(), SceneError> {
+    if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(invalid(key, v.to_string(), "must be finite and not negative")) }
+}
+
+fn validate_selector(key: &str, sel: &NodeSelector, invalid: &Invalid<'_>) -> Result<(), SceneError> {
+    match (&sel.plane, sel.at_m, sel.box_min_m, sel.box_max_m) {
+        (Some(p), Some(at), None, None) => {
+            if axis_index(p).is_none() {
+                return Err(invalid(&format!("{key}.plane"), format!("{p:?}"), "expected \"x\", \"y\" or \"z\""));
+            }
+            if !at.is_finite() {
+                return Err(invalid(&format!("{key}.at_m"), at.to_string(), "must be finite"));
+            }
+            Ok(())
+        }
+        (None, None, Some(a), Some(b)) => {
+            finite3(&format!("{key}.box_min_m"), &a, invalid)?;
+            finite3(&format!("{key}.box_max_m"), &b, invalid)
+        }
+        _ => Err(invalid(key, format!("{sel:?}"), "give either plane and at_m, or box_min_m and box_max_m")),
+    }
+}
+
+fn validate_effect(k: usize, e: &EffectSpec, invalid: &Invalid<'_>) -> Result<(), SceneError> {
+    let key = |f: &str| format!("effects[{k}].{f}");
+    match e {
+        EffectSpec::Gravity { acceleration_m_s2 } => finite3(&key("acceleration_m_s2"), acceleration_m_s2, invalid),
+        EffectSpec::Clamp { nodes } => validate_selector(&key("nodes"), nodes, invalid),
+        EffectSpec::Prescribed { nodes, translation_m, rotation_axis, rotation_origin_m, rotation_deg, ramp_secs } => {
+            validate_selector(&key("nodes"), nodes, invalid)?;
+            finite3(&key("translation_m"), translation_m, invalid)?;
+            if let Some(a) = rotation_axis {
+                finite3(&key("rotation_axis"), a, invalid)?;
+                if Vec3::from(*a).norm() == 0.0 {
+                    return Err(invalid(&key("rotation_axis"), format!("{a:?}"), "must not be zero"));
+                }
+            }
+            if let Some(o) = rotation_origin_m {
+                finite3(&key("rotation_origin_m"), o, invalid)?;
+            }
+            if !rotation_deg.is_finite() {
+                return Err(invalid(&key("rotation_deg"), rotation_deg.to_string(), "must be finite"));
+            }
+            if *rotation_deg != 0.0 && rotation_axis.is_none() {
+                return Err(invalid(&key("rotation_axis"), "missing".into(), "a rotation needs an axis"));
+            }
+            non_negative(&key("ramp_secs"), *ramp_secs, invalid)
+        }
+        EffectSpec::Damping { rate_per_sec } => non_negative(&key("rate_per_sec"), *rate_per_sec, invalid),
+        EffectSpec::Contact { point_m, normal, velocity_m_s, move_secs, friction } => {
+            finite3(&key("point_m"), point_m, invalid)?;
+            finite3(&key("normal"), normal, invalid)?;
+            if Vec3::from(*normal).norm() == 0.0 {
+                return Err(invalid(&key("normal"), format!("{normal:?}"), "must not be zero"));
+            }
+            finite3(&key("velocity_m_s"), velocity_m_s, invalid)?;
+            if let Some(t) = move_secs {
+                non_negative(&key("move_secs"), *t, invalid)?;
+            }
+            non_negative(&key("friction"), *friction, invalid)
+        }
+    }
+}

@@ -1,0 +1,132 @@
+use super::*;
+use crate::scene::EffectSpec;
+
+#[test]
+fn every_scene_file_in_assets_is_registered_and_parses() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes");
+    let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .map(|p| {
+            let scene = Scene::load(&p).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(Some(scene.name()), p.file_stem().and_then(|s| s.to_str()), "file name = scene name");
+            scene.name().to_string()
+        })
+        .collect();
+    on_disk.sort();
+    let mut registered: Vec<String> = registry().unwrap().iter().map(|s| s.name().to_string()).collect();
+    registered.sort();
+    assert_eq!(on_disk, registered);
+    assert!(registered.len() >= 6, "three paper scenes and at least three teaching scenes");
+}
+
+#[test]
+fn the_paper_scenes_have_the_papers_parameters() {
+    let b = by_name("bending").unwrap();
+    assert_eq!((b.mesh.element_type.name(), b.mesh.grid.cells), ("p2", [8, 2, 2]));
+    assert_eq!((b.material.youngs_modulus_pa, b.material.poisson_ratio, b.material.density_kg_m3), (3e6, 0.35, 1000.0));
+    assert_eq!((b.settings.substeps, b.settings.iterations, b.settings.frames_per_second), (50, 1, 60.0));
+    for name in ["tension", "torsion"] {
+        let s = by_name(name).unwrap();
+        assert_eq!((s.mesh.element_type.name(), s.mesh.grid.cells, s.mesh.split.name()), ("p2", [6, 3, 3], "six"));
+        assert_eq!(s.material.youngs_modulus_pa, 1e6);
+        assert!(!s.file.effects.iter().any(|e| matches!(e, EffectSpec::Gravity { .. })), "{name} has no gravity");
+    }
+}
+
+#[test]
+fn teaching_scenes_each_use_an_effect_the_paper_scenes_do_not() {
+    let paper: std::collections::HashSet<&str> =
+        PAPER_SCENES.iter().flat_map(|n| by_name(n).unwrap().file.effects.iter().map(|e| e.kind()).collect::<Vec<_>>()).collect();
+    let teaching: Vec<Scene> = registry().unwrap().into_iter().filter(|s| !PAPER_SCENES.contains(&s.name())).collect();
+    assert!(teaching.len() >= 3);
+    for s in teaching {
+        assert!(s.file.effects.iter().any(|e| !paper.contains(e.kind())), "{} uses only the paper's effects", s.name());
+    }
+}
+
+#[test]
+fn every_scene_runs_one_second_headless_without_nan() {
+    for scene in registry().unwrap() {
+        let name = scene.name().to_string();
+        let mut inst = Instance::new(scene).unwrap();
+        let report = run(&mut inst, RunMode::Seconds(1.0), &mut |_, _| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(report.frames, 60, "{name}");
+        assert!(inst.sim.positions.iter().all(|p| p.iter().all(|c| c.is_finite())), "{name}");
+        assert!(report.probes.values().all(|u| u.iter().all(|c| c.is_finite())), "{name}");
+        assert!(report.kinetic_energy_j.is_finite() && report.elastic_energy_j.is_finite());
+    }
+}
+
+#[test]
+fn only_the_listed_effects_run_and_unlisted_ones_cost_nothing() {
+    for scene in registry().unwrap() {
+        let listed: Vec<&str> = scene.file.effects.iter().map(|e| e.kind()).collect();
+        let inst = Instance::new(scene.clone()).unwrap();
+        let running: Vec<&str> = inst.sim.effects().iter().map(|e| e.name()).collect();
+        assert_eq!(listed, running, "{}", scene.name());
+    }
+    // the tension scene has no gravity and no contact: after a second, no effect did any
+    // gravity or contact work, and the drop scene's contact did
+    let mut tension = Instance::new(by_name("tension").unwrap()).unwrap();
+    run(&mut tension, RunMode::Seconds(0.5), &mut |_, _| {}).unwrap();
+    assert!(tension.sim.effects().iter().all(|e| e.work_count() == 0));
+    let mut drop = Instance::new(by_name("drop").unwrap()).unwrap();
+    run(&mut drop, RunMode::Seconds(0.5), &mut |_, _| {}).unwrap();
+    let contact = drop.sim.effects().iter().find(|e| e.name() == "contact").unwrap();
+    assert!(contact.work_count() > 0);
+}
+
+fn bending_text() -> &'static str {
+    BUILTIN[0].1
+}
+
+#[test]
+fn bad_scene_files_give_errors_naming_the_file_key_and_value() {
+    let cases: Vec<(String, &str)> = vec![
+        (bending_text().replace("refine = 0", "refine = 0\ncolour = \"red\""), "colour"),
+        (bending_text().replace("youngs_modulus_pa = 3.0e6", "youngs_modulus_pa = -3.0e6"), "Young"),
+        (bending_text().replace("poisson_ratio = 0.35", "poisson_ratio = 0.5"), "Poisson"),
+        (bending_text().replace("density_kg_m3 = 1000.0", "density_kg_m3 = nan"), "density"),
+        (bending_text().replace("substeps = 50", "substeps = 0"), "solver.substeps"),
+        (bending_text().replace("frames_per_second = 60.0", "frames_per_second = inf"), "solver.frames_per_second"),
+        (bending_text().replace("element = \"p2\"", "element = \"p9\""), "mesh.element"),
+        (bending_text().replace("split = \"five\"", "split = \"seven\""), "mesh.split"),
+        (bending_text().replace("grid = [8, 2, 2]", "grid = [8, 0, 2]"), "mesh.grid"),
+        (bending_text().replace("acceleration_m_s2 = [0.0, 0.0, -9.81]", "acceleration_m_s2 = [0.0, nan, -9.81]"), "effects[0].acceleration_m_s2"),
+        (bending_text().replace("nodes = { plane = \"x\", at_m = 0.0 }", "nodes = { plane = \"w\", at_m = 0.0 }"), "effects[1].nodes.plane"),
+        (bending_text().replace("type = \"gravity\"", "type = \"magnetism\""), "magnetism"),
+        (bending_text().replace("[material]\nmodel = \"stvk\"\n", "[material]\n"), "model"),
+    ];
+    for (text, needle) in cases {
+        let err = Scene::from_toml(&text, "my_scene.toml").unwrap_err().to_string();
+        assert!(err.contains("my_scene.toml") && err.contains(needle), "expected '{needle}' in: {err}");
+    }
+}
+
+#[test]
+fn a_probe_outside_the_body_and_a_clamp_selecting_nothing_are_errors() {
+    let text = bending_text().replace("point_m = [2.0, 0.25, 0.25]", "point_m = [3.0, 0.25, 0.25]");
+    let scene = Scene::from_toml(&text, "far.toml").unwrap();
+    let err = Instance::new(scene).err().unwrap().to_string();
+    assert!(err.contains("far.toml") && err.contains("tip") && err.contains("outside"), "{err}");
+    let text = bending_text().replace("at_m = 0.0 }", "at_m = -1.0 }");
+    let err = Instance::new(Scene::from_toml(&text, "air.toml").unwrap()).err().unwrap().to_string();
+    assert!(err.contains("air.toml") && err.contains("effects[1].nodes") && err.contains("selects no node"), "{err}");
+    let err = by_name("bendnig").unwrap_err().to_string();
+    assert!(err.contains("bendnig") && err.contains("bending, tension, torsion"), "{err}");
+}
+
+#[test]
+fn overrides_change_the_scene_and_are_validated() {
+    let s = by_name("bending").unwrap();
+    let o = SceneOverrides { element: Some("p1".into()), grid: Some([16, 4, 4]), youngs_modulus_pa: Some(1e6), ..Default::default() };
+    let t = s.with_overrides(&o).unwrap();
+    assert_eq!(t.build_mesh().unwrap().num_elements(), 1280);
+    assert_eq!(t.material.youngs_modulus_pa, 1e6);
+    let bad = SceneOverrides { poisson_ratio: Some(0.7), ..Default::default() };
+    assert!(s.with_overrides(&bad).unwrap_err().to_string().contains("Poisson"));
+    let split_negative = SceneOverrides { formulation: Some("split".into()), poisson_ratio: Some(-0.2), ..Default::default() };
+    assert!(s.with_overrides(&split_negative).unwrap_err().to_string().contains("split formulation"));
+}
