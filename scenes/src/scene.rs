@@ -279,8 +279,19 @@ impl Scene {
         let mm = &file.material;
         let model = MaterialModel::from_name(&mm.model)
             .ok_or_else(|| invalid("material.model", format!("{:?}", mm.model), "expected stvk, snh or nh"))?;
-        let material = Material::new(model, mm.youngs_modulus_pa, mm.poisson_ratio, mm.density_kg_m3)
-            .map_err(|e| invalid("material", format!("{mm:?}"), &e.to_string()))?;
+        let material = Material::new(model, mm.youngs_modulus_pa, mm.poisson_ratio, mm.density_kg_m3).map_err(|e| {
+            let message = e.to_string();
+            let (key, value) = if message.contains("Young") {
+                ("material.youngs_modulus_pa", mm.youngs_modulus_pa)
+            } else if message.contains("Poisson") {
+                ("material.poisson_ratio", mm.poisson_ratio)
+            } else if message.contains("ensity") {
+                ("material.density_kg_m3", mm.density_kg_m3)
+            } else {
+                ("material", f64::NAN)
+            };
+            invalid(key, value.to_string(), &message)
+        })?;
         let s = &file.solver;
         let formulation = Formulation::from_name(&s.formulation)
             .ok_or_else(|| invalid("solver.formulation", format!("{:?}", s.formulation), "expected \"energy\" or \"split\""))?;

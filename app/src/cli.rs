@@ -1,0 +1,305 @@
+//! The headless command line. JSON goes to stdout (`--json`), progress and messages to stderr.
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand};
+use hox_scenes::{Instance, RunMode, Scene, SceneOverrides};
+use hox_sim::element::ElementType;
+use hox_sim::quadrature;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+#[derive(Parser)]
+#[command(name = "hox", version, about = "hox: see, measure and teach high-order finite elements in XPBD")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// List the element types: nodes, faces, default quadrature (degree and points).
+    Elements {
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// List the built-in scenes.
+    Scenes {
+        #[arg(long)]
+        json: bool,
+    },
+    /// Build a scene's mesh and print its element and node counts and volume.
+    Mesh {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[command(flatten)]
+        mesh: MeshArgs,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Run a scene (for --seconds, or until it --settle-s) and print the probe displacements.
+    Simulate {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[command(flatten)]
+        mesh: MeshArgs,
+        #[command(flatten)]
+        physics: PhysicsArgs,
+        /// Simulated time to run, seconds (default: the scene's duration).
+        #[arg(long, conflicts_with = "settle")]
+        seconds: Option<f64>,
+        /// Run with the scene's settle damping until the motion has died out (every node moves
+        /// less than 1e-7 × the body's diagonal per frame for 30 frames) or 120 s.
+        #[arg(long)]
+        settle: bool,
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Args)]
+pub struct SceneArgs {
+    /// A built-in scene (see `hox scenes`).
+    #[arg(long, conflicts_with = "scene_file", required_unless_present = "scene_file")]
+    pub scene: Option<String>,
+    /// A scene file (TOML, see assets/scenes/).
+    #[arg(long)]
+    pub scene_file: Option<PathBuf>,
+}
+
+#[derive(Args)]
+pub struct MeshArgs {
+    /// Element type: p1 p2 p3 q1 q2 prism pyramid.
+    #[arg(long)]
+    pub element: Option<String>,
+    /// Hexahedral cells, NXxNYxNZ (e.g. 16x4x4).
+    #[arg(long, value_parser = parse_grid)]
+    pub grid: Option<[usize; 3]>,
+    /// Tetrahedra per cell: five (unbiased) or six (biased).
+    #[arg(long)]
+    pub split: Option<String>,
+    /// 1-to-8 refinements of the tetrahedra.
+    #[arg(long)]
+    pub refine: Option<usize>,
+}
+
+#[derive(Args)]
+pub struct PhysicsArgs {
+    /// Material model: stvk, snh (stable Neo-Hookean) or nh (Neo-Hookean).
+    #[arg(long)]
+    pub material: Option<String>,
+    /// Young's modulus, Pa.
+    #[arg(long)]
+    pub youngs: Option<f64>,
+    /// Poisson ratio.
+    #[arg(long, allow_negative_numbers = true)]
+    pub poisson: Option<f64>,
+    /// Density, kg/m³.
+    #[arg(long)]
+    pub density: Option<f64>,
+    /// Constraint formulation: energy or split.
+    #[arg(long)]
+    pub formulation: Option<String>,
+    /// Quadrature degree (default: each element type's).
+    #[arg(long)]
+    pub quadrature: Option<usize>,
+    /// Substeps per frame.
+    #[arg(long)]
+    pub substeps: Option<u32>,
+    /// Solver iterations per substep.
+    #[arg(long)]
+    pub iterations: Option<u32>,
+    /// Frames per second.
+    #[arg(long)]
+    pub fps: Option<f64>,
+}
+
+fn parse_grid(s: &str) -> Result<[usize; 3], String> {
+    let parts: Vec<&str> = s.split(['x', 'X']).collect();
+    let bad = || format!("grid '{s}' must look like NXxNYxNZ with positive whole numbers, e.g. 16x4x4");
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let mut g = [0; 3];
+    for (gi, p) in g.iter_mut().zip(parts) {
+        *gi = p.trim().parse().map_err(|_| bad())?;
+        if *gi == 0 {
+            return Err(bad());
+        }
+    }
+    Ok(g)
+}
+
+pub fn main(cli: Cli) -> Result<()> {
+    match cli.command.unwrap_or(Command::Elements { json: false }) {
+        Command::Elements { json } => elements(json),
+        Command::Scenes { json } => scenes(json),
+        Command::Mesh { scene, mesh, json } => mesh_command(&scene, &mesh, json),
+        Command::Simulate { scene, mesh, physics, seconds, settle, json } => simulate(&scene, &mesh, &physics, seconds, settle, json),
+    }
+}
+
+fn load_scene(args: &SceneArgs) -> Result<Scene> {
+    Ok(match (&args.scene, &args.scene_file) {
+        (Some(name), None) => hox_scenes::by_name(name)?,
+        (None, Some(path)) => Scene::load(path)?,
+        _ => bail!("give exactly one of --scene NAME and --scene-file FILE"),
+    })
+}
+
+fn overrides(mesh: &MeshArgs, physics: Option<&PhysicsArgs>) -> SceneOverrides {
+    let mut o = SceneOverrides {
+        element: mesh.element.clone(),
+        grid: mesh.grid,
+        split: mesh.split.clone(),
+        refine: mesh.refine,
+        ..Default::default()
+    };
+    if let Some(p) = physics {
+        o.material = p.material.clone();
+        o.youngs_modulus_pa = p.youngs;
+        o.poisson_ratio = p.poisson;
+        o.density_kg_m3 = p.density;
+        o.formulation = p.formulation.clone();
+        o.quadrature_degree = p.quadrature;
+        o.substeps = p.substeps;
+        o.iterations = p.iterations;
+        o.frames_per_second = p.fps;
+    }
+    o
+}
+
+fn mesh_command(scene: &SceneArgs, mesh: &MeshArgs, json: bool) -> Result<()> {
+    let scene = load_scene(scene)?.with_overrides(&overrides(mesh, None))?;
+    let m = scene.build_mesh()?;
+    let geometry = hox_sim::geometry::precompute(&m, scene.settings.quadrature_degree)
+        .with_context(|| format!("{}: the mesh has a bad element", scene.source))?;
+    let out = serde_json::json!({
+        "element": scene.mesh.element_type.name(),
+        "elements": m.num_elements(),
+        "nodes": m.num_nodes(),
+        "volume_m3": hox_sim::geometry::total_volume_m3(&geometry),
+    });
+    if json {
+        println!("{out}");
+    } else {
+        println!(
+            "{}: {} {} elements, {} nodes, volume {:.6} m³",
+            scene.name(),
+            out["elements"],
+            out["element"].as_str().unwrap_or_default(),
+            out["nodes"],
+            out["volume_m3"].as_f64().unwrap_or_default()
+        );
+    }
+    Ok(())
+}
+
+fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: Option<f64>, settle: bool, json: bool) -> Result<()> {
+    let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
+    let mode = if settle {
+        RunMode::Settle
+    } else {
+        let t = seconds.unwrap_or(scene.file.solver.duration_secs);
+        if !(t.is_finite() && t >= 0.0) {
+            bail!("--seconds must be a finite, non-negative number of seconds, got {t}");
+        }
+        RunMode::Seconds(t)
+    };
+    let mut instance = Instance::new(scene)?;
+    let started = Instant::now();
+    let bar = ProgressBar::hidden();
+    let mut shown = false;
+    let report = hox_scenes::run(&mut instance, mode, &mut |t, fraction| {
+        // show a bar only for runs that last more than a couple of seconds
+        if !shown && started.elapsed() > Duration::from_secs(2) {
+            shown = true;
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            match fraction {
+                Some(_) => {
+                    bar.set_length(1000);
+                    bar.set_style(ProgressStyle::with_template("{spinner} {bar:40} {percent}% {msg} (eta {eta})").expect("valid template"));
+                }
+                None => bar.set_style(ProgressStyle::with_template("{spinner} settling… {msg}").expect("valid template")),
+            }
+        }
+        if let Some(f) = fraction {
+            bar.set_position((1000.0 * f) as u64);
+        }
+        bar.set_message(format!("t = {t:.2} s"));
+    })?;
+    bar.finish_and_clear();
+    if json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        println!(
+            "{}: {} frames, {:.3} s simulated, {:.2} ms per frame{}",
+            instance.scene.name(),
+            report.frames,
+            report.sim_seconds,
+            report.ms_per_frame,
+            if settle { if report.settled { ", settled" } else { ", NOT settled (cap reached)" } } else { "" }
+        );
+        for (name, u) in &report.probes {
+            println!("  probe {name}: u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
+        }
+        println!("  kinetic energy {:.6e} J, elastic energy {:.6e} J", report.kinetic_energy_j, report.elastic_energy_j);
+    }
+    if settle && !report.settled {
+        eprintln!("warning: the run did not settle within {} s", hox_scenes::SETTLE_CAP_SECS);
+    }
+    Ok(())
+}
+
+fn scenes(json: bool) -> Result<()> {
+    let all = hox_scenes::registry()?;
+    if json {
+        let rows: Vec<_> = all
+            .iter()
+            .map(|s| serde_json::json!({"name": s.name(), "description": s.file.description, "effects": s.file.effects.iter().map(|e| e.kind()).collect::<Vec<_>>()}))
+            .collect();
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        for s in &all {
+            let effects: Vec<&str> = s.file.effects.iter().map(|e| e.kind()).collect();
+            println!("{:<8} {} [{}]", s.name(), s.file.description, effects.join(", "));
+        }
+    }
+    Ok(())
+}
+
+fn elements(json: bool) -> Result<()> {
+    let rows: Vec<serde_json::Value> = ElementType::all()
+        .map(|e| -> Result<serde_json::Value> {
+            let degree = e.default_quadrature_degree();
+            let rule = quadrature::rule(e.shape(), degree)?;
+            Ok(serde_json::json!({
+                "element": e.name(),
+                "description": e.description(),
+                "gmsh_type": e.gmsh_type(),
+                "nodes": e.num_nodes(),
+                "faces": e.faces().len(),
+                "quadrature_degree": degree,
+                "quadrature_points": rule.len(),
+            }))
+        })
+        .collect::<Result<_>>()?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+        return Ok(());
+    }
+    println!("{:<8} {:<38} {:>5} {:>5} {:>6} {:>7}", "element", "description", "gmsh", "nodes", "degree", "points");
+    for r in &rows {
+        println!(
+            "{:<8} {:<38} {:>5} {:>5} {:>6} {:>7}",
+            r["element"].as_str().unwrap_or(""),
+            r["description"].as_str().unwrap_or(""),
+            r["gmsh_type"].to_string(),
+            r["nodes"].to_string(),
+            r["quadrature_degree"].to_string(),
+            r["quadrature_points"].to_string()
+        );
+    }
+    Ok(())
+}
