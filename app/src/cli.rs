@@ -38,6 +38,21 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Solve a scene's static equilibrium (Newton's method, dense: small meshes) and print the
+    /// probe displacements.
+    Static {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[command(flatten)]
+        mesh: MeshArgs,
+        #[command(flatten)]
+        physics: PhysicsArgs,
+        /// Relative residual to stop at.
+        #[arg(long, default_value_t = 1e-8)]
+        tolerance: f64,
+        #[arg(long)]
+        json: bool,
+    },
     /// Run a scene (for --seconds, or until it --settle-s) and print the probe displacements.
     Simulate {
         #[command(flatten)]
@@ -47,7 +62,7 @@ pub enum Command {
         #[command(flatten)]
         physics: PhysicsArgs,
         /// Simulated time to run, seconds (default: the scene's duration).
-        #[arg(long, conflicts_with = "settle")]
+        #[arg(long, conflicts_with = "settle", allow_negative_numbers = true)]
         seconds: Option<f64>,
         /// Run with the scene's settle damping until the motion has died out (every node moves
         /// less than 1e-7 × the body's diagonal per frame for 30 frames) or 120 s.
@@ -90,13 +105,13 @@ pub struct PhysicsArgs {
     #[arg(long)]
     pub material: Option<String>,
     /// Young's modulus, Pa.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub youngs: Option<f64>,
     /// Poisson ratio.
     #[arg(long, allow_negative_numbers = true)]
     pub poisson: Option<f64>,
     /// Density, kg/m³.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub density: Option<f64>,
     /// Constraint formulation: energy or split.
     #[arg(long)]
@@ -111,7 +126,7 @@ pub struct PhysicsArgs {
     #[arg(long)]
     pub iterations: Option<u32>,
     /// Frames per second.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub fps: Option<f64>,
 }
 
@@ -137,6 +152,7 @@ pub fn main(cli: Cli) -> Result<()> {
         Command::Scenes { json } => scenes(json),
         Command::Mesh { scene, mesh, json } => mesh_command(&scene, &mesh, json),
         Command::Simulate { scene, mesh, physics, seconds, settle, json } => simulate(&scene, &mesh, &physics, seconds, settle, json),
+        Command::Static { scene, mesh, physics, tolerance, json } => static_command(&scene, &mesh, &physics, tolerance, json),
     }
 }
 
@@ -248,6 +264,42 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
     }
     if settle && !report.settled {
         eprintln!("warning: the run did not settle within {} s", hox_scenes::SETTLE_CAP_SECS);
+    }
+    Ok(())
+}
+
+fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tolerance: f64, json: bool) -> Result<()> {
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        bail!("--tolerance must be a finite positive number, got {tolerance}");
+    }
+    let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
+    let m = scene.build_mesh()?;
+    let (acceleration, dirichlet) = hox_scenes::static_problem(&scene, &m)?;
+    let dofs = 3 * (m.num_nodes() - dirichlet.len());
+    let started = Instant::now();
+    let solution = hox_sim::statics::solve_dense(&m, &scene.material, scene.settings.quadrature_degree, acceleration, &dirichlet, tolerance)
+        .with_context(|| format!("{}: static solve", scene.source))?;
+    let seconds = started.elapsed().as_secs_f64();
+    let mut probes = std::collections::BTreeMap::new();
+    for p in &scene.file.probes {
+        let probe = hox_sim::probe::Probe::locate(&m, &p.name, hox_sim::Vec3::from(p.point_m))?;
+        let u = probe.displacement(&solution.positions, &m.rest_positions);
+        probes.insert(p.name.clone(), [u.x, u.y, u.z]);
+    }
+    let out = serde_json::json!({
+        "probes": probes,
+        "newton_iterations": solution.newton_iterations,
+        "residual": solution.relative_residual,
+        "seconds": seconds,
+        "dofs": dofs,
+    });
+    if json {
+        println!("{out}");
+    } else {
+        println!("{}: static equilibrium, {dofs} DOFs, {} Newton iterations, residual {:.2e}, {seconds:.2} s", scene.name(), solution.newton_iterations, solution.relative_residual);
+        for (name, u) in &probes {
+            println!("  probe {name}: u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
+        }
     }
     Ok(())
 }

@@ -99,5 +99,38 @@ impl Instance {
     }
 }
 
+/// The static problem of a scene: body acceleration and Dirichlet nodes (clamped at rest,
+/// prescribed ones at their final, fully ramped positions). Scenes with contact or damping-only
+/// dynamics have no such reference: contact is refused.
+pub fn static_problem(scene: &Scene, mesh: &hox_sim::mesh::Mesh) -> Result<(hox_sim::Vec3, Vec<(u32, hox_sim::Vec3)>), SceneError> {
+    use scene::EffectSpec;
+    let mut acceleration = hox_sim::Vec3::zeros();
+    let mut dirichlet = Vec::new();
+    for (spec, effect) in scene.file.effects.iter().zip(scene.build_effects(mesh)?) {
+        match spec {
+            EffectSpec::Gravity { acceleration_m_s2 } => acceleration += hox_sim::Vec3::from(*acceleration_m_s2),
+            EffectSpec::Clamp { .. } => {
+                dirichlet.extend(effect.pinned_nodes(mesh).into_iter().map(|n| (n, mesh.rest_positions[n as usize])))
+            }
+            EffectSpec::Prescribed { nodes, .. } => {
+                let p = spec.prescribed(scene::select_nodes(mesh, nodes)).expect("a prescribed spec");
+                // the final, fully ramped position
+                let end = f64::INFINITY;
+                dirichlet.extend(p.nodes.iter().map(|&n| (n, p.target(&mesh.rest_positions[n as usize], end))));
+            }
+            EffectSpec::Damping { .. } => {}
+            EffectSpec::Contact { .. } => {
+                return Err(SceneError::Invalid {
+                    source_name: scene.source.clone(),
+                    key: "effects".into(),
+                    value: "contact".into(),
+                    reason: "a static solution with contact is not supported".into(),
+                });
+            }
+        }
+    }
+    Ok((acceleration, dirichlet))
+}
+
 #[cfg(test)]
 mod tests;

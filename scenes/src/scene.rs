@@ -185,6 +185,19 @@ pub enum EffectSpec {
 }
 
 impl EffectSpec {
+    /// The prescribed motion this spec describes, acting on `nodes` (None for other effects).
+    pub fn prescribed(&self, nodes: Vec<u32>) -> Option<Prescribed> {
+        let EffectSpec::Prescribed { translation_m, rotation_axis, rotation_origin_m, rotation_deg, ramp_secs, .. } = self else {
+            return None;
+        };
+        let rotation = rotation_axis.map(|axis| AxisRotation {
+            axis: Vec3::from(axis).normalize(),
+            origin_m: Vec3::from(rotation_origin_m.unwrap_or([0.0; 3])),
+            angle_rad: rotation_deg.to_radians(),
+        });
+        Some(Prescribed { nodes, translation_m: Vec3::from(*translation_m), rotation, ramp_secs: *ramp_secs })
+    }
+
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Gravity { .. } => "gravity",
@@ -410,14 +423,7 @@ impl Scene {
             effects.push(match e {
                 EffectSpec::Gravity { acceleration_m_s2 } => Box::new(Gravity::new(Vec3::from(*acceleration_m_s2))),
                 EffectSpec::Clamp { nodes } => Box::new(Clamp { nodes: select(nodes)? }),
-                EffectSpec::Prescribed { nodes, translation_m, rotation_axis, rotation_origin_m, rotation_deg, ramp_secs } => {
-                    let rotation = rotation_axis.map(|axis| AxisRotation {
-                        axis: Vec3::from(axis).normalize(),
-                        origin_m: Vec3::from(rotation_origin_m.unwrap_or([0.0; 3])),
-                        angle_rad: rotation_deg.to_radians(),
-                    });
-                    Box::new(Prescribed { nodes: select(nodes)?, translation_m: Vec3::from(*translation_m), rotation, ramp_secs: *ramp_secs })
-                }
+                EffectSpec::Prescribed { nodes, .. } => Box::new(e.prescribed(select(nodes)?).expect("a prescribed spec")),
                 EffectSpec::Damping { rate_per_sec } => Box::new(Damping { rate_per_sec: *rate_per_sec }),
                 EffectSpec::Contact { point_m, normal, velocity_m_s, move_secs, friction } => Box::new(ContactPlane::new(
                     Vec3::from(*point_m),

@@ -17,6 +17,7 @@
 //! - [`probe`]: material points located in the rest mesh, followed through the deformation.
 //! - [`energy`]: total elastic energy, gradient and Hessian of a mesh.
 //! - [`constraint`]: pure XPBD constraint kernels (energy and split formulations).
+//! - [`statics`]: static equilibrium by Newton's method (the reference XPBD must settle to).
 //! - [`solver`]: the stateful XPBD solver and the opt-in [`effect`]s it runs.
 
 pub mod constraint;
@@ -30,6 +31,7 @@ pub mod mesh;
 pub mod probe;
 pub mod quadrature;
 pub mod solver;
+pub mod statics;
 
 pub use nalgebra;
 

@@ -47,6 +47,14 @@ fn rigid_motions_give_zero_energy_and_zero_gradient() {
     }
 }
 
+/// Smallest det F over the quadrature points of a one-element mesh.
+fn min_det_f(mesh: &Mesh, geo: &[BlockGeometry], x: &[Vec3]) -> f64 {
+    let g = &geo[0];
+    (0..g.points_per_element)
+        .map(|q| local_deformation_gradient(x, &mesh.rest_positions, g.gradients(0, q)).determinant())
+        .fold(f64::INFINITY, f64::min)
+}
+
 fn total_volume(geo: &[BlockGeometry]) -> f64 {
     crate::geometry::total_volume_m3(geo)
 }
@@ -58,8 +66,14 @@ proptest! {
     fn energy_gradients_match_finite_differences(seed in proptest::collection::vec(-1.0..1.0f64, 81)) {
         let h = 1e-6;
         for (et, mesh, geo) in elements() {
+            let x = perturbed(&mesh, &seed);
+            let min_j = min_det_f(&mesh, &geo, &x);
             for material in materials() {
-                let x = perturbed(&mesh, &seed);
+                // Neo-Hookean's ln J is continued linearly below J = 1e-6: finite differences
+                // across that seam are meaningless, so keep NH to well-shaped deformations.
+                if material.model == MaterialModel::NeoHookean && min_j < 0.2 {
+                    continue;
+                }
                 let mut grad = vec![Vec3::zeros(); x.len()];
                 total_energy_and_gradient(&mesh, &geo, &material, &x, &mut grad);
                 let gmax = grad.iter().map(|g| g.norm()).fold(0.0, f64::max);

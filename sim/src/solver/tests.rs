@@ -1,10 +1,9 @@
 use super::*;
 use crate::effect::{Clamp, Damping, Gravity};
 use crate::element::ElementType;
-use crate::energy::{element_grads, element_hessian, total_energy_and_gradient};
 use crate::material::MaterialModel;
 use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 
@@ -23,69 +22,11 @@ fn clamped_at_x0(mesh: &Mesh) -> Vec<u32> {
     mesh.nodes_where(|p| p.x.abs() < 1e-12)
 }
 
-/// Static equilibrium `∇U(x) = M g` with clamped nodes, by Newton's method on the total
-/// potential `U(x) − Σ m_i g·x_i` with a dense Hessian and backtracking: independent of XPBD.
+/// Static equilibrium `∇U(x) = M g` with clamped nodes, by Newton's method
+/// ([`crate::statics`]): independent of XPBD.
 fn static_equilibrium(mesh: &Mesh, material: &Material, degree: Option<usize>, clamped: &[u32]) -> Vec<Vec3> {
-    let geo = precompute(mesh, degree).unwrap();
-    let masses = lumped_masses_kg(mesh, material.density_kg_m3).unwrap();
-    let n = mesh.num_nodes();
-    let mut free = vec![true; n];
-    clamped.iter().for_each(|&c| free[c as usize] = false);
-    let dof: Vec<usize> = (0..3 * n).filter(|d| free[d / 3]).collect();
-    let potential = |x: &[Vec3]| -> (f64, Vec<Vec3>) {
-        let mut g = vec![Vec3::zeros(); n];
-        let u = total_energy_and_gradient(mesh, &geo, material, x, &mut g);
-        let mut pot = u;
-        for i in 0..n {
-            pot -= masses[i] * G.dot(&x[i]);
-            g[i] -= masses[i] * G;
-        }
-        (pot, g)
-    };
-    let mut x = mesh.rest_positions.clone();
-    let f_norm: f64 = masses.iter().map(|m| m * G.norm()).sum();
-    for _ in 0..100 {
-        let (pot, g) = potential(&x);
-        let r = DVector::from_iterator(dof.len(), dof.iter().map(|&d| g[d / 3][d % 3]));
-        // relative residual 1e-8: below that the potential's round-off stalls the line search
-        if r.norm() < 1e-8 * f_norm {
-            return x;
-        }
-        let mut k = DMatrix::zeros(3 * n, 3 * n);
-        let mut xl = Vec::new();
-        for (b, gb) in mesh.blocks.iter().zip(&geo) {
-            for (e, nodes) in b.elements().enumerate() {
-                xl.clear();
-                xl.extend(nodes.iter().map(|&i| x[i as usize]));
-                let rest: Vec<Vec3> = nodes.iter().map(|&i| mesh.rest_positions[i as usize]).collect();
-                let he = element_hessian(&xl, &rest, element_grads(gb, e), gb.volumes(e), material, true);
-                for (li, &i) in nodes.iter().enumerate() {
-                    for (lj, &j) in nodes.iter().enumerate() {
-                        for a in 0..3 {
-                            for c in 0..3 {
-                                k[(3 * i as usize + a, 3 * j as usize + c)] += he[(3 * li + a, 3 * lj + c)];
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        let kf = DMatrix::from_fn(dof.len(), dof.len(), |i, j| k[(dof[i], dof[j])]);
-        let step = kf.cholesky().expect("SPD reduced Hessian").solve(&(-&r));
-        let mut t = 1.0;
-        loop {
-            let mut xt = x.clone();
-            for (s, &d) in step.iter().zip(&dof) {
-                xt[d / 3][d % 3] += t * s;
-            }
-            if potential(&xt).0 <= pot || t < 1e-8 {
-                x = xt;
-                break;
-            }
-            t *= 0.5;
-        }
-    }
-    panic!("Newton did not converge");
+    let dirichlet: Vec<(u32, Vec3)> = clamped.iter().map(|&c| (c, mesh.rest_positions[c as usize])).collect();
+    crate::statics::solve_dense(mesh, material, degree, G, &dirichlet, 1e-10).unwrap().positions
 }
 
 /// The circular frequencies (rad/s) of the clamped mesh's lowest and highest modes at `x`:
@@ -97,34 +38,12 @@ fn frequency_range(mesh: &Mesh, material: &Material, clamped: &[u32], x: &[Vec3]
     let mut free = vec![true; n];
     clamped.iter().for_each(|&c| free[c as usize] = false);
     let dof: Vec<usize> = (0..3 * n).filter(|d| free[d / 3]).collect();
-    let k = assemble_dense_hessian(mesh, &geo, material, x);
+    let k = crate::statics::assemble_dense(mesh, &geo, material, x);
     let s = DMatrix::from_fn(dof.len(), dof.len(), |i, j| {
         k[(dof[i], dof[j])] / (masses[dof[i] / 3] * masses[dof[j] / 3]).sqrt()
     });
     let eig = s.symmetric_eigenvalues();
     (eig.min().max(0.0).sqrt(), eig.max().sqrt())
-}
-
-fn assemble_dense_hessian(mesh: &Mesh, geo: &[BlockGeometry], material: &Material, x: &[Vec3]) -> DMatrix<f64> {
-    let n = mesh.num_nodes();
-    let mut k = DMatrix::zeros(3 * n, 3 * n);
-    for (b, gb) in mesh.blocks.iter().zip(geo) {
-        for (e, nodes) in b.elements().enumerate() {
-            let xl: Vec<Vec3> = nodes.iter().map(|&i| x[i as usize]).collect();
-            let rest: Vec<Vec3> = nodes.iter().map(|&i| mesh.rest_positions[i as usize]).collect();
-            let he = element_hessian(&xl, &rest, element_grads(gb, e), gb.volumes(e), material, true);
-            for (li, &i) in nodes.iter().enumerate() {
-                for (lj, &j) in nodes.iter().enumerate() {
-                    for a in 0..3 {
-                        for c in 0..3 {
-                            k[(3 * i as usize + a, 3 * j as usize + c)] += he[(3 * li + a, 3 * lj + c)];
-                        }
-                    }
-                }
-            }
-        }
-    }
-    k
 }
 
 /// Runs XPBD (one iteration per substep, as the paper) with velocity damping until it has
