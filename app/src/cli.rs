@@ -38,8 +38,8 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Solve a scene's static equilibrium (Newton's method, dense: small meshes) and print the
-    /// probe displacements.
+    /// Solve a scene's static equilibrium (Newton's method with a sparse Cholesky factorisation,
+    /// load stepping) and print the probe displacements.
     Static {
         #[command(flatten)]
         scene: SceneArgs,
@@ -50,6 +50,9 @@ pub enum Command {
         /// Relative residual to stop at.
         #[arg(long, default_value_t = 1e-8)]
         tolerance: f64,
+        /// Initial number of load increments (halved automatically where Newton struggles).
+        #[arg(long, default_value_t = 1)]
+        load_steps: usize,
         #[arg(long)]
         json: bool,
     },
@@ -152,7 +155,7 @@ pub fn main(cli: Cli) -> Result<()> {
         Command::Scenes { json } => scenes(json),
         Command::Mesh { scene, mesh, json } => mesh_command(&scene, &mesh, json),
         Command::Simulate { scene, mesh, physics, seconds, settle, json } => simulate(&scene, &mesh, &physics, seconds, settle, json),
-        Command::Static { scene, mesh, physics, tolerance, json } => static_command(&scene, &mesh, &physics, tolerance, json),
+        Command::Static { scene, mesh, physics, tolerance, load_steps, json } => static_command(&scene, &mesh, &physics, tolerance, load_steps, json),
     }
 }
 
@@ -268,17 +271,38 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
     Ok(())
 }
 
-fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tolerance: f64, json: bool) -> Result<()> {
+fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tolerance: f64, load_steps: usize, json: bool) -> Result<()> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
         bail!("--tolerance must be a finite positive number, got {tolerance}");
     }
     let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
     let m = scene.build_mesh()?;
     let (acceleration, dirichlet) = hox_scenes::static_problem(&scene, &m)?;
-    let dofs = 3 * (m.num_nodes() - dirichlet.len());
+    let problem = hox_sim::statics::StaticProblem {
+        mesh: &m,
+        material: scene.material,
+        quadrature_degree: scene.settings.quadrature_degree,
+        acceleration_m_s2: acceleration,
+        dirichlet,
+        tolerance,
+        load_steps,
+    };
     let started = Instant::now();
-    let solution = hox_sim::statics::solve_dense(&m, &scene.material, scene.settings.quadrature_degree, acceleration, &dirichlet, tolerance)
-        .with_context(|| format!("{}: static solve", scene.source))?;
+    let bar = ProgressBar::hidden();
+    let mut shown = false;
+    let solution = hox_sim::statics::solve(&problem, &mut |fraction, iteration, residual| {
+        if !shown && started.elapsed() > Duration::from_secs(2) {
+            shown = true;
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            bar.set_length(1000);
+            bar.set_style(ProgressStyle::with_template("{spinner} load {bar:30} {msg} [{elapsed}]").expect("valid template"));
+        }
+        bar.set_position((1000.0 * fraction) as u64);
+        bar.set_message(format!("Newton iteration {iteration}, residual {residual:.2e}"));
+    })
+    .with_context(|| format!("{}: static solve", scene.source))?;
+    bar.finish_and_clear();
+    let dofs = solution.free_dofs;
     let seconds = started.elapsed().as_secs_f64();
     let mut probes = std::collections::BTreeMap::new();
     for p in &scene.file.probes {

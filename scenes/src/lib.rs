@@ -99,30 +99,39 @@ impl Instance {
     }
 }
 
-/// The static problem of a scene: body acceleration and Dirichlet nodes (clamped at rest,
-/// prescribed ones at their final, fully ramped positions). Scenes with contact or damping-only
-/// dynamics have no such reference: contact is refused.
-pub fn static_problem(scene: &Scene, mesh: &hox_sim::mesh::Mesh) -> Result<(hox_sim::Vec3, Vec<(u32, hox_sim::Vec3)>), SceneError> {
+/// The static problem of a scene: body acceleration and Dirichlet conditions (clamped nodes at
+/// rest, prescribed ones moved to their final, fully ramped positions). Contact has no static
+/// counterpart here and is refused; damping does not change the equilibrium.
+pub fn static_problem(scene: &Scene, mesh: &hox_sim::mesh::Mesh) -> Result<(hox_sim::Vec3, Vec<hox_sim::effect::Prescribed>), SceneError> {
     use scene::EffectSpec;
     let mut acceleration = hox_sim::Vec3::zeros();
     let mut dirichlet = Vec::new();
-    for (spec, effect) in scene.file.effects.iter().zip(scene.build_effects(mesh)?) {
+    for (k, spec) in scene.file.effects.iter().enumerate() {
+        let select = |nodes| {
+            let selected = scene::select_nodes(mesh, nodes);
+            if selected.is_empty() {
+                return Err(SceneError::Invalid {
+                    source_name: scene.source.clone(),
+                    key: format!("effects[{k}].nodes"),
+                    value: format!("{nodes:?}"),
+                    reason: "selects no node of the mesh".into(),
+                });
+            }
+            Ok(selected)
+        };
         match spec {
             EffectSpec::Gravity { acceleration_m_s2 } => acceleration += hox_sim::Vec3::from(*acceleration_m_s2),
-            EffectSpec::Clamp { .. } => {
-                dirichlet.extend(effect.pinned_nodes(mesh).into_iter().map(|n| (n, mesh.rest_positions[n as usize])))
-            }
+            EffectSpec::Clamp { nodes } => dirichlet.push(hox_sim::statics::clamp(select(nodes)?)),
             EffectSpec::Prescribed { nodes, .. } => {
-                let p = spec.prescribed(scene::select_nodes(mesh, nodes)).expect("a prescribed spec");
-                // the final, fully ramped position
-                let end = f64::INFINITY;
-                dirichlet.extend(p.nodes.iter().map(|&n| (n, p.target(&mesh.rest_positions[n as usize], end))));
+                let mut p = spec.prescribed(select(nodes)?).expect("a prescribed spec");
+                p.ramp_secs = 1.0; // evaluated at "time" = load fraction
+                dirichlet.push(p);
             }
             EffectSpec::Damping { .. } => {}
             EffectSpec::Contact { .. } => {
                 return Err(SceneError::Invalid {
                     source_name: scene.source.clone(),
-                    key: "effects".into(),
+                    key: format!("effects[{k}]"),
                     value: "contact".into(),
                     reason: "a static solution with contact is not supported".into(),
                 });

@@ -25,8 +25,16 @@ fn clamped_at_x0(mesh: &Mesh) -> Vec<u32> {
 /// Static equilibrium `∇U(x) = M g` with clamped nodes, by Newton's method
 /// ([`crate::statics`]): independent of XPBD.
 fn static_equilibrium(mesh: &Mesh, material: &Material, degree: Option<usize>, clamped: &[u32]) -> Vec<Vec3> {
-    let dirichlet: Vec<(u32, Vec3)> = clamped.iter().map(|&c| (c, mesh.rest_positions[c as usize])).collect();
-    crate::statics::solve_dense(mesh, material, degree, G, &dirichlet, 1e-10).unwrap().positions
+    let problem = crate::statics::StaticProblem {
+        mesh,
+        material: *material,
+        quadrature_degree: degree,
+        acceleration_m_s2: G,
+        dirichlet: vec![crate::statics::clamp(clamped.to_vec())],
+        tolerance: 1e-10,
+        load_steps: 1,
+    };
+    crate::statics::solve(&problem, &mut |_, _, _| {}).unwrap().positions
 }
 
 /// The circular frequencies (rad/s) of the clamped mesh's lowest and highest modes at `x`:
