@@ -56,6 +56,16 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// The accuracy-versus-time study over the paper scenes: writes study.md, study.csv and
+    /// study.svg to --out.
+    Study {
+        /// Only the coarse configurations (minutes instead of an hour).
+        #[arg(long)]
+        quick: bool,
+        /// Output folder (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Run a scene (for --seconds, or until it --settle-s) and print the probe displacements.
     Simulate {
         #[command(flatten)]
@@ -155,6 +165,7 @@ pub fn main(cli: Cli) -> Result<()> {
         Command::Scenes { json } => scenes(json),
         Command::Mesh { scene, mesh, json } => mesh_command(&scene, &mesh, json),
         Command::Simulate { scene, mesh, physics, seconds, settle, json } => simulate(&scene, &mesh, &physics, seconds, settle, json),
+        Command::Study { quick, out } => study(quick, &out),
         Command::Static { scene, mesh, physics, tolerance, load_steps, json } => static_command(&scene, &mesh, &physics, tolerance, load_steps, json),
     }
 }
@@ -324,6 +335,37 @@ fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tol
         for (name, u) in &probes {
             println!("  probe {name}: u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
         }
+    }
+    Ok(())
+}
+
+fn study(quick: bool, out: &std::path::Path) -> Result<()> {
+    // refuse an unwritable folder before spending minutes
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
+    let probe = out.join(".hox-write-test");
+    std::fs::write(&probe, b"").with_context(|| format!("cannot write to the output folder {}", out.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed}] {msg}").expect("valid template"));
+    bar.enable_steady_tick(Duration::from_millis(200));
+    let started = Instant::now();
+    let rows = hox_scenes::study::run_study(quick, &mut |message| {
+        // a log line per step when stderr is not a terminal (CI), the spinner otherwise
+        if bar.is_hidden() {
+            eprintln!("[{:>6.1} s] {message}", started.elapsed().as_secs_f64());
+        }
+        bar.set_message(message.to_string());
+    })?;
+    bar.finish_and_clear();
+    let files = [
+        ("study.md", hox_scenes::study::markdown(&rows, quick)),
+        ("study.csv", hox_scenes::study::csv(&rows)),
+        ("study.svg", hox_scenes::study::svg(&rows)),
+    ];
+    for (name, text) in files {
+        let path = out.join(name);
+        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
     }
     Ok(())
 }

@@ -6,6 +6,7 @@
 
 pub mod run;
 pub mod scene;
+pub mod study;
 
 pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, run};
 pub use scene::{Scene, SceneFile, SceneOverrides};

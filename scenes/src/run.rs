@@ -3,7 +3,7 @@
 //! **Settling** (`RunMode::Settle`): velocity damping `v ← v e^{−c h}` with the scene's
 //! `settle_damping_per_sec` is added, and the run stops once every node has moved less than
 //! `SETTLE_TOLERANCE_REL` × the body's bounding-box diagonal per frame for `SETTLE_FRAMES`
-//! consecutive frames, after all prescribed ramps and moving planes have stopped; or at
+//! consecutive frames, after all prescribed ramps and moving planes have stopped; or after
 //! `SETTLE_CAP_SECS` simulated seconds, reported as not settled.
 
 use crate::{Instance, SceneError};
@@ -30,6 +30,7 @@ pub struct RunReport {
     pub probes: std::collections::BTreeMap<String, [f64; 3]>,
     pub frames: u64,
     pub sim_seconds: f64,
+    /// Median wall-clock time of one frame (stepping only), milliseconds.
     pub ms_per_frame: f64,
     pub settled: bool,
     pub kinetic_energy_j: f64,
@@ -43,7 +44,7 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
     let source = instance.scene.source.clone();
     let fail = |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: source.clone(), message: e.to_string() };
     let mut settled = false;
-    let mut stepping_secs = 0.0;
+    let mut frame_ms: Vec<f64> = Vec::new();
     let start_frames = instance.sim.frames();
     match mode {
         RunMode::Seconds(t) => {
@@ -51,7 +52,7 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
             for f in 0..frames {
                 let clock = Instant::now();
                 instance.sim.step_frame().map_err(fail)?;
-                stepping_secs += clock.elapsed().as_secs_f64();
+                frame_ms.push(1e3 * clock.elapsed().as_secs_f64());
                 progress(instance.sim.time_secs(), Some((f + 1) as f64 / frames as f64));
             }
         }
@@ -60,15 +61,17 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
             if damping > 0.0 {
                 instance.sim.add_effect(Box::new(Damping { rate_per_sec: damping })).map_err(fail)?;
             }
-            let driven_until = driven_until_secs(&instance.scene.file.effects);
+            // a warm-started run (positions set by the caller) has its drives already applied
+            let driven_until = if instance.sim.time_secs() > 0.0 { 0.0 } else { driven_until_secs(&instance.scene.file.effects) };
             let (lo, hi) = instance.sim.mesh().bounding_box();
             let tolerance_m = SETTLE_TOLERANCE_REL * (hi - lo).norm();
             let mut quiet = 0;
             let mut before = instance.sim.positions.clone();
-            while instance.sim.time_secs() < SETTLE_CAP_SECS {
+            let give_up_at = instance.sim.time_secs() + SETTLE_CAP_SECS;
+            while instance.sim.time_secs() < give_up_at {
                 let clock = Instant::now();
                 instance.sim.step_frame().map_err(fail)?;
-                stepping_secs += clock.elapsed().as_secs_f64();
+                frame_ms.push(1e3 * clock.elapsed().as_secs_f64());
                 let moved = instance.sim.positions.iter().zip(&before).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
                 before.copy_from_slice(&instance.sim.positions);
                 quiet = if moved < tolerance_m && instance.sim.time_secs() >= driven_until { quiet + 1 } else { 0 };
@@ -85,11 +88,21 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
         probes: instance.probe_displacements().into_iter().collect(),
         frames,
         sim_seconds: instance.sim.time_secs(),
-        ms_per_frame: if frames > 0 { 1e3 * stepping_secs / frames as f64 } else { 0.0 },
+        ms_per_frame: median(&mut frame_ms),
         settled,
         kinetic_energy_j: instance.sim.kinetic_energy_j(),
         elastic_energy_j: instance.sim.elastic_energy_j(),
     })
+}
+
+/// Median of `values` (0 when empty).
+pub fn median(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f64::total_cmp);
+    let m = values.len() / 2;
+    if values.len() % 2 == 1 { values[m] } else { 0.5 * (values[m - 1] + values[m]) }
 }
 
 /// Time after which no listed effect drives motion any more (ramps done, planes stopped).

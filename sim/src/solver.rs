@@ -239,6 +239,15 @@ impl Simulation {
         Ok(())
     }
 
+    /// Continues from another run's state: positions copied, velocities zero, clock at
+    /// `time_secs` (so prescribed motions are where they were).
+    pub fn warm_start(&mut self, positions: &[Vec3], time_secs: f64) {
+        self.positions.copy_from_slice(positions);
+        self.prev_positions.copy_from_slice(positions);
+        self.velocities.iter_mut().for_each(|v| *v = Vec3::zeros());
+        self.time_secs = time_secs;
+    }
+
     /// Back to the rest shape at t = 0.
     pub fn reset(&mut self) {
         self.positions.clone_from(&self.mesh.rest_positions);
