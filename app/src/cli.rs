@@ -229,7 +229,7 @@ fn mesh_command(scene: &SceneArgs, mesh: &MeshArgs, json: bool) -> Result<()> {
 fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: Option<f64>, settle: bool, json: bool) -> Result<()> {
     let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
     let mode = if settle {
-        RunMode::Settle
+        RunMode::SETTLE
     } else {
         let t = seconds.unwrap_or(scene.file.solver.duration_secs);
         if !(t.is_finite() && t >= 0.0) {

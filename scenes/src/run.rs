@@ -21,13 +21,22 @@ pub const SETTLE_CAP_SECS: f64 = 120.0;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RunMode {
     Seconds(f64),
-    Settle,
+    /// Until settled, or for at most `cap_secs` simulated seconds.
+    Settle { cap_secs: f64 },
+}
+
+impl RunMode {
+    /// Settling with the default cap.
+    pub const SETTLE: RunMode = RunMode::Settle { cap_secs: SETTLE_CAP_SECS };
 }
 
 /// What a run produced (the CLI prints it as JSON).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct RunReport {
     pub probes: std::collections::BTreeMap<String, [f64; 3]>,
+    /// Probe displacements averaged over the last simulated second (over the whole run when
+    /// shorter): the state an oscillation that never settles hovers around.
+    pub probes_last_second_mean: std::collections::BTreeMap<String, [f64; 3]>,
     pub frames: u64,
     pub sim_seconds: f64,
     /// Median wall-clock time of one frame (stepping only), milliseconds.
@@ -45,6 +54,14 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
     let fail = |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: source.clone(), message: e.to_string() };
     let mut settled = false;
     let mut frame_ms: Vec<f64> = Vec::new();
+    let window = (instance.scene.settings.frames_per_second.round() as usize).max(1);
+    let mut history: std::collections::VecDeque<Vec<(String, [f64; 3])>> = std::collections::VecDeque::with_capacity(window + 1);
+    let mut remember = |instance: &Instance| {
+        history.push_back(instance.probe_displacements());
+        if history.len() > window {
+            history.pop_front();
+        }
+    };
     let start_frames = instance.sim.frames();
     match mode {
         RunMode::Seconds(t) => {
@@ -53,10 +70,11 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
                 let clock = Instant::now();
                 instance.sim.step_frame().map_err(fail)?;
                 frame_ms.push(1e3 * clock.elapsed().as_secs_f64());
+                remember(instance);
                 progress(instance.sim.time_secs(), Some((f + 1) as f64 / frames as f64));
             }
         }
-        RunMode::Settle => {
+        RunMode::Settle { cap_secs } => {
             let damping = instance.scene.file.solver.settle_damping_per_sec;
             if damping > 0.0 {
                 instance.sim.add_effect(Box::new(Damping { rate_per_sec: damping })).map_err(fail)?;
@@ -67,11 +85,12 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
             let tolerance_m = SETTLE_TOLERANCE_REL * (hi - lo).norm();
             let mut quiet = 0;
             let mut before = instance.sim.positions.clone();
-            let give_up_at = instance.sim.time_secs() + SETTLE_CAP_SECS;
+            let give_up_at = instance.sim.time_secs() + cap_secs;
             while instance.sim.time_secs() < give_up_at {
                 let clock = Instant::now();
                 instance.sim.step_frame().map_err(fail)?;
                 frame_ms.push(1e3 * clock.elapsed().as_secs_f64());
+                remember(instance);
                 let moved = instance.sim.positions.iter().zip(&before).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
                 before.copy_from_slice(&instance.sim.positions);
                 quiet = if moved < tolerance_m && instance.sim.time_secs() >= driven_until { quiet + 1 } else { 0 };
@@ -84,8 +103,18 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
         }
     }
     let frames = instance.sim.frames() - start_frames;
+    let mut mean: std::collections::BTreeMap<String, [f64; 3]> = std::collections::BTreeMap::new();
+    for frame in &history {
+        for (name, u) in frame {
+            let m = mean.entry(name.clone()).or_insert([0.0; 3]);
+            for d in 0..3 {
+                m[d] += u[d] / history.len() as f64;
+            }
+        }
+    }
     Ok(RunReport {
         probes: instance.probe_displacements().into_iter().collect(),
+        probes_last_second_mean: mean,
         frames,
         sim_seconds: instance.sim.time_secs(),
         ms_per_frame: median(&mut frame_ms),
