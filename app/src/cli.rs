@@ -141,6 +141,10 @@ pub struct PhysicsArgs {
     /// Frames per second.
     #[arg(long, allow_negative_numbers = true)]
     pub fps: Option<f64>,
+    /// Project elements in parallel (colour by colour, on all threads; RAYON_NUM_THREADS sets
+    /// how many).
+    #[arg(long)]
+    pub parallel: bool,
 }
 
 fn parse_grid(s: &str) -> Result<[usize; 3], String> {
@@ -196,6 +200,7 @@ fn overrides(mesh: &MeshArgs, physics: Option<&PhysicsArgs>) -> SceneOverrides {
         o.substeps = p.substeps;
         o.iterations = p.iterations;
         o.frames_per_second = p.fps;
+        o.parallel = p.parallel.then_some(true);
     }
     o
 }

@@ -24,6 +24,7 @@
 //! quadrature_degree = 2   # omit for each element type's default
 //! duration_secs = 3       # default run length
 //! settle_damping_per_sec = 10  # velocity damping used by --settle
+//! parallel = false        # project elements colour by colour on all threads
 //! [[effects]]             # only the effects listed are simulated
 //! type = "gravity"        # gravity | clamp | prescribed | damping | contact
 //! acceleration_m_s2 = [0, 0, -9.81]
@@ -121,6 +122,8 @@ pub struct SolverSpec {
     pub quadrature_degree: Option<usize>,
     pub duration_secs: f64,
     pub settle_damping_per_sec: f64,
+    /// Project elements in parallel, colour by colour.
+    pub parallel: bool,
 }
 
 impl Default for SolverSpec {
@@ -133,6 +136,7 @@ impl Default for SolverSpec {
             quadrature_degree: None,
             duration_secs: 3.0,
             settle_damping_per_sec: 10.0,
+            parallel: false,
         }
     }
 }
@@ -243,6 +247,7 @@ pub struct SceneOverrides {
     pub substeps: Option<u32>,
     pub iterations: Option<u32>,
     pub frames_per_second: Option<f64>,
+    pub parallel: Option<bool>,
 }
 
 impl Scene {
@@ -336,6 +341,7 @@ impl Scene {
             frames_per_second: s.frames_per_second,
             formulation,
             quadrature_degree: s.quadrature_degree,
+            parallel: s.parallel,
         };
         for (k, e) in file.effects.iter().enumerate() {
             validate_effect(k, e, &invalid)?;
@@ -395,6 +401,9 @@ impl Scene {
         }
         if let Some(v) = o.frames_per_second {
             f.solver.frames_per_second = v;
+        }
+        if let Some(v) = o.parallel {
+            f.solver.parallel = v;
         }
         Scene::from_file(f, &self.source)
     }

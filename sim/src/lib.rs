@@ -20,6 +20,7 @@
 //! - [`statics`]: static equilibrium by Newton's method (the reference XPBD must settle to).
 //! - [`solver`]: the stateful XPBD solver and the opt-in [`effect`]s it runs.
 
+pub mod colouring;
 pub mod constraint;
 pub mod effect;
 pub mod element;

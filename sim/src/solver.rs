@@ -30,11 +30,14 @@ pub struct SolverSettings {
     pub formulation: Formulation,
     /// Quadrature degree for the elastic energy; None: each element type's default.
     pub quadrature_degree: Option<usize>,
+    /// Project same-colour elements in parallel (rayon's thread pool); otherwise serially in
+    /// element order. Both are Gauss–Seidel sweeps, in different orders.
+    pub parallel: bool,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        Self { substeps: 50, iterations: 1, frames_per_second: 60.0, formulation: Formulation::Energy, quadrature_degree: None }
+        Self { substeps: 50, iterations: 1, frames_per_second: 60.0, formulation: Formulation::Energy, quadrature_degree: None, parallel: false }
     }
 }
 
@@ -95,6 +98,8 @@ pub struct Simulation {
     inv_mass: Vec<f64>,
     lambdas: Vec<Vec<f64>>,
     effects: Vec<Box<dyn Effect>>,
+    /// Per block, the elements grouped by colour (no two elements of a colour share a node).
+    colours: Vec<Vec<Vec<u32>>>,
     time_secs: f64,
     frames: u64,
     counters: SolverCounters,
@@ -129,6 +134,7 @@ impl Simulation {
             inv_mass,
             lambdas,
             effects: Vec::with_capacity(effects.len()),
+            colours: Vec::new(),
             time_secs: 0.0,
             frames: 0,
             counters: SolverCounters::default(),
@@ -136,6 +142,7 @@ impl Simulation {
         for e in effects {
             sim.add_effect(e)?;
         }
+        sim.colours = sim.mesh.blocks.iter().map(|b| crate::colouring::colour_elements(b, sim.mesh.num_nodes())).collect();
         Ok(sim)
     }
 
@@ -176,6 +183,11 @@ impl Simulation {
     pub fn effects(&self) -> &[Box<dyn Effect>] {
         &self.effects
     }
+    /// Number of element colours per block (elements of one colour share no node).
+    pub fn num_colours(&self) -> Vec<usize> {
+        self.colours.iter().map(Vec::len).collect()
+    }
+
     /// Number of XPBD constraints per solver iteration.
     pub fn num_constraints(&self) -> usize {
         self.lambdas.iter().map(Vec::len).sum()
@@ -306,38 +318,68 @@ impl Simulation {
         self.check_finite()
     }
 
-    /// One Gauss–Seidel sweep over every element constraint.
+    /// One Gauss–Seidel sweep over every element constraint: in element order, or colour by
+    /// colour with the elements of a colour projected in parallel.
     fn project_elements(&mut self, h: f64) {
         let inv_dt2 = 1.0 / (h * h);
+        if self.settings.parallel {
+            self.project_elements_parallel(inv_dt2);
+            return;
+        }
         let mut x = [Vec3::zeros(); MAX_NODES];
-        let mut rest = [Vec3::zeros(); MAX_NODES];
-        let mut w = [0.0; MAX_NODES];
-        for ((block, g), lambdas) in self.mesh.blocks.iter().zip(&self.geometry).zip(&mut self.lambdas) {
+        for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
+            let block = &self.mesh.blocks[bi];
             let n = block.nodes_per_element();
             let per_element = lambdas.len() / block.len().max(1);
-            let (x, rest, w) = (&mut x[..n], &mut rest[..n], &mut w[..n]);
             for (e, nodes) in block.elements().enumerate() {
-                for (wi, &node) in w.iter_mut().zip(nodes) {
-                    *wi = self.inv_mass[node as usize];
-                }
-                if w.iter().all(|&wi| wi == 0.0) {
-                    continue;
-                }
-                gather(&self.positions, nodes, x);
-                gather(&self.mesh.rest_positions, nodes, rest);
                 let lambda = &mut lambdas[e * per_element..(e + 1) * per_element];
-                match self.settings.formulation {
-                    Formulation::Energy => {
-                        project_energy_constraint(x, rest, w, element_grads(g, e), g.volumes(e), &self.material, inv_dt2, &mut lambda[0]);
+                let ctx = ProjectionContext { rest: &self.mesh.rest_positions, inv_mass: &self.inv_mass, material: &self.material, formulation: self.settings.formulation, inv_dt2 };
+                let positions = &self.positions;
+                if ctx.project(|i| positions[i], &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
+                    for (xi, &node) in x.iter().zip(nodes) {
+                        self.positions[node as usize] = *xi;
                     }
-                    Formulation::Split => {
-                        project_split_constraints(x, rest, w, element_grads(g, e), g.volumes(e), &self.material, inv_dt2, lambda);
-                    }
+                    self.counters.element_projections += 1;
                 }
-                for (xi, &node) in x.iter().zip(nodes) {
-                    self.positions[node as usize] = *xi;
-                }
-                self.counters.element_projections += 1;
+            }
+        }
+    }
+
+    /// The parallel sweep: same-colour elements touch disjoint nodes and multipliers, so they
+    /// are projected concurrently and the result does not depend on the scheduling.
+    fn project_elements_parallel(&mut self, inv_dt2: f64) {
+        use rayon::prelude::*;
+        let positions = SharedSlice::new(&mut self.positions);
+        for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
+            let block = &self.mesh.blocks[bi];
+            let n = block.nodes_per_element();
+            let per_element = lambdas.len() / block.len().max(1);
+            let lambdas = SharedSlice::new(lambdas);
+            for colour in &self.colours[bi] {
+                let projected: usize = colour
+                    .par_iter()
+                    .with_min_len(PARALLEL_MIN_ELEMENTS)
+                    .map(|&e| {
+                        let e = e as usize;
+                        let nodes = block.element(e);
+                        // SAFETY: no two elements of a colour share a node (colouring.rs), and
+                        // each element owns its multipliers: concurrent writes are disjoint.
+                        let lambda = unsafe { lambdas.slice_mut(e * per_element, per_element) };
+                        let ctx = ProjectionContext { rest: &self.mesh.rest_positions, inv_mass: &self.inv_mass, material: &self.material, formulation: self.settings.formulation, inv_dt2 };
+                        let mut x = [Vec3::zeros(); MAX_NODES];
+                        // SAFETY: reads only this element's nodes, which no other thread writes.
+                        let read = |i: usize| unsafe { positions.read(i) };
+                        if !ctx.project(read, &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
+                            return 0;
+                        }
+                        for (xi, &node) in x.iter().zip(nodes) {
+                            // SAFETY: as above.
+                            unsafe { positions.write(node as usize, *xi) };
+                        }
+                        1
+                    })
+                    .sum();
+                self.counters.element_projections += projected as u64;
             }
         }
     }
@@ -368,6 +410,86 @@ impl Simulation {
     /// Displacements `x − X` of every node.
     pub fn displacements(&self) -> Vec<Vec3> {
         self.positions.iter().zip(&self.mesh.rest_positions).map(|(x, x0)| x - x0).collect()
+    }
+}
+
+/// Fewest elements a parallel task gets: below this, splitting costs more than it saves.
+const PARALLEL_MIN_ELEMENTS: usize = 64;
+
+/// What projecting one element needs to read.
+struct ProjectionContext<'a> {
+    rest: &'a [Vec3],
+    inv_mass: &'a [f64],
+    material: &'a Material,
+    formulation: Formulation,
+    inv_dt2: f64,
+}
+
+impl ProjectionContext<'_> {
+    /// Gathers element `e`, projects its constraints into `x` (updating its multipliers) and
+    /// returns true, or false when all its nodes are pinned.
+    #[inline]
+    fn project(&self, read: impl Fn(usize) -> Vec3, g: &BlockGeometry, e: usize, nodes: &[u32], lambda: &mut [f64], x: &mut [Vec3]) -> bool {
+        let n = x.len();
+        let mut w = [0.0; MAX_NODES];
+        let mut rest = [Vec3::zeros(); MAX_NODES];
+        let (w, rest) = (&mut w[..n], &mut rest[..n]);
+        for (wi, &node) in w.iter_mut().zip(nodes) {
+            *wi = self.inv_mass[node as usize];
+        }
+        if w.iter().all(|&wi| wi == 0.0) {
+            return false;
+        }
+        for (xi, &node) in x.iter_mut().zip(nodes) {
+            *xi = read(node as usize);
+        }
+        gather(self.rest, nodes, rest);
+        match self.formulation {
+            Formulation::Energy => {
+                project_energy_constraint(x, rest, w, element_grads(g, e), g.volumes(e), self.material, self.inv_dt2, &mut lambda[0]);
+            }
+            Formulation::Split => {
+                project_split_constraints(x, rest, w, element_grads(g, e), g.volumes(e), self.material, self.inv_dt2, lambda);
+            }
+        }
+        true
+    }
+}
+
+/// A slice shared across threads for disjoint writes.
+struct SharedSlice<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+// SAFETY: used only for writes to disjoint indices (guaranteed by the element colouring).
+unsafe impl<T: Send> Send for SharedSlice<T> {}
+unsafe impl<T: Send> Sync for SharedSlice<T> {}
+
+impl<T> SharedSlice<T> {
+    fn new(slice: &mut [T]) -> Self {
+        Self { ptr: slice.as_mut_ptr(), len: slice.len() }
+    }
+    /// # Safety
+    /// No other thread may write index `i` at the same time.
+    unsafe fn read(&self, i: usize) -> T
+    where
+        T: Copy,
+    {
+        assert!(i < self.len);
+        unsafe { self.ptr.add(i).read() }
+    }
+    /// # Safety
+    /// The range must not be accessed by any other thread at the same time.
+    unsafe fn slice_mut(&self, start: usize, len: usize) -> &mut [T] {
+        assert!(start + len <= self.len);
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(start), len) }
+    }
+    /// # Safety
+    /// No other thread may access index `i` at the same time.
+    unsafe fn write(&self, i: usize, value: T) {
+        assert!(i < self.len);
+        unsafe { self.ptr.add(i).write(value) }
     }
 }
 

@@ -57,7 +57,7 @@ fn frequency_range(mesh: &Mesh, material: &Material, clamped: &[u32], x: &[Vec3]
 /// Runs XPBD (one iteration per substep, as the paper) with velocity damping until it has
 /// settled, and returns the largest node distance to `reference`.
 fn settled_xpbd_error(mesh: &Mesh, material: &Material, formulation: Formulation, clamped: &[u32], dt_secs: f64, damping_per_sec: f64, settle_secs: f64, reference: &[Vec3]) -> f64 {
-    let settings = SolverSettings { substeps: 1, iterations: 1, frames_per_second: 1.0 / dt_secs, formulation, quadrature_degree: None };
+    let settings = SolverSettings { substeps: 1, iterations: 1, frames_per_second: 1.0 / dt_secs, formulation, quadrature_degree: None, parallel: false };
     let effects: Vec<Box<dyn Effect>> = vec![
         Box::new(Gravity::new(G)),
         Box::new(Clamp { nodes: clamped.to_vec() }),
@@ -167,3 +167,67 @@ fn bad_settings_and_blow_ups_are_clear_errors() {
     assert!(err.contains("node 7") && err.contains("element") && err.contains("substep 1"), "{err}");
 }
 
+
+fn beam_sim(parallel: bool, formulation: Formulation) -> Simulation {
+    let mesh = cantilever(ElementType::from_name("p2").unwrap());
+    let clamped = clamped_at_x0(&mesh);
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
+    let settings = SolverSettings { formulation, parallel, ..SolverSettings::default() };
+    let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped })];
+    Simulation::new(mesh, material, settings, effects).unwrap()
+}
+
+/// The parallel sweep's result does not depend on the number of threads or the scheduling:
+/// bitwise identical with 1 and 2 threads, run after run.
+#[test]
+fn parallel_projection_is_deterministic_for_any_thread_count() {
+    for formulation in Formulation::ALL {
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let mut sim = beam_sim(true, formulation);
+                for _ in 0..20 {
+                    sim.step_frame().unwrap();
+                }
+                sim.positions
+            })
+        };
+        let (one, two, again) = (run(1), run(2), run(2));
+        assert_eq!(one, two, "{formulation}");
+        assert_eq!(two, again, "{formulation}");
+    }
+}
+
+/// Serial and parallel sweeps visit the elements in different orders (Gauss–Seidel), so they
+/// differ slightly along the way and settle on the same static answer.
+#[test]
+fn serial_and_parallel_sweeps_agree_and_settle_on_the_same_static_answer() {
+    let mesh = cantilever(ElementType::from_name("p2").unwrap());
+    let clamped = clamped_at_x0(&mesh);
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
+    let reference = static_equilibrium(&mesh, &material, None, &clamped);
+    let u_max = reference.iter().zip(&mesh.rest_positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    for formulation in Formulation::ALL {
+        let mut serial = beam_sim(false, formulation);
+        let mut parallel = beam_sim(true, formulation);
+        assert!(parallel.num_colours()[0] > 1);
+        // along the way: close, but not identical (different Gauss–Seidel order)
+        for _ in 0..30 {
+            serial.step_frame().unwrap();
+            parallel.step_frame().unwrap();
+        }
+        let gap = serial.positions.iter().zip(&parallel.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        assert!(gap > 0.0 && gap < 0.02 * u_max, "{formulation}: serial and parallel differ by {gap:.3e} m");
+        // settled: both on the static answer, up to XPBD's solver bias at these settings
+        for sim in [&mut serial, &mut parallel] {
+            sim.add_effect(Box::new(Damping { rate_per_sec: 20.0 })).unwrap();
+            for _ in 0..600 {
+                sim.step_frame().unwrap();
+            }
+        }
+        let settled_gap = serial.positions.iter().zip(&parallel.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        let to_static = parallel.positions.iter().zip(&reference).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        assert!(settled_gap < 1e-3 * u_max, "{formulation}: settled states differ by {settled_gap:.3e} m");
+        assert!(to_static < 0.02 * u_max, "{formulation}: parallel settles {to_static:.3e} m from the static answer");
+    }
+}
