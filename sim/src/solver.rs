@@ -481,6 +481,7 @@ impl<T> SharedSlice<T> {
     }
     /// # Safety
     /// The range must not be accessed by any other thread at the same time.
+    #[allow(clippy::mut_from_ref)] // disjoint ranges handed to different threads: the point
     unsafe fn slice_mut(&self, start: usize, len: usize) -> &mut [T] {
         assert!(start + len <= self.len);
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(start), len) }
