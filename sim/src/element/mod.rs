@@ -50,7 +50,7 @@ pub enum ReferenceShape {
 
 impl ReferenceShape {
     /// Corner vertices of the reference domain, in Gmsh order.
-    pub fn vertices(self) -> &'static [[f64; 3]] {
+    pub const fn vertices(self) -> &'static [[f64; 3]] {
         match self {
             Self::Tetrahedron => &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
             Self::Hexahedron => &[

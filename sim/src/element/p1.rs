@@ -13,7 +13,7 @@ pub static P1: LagrangeElement = LagrangeElement {
     description: "linear tetrahedron (4 nodes)",
     shape: ReferenceShape::Tetrahedron,
     order: 1,
-    nodes: &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+    nodes: ReferenceShape::Tetrahedron.vertices(),
     exponents: || total_degree_exponents(1),
     default_quadrature_degree: 1,
     mass_quadrature_degree: 2,

@@ -17,7 +17,7 @@ pub static PRISM: LagrangeElement = LagrangeElement {
     description: "linear prism (6 nodes)",
     shape: ReferenceShape::Prism,
     order: 1,
-    nodes: &[[0., 0., -1.], [1., 0., -1.], [0., 1., -1.], [0., 0., 1.], [1., 0., 1.], [0., 1., 1.]],
+    nodes: ReferenceShape::Prism.vertices(),
     exponents,
     default_quadrature_degree: 2,
     mass_quadrature_degree: 4,
