@@ -174,6 +174,29 @@ pub fn main(cli: Cli) -> Result<()> {
     }
 }
 
+/// A progress bar (1000 steps) on stderr that appears only once a run has lasted two seconds,
+/// so short runs print nothing but their result.
+struct DelayedBar {
+    bar: ProgressBar,
+    started: Instant,
+    shown: bool,
+}
+
+impl DelayedBar {
+    fn new() -> Self {
+        Self { bar: ProgressBar::hidden(), started: Instant::now(), shown: false }
+    }
+    /// Shows the bar with `template` once the delay is over.
+    fn reveal(&mut self, template: &str) {
+        if !self.shown && self.started.elapsed() > Duration::from_secs(2) {
+            self.shown = true;
+            self.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            self.bar.set_length(1000);
+            self.bar.set_style(ProgressStyle::with_template(template).expect("valid template"));
+        }
+    }
+}
+
 fn load_scene(args: &SceneArgs) -> Result<Scene> {
     Ok(match (&args.scene, &args.scene_file) {
         (Some(name), None) => hox_scenes::by_name(name)?,
@@ -243,28 +266,16 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
         RunMode::Seconds(t)
     };
     let mut instance = Instance::new(scene)?;
-    let started = Instant::now();
-    let bar = ProgressBar::hidden();
-    let mut shown = false;
+    let mut bar = DelayedBar::new();
     let report = hox_scenes::run(&mut instance, mode, &mut |t, fraction| {
-        // show a bar only for runs that last more than a couple of seconds
-        if !shown && started.elapsed() > Duration::from_secs(2) {
-            shown = true;
-            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-            match fraction {
-                Some(_) => {
-                    bar.set_length(1000);
-                    bar.set_style(ProgressStyle::with_template("{spinner} {bar:40} {percent}% {msg} (eta {eta})").expect("valid template"));
-                }
-                None => bar.set_style(ProgressStyle::with_template("{spinner} settling… {msg}").expect("valid template")),
-            }
-        }
+        let template = if fraction.is_some() { "{spinner} {bar:40} {percent}% {msg} (eta {eta})" } else { "{spinner} settling… {msg}" };
+        bar.reveal(template);
         if let Some(f) = fraction {
-            bar.set_position((1000.0 * f) as u64);
+            bar.bar.set_position((1000.0 * f) as u64);
         }
-        bar.set_message(format!("t = {t:.2} s"));
+        bar.bar.set_message(format!("t = {t:.2} s"));
     })?;
-    bar.finish_and_clear();
+    bar.bar.finish_and_clear();
     if json {
         println!("{}", serde_json::to_string(&report)?);
     } else {
@@ -304,20 +315,14 @@ fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tol
         load_steps,
     };
     let started = Instant::now();
-    let bar = ProgressBar::hidden();
-    let mut shown = false;
+    let mut bar = DelayedBar::new();
     let solution = hox_sim::statics::solve(&problem, &mut |fraction, iteration, residual| {
-        if !shown && started.elapsed() > Duration::from_secs(2) {
-            shown = true;
-            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-            bar.set_length(1000);
-            bar.set_style(ProgressStyle::with_template("{spinner} load {bar:30} {msg} [{elapsed}]").expect("valid template"));
-        }
-        bar.set_position((1000.0 * fraction) as u64);
-        bar.set_message(format!("Newton iteration {iteration}, residual {residual:.2e}"));
+        bar.reveal("{spinner} load {bar:30} {msg} [{elapsed}]");
+        bar.bar.set_position((1000.0 * fraction) as u64);
+        bar.bar.set_message(format!("Newton iteration {iteration}, residual {residual:.2e}"));
     })
     .with_context(|| format!("{}: static solve", scene.source))?;
-    bar.finish_and_clear();
+    bar.bar.finish_and_clear();
     let dofs = solution.free_dofs;
     let seconds = started.elapsed().as_secs_f64();
     let mut probes = std::collections::BTreeMap::new();

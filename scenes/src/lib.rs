@@ -108,18 +108,7 @@ pub fn static_problem(scene: &Scene, mesh: &hox_sim::mesh::Mesh) -> Result<(hox_
     let mut acceleration = hox_sim::Vec3::zeros();
     let mut dirichlet = Vec::new();
     for (k, spec) in scene.file.effects.iter().enumerate() {
-        let select = |nodes| {
-            let selected = scene::select_nodes(mesh, nodes);
-            if selected.is_empty() {
-                return Err(SceneError::Invalid {
-                    source_name: scene.source.clone(),
-                    key: format!("effects[{k}].nodes"),
-                    value: format!("{nodes:?}"),
-                    reason: "selects no node of the mesh".into(),
-                });
-            }
-            Ok(selected)
-        };
+        let select = |nodes| scene.selected_nodes(mesh, k, nodes);
         match spec {
             EffectSpec::Gravity { acceleration_m_s2 } => acceleration += hox_sim::Vec3::from(*acceleration_m_s2),
             EffectSpec::Clamp { nodes } => dirichlet.push(hox_sim::statics::clamp(select(nodes)?)),

@@ -63,14 +63,19 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
         }
     };
     let start_frames = instance.sim.frames();
+    // one frame, timed and remembered
+    let mut step = |instance: &mut Instance| -> Result<(), SceneError> {
+        let clock = Instant::now();
+        instance.sim.step_frame().map_err(fail)?;
+        frame_ms.push(1e3 * clock.elapsed().as_secs_f64());
+        remember(instance);
+        Ok(())
+    };
     match mode {
         RunMode::Seconds(t) => {
             let frames = (t / frame_secs).round().max(0.0) as u64;
             for f in 0..frames {
-                let clock = Instant::now();
-                instance.sim.step_frame().map_err(fail)?;
-                frame_ms.push(1e3 * clock.elapsed().as_secs_f64());
-                remember(instance);
+                step(instance)?;
                 progress(instance.sim.time_secs(), Some((f + 1) as f64 / frames as f64));
             }
         }
@@ -87,10 +92,7 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
             let mut before = instance.sim.positions.clone();
             let give_up_at = instance.sim.time_secs() + cap_secs;
             while instance.sim.time_secs() < give_up_at {
-                let clock = Instant::now();
-                instance.sim.step_frame().map_err(fail)?;
-                frame_ms.push(1e3 * clock.elapsed().as_secs_f64());
-                remember(instance);
+                step(instance)?;
                 let moved = instance.sim.positions.iter().zip(&before).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
                 before.copy_from_slice(&instance.sim.positions);
                 quiet = if moved < tolerance_m && instance.sim.time_secs() >= driven_until { quiet + 1 } else { 0 };

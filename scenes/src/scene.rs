@@ -298,17 +298,13 @@ impl Scene {
         let model = MaterialModel::from_name(&mm.model)
             .ok_or_else(|| invalid("material.model", format!("{:?}", mm.model), "expected stvk, snh or nh"))?;
         let material = Material::new(model, mm.youngs_modulus_pa, mm.poisson_ratio, mm.density_kg_m3).map_err(|e| {
-            let message = e.to_string();
-            let (key, value) = if message.contains("Young") {
-                ("material.youngs_modulus_pa", mm.youngs_modulus_pa)
-            } else if message.contains("Poisson") {
-                ("material.poisson_ratio", mm.poisson_ratio)
-            } else if message.contains("ensity") {
-                ("material.density_kg_m3", mm.density_kg_m3)
-            } else {
-                ("material", f64::NAN)
+            use hox_sim::material::MaterialError as E;
+            let (key, value) = match &e {
+                E::YoungsModulus { .. } | E::NonFiniteLame { .. } => ("material.youngs_modulus_pa", mm.youngs_modulus_pa),
+                E::PoissonRatio { .. } => ("material.poisson_ratio", mm.poisson_ratio),
+                E::Density { .. } => ("material.density_kg_m3", mm.density_kg_m3),
             };
-            invalid(key, value.to_string(), &message)
+            invalid(key, value.to_string(), &e.to_string())
         })?;
         let s = &file.solver;
         let formulation = Formulation::from_name(&s.formulation)
@@ -413,22 +409,25 @@ impl Scene {
         self.mesh.build().map_err(|e| SceneError::Mesh { source_name: self.source.clone(), message: e.to_string() })
     }
 
+    /// The nodes effect `k`'s selector picks in `mesh`; selecting none is an error.
+    pub fn selected_nodes(&self, mesh: &Mesh, k: usize, sel: &NodeSelector) -> Result<Vec<u32>, SceneError> {
+        let nodes = select_nodes(mesh, sel);
+        if nodes.is_empty() {
+            return Err(SceneError::Invalid {
+                source_name: self.source.clone(),
+                key: format!("effects[{k}].nodes"),
+                value: format!("{sel:?}"),
+                reason: "selects no node of the mesh".into(),
+            });
+        }
+        Ok(nodes)
+    }
+
     /// The effects the scene lists, bound to `mesh`'s nodes.
     pub fn build_effects(&self, mesh: &Mesh) -> Result<Vec<Box<dyn Effect>>, SceneError> {
         let mut effects: Vec<Box<dyn Effect>> = Vec::new();
         for (k, e) in self.file.effects.iter().enumerate() {
-            let select = |sel: &NodeSelector| -> Result<Vec<u32>, SceneError> {
-                let nodes = select_nodes(mesh, sel);
-                if nodes.is_empty() {
-                    return Err(SceneError::Invalid {
-                        source_name: self.source.clone(),
-                        key: format!("effects[{k}].nodes"),
-                        value: format!("{sel:?}"),
-                        reason: "selects no node of the mesh".into(),
-                    });
-                }
-                Ok(nodes)
-            };
+            let select = |sel: &NodeSelector| self.selected_nodes(mesh, k, sel);
             effects.push(match e {
                 EffectSpec::Gravity { acceleration_m_s2 } => Box::new(Gravity::new(Vec3::from(*acceleration_m_s2))),
                 EffectSpec::Clamp { nodes } => Box::new(Clamp { nodes: select(nodes)? }),

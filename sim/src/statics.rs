@@ -228,20 +228,7 @@ impl SparsePattern {
             .blocks
             .iter()
             .zip(geo)
-            .map(|(b, g)| {
-                let mut xl = Vec::with_capacity(b.nodes_per_element());
-                let mut rest = Vec::with_capacity(b.nodes_per_element());
-                b.elements()
-                    .enumerate()
-                    .map(|(e, nodes)| {
-                        xl.clear();
-                        rest.clear();
-                        xl.extend(nodes.iter().map(|&i| x[i as usize]));
-                        rest.extend(nodes.iter().map(|&i| mesh.rest_positions[i as usize]));
-                        element_hessian(&xl, &rest, element_grads(g, e), g.volumes(e), material, true)
-                    })
-                    .collect()
-            })
+            .map(|(b, g)| b.elements().enumerate().map(|(e, nodes)| element_hessian_at(mesh, g, e, nodes, material, x)).collect())
             .collect();
         let mut values = Vec::with_capacity(self.argsort_len_hint());
         for_each_entry(mesh, dof_of, |_, _, b, e, i, j| values.push(hessians[b][e][(i, j)]));
@@ -291,9 +278,7 @@ pub fn assemble_dense(mesh: &Mesh, geo: &[BlockGeometry], material: &Material, x
     let mut k = DMatrix::zeros(3 * n, 3 * n);
     for (b, gb) in mesh.blocks.iter().zip(geo) {
         for (e, nodes) in b.elements().enumerate() {
-            let xl: Vec<Vec3> = nodes.iter().map(|&i| x[i as usize]).collect();
-            let rest: Vec<Vec3> = nodes.iter().map(|&i| mesh.rest_positions[i as usize]).collect();
-            let he = element_hessian(&xl, &rest, element_grads(gb, e), gb.volumes(e), material, true);
+            let he = element_hessian_at(mesh, gb, e, nodes, material, x);
             for (li, &i) in nodes.iter().enumerate() {
                 for (lj, &j) in nodes.iter().enumerate() {
                     for a in 0..3 {
@@ -306,6 +291,13 @@ pub fn assemble_dense(mesh: &Mesh, geo: &[BlockGeometry], material: &Material, x
         }
     }
     k
+}
+
+/// The PSD-projected Hessian of element `e` (nodes `nodes`) at positions `x`.
+fn element_hessian_at(mesh: &Mesh, g: &BlockGeometry, e: usize, nodes: &[u32], material: &Material, x: &[Vec3]) -> DMatrix<f64> {
+    let xl: Vec<Vec3> = nodes.iter().map(|&i| x[i as usize]).collect();
+    let rest: Vec<Vec3> = nodes.iter().map(|&i| mesh.rest_positions[i as usize]).collect();
+    element_hessian(&xl, &rest, element_grads(g, e), g.volumes(e), material, true)
 }
 
 /// Clamps as Dirichlet conditions: the nodes held at their rest positions.
