@@ -1,10 +1,13 @@
 //! Meshes: rest node positions and blocks of elements of one type each (a mesh may mix types).
 //!
 //! Connectivity uses the element's Gmsh node order ([`crate::element`]). [`structured`] builds
-//! the paper's beams; [`high_order`] adds shared edge/face/interior nodes to linear meshes.
+//! the paper's beams; [`high_order`] adds shared edge/face/interior nodes to linear meshes;
+//! [`gmsh`] imports `.msh` files with their physical groups; [`vtk`] exports VTU/PVD for ParaView.
 
+pub mod gmsh;
 pub mod high_order;
 pub mod structured;
+pub mod vtk;
 
 use crate::Vec3;
 use crate::element::ElementType;
