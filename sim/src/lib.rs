@@ -19,6 +19,7 @@
 //! - [`constraint`]: pure XPBD constraint kernels (energy and split formulations).
 //! - [`statics`]: static equilibrium by Newton's method (the reference XPBD must settle to).
 //! - [`solver`]: the stateful XPBD solver and the opt-in [`effect`]s it runs.
+//! - [`surface`]: the tessellated boundary surface and material points for display.
 
 pub mod colouring;
 pub mod constraint;
@@ -33,6 +34,7 @@ pub mod probe;
 pub mod quadrature;
 pub mod solver;
 pub mod statics;
+pub mod surface;
 
 pub use nalgebra;
 
