@@ -8,7 +8,7 @@ pub mod run;
 pub mod scene;
 pub mod study;
 
-pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, run};
+pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, median, run};
 pub use scene::{Scene, SceneFile, SceneOverrides};
 
 use hox_sim::probe::Probe;
@@ -86,6 +86,24 @@ impl Instance {
         let sim = Simulation::new(mesh, scene.material, scene.settings, effects)
             .map_err(|e| SceneError::Simulation { source_name: scene.source.clone(), message: e.to_string() })?;
         Ok(Instance { scene, sim, probes })
+    }
+
+    /// Mean current displacement of the nodes of every physical group of the mesh file (empty
+    /// for a box scene), metres.
+    pub fn group_displacements(&self) -> std::collections::BTreeMap<String, [f64; 3]> {
+        self.scene.group_displacements(&self.sim.positions)
+    }
+
+    /// Writes the current state as the next frame of `series`: current positions,
+    /// `displacement_m` per point and the volume-averaged von Mises stress per cell
+    /// (`von_mises_stress_pa`); see [`hox_sim::mesh::vtk`].
+    pub fn write_vtk_frame(&self, series: &mut hox_sim::mesh::vtk::PvdSeries) -> Result<std::path::PathBuf, SceneError> {
+        use hox_sim::mesh::vtk::{DataArray, von_mises_stress_pa};
+        let sim = &self.sim;
+        let stress = von_mises_stress_pa(sim.mesh(), sim.geometry(), sim.material(), &sim.positions);
+        series
+            .write_frame(sim.time_secs(), sim.mesh(), &sim.positions, &[], &[DataArray::scalars("von_mises_stress_pa", stress)])
+            .map_err(|e| SceneError::Simulation { source_name: self.scene.source.clone(), message: e.to_string() })
     }
 
     /// Current displacement of every probe, metres.

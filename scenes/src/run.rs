@@ -49,6 +49,17 @@ pub struct RunReport {
 /// Runs `instance` and reports. `progress(sim_seconds, fraction)` is called after every frame
 /// (`fraction` is None when settling, whose length is not known in advance).
 pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64, Option<f64>)) -> Result<RunReport, SceneError> {
+    run_observed(instance, mode, progress, &mut |_| Ok(()))
+}
+
+/// [`run`], calling `on_frame(instance)` after every frame (outside the frame timing), e.g. to
+/// write the frame to a file; its error stops the run.
+pub fn run_observed(
+    instance: &mut Instance,
+    mode: RunMode,
+    progress: &mut dyn FnMut(f64, Option<f64>),
+    on_frame: &mut dyn FnMut(&Instance) -> Result<(), SceneError>,
+) -> Result<RunReport, SceneError> {
     let frame_secs = 1.0 / instance.scene.settings.frames_per_second;
     let source = instance.scene.source.clone();
     let fail = |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: source.clone(), message: e.to_string() };
@@ -69,7 +80,7 @@ pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64,
         instance.sim.step_frame().map_err(fail)?;
         frame_ms.push(1e3 * clock.elapsed().as_secs_f64());
         remember(instance);
-        Ok(())
+        on_frame(instance)
     };
     match mode {
         RunMode::Seconds(t) => {

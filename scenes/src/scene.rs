@@ -4,7 +4,8 @@
 //! ```toml
 //! name = "bending"
 //! description = "…"
-//! [mesh]        # a structured box (see hox_sim::mesh::structured)
+//! [mesh]        # a structured box (see hox_sim::mesh::structured), or a Gmsh file:
+//!               # [mesh] file = "beam.msh" (relative to the scene file; see docs/MESHES.md)
 //! box_min_m = [0, 0, 0]
 //! box_max_m = [2, 0.5, 0.5]
 //! element = "p2"          # p1 p2 p3 q1 q2 prism pyramid
@@ -30,7 +31,8 @@
 //! acceleration_m_s2 = [0, 0, -9.81]
 //! [[effects]]
 //! type = "clamp"
-//! nodes = { plane = "x", at_m = 0 }   # or { box_min_m = [...], box_max_m = [...] }
+//! nodes = { plane = "x", at_m = 0 }   # or { box_min_m = [...], box_max_m = [...] },
+//!                                     # or { group = "clamp" } (a mesh file's physical group)
 //! [[effects]]
 //! type = "prescribed"     # translation and/or rotation, ramped smoothly then held
 //! nodes = { plane = "x", at_m = 1 }
@@ -54,8 +56,8 @@
 //! point_m = [2, 0.25, 0.25]
 //! ```
 //!
-//! Unknown keys, missing fields, wrong types, negative or non-finite values and probes outside
-//! the body are errors naming the file, the key and the value.
+//! Unknown keys, missing fields, wrong types, negative or non-finite values, probes outside
+//! the body and unknown physical groups are errors naming the file, the key and the value.
 
 use hox_sim::Vec3;
 use hox_sim::constraint::Formulation;
@@ -63,9 +65,12 @@ use hox_sim::effect::{AxisRotation, Clamp, ContactPlane, Damping, Effect, Gravit
 use hox_sim::element::ElementType;
 use hox_sim::material::{Material, MaterialModel};
 use hox_sim::mesh::Mesh;
+use hox_sim::mesh::gmsh::ImportedMesh;
 use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 use hox_sim::solver::SolverSettings;
 use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use crate::SceneError;
 
@@ -86,21 +91,26 @@ pub struct SceneFile {
     pub probes: Vec<ProbeSpec>,
 }
 
+/// The `[mesh]` table: either `file` (a Gmsh `.msh` file) or a structured box (`box_min_m`,
+/// `box_max_m`, `element`, `grid`, optionally `split` and `refine`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
-    pub box_min_m: [f64; 3],
-    pub box_max_m: [f64; 3],
-    pub element: String,
-    pub grid: [usize; 3],
-    #[serde(default = "default_split")]
-    pub split: String,
-    #[serde(default)]
-    pub refine: usize,
-}
-
-fn default_split() -> String {
-    "five".into()
+    /// A Gmsh mesh file, relative to the scene file (or absolute).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub box_min_m: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub box_max_m: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<[usize; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub split: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refine: Option<usize>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -141,14 +151,29 @@ impl Default for SolverSpec {
     }
 }
 
-/// Which nodes an effect acts on: those on an axis-aligned plane, or inside a box.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// Which nodes an effect acts on: those on an axis-aligned plane, inside a box, or in a
+/// physical group of the mesh file.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NodeSelector {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plane: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub at_m: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub box_min_m: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub box_max_m: Option<[f64; 3]>,
+    /// A physical group of the mesh file (`[mesh] file = …`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub group: Option<String>,
+}
+
+impl NodeSelector {
+    /// The nodes of a mesh file's physical group.
+    pub fn group(name: &str) -> Self {
+        Self { group: Some(name.to_string()), ..Default::default() }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -220,15 +245,88 @@ pub struct ProbeSpec {
     pub point_m: [f64; 3],
 }
 
+/// Prescribed motion of a mesh file's physical group (see [`Scene::from_mesh_file`]): a
+/// translation and/or a rotation, ramped in smoothly over `ramp_secs`, then held.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Drive {
+    pub group: String,
+    pub translation_m: [f64; 3],
+    pub rotation_axis: Option<[f64; 3]>,
+    /// Default: the centre of the group's nodes.
+    pub rotation_origin_m: Option<[f64; 3]>,
+    pub rotation_deg: f64,
+    pub ramp_secs: f64,
+}
+
 /// A validated scene: typed settings ready to build a simulation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// Where the scene came from (a file path or `builtin:NAME`), for error messages.
     pub source: String,
+    /// The folder relative mesh file paths are resolved against (the scene file's folder).
+    pub base_dir: Option<PathBuf>,
     pub file: SceneFile,
-    pub mesh: BoxMeshSpec,
+    pub mesh: SceneMesh,
     pub material: Material,
     pub settings: SolverSettings,
+}
+
+/// Where a scene's mesh comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneMesh {
+    /// A structured box, built on demand.
+    Box(BoxMeshSpec),
+    /// A mesh file, read (and checked) when the scene is validated.
+    File { path: PathBuf, imported: Arc<ImportedMesh> },
+}
+
+impl SceneMesh {
+    /// The box spec, for a box scene.
+    pub fn as_box(&self) -> Option<&BoxMeshSpec> {
+        match self {
+            SceneMesh::Box(b) => Some(b),
+            SceneMesh::File { .. } => None,
+        }
+    }
+    /// The imported mesh, for a mesh-file scene.
+    pub fn imported(&self) -> Option<&ImportedMesh> {
+        match self {
+            SceneMesh::Box(_) => None,
+            SceneMesh::File { imported, .. } => Some(imported),
+        }
+    }
+    /// A short description: "p2" for a box, the element types for a file ("p2" or "q1+pyramid").
+    pub fn element_names(&self) -> String {
+        match self {
+            SceneMesh::Box(b) => b.element_type.name().to_string(),
+            SceneMesh::File { imported, .. } => imported.mesh.blocks.iter().map(|b| b.element_type.name()).collect::<Vec<_>>().join("+"),
+        }
+    }
+}
+
+impl SceneFile {
+    /// A scene around a mesh file: the bending scene's material (StVK, E = 3 MPa, ν = 0.35,
+    /// ρ = 1000 kg/m³), the default solver settings, and gravity unless `gravity` is false.
+    /// Callers add clamps and drives (`NodeSelector::group`).
+    pub fn for_mesh_file(path: &Path, gravity: bool) -> SceneFile {
+        SceneFile {
+            name: path.file_stem().map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned()),
+            description: format!("the mesh {}", path.display()),
+            mesh: MeshSpec {
+                file: Some(path.display().to_string()),
+                box_min_m: None,
+                box_max_m: None,
+                element: None,
+                grid: None,
+                split: None,
+                refine: None,
+            },
+            material: MaterialSpec { model: "stvk".into(), youngs_modulus_pa: 3e6, poisson_ratio: 0.35, density_kg_m3: 1000.0 },
+            solver: SolverSpec::default(),
+            effects: if gravity { vec![EffectSpec::Gravity { acceleration_m_s2: [0.0, 0.0, -9.81] }] } else { Vec::new() },
+            probes: Vec::new(),
+        }
+    }
 }
 
 /// Command-line (or app) changes to a scene, applied before validation.
@@ -251,49 +349,41 @@ pub struct SceneOverrides {
 }
 
 impl Scene {
-    /// Parses and validates a scene file's text. `source` names it in errors.
+    /// Parses and validates a scene file's text. `source` names it in errors; a mesh file is
+    /// looked for relative to the working directory.
     pub fn from_toml(text: &str, source: &str) -> Result<Scene, SceneError> {
+        Scene::from_toml_in(text, source, None)
+    }
+
+    /// Like [`Scene::from_toml`], with relative mesh file paths resolved against `base_dir`.
+    pub fn from_toml_in(text: &str, source: &str, base_dir: Option<&Path>) -> Result<Scene, SceneError> {
         let file: SceneFile = toml::from_str(text)
             .map_err(|e| SceneError::Parse { source_name: source.to_string(), message: e.to_string() })?;
-        Scene::from_file(file, source)
+        Scene::validate(file, source, base_dir.map(Path::to_path_buf), None)
     }
 
-    /// Reads a scene file from disk.
-    pub fn load(path: &std::path::Path) -> Result<Scene, SceneError> {
+    /// Reads a scene file from disk (a mesh file it names is relative to its folder).
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| SceneError::Io { path: path.display().to_string(), message: e.to_string() })?;
-        Scene::from_toml(&text, &path.display().to_string())
+        Scene::from_toml_in(&text, &path.display().to_string(), path.parent())
     }
 
-    /// Validates a parsed scene file.
+    /// Validates a parsed scene file (a relative mesh file path is relative to the working
+    /// directory).
     pub fn from_file(file: SceneFile, source: &str) -> Result<Scene, SceneError> {
+        Scene::validate(file, source, None, None)
+    }
+
+    /// Validates `file`; `cached` is a mesh file already read for the same path.
+    fn validate(file: SceneFile, source: &str, base_dir: Option<PathBuf>, cached: Option<&SceneMesh>) -> Result<Scene, SceneError> {
         let invalid = |key: &str, value: String, reason: &str| SceneError::Invalid {
             source_name: source.to_string(),
             key: key.to_string(),
             value,
             reason: reason.to_string(),
         };
-        let m = &file.mesh;
-        let element_type = ElementType::from_name(&m.element)
-            .ok_or_else(|| invalid("mesh.element", format!("{:?}", m.element), &format!("expected one of {}", ElementType::names())))?;
-        let split = TetSplit::from_name(&m.split)
-            .ok_or_else(|| invalid("mesh.split", format!("{:?}", m.split), "expected \"five\" or \"six\""))?;
-        finite3("mesh.box_min_m", &m.box_min_m, &invalid)?;
-        finite3("mesh.box_max_m", &m.box_max_m, &invalid)?;
-        for d in 0..3 {
-            if m.box_max_m[d] <= m.box_min_m[d] {
-                return Err(invalid("mesh.box_max_m", format!("{:?}", m.box_max_m), "must exceed box_min_m in every direction"));
-            }
-            if m.grid[d] == 0 {
-                return Err(invalid("mesh.grid", format!("{:?}", m.grid), "needs at least one cell per direction"));
-            }
-        }
-        let mesh = BoxMeshSpec {
-            grid: BoxGrid { min_m: Vec3::from(m.box_min_m), max_m: Vec3::from(m.box_max_m), cells: m.grid },
-            element_type,
-            split,
-            refine: m.refine,
-        };
+        let mesh = mesh_of(&file.mesh, source, base_dir.as_deref(), cached, &invalid)?;
         let mm = &file.material;
         let model = MaterialModel::from_name(&mm.model)
             .ok_or_else(|| invalid("material.model", format!("{:?}", mm.model), "expected stvk, snh or nh"))?;
@@ -319,9 +409,15 @@ impl Scene {
         positive("solver.duration_secs", s.duration_secs, &invalid)?;
         non_negative("solver.settle_damping_per_sec", s.settle_damping_per_sec, &invalid)?;
         if let Some(d) = s.quadrature_degree {
-            let max = hox_sim::quadrature::max_degree(element_type.shape());
-            if d == 0 || d > max {
-                return Err(invalid("solver.quadrature_degree", d.to_string(), &format!("must lie in 1..={max} for {element_type}")));
+            let types: Vec<ElementType> = match &mesh {
+                SceneMesh::Box(b) => vec![b.element_type],
+                SceneMesh::File { imported, .. } => imported.mesh.blocks.iter().map(|b| b.element_type).collect(),
+            };
+            for element_type in types {
+                let max = hox_sim::quadrature::max_degree(element_type.shape());
+                if d == 0 || d > max {
+                    return Err(invalid("solver.quadrature_degree", d.to_string(), &format!("must lie in 1..={max} for {element_type}")));
+                }
             }
         }
         if formulation == Formulation::Split && material.split_stiffness_pa().iter().any(|k| !(*k > 0.0)) {
@@ -341,6 +437,9 @@ impl Scene {
         };
         for (k, e) in file.effects.iter().enumerate() {
             validate_effect(k, e, &invalid)?;
+            if let EffectSpec::Clamp { nodes } | EffectSpec::Prescribed { nodes, .. } = e {
+                validate_group(&format!("effects[{k}].nodes"), nodes, &mesh, &invalid)?;
+            }
         }
         let mut names = std::collections::HashSet::new();
         for (k, p) in file.probes.iter().enumerate() {
@@ -349,27 +448,76 @@ impl Scene {
                 return Err(invalid(&format!("probes[{k}].name"), format!("{:?}", p.name), "is used twice"));
             }
         }
-        Ok(Scene { source: source.to_string(), file, mesh, material, settings })
+        Ok(Scene { source: source.to_string(), base_dir, file, mesh, material, settings })
     }
 
     pub fn name(&self) -> &str {
         &self.file.name
     }
 
+    /// A scene around a Gmsh mesh file ([`SceneFile::for_mesh_file`]) with its physical groups
+    /// `clamps` held and `drives` moved: what `hox simulate --mesh` and the app's "Open mesh"
+    /// build. Unknown groups are errors listing the file's groups.
+    pub fn from_mesh_file(path: &Path, clamps: &[String], drives: &[Drive], gravity: bool) -> Result<Scene, SceneError> {
+        let source = path.display().to_string();
+        let base = Scene::from_file(SceneFile::for_mesh_file(path, gravity), &source)?;
+        let imported = base.mesh.imported().expect("a mesh-file scene");
+        let mut file = base.file.clone();
+        for group in clamps {
+            file.effects.push(EffectSpec::Clamp { nodes: NodeSelector::group(group) });
+        }
+        for d in drives {
+            // rotate about the group's centre unless told otherwise
+            let origin = match (d.rotation_axis, d.rotation_origin_m) {
+                (Some(_), None) => imported.node_set(&d.group).ok().filter(|n| !n.is_empty()).map(|nodes| {
+                    let c: Vec3 = nodes.iter().map(|&n| imported.mesh.rest_positions[n as usize]).sum::<Vec3>() / nodes.len() as f64;
+                    [c.x, c.y, c.z]
+                }),
+                (_, o) => o,
+            };
+            file.effects.push(EffectSpec::Prescribed {
+                nodes: NodeSelector::group(&d.group),
+                translation_m: d.translation_m,
+                rotation_axis: d.rotation_axis,
+                rotation_origin_m: origin,
+                rotation_deg: d.rotation_deg,
+                ramp_secs: d.ramp_secs,
+            });
+        }
+        Scene::validate(file, &source, None, Some(&base.mesh))
+    }
+
+    /// Mean displacement of the nodes of every non-empty physical group of the mesh file, for
+    /// `positions` (empty for a box scene), metres.
+    pub fn group_displacements(&self, positions: &[Vec3]) -> std::collections::BTreeMap<String, [f64; 3]> {
+        let Some(imported) = self.mesh.imported() else { return Default::default() };
+        let rest = &imported.mesh.rest_positions;
+        imported
+            .node_sets
+            .iter()
+            .filter(|(_, nodes)| !nodes.is_empty())
+            .map(|(name, nodes)| {
+                let sum: Vec3 = nodes.iter().map(|&n| positions[n as usize] - rest[n as usize]).sum();
+                let u = sum / nodes.len() as f64;
+                (name.clone(), [u.x, u.y, u.z])
+            })
+            .collect()
+    }
+
     /// The scene with `overrides` applied, validated again.
     pub fn with_overrides(&self, o: &SceneOverrides) -> Result<Scene, SceneError> {
         let mut f = self.file.clone();
-        if let Some(v) = &o.element {
-            f.mesh.element = v.clone();
+        if o.element.is_some() {
+            f.mesh.element.clone_from(&o.element);
         }
-        if let Some(v) = o.grid {
-            f.mesh.grid = v;
+        if o.grid.is_some() {
+            f.mesh.grid = o.grid;
         }
-        if let Some(v) = &o.split {
-            f.mesh.split = v.clone();
+        if o.split.is_some() {
+            f.mesh.split.clone_from(&o.split);
         }
-        if let Some(v) = o.refine {
-            f.mesh.refine = v;
+        if o.refine.is_some() {
+            f.mesh.refine = o.refine;
         }
         if let Some(v) = &o.material {
             f.material.model = v.clone();
@@ -401,17 +549,31 @@ impl Scene {
         if let Some(v) = o.parallel {
             f.solver.parallel = v;
         }
-        Scene::from_file(f, &self.source)
+        Scene::validate(f, &self.source, self.base_dir.clone(), Some(&self.mesh))
     }
 
-    /// Builds the mesh.
+    /// Builds the mesh (a mesh file's was read when the scene was validated).
     pub fn build_mesh(&self) -> Result<Mesh, SceneError> {
-        self.mesh.build().map_err(|e| SceneError::Mesh { source_name: self.source.clone(), message: e.to_string() })
+        match &self.mesh {
+            SceneMesh::Box(b) => b.build().map_err(|e| SceneError::Mesh { source_name: self.source.clone(), message: e.to_string() }),
+            SceneMesh::File { imported, .. } => Ok(imported.mesh.clone()),
+        }
     }
 
     /// The nodes effect `k`'s selector picks in `mesh`; selecting none is an error.
     pub fn selected_nodes(&self, mesh: &Mesh, k: usize, sel: &NodeSelector) -> Result<Vec<u32>, SceneError> {
-        let nodes = select_nodes(mesh, sel);
+        let nodes = match (&sel.group, self.mesh.imported()) {
+            (Some(name), Some(imported)) => imported
+                .node_set(name)
+                .map_err(|e| SceneError::Invalid {
+                    source_name: self.source.clone(),
+                    key: format!("effects[{k}].nodes.group"),
+                    value: format!("{name:?}"),
+                    reason: e.to_string(),
+                })?
+                .to_vec(),
+            _ => select_nodes(mesh, sel),
+        };
         if nodes.is_empty() {
             return Err(SceneError::Invalid {
                 source_name: self.source.clone(),
@@ -484,6 +646,13 @@ fn non_negative(key: &str, v: f64, invalid: &Invalid<'_>) -> Result<(), SceneErr
 }
 
 fn validate_selector(key: &str, sel: &NodeSelector, invalid: &Invalid<'_>) -> Result<(), SceneError> {
+    if sel.group.is_some() {
+        return if sel.plane.is_none() && sel.at_m.is_none() && sel.box_min_m.is_none() && sel.box_max_m.is_none() {
+            Ok(())
+        } else {
+            Err(invalid(key, format!("{sel:?}"), "give a group alone, not with a plane or box"))
+        };
+    }
     match (&sel.plane, sel.at_m, sel.box_min_m, sel.box_max_m) {
         (Some(p), Some(at), None, None) => {
             if axis_index(p).is_none() {
@@ -498,8 +667,70 @@ fn validate_selector(key: &str, sel: &NodeSelector, invalid: &Invalid<'_>) -> Re
             finite3(&format!("{key}.box_min_m"), &a, invalid)?;
             finite3(&format!("{key}.box_max_m"), &b, invalid)
         }
-        _ => Err(invalid(key, format!("{sel:?}"), "give either plane and at_m, or box_min_m and box_max_m")),
+        _ => Err(invalid(key, format!("{sel:?}"), "give either plane and at_m, box_min_m and box_max_m, or group")),
     }
+}
+
+/// A group selector needs a mesh file that has the group.
+fn validate_group(key: &str, sel: &NodeSelector, mesh: &SceneMesh, invalid: &Invalid<'_>) -> Result<(), SceneError> {
+    let Some(name) = &sel.group else { return Ok(()) };
+    match mesh.imported() {
+        None => Err(invalid(&format!("{key}.group"), format!("{name:?}"), "physical groups need a mesh file ([mesh] file = \"….msh\")")),
+        Some(imported) => imported.node_set(name).map(|_| ()).map_err(|e| invalid(&format!("{key}.group"), format!("{name:?}"), &e.to_string())),
+    }
+}
+
+/// The scene's mesh: a box from its fields, or the file (read now, or reused from `cached`).
+fn mesh_of(m: &MeshSpec, source: &str, base_dir: Option<&Path>, cached: Option<&SceneMesh>, invalid: &Invalid<'_>) -> Result<SceneMesh, SceneError> {
+    if let Some(file) = &m.file {
+        let box_keys = [
+            ("mesh.box_min_m", m.box_min_m.is_some()),
+            ("mesh.box_max_m", m.box_max_m.is_some()),
+            ("mesh.element", m.element.is_some()),
+            ("mesh.grid", m.grid.is_some()),
+            ("mesh.split", m.split.is_some()),
+            ("mesh.refine", m.refine.is_some()),
+        ];
+        if let Some((key, _)) = box_keys.iter().find(|(_, given)| *given) {
+            return Err(invalid(key, "given".into(), &format!("the mesh is read from {file}; box_min_m, box_max_m, element, grid, split and refine describe box meshes")));
+        }
+        let path = match base_dir {
+            Some(dir) if Path::new(file).is_relative() => dir.join(file),
+            _ => PathBuf::from(file),
+        };
+        if let Some(SceneMesh::File { path: p, imported }) = cached
+            && *p == path
+        {
+            return Ok(SceneMesh::File { path, imported: imported.clone() });
+        }
+        let imported = hox_sim::mesh::gmsh::read_msh(&path).map_err(|e| SceneError::Mesh { source_name: source.to_string(), message: e.to_string() })?;
+        return Ok(SceneMesh::File { path, imported: Arc::new(imported) });
+    }
+    let missing = |key: &str| invalid(key, "missing".into(), "a box mesh needs box_min_m, box_max_m, element and grid (or give file = \"….msh\")");
+    let box_min_m = m.box_min_m.ok_or_else(|| missing("mesh.box_min_m"))?;
+    let box_max_m = m.box_max_m.ok_or_else(|| missing("mesh.box_max_m"))?;
+    let element = m.element.as_deref().ok_or_else(|| missing("mesh.element"))?;
+    let grid = m.grid.ok_or_else(|| missing("mesh.grid"))?;
+    let split = m.split.as_deref().unwrap_or("five");
+    let element_type = ElementType::from_name(element)
+        .ok_or_else(|| invalid("mesh.element", format!("{element:?}"), &format!("expected one of {}", ElementType::names())))?;
+    let split = TetSplit::from_name(split).ok_or_else(|| invalid("mesh.split", format!("{split:?}"), "expected \"five\" or \"six\""))?;
+    finite3("mesh.box_min_m", &box_min_m, invalid)?;
+    finite3("mesh.box_max_m", &box_max_m, invalid)?;
+    for d in 0..3 {
+        if box_max_m[d] <= box_min_m[d] {
+            return Err(invalid("mesh.box_max_m", format!("{box_max_m:?}"), "must exceed box_min_m in every direction"));
+        }
+        if grid[d] == 0 {
+            return Err(invalid("mesh.grid", format!("{grid:?}"), "needs at least one cell per direction"));
+        }
+    }
+    Ok(SceneMesh::Box(BoxMeshSpec {
+        grid: BoxGrid { min_m: Vec3::from(box_min_m), max_m: Vec3::from(box_max_m), cells: grid },
+        element_type,
+        split,
+        refine: m.refine.unwrap_or(0),
+    }))
 }
 
 fn validate_effect(k: usize, e: &EffectSpec, invalid: &Invalid<'_>) -> Result<(), SceneError> {
