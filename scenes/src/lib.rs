@@ -8,8 +8,8 @@ pub mod run;
 pub mod scene;
 pub mod study;
 
-pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, median, run};
-pub use scene::{Scene, SceneFile, SceneOverrides};
+pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, median, run, run_observed};
+pub use scene::{Drive, NodeSelector, Scene, SceneFile, SceneMesh, SceneOverrides};
 
 use hox_sim::probe::Probe;
 use hox_sim::solver::Simulation;
