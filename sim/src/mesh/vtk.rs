@@ -12,7 +12,7 @@
 //! | p3 | `VTK_LAGRANGE_TETRAHEDRON` (71) | 0 1 2 3 4 5 6 7 8 9 11 10 15 14 13 12 17 19 18 16 |
 //! | q1 | `VTK_HEXAHEDRON` (12) | identity |
 //! | q2 | `VTK_TRIQUADRATIC_HEXAHEDRON` (29) | 0 1 2 3 4 5 6 7 8 11 13 9 16 18 19 17 10 12 14 15 22 23 21 24 20 25 26 |
-//! | prism | `VTK_WEDGE` (13) | 0 2 1 3 5 4 |
+//! | prism | `VTK_WEDGE` (13) | identity |
 //! | pyramid | `VTK_PYRAMID` (14) | identity |
 //!
 //! Points are the current positions; point data holds `displacement_m` (current − rest) and any
@@ -47,7 +47,7 @@ pub fn vtk_cell(element_type: ElementType) -> (u8, &'static [usize]) {
         "p3" => (71, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 10, 15, 14, 13, 12, 17, 19, 18, 16]),
         "q1" => (12, &[0, 1, 2, 3, 4, 5, 6, 7]),
         "q2" => (29, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 13, 9, 16, 18, 19, 17, 10, 12, 14, 15, 22, 23, 21, 24, 20, 25, 26]),
-        "prism" => (13, &[0, 2, 1, 3, 5, 4]),
+        "prism" => (13, &[0, 1, 2, 3, 4, 5]),
         "pyramid" => (14, &[0, 1, 2, 3, 4]),
         other => unreachable!("element type {other} has no VTK cell type: add it to vtk_cell"),
     }
@@ -407,16 +407,21 @@ mod tests {
         }
     }
 
-    /// VTK's wedge has its first triangle (0,1,2) facing away from (3,4,5); Gmsh's faces
-    /// towards it. The permutation flips both triangles.
+    /// VTK (checked with VTK 9.7: vtkCellSizeFilter, vtkMeshQuality and vtkCellValidator) takes
+    /// the wedge in Gmsh's order, the first triangle (0,1,2) turning counter-clockwise seen from
+    /// the second (3,4,5); Gmsh's own legacy VTK table (0 2 1 3 5 4) makes VTK report it
+    /// inverted. Likewise the pyramid's base turns counter-clockwise seen from the apex.
     #[test]
-    fn the_wedge_permutation_turns_the_first_triangle_away_from_the_second() {
-        let et = ElementType::from_name("prism").unwrap();
-        let (_, perm) = vtk_cell(et);
-        let x: Vec<Vec3> = perm.iter().map(|&p| Vec3::from(et.nodes()[p])).collect();
-        let normal = (x[1] - x[0]).cross(&(x[2] - x[0]));
-        let towards_top = (x[3] + x[4] + x[5]) / 3.0 - (x[0] + x[1] + x[2]) / 3.0;
-        assert!(normal.dot(&towards_top) < 0.0);
+    fn wedges_and_pyramids_keep_gmsh_order_with_the_base_facing_the_rest_of_the_cell() {
+        for name in ["prism", "pyramid"] {
+            let et = ElementType::from_name(name).unwrap();
+            let (_, perm) = vtk_cell(et);
+            assert!(perm.iter().enumerate().all(|(i, &p)| i == p), "{name}");
+            let x: Vec<Vec3> = et.nodes().iter().map(|&r| Vec3::from(r)).collect();
+            let normal = (x[1] - x[0]).cross(&(x[2] - x[0]));
+            let rest: Vec3 = x[3..].iter().sum::<Vec3>() / (x.len() - 3) as f64;
+            assert!(normal.dot(&(rest - x[0])) > 0.0, "{name}");
+        }
     }
 
     #[test]
