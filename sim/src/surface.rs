@@ -64,6 +64,12 @@ impl PointMap {
         self.offsets.len() - 1
     }
 
+    /// The node point `p` coincides with, if it is exactly one mesh node.
+    pub fn single_node(&self, p: usize) -> Option<u32> {
+        let (a, b) = (self.offsets[p] as usize, self.offsets[p + 1] as usize);
+        (b - a == 1 && self.weights[a] == 1.0).then(|| self.nodes[a])
+    }
+
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }

@@ -1,0 +1,344 @@
+//! `hox record` (a scene, or several configurations of it side by side, to a Rerun .rrd file,
+//! headless) and `hox inspect` (read an .rrd back and check what it holds).
+
+use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, load_scene, overrides};
+use crate::recording::{LogSettings, SimLogger, config_label, entity_name};
+use anyhow::{Context, Result, bail};
+use hox_scenes::{Instance, SceneOverrides};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct RecordArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
+    #[command(flatten)]
+    pub physics: PhysicsArgs,
+    /// Simulated time to record, seconds (default: the scene's duration).
+    #[arg(long, allow_negative_numbers = true)]
+    pub seconds: Option<f64>,
+    /// The Rerun file to write (.rrd). Checked for writability before simulating.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Record several configurations of the scene side by side (give it two or more times).
+    /// Each value lists option=value pairs applied on top of the other options, e.g.
+    /// `--compare element=p1,refine=1 --compare element=p2`. Options: element, grid, split,
+    /// refine, material, youngs, poisson, density, formulation, quadrature, substeps,
+    /// iterations, fps.
+    #[arg(long, value_name = "OPTION=VALUE,...")]
+    pub compare: Vec<String>,
+    /// Pieces per edge when tessellating curved (high-order) and quadrilateral faces.
+    #[arg(long, default_value_t = 4)]
+    pub tessellation: usize,
+    /// Top of the displacement colour range, metres (default: a fifth of the body's largest
+    /// extent). The range is fixed for the whole recording.
+    #[arg(long)]
+    pub colour_max_m: Option<f64>,
+    /// Also log every quadrature point.
+    #[arg(long)]
+    pub quadrature_points: bool,
+    /// Print a JSON summary on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(clap::Args)]
+pub struct InspectArgs {
+    /// The .rrd file to read.
+    pub file: PathBuf,
+    /// Fail unless every recorded configuration has its surface positions and colours, edges
+    /// and probes at exactly this many frames.
+    #[arg(long)]
+    pub expect_frames: Option<usize>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Applies one `--compare` value (`option=value,...`) on top of `base`.
+pub fn parse_compare(spec: &str, base: &SceneOverrides) -> Result<SceneOverrides> {
+    let mut o = base.clone();
+    for pair in spec.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (key, value) = pair.split_once('=').with_context(|| format!("--compare '{spec}': '{pair}' is not option=value"))?;
+        let (key, value) = (key.trim(), value.trim());
+        let number = |what: &str| -> Result<f64> {
+            let v: f64 = value.parse().with_context(|| format!("--compare '{spec}': {key} needs {what}, got '{value}'"))?;
+            Ok(v)
+        };
+        let whole = || -> Result<usize> { value.parse().with_context(|| format!("--compare '{spec}': {key} needs a whole number, got '{value}'")) };
+        match key {
+            "element" => o.element = Some(value.into()),
+            "grid" => o.grid = Some(super::parse_grid(value).map_err(anyhow::Error::msg)?),
+            "split" => o.split = Some(value.into()),
+            "refine" => o.refine = Some(whole()?),
+            "material" => o.material = Some(value.into()),
+            "youngs" => o.youngs_modulus_pa = Some(number("a Young's modulus in Pa")?),
+            "poisson" => o.poisson_ratio = Some(number("a Poisson ratio")?),
+            "density" => o.density_kg_m3 = Some(number("a density in kg/m³")?),
+            "formulation" => o.formulation = Some(value.into()),
+            "quadrature" => o.quadrature_degree = Some(whole()?),
+            "substeps" => o.substeps = Some(whole()? as u32),
+            "iterations" => o.iterations = Some(whole()? as u32),
+            "fps" => o.frames_per_second = Some(number("frames per second")?),
+            _ => bail!(
+                "--compare '{spec}': unknown option '{key}' (use element, grid, split, refine, material, youngs, poisson, density, formulation, quadrature, substeps, iterations, fps)"
+            ),
+        }
+    }
+    Ok(o)
+}
+
+/// Fails unless `path` can be written, without truncating an existing file and without leaving
+/// a new one behind.
+pub fn check_writable(path: &Path) -> Result<()> {
+    let existed = path.exists();
+    if path.is_dir() {
+        bail!("cannot write {}: it is a folder", path.display());
+    }
+    std::fs::OpenOptions::new().append(true).create(true).open(path).with_context(|| format!("cannot write {}", path.display()))?;
+    if !existed {
+        let _ = std::fs::remove_file(path);
+    }
+    Ok(())
+}
+
+pub fn record(args: &RecordArgs) -> Result<()> {
+    let scene = load_scene(&args.scene)?;
+    let base = overrides(&args.mesh, Some(&args.physics));
+    let configurations: Vec<SceneOverrides> = match args.compare.len() {
+        0 => vec![base],
+        1 => bail!("--compare needs two or more configurations (give it once per configuration)"),
+        _ => args.compare.iter().map(|spec| parse_compare(spec, &base)).collect::<Result<_>>()?,
+    };
+    if args.tessellation == 0 || args.tessellation > 32 {
+        bail!("--tessellation must be between 1 and 32 pieces per edge, got {}", args.tessellation);
+    }
+    if let Some(c) = args.colour_max_m
+        && !(c.is_finite() && c > 0.0)
+    {
+        bail!("--colour-max-m must be a finite positive length in metres, got {c}");
+    }
+    let mut instances = Vec::new();
+    for (k, o) in configurations.iter().enumerate() {
+        let s = scene.with_overrides(o).with_context(|| if args.compare.is_empty() { String::new() } else { format!("--compare '{}'", args.compare[k]) })?;
+        instances.push(Instance::new(s)?);
+    }
+    let seconds = args.seconds.unwrap_or(instances[0].scene.file.solver.duration_secs);
+    if !(seconds.is_finite() && seconds >= 0.0) {
+        bail!("--seconds must be a finite, non-negative number of seconds, got {seconds}");
+    }
+    let fps = instances[0].scene.settings.frames_per_second;
+    if instances.iter().any(|i| i.scene.settings.frames_per_second != fps) {
+        bail!("the compared configurations must share one frame rate (fps) so their frames line up");
+    }
+    check_writable(&args.out)?;
+
+    let rec = rerun::RecordingStreamBuilder::new("hox")
+        .recording_name(format!("hox record {}", instances[0].scene.name()))
+        .save(&args.out)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    let settings = LogSettings { segments: args.tessellation, colour_max_m: args.colour_max_m, quadrature_points: args.quadrature_points };
+    // configurations side by side along y, one body width plus a gap apart
+    let (lo, hi) = instances[0].sim.mesh().bounding_box();
+    let extent = hi - lo;
+    let spacing_m = extent.y + (0.5 * extent.y).max(0.25 * extent.max());
+    let mut names = BTreeSet::new();
+    let mut loggers = Vec::new();
+    for (k, inst) in instances.iter().enumerate() {
+        let mut name = entity_name(&config_label(inst));
+        if !names.insert(name.clone()) {
+            name = format!("{name}_{}", k + 1);
+            names.insert(name.clone());
+        }
+        let offset = hox_sim::Vec3::new(0.0, k as f64 * spacing_m, 0.0);
+        loggers.push(SimLogger::new(&rec, &name, inst, offset, &settings)?);
+    }
+
+    let interrupted = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupted.clone();
+        ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst)).context("cannot install the Ctrl-C handler")?;
+    }
+    let frames = (seconds * fps).round() as u64;
+    let mut step_ms: Vec<Vec<f64>> = vec![Vec::new(); instances.len()];
+    let mut log_ms = Vec::new();
+    let mut bar = DelayedBar::new();
+    let started = Instant::now();
+    for (inst, logger) in instances.iter().zip(loggers.iter_mut()) {
+        logger.log_frame(&rec, inst, 0.0)?;
+    }
+    let mut failure = None;
+    let mut done = 0;
+    'frames: for frame in 1..=frames {
+        if interrupted.load(Ordering::SeqCst) {
+            break;
+        }
+        for (k, (inst, logger)) in instances.iter_mut().zip(loggers.iter_mut()).enumerate() {
+            let t0 = Instant::now();
+            if let Err(e) = inst.sim.step_frame() {
+                failure = Some(anyhow::anyhow!("{}: configuration {}: {e}", inst.scene.source, logger.name()));
+                break 'frames;
+            }
+            let ms = t0.elapsed().as_secs_f64() * 1e3;
+            step_ms[k].push(ms);
+            let t1 = Instant::now();
+            logger.log_frame(&rec, inst, ms)?;
+            log_ms.push(t1.elapsed().as_secs_f64() * 1e3);
+        }
+        done = frame;
+        bar.reveal("{spinner} {bar:40} {percent}% {msg} (eta {eta})");
+        bar.bar.set_position(1000 * frame / frames.max(1));
+        bar.bar.set_message(format!("frame {frame}/{frames}"));
+    }
+    bar.bar.finish_and_clear();
+    rec.flush_blocking().with_context(|| format!("cannot finish writing {}", args.out.display()))?;
+    drop(rec);
+    let bytes = std::fs::metadata(&args.out).map(|m| m.len()).unwrap_or(0);
+    if let Some(e) = failure {
+        eprintln!("{}: kept frames 0..={done} before the failure", args.out.display());
+        return Err(e);
+    }
+    if interrupted.load(Ordering::SeqCst) {
+        eprintln!("interrupted: {} holds frames 0..={done} ({bytes} bytes) and plays back", args.out.display());
+        std::process::exit(130);
+    }
+    let configs: Vec<serde_json::Value> = instances
+        .iter()
+        .zip(&loggers)
+        .zip(step_ms.iter_mut())
+        .map(|((inst, logger), ms)| {
+            serde_json::json!({
+                "entity": format!("world/{}", logger.name()),
+                "elements": inst.sim.mesh().num_elements(),
+                "nodes": inst.sim.mesh().num_nodes(),
+                "probes": inst.probe_displacements().into_iter().collect::<BTreeMap<_, _>>(),
+                "ms_per_frame": hox_scenes::median(ms),
+            })
+        })
+        .collect();
+    let summary = serde_json::json!({
+        "file": args.out,
+        "frames": frames + 1,
+        "sim_seconds": instances[0].sim.time_secs(),
+        "bytes": bytes,
+        "log_ms_per_frame": hox_scenes::median(&mut log_ms),
+        "wall_seconds": started.elapsed().as_secs_f64(),
+        "configurations": configs,
+    });
+    if args.json {
+        println!("{summary}");
+    } else {
+        println!(
+            "{}: {} frames of {} configuration(s), {:.2} MB, logging {:.2} ms per frame and configuration",
+            args.out.display(),
+            frames + 1,
+            instances.len(),
+            bytes as f64 / 1e6,
+            summary["log_ms_per_frame"].as_f64().unwrap_or_default()
+        );
+        for c in summary["configurations"].as_array().into_iter().flatten() {
+            println!("  {}: {} elements, {} nodes, {:.2} ms per frame", c["entity"].as_str().unwrap_or_default(), c["elements"], c["nodes"], c["ms_per_frame"].as_f64().unwrap_or_default());
+        }
+        println!("play it back with the Rerun viewer {}: rerun {}", rerun::build_info().version, args.out.display());
+    }
+    Ok(())
+}
+
+/// What an .rrd file holds, per entity.
+#[derive(Debug, Default, serde::Serialize)]
+pub struct EntitySummary {
+    /// Components logged as static data.
+    pub static_components: BTreeSet<String>,
+    /// Components logged on the `frame` timeline, with the distinct frames they were logged at.
+    pub frames_per_component: BTreeMap<String, BTreeSet<i64>>,
+}
+
+/// Reads every chunk of `path` with the Rerun decoder.
+pub fn read_rrd(path: &Path) -> Result<BTreeMap<String, EntitySummary>> {
+    use rerun::external::re_log_encoding::DecoderApp;
+    let file = std::fs::File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    let mut entities: BTreeMap<String, EntitySummary> = BTreeMap::new();
+    let mut messages = 0usize;
+    for msg in DecoderApp::decode_lazy(std::io::BufReader::new(file)) {
+        let msg = msg.with_context(|| format!("{} is not a readable Rerun recording", path.display()))?;
+        messages += 1;
+        let rerun::external::re_log_types::LogMsg::ArrowMsg(_, arrow) = msg else { continue };
+        let chunk = rerun::log::Chunk::from_arrow_msg(&arrow).with_context(|| format!("{}: a chunk does not decode", path.display()))?;
+        let entity = chunk.entity_path().to_string().trim_start_matches('/').to_string();
+        let summary = entities.entry(entity).or_default();
+        let components: Vec<String> = chunk.component_descriptors().map(|d| d.component.to_string()).collect();
+        if chunk.is_static() {
+            summary.static_components.extend(components);
+            continue;
+        }
+        let frames: Vec<i64> = chunk.timelines().iter().find(|(name, _)| name.as_str() == "frame").map(|(_, t)| t.times_raw().to_vec()).unwrap_or_default();
+        for c in components {
+            summary.frames_per_component.entry(c).or_default().extend(frames.iter().copied());
+        }
+    }
+    if messages == 0 {
+        bail!("{} is empty: not a Rerun recording", path.display());
+    }
+    Ok(entities)
+}
+
+/// Checks that every configuration (`world/<name>/surface`) was recorded at `frames` frames.
+pub fn check_frames(entities: &BTreeMap<String, EntitySummary>, frames: usize) -> Result<Vec<String>> {
+    let configs: Vec<String> =
+        entities.keys().filter_map(|e| e.strip_prefix("world/").and_then(|r| r.strip_suffix("/surface"))).map(str::to_string).collect();
+    if configs.is_empty() {
+        bail!("no world/<configuration>/surface entity: not a hox recording");
+    }
+    for c in &configs {
+        let surface = &entities[&format!("world/{c}/surface")];
+        if !surface.static_components.contains("Mesh3D:triangle_indices") {
+            bail!("world/{c}/surface has no static triangle indices");
+        }
+        for component in ["Mesh3D:vertex_positions", "Mesh3D:vertex_colors"] {
+            let n = surface.frames_per_component.get(component).map_or(0, BTreeSet::len);
+            if n != frames {
+                bail!("world/{c}/surface has {component} at {n} frames, expected {frames}");
+            }
+        }
+        for (entity, component) in [(format!("world/{c}/edges"), "LineStrips3D:strips"), (format!("world/{c}/probes"), "Points3D:positions")] {
+            let n = entities.get(&entity).and_then(|s| s.frames_per_component.get(component)).map_or(0, BTreeSet::len);
+            if n != frames {
+                bail!("{entity} has {component} at {n} frames, expected {frames}");
+            }
+        }
+        for quantity in ["kinetic_energy_j", "elastic_energy_j", "min_det_f"] {
+            let entity = format!("plots/{quantity}/{c}");
+            let n = entities.get(&entity).and_then(|s| s.frames_per_component.get("Scalars:scalars")).map_or(0, BTreeSet::len);
+            if n != frames {
+                bail!("{entity} has {n} frames, expected {frames}");
+            }
+        }
+    }
+    Ok(configs)
+}
+
+pub fn inspect(args: &InspectArgs) -> Result<()> {
+    let entities = read_rrd(&args.file)?;
+    let configs = match args.expect_frames {
+        Some(n) => Some(check_frames(&entities, n).with_context(|| format!("{}", args.file.display()))?),
+        None => None,
+    };
+    if args.json {
+        println!("{}", serde_json::json!({ "entities": entities, "configurations": configs }));
+        return Ok(());
+    }
+    for (entity, s) in &entities {
+        let frames = s.frames_per_component.values().map(BTreeSet::len).max().unwrap_or(0);
+        let mut components: Vec<&str> = s.static_components.iter().map(|c| c.as_str()).collect();
+        components.extend(s.frames_per_component.keys().map(|c| c.as_str()));
+        println!("{entity:<48} {frames:>6} frames  {}", components.join(", "));
+    }
+    if let Some(configs) = configs {
+        println!("ok: {} configuration(s) ({}) recorded at {} frames each", configs.len(), configs.join(", "), args.expect_frames.unwrap_or_default());
+    }
+    Ok(())
+}

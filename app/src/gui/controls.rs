@@ -1,0 +1,473 @@
+//! The control panel, the menu bar and the open-file dialog. Every control edits a copy of the
+//! active configuration and hands it to [`HoxApp::apply`], which validates it through the
+//! scene (so the app refuses exactly what a scene file or the CLI would) and rebuilds only
+//! what the change invalidates.
+
+use super::config::Config;
+use super::{HoxApp, SceneSource};
+use eframe::egui;
+use hox_sim::element::ElementType;
+use hox_sim::material::MaterialModel;
+
+/// The File → Open dialog: a path typed or picked from the project's assets.
+#[derive(Clone, Debug, Default)]
+pub struct OpenDialog {
+    pub mesh: bool,
+    pub path: String,
+    pub clamp_group: String,
+    pub error: Option<String>,
+}
+
+pub fn menu_bar_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    egui::MenuBar::new().ui(ui, |ui| {
+        ui.menu_button("File", |ui| {
+            if ui.button("Open scene file…").on_hover_text("Load a scene from a TOML file (see assets/scenes/).").clicked() {
+                app.open_dialog = Some(OpenDialog { mesh: false, path: "assets/scenes/".into(), ..Default::default() });
+                ui.close();
+            }
+            if ui.button("Open mesh file…").on_hover_text("Simulate a Gmsh .msh mesh: clamp one of its physical groups, gravity on.").clicked() {
+                app.open_dialog = Some(OpenDialog { mesh: true, path: "assets/meshes/".into(), clamp_group: "clamp".into(), ..Default::default() });
+                ui.close();
+            }
+        });
+        ui.menu_button("View", |ui| {
+            ui.checkbox(&mut app.show_reference_element, "Reference element").on_hover_text("Shape functions of a reference element as colour fields, with its quadrature points.");
+            if ui.button("Reset camera").on_hover_text("Frame the bodies again (double-click in the view does the same).").clicked() {
+                let offsets = app.offsets();
+                app.viewport.reset_camera(&app.sessions, &offsets);
+                ui.close();
+            }
+        });
+        ui.separator();
+        let play = if app.playing { "Pause" } else { "Play" };
+        if ui.button(play).on_hover_text("Run or pause the simulation (space).").clicked() {
+            app.playing = !app.playing;
+        }
+        if ui.button("Step").on_hover_text("Advance exactly one frame (S).").clicked() {
+            app.playing = false;
+            app.step(1);
+        }
+        if ui.button("Reset").on_hover_text("Back to the rest shape at t = 0 (R).").clicked() {
+            app.reset();
+        }
+        ui.label(format!("t = {:.2} s", app.sessions[0].instance.sim.time_secs()));
+        if let Some(m) = &app.message {
+            ui.separator();
+            ui.label(m.as_str());
+        }
+    });
+}
+
+/// A row label with a tooltip.
+fn label(ui: &mut egui::Ui, text: &str, tip: &str) -> egui::Response {
+    ui.label(text).on_hover_text(tip)
+}
+
+/// The reason a control's last change was refused, under it.
+fn refusal_ui(app: &HoxApp, ui: &mut egui::Ui, control: &str) {
+    if let Some((c, reason)) = &app.refusal
+        && c == control
+    {
+        ui.colored_label(egui::Color32::from_rgb(255, 110, 90), format!("refused: {reason}"));
+    }
+}
+
+/// A link toggle for `field` in compare mode.
+fn link_ui(app: &mut HoxApp, ui: &mut egui::Ui, field: &str) {
+    if !app.compare {
+        return;
+    }
+    let linked = app.links.linked(field);
+    let text = if linked { "🔗" } else { "⛓‍💥" };
+    if ui.selectable_label(linked, text).on_hover_text("Linked: the other configuration follows this control. Click to unlink.").clicked() {
+        app.links.0.insert(field.to_string(), !linked);
+    }
+}
+
+/// A numeric text field that applies on Enter or focus loss; unparsable or refused values
+/// keep the previous value and show the reason.
+fn number_ui(app: &mut HoxApp, ui: &mut egui::Ui, field: &str, text: &str, tip: &str, value: f64, set: impl Fn(&mut Config, f64)) {
+    ui.horizontal(|ui| {
+        let l = label(ui, text, tip);
+        let key = format!("{}:{field}", app.active);
+        let buffer = app.edits.entry(key.clone()).or_insert_with(|| format!("{value}"));
+        let response = ui.add(egui::TextEdit::singleline(buffer).desired_width(90.0)).labelled_by(l.id).on_hover_text(tip);
+        let commit = response.lost_focus() || (response.has_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)));
+        if commit {
+            let typed = buffer.trim().to_string();
+            match typed.parse::<f64>() {
+                Ok(v) if v != value => {
+                    let mut c = app.sessions[app.active].config.clone();
+                    set(&mut c, v);
+                    app.apply(field, c);
+                }
+                Ok(_) => {}
+                Err(_) => app.refusal = Some((field.to_string(), format!("'{typed}' is not a number"))),
+            }
+            // show what is in force now
+            let now = app.sessions[app.active].config.clone();
+            let shown = match field {
+                "youngs" => now.youngs_modulus_pa,
+                "poisson" => now.poisson_ratio,
+                _ => now.density_kg_m3,
+            };
+            app.edits.insert(key, format!("{shown}"));
+        } else if !response.has_focus() {
+            *buffer = format!("{value}");
+        }
+        link_ui(app, ui, field);
+    });
+    refusal_ui(app, ui, field);
+}
+
+pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.heading("Scene");
+    let current = app.scene.label();
+    let mut chosen = None;
+    egui::ComboBox::from_id_salt("scene").selected_text(&current).show_ui(ui, |ui| {
+        for name in hox_scenes::BUILTIN.iter().map(|(n, _)| *n) {
+            if ui.selectable_label(current == name, name).clicked() {
+                chosen = Some(SceneSource::Builtin(name.to_string()));
+            }
+        }
+    })
+    .response
+    .on_hover_text("The scene: its mesh, material, effects (gravity, clamps, motion…) and probes.");
+    if let Some(source) = chosen
+        && let Err(e) = app.load_scene(source, None)
+    {
+        app.message = Some(e);
+    }
+    ui.label(egui::RichText::new(&app.sessions[0].base.file.description).small());
+    let mut compare = app.compare;
+    if ui.checkbox(&mut compare, "Compare two configurations").on_hover_text("Run a second configuration of the scene side by side; 🔗 links choose which controls it shares.").changed() {
+        app.set_compare(compare);
+    }
+    if app.compare {
+        ui.horizontal(|ui| {
+            ui.label("Editing:");
+            for k in 0..2 {
+                let text = format!("{} {}", ["A", "B"][k], app.sessions[k].config.label());
+                if ui.selectable_label(app.active == k, text).on_hover_text("The configuration the controls below change.").clicked() {
+                    app.active = k;
+                }
+            }
+        });
+    }
+    ui.separator();
+    mesh_ui(app, ui);
+    ui.separator();
+    material_ui(app, ui);
+    ui.separator();
+    solver_ui(app, ui);
+    ui.separator();
+    playback_ui(app, ui);
+    ui.separator();
+    view_ui(app, ui);
+    ui.separator();
+    rerun_ui(app, ui);
+}
+
+fn mesh_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.heading("Mesh");
+    let c = app.sessions[app.active].config.clone();
+    if !c.is_box() {
+        ui.label("from a mesh file (element type and grid are the file's)");
+        return;
+    }
+    ui.horizontal(|ui| {
+        label(ui, "Element", "The element type: P1/P2/P3 tetrahedra (order 1–3), Q1/Q2 hexahedra, prisms, pyramids.");
+        let mut element = c.element.clone();
+        egui::ComboBox::from_id_salt(("element", app.active)).selected_text(element.to_uppercase()).show_ui(ui, |ui| {
+            for e in ElementType::all() {
+                ui.selectable_value(&mut element, e.name().to_string(), format!("{} — {}", e.name().to_uppercase(), e.description()));
+            }
+        });
+        if element != c.element {
+            let mut n = c.clone();
+            n.element = element;
+            app.apply("element", n);
+        }
+        link_ui(app, ui, "element");
+    });
+    refusal_ui(app, ui, "element");
+    let tets = ["p1", "p2", "p3"].contains(&c.element.as_str());
+    ui.horizontal(|ui| {
+        label(ui, "Tet split", "How each hexahedral cell is cut into tetrahedra: five (unbiased, alternating) or six (biased along one diagonal).");
+        let mut split = c.split.clone();
+        ui.add_enabled_ui(tets, |ui| {
+            ui.radio_value(&mut split, "five".to_string(), "five (unbiased)");
+            ui.radio_value(&mut split, "six".to_string(), "six (biased)");
+        });
+        if split != c.split {
+            let mut n = c.clone();
+            n.split = split;
+            app.apply("split", n);
+        }
+        link_ui(app, ui, "split");
+    });
+    ui.horizontal(|ui| {
+        label(ui, "Grid", "Hexahedral cells along x, y and z before any splitting (each 1–64).");
+        let mut grid = c.grid;
+        for g in &mut grid {
+            ui.add(egui::DragValue::new(g).range(1..=64)).on_hover_text("Cells in this direction (1–64).");
+        }
+        if grid != c.grid {
+            let mut n = c.clone();
+            n.grid = grid;
+            app.apply("grid", n);
+        }
+        link_ui(app, ui, "grid");
+    });
+    refusal_ui(app, ui, "grid");
+    ui.horizontal(|ui| {
+        label(ui, "Refine", "1-to-8 refinements of the tetrahedra (each multiplies the element count by 8; tetrahedra only).");
+        let mut refine = c.refine;
+        ui.add_enabled(tets, egui::Slider::new(&mut refine, 0..=3));
+        if refine != c.refine {
+            let mut n = c.clone();
+            n.refine = refine;
+            app.apply("refine", n);
+        }
+        link_ui(app, ui, "refine");
+    });
+    refusal_ui(app, ui, "refine");
+}
+
+fn material_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.heading("Material");
+    let c = app.sessions[app.active].config.clone();
+    ui.horizontal(|ui| {
+        label(ui, "Model", "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean or Neo-Hookean.");
+        let mut model = c.material.clone();
+        egui::ComboBox::from_id_salt(("model", app.active)).selected_text(MaterialModel::from_name(&model).map_or(model.clone(), |m| m.long_name().to_string())).show_ui(ui, |ui| {
+            for m in MaterialModel::ALL {
+                ui.selectable_value(&mut model, m.name().to_string(), m.long_name());
+            }
+        });
+        if model != c.material {
+            let mut n = c.clone();
+            n.material = model;
+            app.apply("material", n);
+        }
+        link_ui(app, ui, "material");
+    });
+    refusal_ui(app, ui, "material");
+    number_ui(app, ui, "youngs", "Young's modulus E (Pa)", "Stiffness in pascals, > 0 (rubber ~1e6, the paper's beam 3e6).", c.youngs_modulus_pa, |c, v| c.youngs_modulus_pa = v);
+    number_ui(app, ui, "poisson", "Poisson ratio ν", "Lateral contraction, between −1 and 0.5 (exclusive); near 0.5 is nearly incompressible.", c.poisson_ratio, |c, v| c.poisson_ratio = v);
+    number_ui(app, ui, "density", "Density ρ (kg/m³)", "Mass per volume in kg/m³, > 0 (water 1000).", c.density_kg_m3, |c, v| c.density_kg_m3 = v);
+}
+
+fn solver_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.heading("Solver");
+    let c = app.sessions[app.active].config.clone();
+    ui.horizontal(|ui| {
+        label(ui, "Formulation", "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.");
+        let mut f = c.formulation.clone();
+        ui.radio_value(&mut f, "energy".to_string(), "energy");
+        ui.radio_value(&mut f, "split".to_string(), "split");
+        if f != c.formulation {
+            let mut n = c.clone();
+            n.formulation = f;
+            app.apply("formulation", n);
+        }
+        link_ui(app, ui, "formulation");
+    });
+    refusal_ui(app, ui, "formulation");
+    ui.horizontal(|ui| {
+        label(ui, "Quadrature", "Degree of polynomials the element quadrature integrates exactly (default: the element's own).");
+        let mut q = c.quadrature_degree;
+        egui::ComboBox::from_id_salt(("quadrature", app.active)).selected_text(q.map_or("element default".to_string(), |d| format!("degree {d}"))).show_ui(ui, |ui| {
+            ui.selectable_value(&mut q, None, "element default");
+            for d in 1..=8 {
+                ui.selectable_value(&mut q, Some(d), format!("degree {d}"));
+            }
+        });
+        if q != c.quadrature_degree {
+            let mut n = c.clone();
+            n.quadrature_degree = q;
+            app.apply("quadrature", n);
+        }
+        link_ui(app, ui, "quadrature");
+    });
+    refusal_ui(app, ui, "quadrature");
+    let slider = |app: &mut HoxApp, ui: &mut egui::Ui, field: &str, text: &str, tip: &str, value: u32, range: std::ops::RangeInclusive<u32>, set: fn(&mut Config, u32)| {
+        ui.horizontal(|ui| {
+            label(ui, text, tip);
+            let mut v = value;
+            ui.add(egui::Slider::new(&mut v, range).logarithmic(true)).on_hover_text(tip);
+            if v != value {
+                let mut n = app.sessions[app.active].config.clone();
+                set(&mut n, v);
+                app.apply(field, n);
+            }
+            link_ui(app, ui, field);
+        });
+        refusal_ui(app, ui, field);
+    };
+    slider(app, ui, "substeps", "Substeps", "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.", c.substeps, 1..=500, |c, v| c.substeps = v);
+    slider(app, ui, "iterations", "Iterations", "Constraint sweeps per substep (the paper: 1).", c.iterations, 1..=20, |c, v| c.iterations = v);
+    ui.horizontal(|ui| {
+        label(ui, "Frames per second", "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.");
+        let mut fps = c.frames_per_second;
+        ui.add(egui::Slider::new(&mut fps, 10.0..=240.0).logarithmic(true).suffix(" fps"));
+        if fps != c.frames_per_second {
+            let mut n = c.clone();
+            n.frames_per_second = fps;
+            app.apply("fps", n);
+        }
+        link_ui(app, ui, "fps");
+    });
+    refusal_ui(app, ui, "fps");
+}
+
+fn playback_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.heading("Playback");
+    ui.horizontal(|ui| {
+        if ui.button(if app.playing { "Pause" } else { "Play" }).on_hover_text("Run or pause (space).").clicked() {
+            app.playing = !app.playing;
+        }
+        if ui.button("Step").on_hover_text("One frame (S).").clicked() {
+            app.playing = false;
+            app.step(1);
+        }
+        if ui.button("Reset").on_hover_text("Rest shape, t = 0 (R).").clicked() {
+            app.reset();
+        }
+    });
+    ui.horizontal(|ui| {
+        label(ui, "Time scale", "Simulated seconds per real second (1 = real time; the simulation slows down by itself when a frame costs more than real time).");
+        ui.add(egui::Slider::new(&mut app.time_scale, 0.05..=4.0).logarithmic(true).suffix("×"));
+    });
+}
+
+fn view_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.heading("View");
+    let v = &mut app.view;
+    ui.horizontal_wrapped(|ui| {
+        ui.checkbox(&mut v.edges, "edges").on_hover_text("Element edges on the surface (curved for high-order elements).");
+        ui.checkbox(&mut v.nodes, "nodes").on_hover_text("Corner nodes white, high-order (edge, face, interior) nodes cyan.");
+        ui.checkbox(&mut v.quadrature_points, "quadrature points").on_hover_text("Where the elastic energy is sampled (orange).");
+        ui.checkbox(&mut v.boundary_conditions, "clamped / driven").on_hover_text("Clamped nodes blue, nodes with prescribed motion magenta.");
+        ui.checkbox(&mut v.ghost, "rest shape").on_hover_text("The undeformed shape's edges as a faint ghost.");
+        ui.checkbox(&mut v.probes, "probes").on_hover_text("The probe points the study measures (red).");
+    });
+    let mut segments = v.segments;
+    ui.horizontal(|ui| {
+        label(ui, "Curved-face pieces", "Pieces per edge when drawing curved (high-order) and quadrilateral faces.");
+        ui.add(egui::Slider::new(&mut segments, 1..=12));
+    });
+    if segments != app.view.segments {
+        app.view.segments = segments;
+        for s in &mut app.sessions {
+            s.set_segments(segments);
+        }
+    }
+    let mut auto = app.view.colour_max_m.is_none();
+    ui.horizontal(|ui| {
+        label(ui, "Colour range", "Top of the displacement colour map, metres (auto: a fifth of the body's largest extent).");
+        ui.checkbox(&mut auto, "auto");
+        let mut max = app.view.colour_max_m.unwrap_or_else(|| super::viewport::Viewport::colour_range(&app.sessions, &app.view).max_m);
+        if !auto {
+            ui.add(egui::DragValue::new(&mut max).range(1e-6..=1e3).speed(0.01).suffix(" m"));
+        }
+        app.view.colour_max_m = (!auto).then_some(max);
+    });
+}
+
+fn rerun_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.heading("Rerun");
+    let on = app.rerun_target().is_some();
+    ui.horizontal(|ui| {
+        label(ui, "Viewer", "A running Rerun viewer 0.36.3 to stream to (start one with scripts/rerun.sh).");
+        ui.add_enabled(!on, egui::TextEdit::singleline(&mut app.rerun_url).desired_width(200.0));
+    });
+    ui.horizontal(|ui| {
+        label(ui, "File", "An .rrd file to save the recording to.");
+        ui.add_enabled(!on, egui::TextEdit::singleline(&mut app.rerun_file).desired_width(200.0));
+    });
+    ui.horizontal(|ui| {
+        if on {
+            if ui.button("Stop Rerun").clicked() {
+                app.set_rerun(false, false);
+            }
+        } else {
+            if ui.button("Stream to viewer").on_hover_text("Log every simulated frame to the viewer at the URL above.").clicked() {
+                app.set_rerun(true, false);
+            }
+            if ui.button("Save to file").on_hover_text("Log every simulated frame to the .rrd file above.").clicked() {
+                app.set_rerun(true, true);
+            }
+        }
+    });
+    if let Some(t) = app.rerun_target() {
+        ui.label(format!("Rerun: {t}"));
+    }
+}
+
+/// The File → Open dialog.
+pub fn open_dialog_ui(app: &mut HoxApp, ctx: &egui::Context) {
+    let Some(mut dialog) = app.open_dialog.take() else { return };
+    let mut open = true;
+    let mut done = false;
+    let title = if dialog.mesh { "Open mesh file" } else { "Open scene file" };
+    egui::Window::new(title).open(&mut open).collapsible(false).show(ctx, |ui| {
+        ui.horizontal(|ui| {
+            ui.label("Path");
+            ui.add(egui::TextEdit::singleline(&mut dialog.path).desired_width(320.0));
+        });
+        if dialog.mesh {
+            ui.horizontal(|ui| {
+                ui.label("Clamp group").on_hover_text("The physical group (named node set) held fixed.");
+                ui.add(egui::TextEdit::singleline(&mut dialog.clamp_group).desired_width(120.0));
+            });
+        }
+        // quick picks from the project's assets
+        let folder = if dialog.mesh { "assets/meshes" } else { "assets/scenes" };
+        let ext = if dialog.mesh { "msh" } else { "toml" };
+        if let Ok(entries) = std::fs::read_dir(folder) {
+            let mut files: Vec<_> = entries.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.extension().is_some_and(|e| e == ext)).collect();
+            files.sort();
+            egui::ScrollArea::vertical().max_height(160.0).show(ui, |ui| {
+                for f in files {
+                    if ui.selectable_label(false, f.display().to_string()).clicked() {
+                        dialog.path = f.display().to_string();
+                    }
+                }
+            });
+        }
+        if let Some(e) = &dialog.error {
+            ui.colored_label(egui::Color32::from_rgb(255, 110, 90), e);
+        }
+        if ui.button("Open").clicked() {
+            let path = std::path::PathBuf::from(dialog.path.trim());
+            let result = if dialog.mesh { mesh_scene_file(&path, dialog.clamp_group.trim()).and_then(|p| app.load_scene(SceneSource::File(p), None)) } else { app.load_scene(SceneSource::File(path), None) };
+            match result {
+                Ok(()) => done = true,
+                Err(e) => dialog.error = Some(e),
+            }
+        }
+    });
+    if open && !done {
+        app.open_dialog = Some(dialog);
+    }
+}
+
+/// A scene file for a mesh file: the mesh, its `clamp_group` clamped, gravity, the paper
+/// beam's material; written next to the user's settings so it can be reopened.
+fn mesh_scene_file(mesh: &std::path::Path, clamp_group: &str) -> Result<std::path::PathBuf, String> {
+    let mesh = std::fs::canonicalize(mesh).map_err(|e| format!("{}: {e}", mesh.display()))?;
+    let name = mesh.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().to_string());
+    let text = format!(
+        "name = \"{name}\"\ndescription = \"{} with group '{clamp_group}' clamped, under gravity\"\n[mesh]\nfile = {:?}\n[material]\nmodel = \"stvk\"\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.35\ndensity_kg_m3 = 1000.0\n[[effects]]\ntype = \"gravity\"\nacceleration_m_s2 = [0.0, 0.0, -9.81]\n[[effects]]\ntype = \"clamp\"\nnodes = {{ group = {clamp_group:?} }}\n",
+        mesh.display(),
+        mesh.display().to_string()
+    );
+    let dir = std::env::temp_dir().join("hox-app-scenes");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    // validate now, so a missing group is reported in the dialog
+    hox_scenes::Scene::load(&path).map_err(|e| e.to_string())?;
+    Ok(path)
+}

@@ -1,0 +1,304 @@
+//! One running configuration in the app: the simulation, its display surface, its history for
+//! the plots, and its error against the scene's reference solution.
+//!
+//! A configuration change rebuilds only what it invalidates ([`Invalidates`]): a material or
+//! solver change keeps the current positions and velocities; a mesh change rebuilds from rest.
+
+use super::config::{Config, Invalidates};
+use hox_scenes::{Instance, Scene};
+use hox_sim::Vec3;
+use hox_sim::effect::Attachment;
+use hox_sim::surface::{PointMap, Surface};
+use std::time::Instant;
+
+/// Samples kept for the time plots (older ones are dropped).
+const HISTORY_LEN: usize = 20_000;
+
+/// Time series of one session, for the plots.
+#[derive(Clone, Debug, Default)]
+pub struct History {
+    pub time_secs: Vec<f64>,
+    /// First probe's displacement components, metres.
+    pub probe_m: Vec<[f64; 3]>,
+    pub kinetic_j: Vec<f64>,
+    pub elastic_j: Vec<f64>,
+}
+
+impl History {
+    fn push(&mut self, t: f64, probe: [f64; 3], kinetic: f64, elastic: f64) {
+        if self.time_secs.len() >= HISTORY_LEN {
+            let drop = HISTORY_LEN / 10;
+            self.time_secs.drain(..drop);
+            self.probe_m.drain(..drop);
+            self.kinetic_j.drain(..drop);
+            self.elastic_j.drain(..drop);
+        }
+        self.time_secs.push(t);
+        self.probe_m.push(probe);
+        self.kinetic_j.push(kinetic);
+        self.elastic_j.push(elastic);
+    }
+}
+
+/// A node being dragged with the mouse: an attachment effect that exists only meanwhile.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drag {
+    pub node: u32,
+    pub target_m: Vec3,
+}
+
+/// Compliance of the mouse attachment, m/N (stiff, but not rigid).
+const DRAG_COMPLIANCE_M_PER_N: f64 = 1e-6;
+
+pub struct Session {
+    pub base: Scene,
+    pub config: Config,
+    pub instance: Instance,
+    pub surface: Surface,
+    pub history: History,
+    /// Reference displacement of each probe (the paper scenes'), metres.
+    pub reference: Vec<(String, Vec3)>,
+    /// Wall time of the last frames' stepping, exponentially averaged, milliseconds.
+    pub ms_per_frame: f64,
+    /// Relative force residual |f_int + f_ext| / |f_ext| over free nodes at the last frame.
+    pub residual: f64,
+    /// Why the simulation stopped (the NaN guard), until reset.
+    pub failure: Option<String>,
+    pub drag: Option<Drag>,
+    /// Nodes held by clamps and moved by prescribed motions (for display).
+    pub clamped: Vec<u32>,
+    pub driven: Vec<u32>,
+    quadrature: std::cell::OnceCell<PointMap>,
+    segments: usize,
+}
+
+impl Session {
+    pub fn new(base: Scene, config: Config, segments: usize) -> Result<Session, String> {
+        let scene = config.resolve(&base)?;
+        let instance = Instance::new(scene).map_err(|e| e.to_string())?;
+        let surface = Surface::new(instance.sim.mesh(), segments);
+        let reference = hox_scenes::study::reference(base.name()).unwrap_or_default();
+        let mut s = Session {
+            base,
+            config,
+            instance,
+            surface,
+            history: History::default(),
+            reference,
+            ms_per_frame: 0.0,
+            residual: f64::NAN,
+            failure: None,
+            drag: None,
+            clamped: Vec::new(),
+            driven: Vec::new(),
+            quadrature: std::cell::OnceCell::new(),
+            segments,
+        };
+        s.mesh_changed();
+        Ok(s)
+    }
+
+    /// Applies `new`, rebuilding only what it invalidates. On refusal nothing changes and the
+    /// reason is returned.
+    pub fn apply(&mut self, new: Config) -> Result<Invalidates, String> {
+        let what = self.config.invalidated_by(&new);
+        if what == Invalidates::Nothing {
+            return Ok(what);
+        }
+        let scene = new.resolve(&self.base)?;
+        match what {
+            Invalidates::Mesh => {
+                let instance = Instance::new(scene).map_err(|e| e.to_string())?;
+                self.surface = Surface::new(instance.sim.mesh(), self.segments);
+                self.instance = instance;
+                self.history = History::default();
+                self.failure = None;
+                self.drag = None;
+                self.mesh_changed();
+            }
+            Invalidates::Material => {
+                self.instance.sim.set_material(scene.material).map_err(|e| e.to_string())?;
+                self.instance.sim.set_settings(scene.settings).map_err(|e| e.to_string())?;
+                self.instance.scene = scene;
+            }
+            Invalidates::Settings => {
+                self.instance.sim.set_settings(scene.settings).map_err(|e| e.to_string())?;
+                self.instance.scene = scene;
+                self.quadrature = std::cell::OnceCell::new();
+            }
+            Invalidates::Nothing => {}
+        }
+        self.config = new;
+        Ok(what)
+    }
+
+    /// After a (re)build: the boundary-condition node sets, the first history sample.
+    fn mesh_changed(&mut self) {
+        let scene = &self.instance.scene;
+        let mesh = self.instance.sim.mesh();
+        self.clamped.clear();
+        self.driven.clear();
+        for (k, e) in scene.file.effects.iter().enumerate() {
+            let (hox_scenes::scene::EffectSpec::Clamp { nodes } | hox_scenes::scene::EffectSpec::Prescribed { nodes, .. }) = e else { continue };
+            let set = scene.selected_nodes(mesh, k, nodes).unwrap_or_default();
+            if matches!(e, hox_scenes::scene::EffectSpec::Clamp { .. }) {
+                self.clamped.extend(set);
+            } else {
+                self.driven.extend(set);
+            }
+        }
+        self.quadrature = std::cell::OnceCell::new();
+        self.record();
+    }
+
+    /// Every quadrature point as a material point (computed on first use).
+    pub fn quadrature_points(&self) -> &PointMap {
+        self.quadrature.get_or_init(|| hox_sim::surface::quadrature_points(self.instance.sim.mesh(), self.instance.sim.geometry()))
+    }
+
+    /// Changes the display tessellation.
+    pub fn set_segments(&mut self, segments: usize) {
+        if segments != self.segments {
+            self.segments = segments;
+            self.surface = Surface::new(self.instance.sim.mesh(), segments);
+        }
+    }
+
+    /// Back to the rest state at t = 0.
+    pub fn reset(&mut self) {
+        self.instance.sim.reset();
+        self.instance.sim.remove_effects_named("attachment");
+        self.drag = None;
+        self.failure = None;
+        self.history = History::default();
+        self.record();
+    }
+
+    /// Steps `frames` frames (stopping at a failure).
+    pub fn step(&mut self, frames: usize) {
+        if self.failure.is_some() {
+            return;
+        }
+        for _ in 0..frames {
+            self.instance.sim.remove_effects_named("attachment");
+            if let Some(d) = self.drag {
+                let _ = self.instance.sim.add_effect(Box::new(Attachment::new(d.node, d.target_m, DRAG_COMPLIANCE_M_PER_N)));
+            }
+            let t0 = Instant::now();
+            let result = self.instance.sim.step_frame();
+            let ms = t0.elapsed().as_secs_f64() * 1e3;
+            self.ms_per_frame = if self.ms_per_frame == 0.0 { ms } else { 0.9 * self.ms_per_frame + 0.1 * ms };
+            if let Err(e) = result {
+                self.failure = Some(format!("{e} — press Reset (R)"));
+                break;
+            }
+            self.record();
+        }
+        if self.drag.is_none() {
+            self.instance.sim.remove_effects_named("attachment");
+        }
+        self.residual = self.force_residual();
+    }
+
+    fn record(&mut self) {
+        let sim = &self.instance.sim;
+        let probe = self.instance.probe_displacements().first().map(|p| p.1).unwrap_or_default();
+        self.history.push(sim.time_secs(), probe, sim.kinetic_energy_j(), sim.elastic_energy_j());
+    }
+
+    /// |f_int + f_ext| / |f_ext| over the free nodes (gravity as the external load); 0 at an
+    /// equilibrium, about 1 far from it.
+    fn force_residual(&self) -> f64 {
+        let sim = &self.instance.sim;
+        let mesh = sim.mesh();
+        let mut grad = vec![Vec3::zeros(); mesh.num_nodes()];
+        hox_sim::energy::total_energy_and_gradient(mesh, sim.geometry(), sim.material(), &sim.positions, &mut grad);
+        let g = gravity(&self.instance.scene);
+        let (mut num, mut den) = (0.0, 0.0);
+        for (i, w) in sim.inv_mass().iter().enumerate() {
+            if *w > 0.0 {
+                let f_ext = g * sim.masses_kg()[i];
+                num += (f_ext - grad[i]).norm_squared();
+                den += f_ext.norm_squared() + grad[i].norm_squared();
+            }
+        }
+        if den > 0.0 { (num / den).sqrt() } else { 0.0 }
+    }
+
+    /// Largest probe error against the reference, metres (None for scenes without one).
+    pub fn probe_error_m(&self) -> Option<f64> {
+        if self.reference.is_empty() {
+            return None;
+        }
+        let now = self.instance.probe_displacements();
+        let errors: Vec<f64> = self
+            .reference
+            .iter()
+            .filter_map(|(name, r)| now.iter().find(|(n, _)| n == name).map(|(_, u)| (Vec3::from(*u) - r).norm()))
+            .collect();
+        errors.into_iter().reduce(f64::max)
+    }
+}
+
+fn gravity(scene: &Scene) -> Vec3 {
+    scene
+        .file
+        .effects
+        .iter()
+        .find_map(|e| match e {
+            hox_scenes::scene::EffectSpec::Gravity { acceleration_m_s2 } => Some(Vec3::from(*acceleration_m_s2)),
+            _ => None,
+        })
+        .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bending() -> Session {
+        let scene = hox_scenes::by_name("bending").unwrap();
+        let config = Config::from_scene(&scene);
+        Session::new(scene, config, 2).unwrap()
+    }
+
+    #[test]
+    fn material_change_keeps_positions_mesh_change_rebuilds() {
+        let mut s = bending();
+        s.step(10);
+        let moved = s.instance.sim.positions.clone();
+        let mut c = s.config.clone();
+        c.youngs_modulus_pa *= 2.0;
+        assert_eq!(s.apply(c.clone()), Ok(Invalidates::Material));
+        assert_eq!(s.instance.sim.positions, moved, "a material change keeps the state");
+        assert_eq!(s.instance.sim.material().youngs_modulus_pa, c.youngs_modulus_pa);
+        c.element = "q2".into();
+        c.grid = [4, 1, 1];
+        assert_eq!(s.apply(c), Ok(Invalidates::Mesh));
+        assert_eq!(s.instance.sim.mesh().num_nodes(), 9 * 3 * 3);
+        assert_eq!(s.instance.sim.time_secs(), 0.0);
+    }
+
+    #[test]
+    fn refused_change_changes_nothing() {
+        let mut s = bending();
+        let before = s.config.clone();
+        let mut c = before.clone();
+        c.poisson_ratio = 0.7;
+        assert!(s.apply(c).is_err());
+        assert_eq!(s.config, before);
+    }
+
+    #[test]
+    fn dragging_pulls_the_node_and_leaves_no_effect_behind() {
+        let mut s = bending();
+        let tip = s.instance.sim.mesh().rest_positions.iter().enumerate().max_by(|a, b| a.1.x.total_cmp(&b.1.x)).unwrap().0 as u32;
+        let target = s.instance.sim.mesh().rest_positions[tip as usize] + Vec3::new(0.0, 0.0, 0.3);
+        s.drag = Some(Drag { node: tip, target_m: target });
+        s.step(60);
+        assert!((s.instance.sim.positions[tip as usize] - target).norm() < 0.05);
+        s.drag = None;
+        s.step(1);
+        assert!(s.instance.sim.effects().iter().all(|e| e.name() != "attachment"));
+    }
+}

@@ -1,0 +1,124 @@
+//! `hox record` and `hox inspect`: Rerun recordings written headlessly and read back with the
+//! Rerun decoder.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn hox(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hox")).args(args).env_remove("RUST_BACKTRACE").output().expect("hox runs")
+}
+
+fn ok_json(args: &[&str]) -> serde_json::Value {
+    let out = hox(args);
+    assert!(out.status.success(), "hox {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("hox {args:?} printed no JSON: {e}"))
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hox-record-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn entities(file: &Path) -> serde_json::Value {
+    ok_json(&["inspect", file.to_str().unwrap(), "--json"])["entities"].clone()
+}
+
+#[test]
+fn paper_scenes_record_and_read_back() {
+    for scene in ["bending", "tension", "torsion"] {
+        let file = temp(&format!("{scene}.rrd"));
+        let summary = ok_json(&["record", "--scene", scene, "--seconds", "0.25", "--out", file.to_str().unwrap(), "--json"]);
+        assert_eq!(summary["frames"], 16, "{scene}: 15 steps at 60 fps plus the initial state");
+        assert!(summary["bytes"].as_u64().unwrap() > 10_000);
+        let checked = ok_json(&["inspect", file.to_str().unwrap(), "--expect-frames", "16", "--json"]);
+        let configs = checked["configurations"].as_array().unwrap();
+        assert_eq!(configs.len(), 1);
+        let c = configs[0].as_str().unwrap();
+        let e = &checked["entities"];
+        let surface = &e[format!("world/{c}/surface")];
+        assert!(surface["static_components"].as_array().unwrap().iter().any(|v| v == "Mesh3D:triangle_indices"));
+        for component in ["Mesh3D:vertex_positions", "Mesh3D:vertex_colors", "Mesh3D:vertex_normals"] {
+            assert_eq!(surface["frames_per_component"][component].as_array().unwrap().len(), 16, "{scene}: {component}");
+        }
+        // every probe component and the energies are time series on the frame timeline
+        for quantity in ["probe_tip_u_z_m", "kinetic_energy_j", "elastic_energy_j", "ms_per_frame", "min_det_f"] {
+            let series = &e[format!("plots/{quantity}/{c}")]["frames_per_component"]["Scalars:scalars"];
+            assert_eq!(series.as_array().map(Vec::len), Some(16), "{scene}: plots/{quantity}/{c}");
+        }
+        assert!(e[format!("world/{c}/legend/bar")]["static_components"].as_array().unwrap().iter().any(|v| v == "Mesh3D:vertex_colors"));
+        assert!(e[format!("legend/{c}")]["static_components"].as_array().unwrap().iter().any(|v| v == "TextDocument:text"));
+    }
+}
+
+#[test]
+fn compare_records_p1_and_p2_side_by_side() {
+    let file = temp("compare.rrd");
+    let f = file.to_str().unwrap();
+    let summary = ok_json(&["record", "--scene", "bending", "--seconds", "0.1", "--out", f, "--compare", "element=p1,refine=1", "--compare", "element=p2", "--quadrature-points", "--json"]);
+    let entities: Vec<&str> = summary["configurations"].as_array().unwrap().iter().map(|c| c["entity"].as_str().unwrap()).collect();
+    assert_eq!(entities, ["world/p1_1280", "world/p2_160"]);
+    let checked = ok_json(&["inspect", f, "--expect-frames", "7", "--json"]);
+    assert_eq!(checked["configurations"], serde_json::json!(["p1_1280", "p2_160"]));
+    let e = &checked["entities"];
+    for c in ["p1_1280", "p2_160"] {
+        assert!(e[format!("world/{c}")]["static_components"].as_array().unwrap().iter().any(|v| v == "Transform3D:translation"), "{c} is offset");
+        assert_eq!(e[format!("world/{c}/quadrature_points")]["frames_per_component"]["Points3D:positions"].as_array().map(Vec::len), Some(7));
+    }
+}
+
+#[test]
+fn bad_output_or_options_fail_before_simulating_and_keep_existing_files() {
+    let out = hox(&["record", "--scene", "bending", "--out", "/nonexistent-folder/x.rrd"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot write /nonexistent-folder/x.rrd"));
+    // an existing file survives a refused command
+    let file = temp("keep.rrd");
+    std::fs::write(&file, b"precious").unwrap();
+    for args in [
+        vec!["--compare", "element=p1"],
+        vec!["--compare", "element=p1", "--compare", "colour=red"],
+        vec!["--poisson", "0.5", "--material", "snh"],
+        vec!["--seconds", "nan"],
+        vec!["--tessellation", "0"],
+    ] {
+        let mut all = vec!["record", "--scene", "bending", "--out", file.to_str().unwrap()];
+        all.extend(args.iter());
+        let out = hox(&all);
+        assert!(!out.status.success(), "{all:?} should fail");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.starts_with("error: ") && !err.contains("panicked"), "{all:?}: {err}");
+        assert_eq!(std::fs::read(&file).unwrap(), b"precious", "{all:?} touched the existing file");
+    }
+    // and an .rrd that is not one is named as such
+    let out = hox(&["inspect", file.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a readable Rerun recording"), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_leaves_a_playable_file_up_to_the_last_frame() {
+    let file = temp("interrupted.rrd");
+    let child = Command::new(env!("CARGO_BIN_EXE_hox"))
+        .args(["record", "--scene", "bending", "--seconds", "600", "--out", file.to_str().unwrap()])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // wait until some frames are on disk
+    let started = std::time::Instant::now();
+    while std::fs::metadata(&file).map(|m| m.len()).unwrap_or(0) < 200_000 {
+        assert!(started.elapsed().as_secs() < 120, "no frames written");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let status = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("interrupted"));
+    let e = entities(&file);
+    let frames = e["world/p2_160/surface"]["frames_per_component"]["Mesh3D:vertex_positions"].as_array().unwrap().len();
+    assert!(frames >= 2, "{frames}");
+    // every entity holds the same, complete frames
+    ok_json(&["inspect", file.to_str().unwrap(), "--expect-frames", &frames.to_string(), "--json"]);
+}
