@@ -9,6 +9,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+mod gmsh;
+
 #[derive(Parser)]
 #[command(name = "hox", version, about = "hox: see, measure and teach high-order finite elements in XPBD")]
 pub struct Cli {
@@ -81,6 +83,8 @@ pub enum Command {
         /// less than 1e-7 × the body's diagonal per frame for 30 frames) or 120 s.
         #[arg(long)]
         settle: bool,
+        #[command(flatten)]
+        vtk: gmsh::VtkArgs,
         #[arg(long)]
         json: bool,
     },
@@ -89,11 +93,13 @@ pub enum Command {
 #[derive(Args)]
 pub struct SceneArgs {
     /// A built-in scene (see `hox scenes`).
-    #[arg(long, conflicts_with = "scene_file", required_unless_present = "scene_file")]
+    #[arg(long, conflicts_with_all = ["scene_file", "mesh_file"], required_unless_present_any = ["scene_file", "mesh_file"])]
     pub scene: Option<String>,
     /// A scene file (TOML, see assets/scenes/).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "mesh_file")]
     pub scene_file: Option<PathBuf>,
+    #[command(flatten)]
+    pub mesh_file: gmsh::MeshFileArgs,
 }
 
 #[derive(Args)]
@@ -168,7 +174,7 @@ pub fn main(cli: Cli) -> Result<()> {
         Command::Elements { json } => elements(json),
         Command::Scenes { json } => scenes(json),
         Command::Mesh { scene, mesh, json } => mesh_command(&scene, &mesh, json),
-        Command::Simulate { scene, mesh, physics, seconds, settle, json } => simulate(&scene, &mesh, &physics, seconds, settle, json),
+        Command::Simulate { scene, mesh, physics, seconds, settle, vtk, json } => simulate(&scene, &mesh, &physics, seconds, settle, &vtk, json),
         Command::Study { quick, out } => study(quick, &out),
         Command::Static { scene, mesh, physics, tolerance, load_steps, json } => static_command(&scene, &mesh, &physics, tolerance, load_steps, json),
     }
@@ -198,10 +204,13 @@ impl DelayedBar {
 }
 
 fn load_scene(args: &SceneArgs) -> Result<Scene> {
+    if let Some(scene) = gmsh::scene(&args.mesh_file)? {
+        return Ok(scene);
+    }
     Ok(match (&args.scene, &args.scene_file) {
         (Some(name), None) => hox_scenes::by_name(name)?,
         (None, Some(path)) => Scene::load(path)?,
-        _ => bail!("give exactly one of --scene NAME and --scene-file FILE"),
+        _ => bail!("give exactly one of --scene NAME, --scene-file FILE and --mesh FILE.msh"),
     })
 }
 
@@ -233,12 +242,16 @@ fn mesh_command(scene: &SceneArgs, mesh: &MeshArgs, json: bool) -> Result<()> {
     let m = scene.build_mesh()?;
     let geometry = hox_sim::geometry::precompute(&m, scene.settings.quadrature_degree)
         .with_context(|| format!("{}: the mesh has a bad element", scene.source))?;
-    let out = serde_json::json!({
-        "element": scene.mesh.element_type.name(),
+    let mut out = serde_json::json!({
+        "element": scene.mesh.element_names(),
         "elements": m.num_elements(),
         "nodes": m.num_nodes(),
         "volume_m3": hox_sim::geometry::total_volume_m3(&geometry),
     });
+    if let Some(imported) = scene.mesh.imported() {
+        out["blocks"] = m.blocks.iter().map(|b| serde_json::json!({"element": b.element_type.name(), "elements": b.len()})).collect();
+        out["groups"] = imported.node_sets.iter().map(|(name, nodes)| (name.clone(), serde_json::json!({"nodes": nodes.len(), "elements": imported.element_sets.get(name).map_or(0, Vec::len)}))).collect();
+    }
     if json {
         println!("{out}");
     } else {
@@ -250,11 +263,14 @@ fn mesh_command(scene: &SceneArgs, mesh: &MeshArgs, json: bool) -> Result<()> {
             out["nodes"],
             out["volume_m3"].as_f64().unwrap_or_default()
         );
+        if let Some(imported) = scene.mesh.imported() {
+            println!("  physical groups: {}", imported.group_names());
+        }
     }
     Ok(())
 }
 
-fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: Option<f64>, settle: bool, json: bool) -> Result<()> {
+fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: Option<f64>, settle: bool, vtk: &gmsh::VtkArgs, json: bool) -> Result<()> {
     let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
     let mode = if settle {
         RunMode::SETTLE
@@ -266,18 +282,29 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
         RunMode::Seconds(t)
     };
     let mut instance = Instance::new(scene)?;
+    let mut vtk_writer = gmsh::VtkWriter::create(vtk, &instance)?;
     let mut bar = DelayedBar::new();
-    let report = hox_scenes::run(&mut instance, mode, &mut |t, fraction| {
+    let mut on_frame = |i: &Instance| vtk_writer.as_mut().map_or(Ok(()), |w| w.frame(i));
+    let report = hox_scenes::run_observed(&mut instance, mode, &mut |t, fraction| {
         let template = if fraction.is_some() { "{spinner} {bar:40} {percent}% {msg} (eta {eta})" } else { "{spinner} settling… {msg}" };
         bar.reveal(template);
         if let Some(f) = fraction {
             bar.bar.set_position((1000.0 * f) as u64);
         }
         bar.bar.set_message(format!("t = {t:.2} s"));
-    })?;
+    }, &mut on_frame)?;
     bar.bar.finish_and_clear();
+    let groups = instance.group_displacements();
+    let vtk_index = vtk_writer.map(|w| w.finish(&instance)).transpose()?;
     if json {
-        println!("{}", serde_json::to_string(&report)?);
+        let mut out = serde_json::to_value(&report)?;
+        if !groups.is_empty() {
+            out["groups"] = serde_json::to_value(&groups)?;
+        }
+        if let Some(index) = &vtk_index {
+            out["vtk"] = index.display().to_string().into();
+        }
+        println!("{out}");
     } else {
         println!(
             "{}: {} frames, {:.3} s simulated, {:.2} ms per frame{}",
@@ -290,7 +317,13 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
         for (name, u) in &report.probes {
             println!("  probe {name}: u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
         }
+        for (name, u) in &groups {
+            println!("  group {name}: mean u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
+        }
         println!("  kinetic energy {:.6e} J, elastic energy {:.6e} J", report.kinetic_energy_j, report.elastic_energy_j);
+        if let Some(index) = &vtk_index {
+            println!("  ParaView series: {}", index.display());
+        }
     }
     if settle && !report.settled {
         eprintln!("warning: the run did not settle within {} s", hox_scenes::SETTLE_CAP_SECS);
@@ -331,8 +364,10 @@ fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tol
         let u = probe.displacement(&solution.positions, &m.rest_positions);
         probes.insert(p.name.clone(), [u.x, u.y, u.z]);
     }
+    let groups = scene.group_displacements(&solution.positions);
     let out = serde_json::json!({
         "probes": probes,
+        "groups": groups,
         "newton_iterations": solution.newton_iterations,
         "residual": solution.relative_residual,
         "seconds": seconds,
@@ -344,6 +379,9 @@ fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tol
         println!("{}: static equilibrium, {dofs} DOFs, {} Newton iterations, residual {:.2e}, {seconds:.2} s", scene.name(), solution.newton_iterations, solution.relative_residual);
         for (name, u) in &probes {
             println!("  probe {name}: u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
+        }
+        for (name, u) in &groups {
+            println!("  group {name}: mean u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
         }
     }
     Ok(())

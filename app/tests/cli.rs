@@ -77,3 +77,111 @@ fn bad_input_is_a_clear_error_with_a_non_zero_exit() {
     fails_with(&["static", "--scene", "drop"], "contact");
     fails_with(&["frobnicate"], "unrecognized subcommand");
 }
+
+/// A committed Gmsh mesh (assets/meshes/).
+fn gmsh_mesh(name: &str) -> String {
+    format!("{}/../assets/meshes/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A fresh scratch folder for one test.
+fn scratch(test: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("hox-cli-{test}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn mesh_reports_a_gmsh_files_blocks_volume_and_groups() {
+    let m = json(&["mesh", "--mesh", &gmsh_mesh("beam-mixed.msh"), "--json"]);
+    assert_eq!((m["elements"].as_u64().unwrap(), m["nodes"].as_u64().unwrap()), (174, 101));
+    assert_eq!(m["element"], "q1+p1+pyramid+prism");
+    assert!((m["volume_m3"].as_f64().unwrap() - 0.5).abs() < 1e-12);
+    assert_eq!(m["groups"]["clamp"]["nodes"], 9);
+    assert_eq!(m["groups"]["body"]["elements"], 174);
+    let out = hox(&["mesh", "--mesh", &gmsh_mesh("beam-tet20.msh")]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("82 p3 elements, 548 nodes") && text.contains("\"body\", \"clamp\", \"tip\""), "{text}");
+}
+
+#[test]
+fn simulate_a_gmsh_mesh_and_write_a_paraview_series() {
+    let dir = scratch("vtk");
+    let vtk = dir.join("out");
+    let r = json(&[
+        "simulate", "--mesh", &gmsh_mesh("beam-tet10.msh"), "--clamp", "clamp", "--seconds", "0.1", "--vtk", vtk.to_str().unwrap(), "--vtk-every", "4", "--json",
+    ]);
+    assert_eq!(r["frames"], 6);
+    assert_eq!(r["groups"]["clamp"], serde_json::json!([0.0, 0.0, 0.0]));
+    assert!(r["groups"]["tip"][2].as_f64().unwrap() < 0.0, "gravity is on by default");
+    // the rest state, frame 4 and the last frame (6)
+    let index = std::fs::read_to_string(vtk.join("beam-tet10.pvd")).unwrap();
+    assert_eq!(index.matches("<DataSet").count(), 3, "{index}");
+    assert_eq!(r["vtk"].as_str().unwrap(), vtk.join("beam-tet10.pvd").to_str().unwrap());
+    for k in 0..3 {
+        let vtu = std::fs::read_to_string(vtk.join(format!("beam-tet10_{k:06}.vtu"))).unwrap();
+        assert!(vtu.contains("NumberOfPoints=\"495\" NumberOfCells=\"218\"") && vtu.contains("Name=\"displacement_m\"") && vtu.contains("Name=\"von_mises_stress_pa\""));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_driven_group_reaches_its_prescribed_position_in_the_static_solution() {
+    let s = json(&[
+        "static", "--mesh", &gmsh_mesh("beam-hex8.msh"), "--clamp", "clamp", "--drive", "tip", "--drive-translation-m", "0,0,-0.1", "--no-gravity", "--json",
+    ]);
+    let tip = &s["groups"]["tip"];
+    assert!((tip[2].as_f64().unwrap() + 0.1).abs() < 1e-12 && tip[0].as_f64().unwrap().abs() < 1e-12, "{tip}");
+    assert!(s["groups"]["body"][2].as_f64().unwrap() < 0.0);
+    // a rotation about the group's own centre: the tip face turns, its centre stays
+    let s = json(&[
+        "static", "--mesh", &gmsh_mesh("beam-hex8.msh"), "--clamp", "clamp", "--drive", "tip", "--drive-rotation-deg", "30", "--no-gravity", "--json",
+    ]);
+    assert!(s["groups"]["tip"].as_array().unwrap().iter().all(|c| c.as_f64().unwrap().abs() < 1e-12), "{}", s["groups"]["tip"]);
+}
+
+#[test]
+fn bad_mesh_files_are_clear_errors_naming_the_file_and_the_element() {
+    let dir = scratch("bad-msh");
+    let head = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 1 \"clamp\"\n$EndPhysicalNames\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n";
+    let write = |name: &str, elements: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, format!("{head}$Elements\n{elements}$EndElements\n")).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let cases = [
+        (write("unknown.msh", "1\n7 99 2 1 1 1 2 3 4\n"), "unknown.msh:17: element 7 has unknown Gmsh element type 99"),
+        (write("hex20.msh", "1\n7 17 2 1 1 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4\n"), "element 7 is a 20-node hexahedron (Gmsh type 17)"),
+        (write("range.msh", "1\n7 4 2 1 1 1 2 3 44\n"), "range.msh:17: element 7 refers to node 44"),
+        (write("inverted.msh", "1\n7 4 2 1 1 2 1 3 4\n"), "element 7 (p1) is inverted"),
+        (write("flat.msh", "1\n7 4 2 1 1 1 2 3 3\n"), "element 7 (p1) uses node 3 twice"),
+        (write("surface.msh", "1\n7 2 2 1 1 1 2 3\n"), "surface-only mesh"),
+        (write("empty.msh", "0\n"), "the mesh is empty: no elements"),
+    ];
+    for (path, needle) in &cases {
+        fails_with(&["mesh", "--mesh", path], needle);
+        fails_with(&["mesh", "--mesh", path], path);
+    }
+    let good = write("good.msh", "2\n6 2 2 1 1 1 3 2\n7 4 2 1 1 1 2 3 4\n");
+    fails_with(&["simulate", "--mesh", &good, "--clamp", "wall"], "physical group \"wall\" does not exist (the file's groups: \"1\", \"clamp\") (the clamp group)");
+    fails_with(&["simulate", "--mesh", &good, "--drive", "clamp"], "--drive clamp: give a --drive-translation-m or a --drive-rotation-deg");
+    fails_with(&["simulate", "--mesh", &good, "--drive-translation-m", "1,2"], "three finite numbers");
+    fails_with(&["simulate", "--scene", "bending", "--clamp", "x"], "--clamp needs --mesh FILE.msh");
+    fails_with(&["simulate", "--scene", "bending", "--vtk-every", "3"], "--vtk-every needs --vtk DIR");
+    fails_with(&["mesh", "--mesh", "/nonexistent/beam.msh"], "cannot read /nonexistent/beam.msh");
+    let not_msh = dir.join("beam.stl");
+    std::fs::write(&not_msh, "solid beam\nendsolid\n").unwrap();
+    fails_with(&["mesh", "--mesh", not_msh.to_str().unwrap()], "not a Gmsh mesh file");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_unwritable_vtk_folder_is_an_error_before_simulating() {
+    let dir = scratch("vtk-unwritable");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let started = std::time::Instant::now();
+    fails_with(&["simulate", "--scene", "bending", "--seconds", "1000", "--vtk", file.join("out").to_str().unwrap()], "--vtk");
+    assert!(started.elapsed().as_secs() < 30, "refused before simulating 1000 s");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

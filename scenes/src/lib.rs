@@ -39,6 +39,9 @@ pub enum SceneError {
     Io { path: String, message: String },
     #[error("{source_name}: cannot build the mesh: {message}")]
     Mesh { source_name: String, message: String },
+    /// A mesh file's own error (it names the file).
+    #[error("{0}")]
+    MeshFile(String),
     #[error("{source_name}: {message}")]
     Simulation { source_name: String, message: String },
     #[error("{source_name}: {message}")]

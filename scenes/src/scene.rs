@@ -462,6 +462,9 @@ impl Scene {
         let source = path.display().to_string();
         let base = Scene::from_file(SceneFile::for_mesh_file(path, gravity), &source)?;
         let imported = base.mesh.imported().expect("a mesh-file scene");
+        for (group, role) in clamps.iter().map(|g| (g, "clamp")).chain(drives.iter().map(|d| (&d.group, "drive"))) {
+            imported.node_set(group).map_err(|e| SceneError::MeshFile(format!("{e} (the {role} group)")))?;
+        }
         let mut file = base.file.clone();
         for group in clamps {
             file.effects.push(EffectSpec::Clamp { nodes: NodeSelector::group(group) });
@@ -703,7 +706,14 @@ fn mesh_of(m: &MeshSpec, source: &str, base_dir: Option<&Path>, cached: Option<&
         {
             return Ok(SceneMesh::File { path, imported: imported.clone() });
         }
-        let imported = hox_sim::mesh::gmsh::read_msh(&path).map_err(|e| SceneError::Mesh { source_name: source.to_string(), message: e.to_string() })?;
+        let imported = hox_sim::mesh::gmsh::read_msh(&path).map_err(|e| {
+            // a scene built from the mesh file alone (`--mesh`) is named by the file already
+            if source == path.display().to_string() {
+                SceneError::MeshFile(e.to_string())
+            } else {
+                SceneError::Mesh { source_name: source.to_string(), message: e.to_string() }
+            }
+        })?;
         return Ok(SceneMesh::File { path, imported: Arc::new(imported) });
     }
     let missing = |key: &str| invalid(key, "missing".into(), "a box mesh needs box_min_m, box_max_m, element and grid (or give file = \"….msh\")");

@@ -142,6 +142,42 @@ pub fn total_energy_and_gradient(
     total
 }
 
+/// Where `det F` is smallest over every quadrature point of a mesh: the robustness checks'
+/// "is any element inverted?" (`det F ≤ 0` somewhere) measure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MinDetF {
+    /// The smallest `det F_q` found.
+    pub det_f: f64,
+    pub block: usize,
+    pub element: usize,
+    pub point: usize,
+}
+
+/// The smallest `det F_q = det(Σ_i x_i ⊗ ∇_X N_i(r_q))` over all elements and quadrature points
+/// at `positions` (None for a mesh without elements). A non-finite `det F` counts as the
+/// smallest (−∞), so NaN positions are never reported as healthy.
+pub fn min_det_f(mesh: &Mesh, geometry: &[BlockGeometry], positions: &[Vec3]) -> Option<MinDetF> {
+    let (mut x, mut rest) = (Vec::new(), Vec::new());
+    let mut best: Option<MinDetF> = None;
+    for (bi, (b, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
+        let n = b.nodes_per_element();
+        x.resize(n, Vec3::zeros());
+        rest.resize(n, Vec3::zeros());
+        for (e, nodes) in b.elements().enumerate() {
+            gather(positions, nodes, &mut x);
+            gather(&mesh.rest_positions, nodes, &mut rest);
+            for q in 0..g.points_per_element {
+                let det = local_deformation_gradient(&x, &rest, g.gradients(e, q)).determinant();
+                let det = if det.is_finite() { det } else { f64::NEG_INFINITY };
+                if best.is_none_or(|m| det < m.det_f) {
+                    best = Some(MinDetF { det_f: det, block: bi, element: e, point: q });
+                }
+            }
+        }
+    }
+    best
+}
+
 /// All quadrature points' material gradients of element `e` (`points × nodes`).
 #[inline]
 pub fn element_grads(g: &BlockGeometry, e: usize) -> &[Vec3] {

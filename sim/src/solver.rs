@@ -9,8 +9,16 @@
 //!
 //! Defaults are the paper's: 50 substeps × 1 iteration, 60 frames per second. The solver
 //! gathers each element's nodes, calls a pure kernel, and scatters the corrections back.
-//! After every substep it checks that all positions are finite; if not, it stops with an error
-//! naming an element that holds the first bad node and the substep, instead of going on.
+//!
+//! **NaN guard.** A kernel whose corrections come out non-finite is not scattered: the substep
+//! stops there with [`SimError::NonFinite`] naming that element (block and index), its bad node,
+//! the frame, the substep within the frame and the time. After every substep all positions and
+//! velocities are checked as well (an effect, or a caller writing `positions`, can also bring a
+//! NaN or an infinity in), naming an element that holds the first bad node. On either failure the
+//! positions go back to the last finite state (the start of the failing substep, or the rest shape
+//! if that was not finite either), velocities to zero, and the simulation refuses to step until
+//! [`Simulation::reset`] (or [`Simulation::warm_start`]): a viewer keeps showing the last sound
+//! state instead of painting garbage, and offers a reset. See `docs/STABILITY.md`.
 
 use crate::Vec3;
 use crate::constraint::{Formulation, MAX_NODES, project_energy_constraint, project_split_constraints};
@@ -71,10 +79,30 @@ pub enum SimError {
     Settings(String),
     #[error("effect '{effect}' refers to node {node}, but the mesh has {num_nodes} nodes")]
     EffectNode { effect: &'static str, node: u32, num_nodes: usize },
+    #[error("node {node}: {reason}")]
+    Mass { node: usize, reason: String },
     #[error(
-        "the simulation blew up: node {node} of element {element} ({element_type}) became non-finite at substep {substep} (t = {time_secs:.6} s); reset, or use more substeps, a softer material or stable Neo-Hookean"
+        "the simulation blew up at frame {frame}, substep {substep_in_frame} of {substeps_per_frame} (t = {time_secs:.6} s): {origin} element {element} of block {block} ({element_type}), at its node {node}; the last finite state is kept — reset, or use more substeps, a softer material or stable Neo-Hookean"
     )]
-    NonFinite { node: usize, element: usize, element_type: String, substep: u64, time_secs: f64 },
+    NonFinite {
+        /// Element block and index within it.
+        block: usize,
+        element: usize,
+        element_type: String,
+        /// A non-finite node of that element (global index).
+        node: usize,
+        /// What went wrong: "the projection of" (the kernel's output) or "a non-finite position
+        /// or velocity in" (found after the substep).
+        origin: &'static str,
+        /// The frame being advanced, counted from 1.
+        frame: u64,
+        /// The substep within that frame, counted from 1, and the substeps per frame.
+        substep_in_frame: u32,
+        substeps_per_frame: u32,
+        /// Substeps taken since the start (or the last reset), the failing one included.
+        substep: u64,
+        time_secs: f64,
+    },
 }
 
 /// Counters of the work done, for tests and the status line.
@@ -100,8 +128,14 @@ pub struct Simulation {
     effects: Vec<Box<dyn Effect>>,
     /// Per block, the elements grouped by colour (no two elements of a colour share a node).
     colours: Vec<Vec<Vec<u32>>>,
+    /// Per block, the element data reordered colour by colour for the parallel sweep.
+    packed: Vec<crate::kernels::ColourPacked>,
     time_secs: f64,
     frames: u64,
+    /// Substeps taken in the frame being advanced.
+    substeps_in_frame: u32,
+    /// Set when the NaN guard stopped the simulation; cleared by reset or warm start.
+    failure: Option<SimError>,
     counters: SolverCounters,
 }
 
@@ -135,15 +169,23 @@ impl Simulation {
             lambdas,
             effects: Vec::with_capacity(effects.len()),
             colours: Vec::new(),
+            packed: Vec::new(),
             time_secs: 0.0,
             frames: 0,
+            substeps_in_frame: 0,
+            failure: None,
             counters: SolverCounters::default(),
         };
         for e in effects {
             sim.add_effect(e)?;
         }
         sim.colours = sim.mesh.blocks.iter().map(|b| crate::colouring::colour_elements(b, sim.mesh.num_nodes())).collect();
+        sim.pack_colours();
         Ok(sim)
+    }
+
+    fn pack_colours(&mut self) {
+        self.packed = self.mesh.blocks.iter().zip(&self.geometry).zip(&self.colours).map(|((b, g), c)| crate::kernels::ColourPacked::new(b, g, c)).collect();
     }
 
     fn multipliers(geometry: &[BlockGeometry], formulation: Formulation) -> Vec<Vec<f64>> {
@@ -224,6 +266,28 @@ impl Simulation {
         before - self.effects.len()
     }
 
+    /// The error that stopped the simulation, if the NaN guard did (until reset).
+    pub fn failure(&self) -> Option<&SimError> {
+        self.failure.as_ref()
+    }
+
+    /// Sets one node's lumped mass (for example a heavy bead on a soft body). A pinned node
+    /// stays pinned. A density change ([`Simulation::set_material`]) recomputes every mass.
+    pub fn set_mass_kg(&mut self, node: usize, mass_kg: f64) -> Result<(), SimError> {
+        let n = self.masses_kg.len();
+        if node >= n {
+            return Err(SimError::Mass { node, reason: format!("the mesh has {n} nodes") });
+        }
+        if !(mass_kg.is_finite() && mass_kg > 0.0) {
+            return Err(SimError::Mass { node, reason: format!("a mass must be a finite positive number of kilograms, got {mass_kg}") });
+        }
+        self.masses_kg[node] = mass_kg;
+        if self.inv_mass[node] > 0.0 {
+            self.inv_mass[node] = 1.0 / mass_kg;
+        }
+        Ok(())
+    }
+
     /// Changes the material, keeping positions and velocities (masses follow the density).
     pub fn set_material(&mut self, material: Material) -> Result<(), SimError> {
         if material.density_kg_m3 != self.material.density_kg_m3 {
@@ -245,6 +309,7 @@ impl Simulation {
         settings.validate()?;
         if settings.quadrature_degree != self.settings.quadrature_degree {
             self.geometry = precompute(&self.mesh, settings.quadrature_degree)?;
+            self.pack_colours();
         }
         self.lambdas = Self::multipliers(&self.geometry, settings.formulation);
         self.settings = settings;
@@ -258,6 +323,8 @@ impl Simulation {
         self.prev_positions.copy_from_slice(positions);
         self.velocities.iter_mut().for_each(|v| *v = Vec3::zeros());
         self.time_secs = time_secs;
+        self.substeps_in_frame = 0;
+        self.failure = None;
     }
 
     /// Back to the rest shape at t = 0.
@@ -267,6 +334,8 @@ impl Simulation {
         self.velocities.iter_mut().for_each(|v| *v = Vec3::zeros());
         self.time_secs = 0.0;
         self.frames = 0;
+        self.substeps_in_frame = 0;
+        self.failure = None;
     }
 
     /// Advances one frame (`substeps` substeps).
@@ -275,14 +344,19 @@ impl Simulation {
             self.substep()?;
         }
         self.frames += 1;
+        self.substeps_in_frame = 0;
         Ok(())
     }
 
     /// Advances one substep of `h = 1/(fps · substeps)`.
     pub fn substep(&mut self) -> Result<(), SimError> {
+        if let Some(e) = &self.failure {
+            return Err(e.clone());
+        }
         let h = self.settings.substep_dt_secs();
         self.time_secs += h;
         self.counters.substeps += 1;
+        self.substeps_in_frame += 1;
         macro_rules! hook {
             ($name:ident) => {
                 for e in self.effects.iter_mut() {
@@ -307,7 +381,9 @@ impl Simulation {
         hook!(after_prediction);
         self.lambdas.iter_mut().for_each(|l| l.fill(0.0));
         for _ in 0..self.settings.iterations {
-            self.project_elements(h);
+            if let Err(bad) = self.project_elements(h) {
+                return Err(self.fail(bad));
+            }
             hook!(after_projection);
         }
         let inv_h = 1.0 / h;
@@ -315,27 +391,49 @@ impl Simulation {
             *v = (x - xp) * inv_h;
         }
         hook!(after_velocity_update);
-        self.check_finite()
+        match self.first_non_finite() {
+            Some(bad) => Err(self.fail(bad)),
+            None => Ok(()),
+        }
     }
 
     /// One Gauss–Seidel sweep over every element constraint: in element order, or colour by
     /// colour with the elements of a colour projected in parallel.
-    fn project_elements(&mut self, h: f64) {
+    /// Stops at the first element whose corrections come out non-finite (not scattered) and
+    /// returns it.
+    fn project_elements(&mut self, h: f64) -> Result<(), BadElement> {
         let inv_dt2 = 1.0 / (h * h);
         if self.settings.parallel {
-            self.project_elements_parallel(inv_dt2);
-            return;
+            return self.project_elements_parallel(inv_dt2);
         }
         let mut x = [Vec3::zeros(); MAX_NODES];
         for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
             let block = &self.mesh.blocks[bi];
             let n = block.nodes_per_element();
+            if self.settings.formulation == Formulation::Energy {
+                use crate::kernels::{BlockData, Multipliers, Positions, energy_sweep};
+                let data = BlockData::of(block, &self.geometry[bi]);
+                // SAFETY: one thread; the mesh was validated, so its node indices fit positions,
+                // and lambdas holds one multiplier per element.
+                let fast = unsafe { energy_sweep(n, &self.material, Positions::new(&mut self.positions), &self.mesh.rest_positions, &self.inv_mass, &data, 0..block.len(), Multipliers::new(lambdas), inv_dt2) };
+                match fast {
+                    Some(Ok(projected)) => {
+                        self.counters.element_projections += projected;
+                        continue;
+                    }
+                    Some(Err(bad)) => return Err(BadElement::projected(bi, bad.element, bad.node, block.element(bad.element), |i| self.positions[i])),
+                    None => {}
+                }
+            }
             let per_element = lambdas.len() / block.len().max(1);
             for (e, nodes) in block.elements().enumerate() {
                 let lambda = &mut lambdas[e * per_element..(e + 1) * per_element];
                 let ctx = ProjectionContext { rest: &self.mesh.rest_positions, inv_mass: &self.inv_mass, material: &self.material, formulation: self.settings.formulation, inv_dt2 };
                 let positions = &self.positions;
                 if ctx.project(|i| positions[i], &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
+                    if let Some(node) = non_finite_node(&x[..n], nodes) {
+                        return Err(BadElement::projected(bi, e, node, nodes, |i| positions[i]));
+                    }
                     for (xi, &node) in x.iter().zip(nodes) {
                         self.positions[node as usize] = *xi;
                     }
@@ -343,20 +441,37 @@ impl Simulation {
                 }
             }
         }
+        Ok(())
     }
 
     /// The parallel sweep: same-colour elements touch disjoint nodes and multipliers, so they
     /// are projected concurrently and the result does not depend on the scheduling.
-    fn project_elements_parallel(&mut self, inv_dt2: f64) {
+    fn project_elements_parallel(&mut self, inv_dt2: f64) -> Result<(), BadElement> {
         use rayon::prelude::*;
         let positions = SharedSlice::new(&mut self.positions);
         for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
             let block = &self.mesh.blocks[bi];
             let n = block.nodes_per_element();
             let per_element = lambdas.len() / block.len().max(1);
+            if self.settings.formulation == Formulation::Energy {
+                // SAFETY of the aliasing: the specialised sweep writes positions through its own
+                // pointer, and nothing else touches them meanwhile.
+                let all = unsafe { positions.slice_mut(0, positions.len) };
+                match crate::kernels::parallel_energy_block(n, &self.material, all, &self.mesh.rest_positions, &self.inv_mass, &self.packed[bi], lambdas, inv_dt2) {
+                    Some(Ok(projected)) => {
+                        self.counters.element_projections += projected;
+                        continue;
+                    }
+                    Some(Err(bad)) => {
+                        let read = |i: usize| unsafe { positions.read(i) };
+                        return Err(BadElement::projected(bi, bad.element, bad.node, block.element(bad.element), read));
+                    }
+                    None => {}
+                }
+            }
             let lambdas = SharedSlice::new(lambdas);
             for colour in &self.colours[bi] {
-                let projected: usize = colour
+                let projected: Result<usize, BadElement> = colour
                     .par_iter()
                     .with_min_len(PARALLEL_MIN_ELEMENTS)
                     .map(|&e| {
@@ -370,31 +485,57 @@ impl Simulation {
                         // SAFETY: reads only this element's nodes, which no other thread writes.
                         let read = |i: usize| unsafe { positions.read(i) };
                         if !ctx.project(read, &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
-                            return 0;
+                            return Ok(0);
+                        }
+                        if let Some(node) = non_finite_node(&x[..n], nodes) {
+                            return Err(BadElement::projected(bi, e, node, nodes, read));
                         }
                         for (xi, &node) in x.iter().zip(nodes) {
                             // SAFETY: as above.
                             unsafe { positions.write(node as usize, *xi) };
                         }
-                        1
+                        Ok(1)
                     })
                     .sum();
-                self.counters.element_projections += projected as u64;
+                self.counters.element_projections += projected? as u64;
             }
         }
+        Ok(())
     }
 
-    fn check_finite(&self) -> Result<(), SimError> {
-        let Some(node) = self.positions.iter().zip(&self.velocities).position(|(x, v)| !(x.iter().chain(v.iter()).all(|c| c.is_finite()))) else {
-            return Ok(());
-        };
-        let (element_type, element) = self
+    /// The first node whose position or velocity is not finite, with an element holding it.
+    fn first_non_finite(&self) -> Option<BadElement> {
+        let node = self.positions.iter().zip(&self.velocities).position(|(x, v)| !(x.iter().chain(v.iter()).all(|c| c.is_finite())))?;
+        let (block, element) = self
             .mesh
             .blocks
             .iter()
-            .find_map(|b| b.elements().position(|el| el.contains(&(node as u32))).map(|e| (b.element_type.to_string(), e)))
-            .unwrap_or_else(|| ("none".into(), 0));
-        Err(SimError::NonFinite { node, element, element_type, substep: self.counters.substeps, time_secs: self.time_secs })
+            .enumerate()
+            .find_map(|(bi, b)| b.elements().position(|el| el.contains(&(node as u32))).map(|e| (bi, e)))
+            .unwrap_or((0, 0));
+        Some(BadElement { block, element, node: node as u32, origin: ORIGIN_STATE })
+    }
+
+    /// Builds the NaN guard's error, puts the state back to the last finite positions (the
+    /// start of this substep, else the rest shape) at rest, and stops the simulation until reset.
+    fn fail(&mut self, bad: BadElement) -> SimError {
+        let err = SimError::NonFinite {
+            block: bad.block,
+            element: bad.element,
+            element_type: self.mesh.blocks.get(bad.block).map(|b| b.element_type.to_string()).unwrap_or_else(|| "none".into()),
+            node: bad.node as usize,
+            origin: bad.origin,
+            frame: self.frames + 1,
+            substep_in_frame: self.substeps_in_frame,
+            substeps_per_frame: self.settings.substeps,
+            substep: self.counters.substeps,
+            time_secs: self.time_secs,
+        };
+        let last = if self.prev_positions.iter().all(|x| x.iter().all(|c| c.is_finite())) { &self.prev_positions } else { &self.mesh.rest_positions };
+        self.positions.clone_from(last);
+        self.velocities.iter_mut().for_each(|v| *v = Vec3::zeros());
+        self.failure = Some(err.clone());
+        err
     }
 
     /// Kinetic energy `½ Σ m_i |v_i|²`, joules.
@@ -411,6 +552,38 @@ impl Simulation {
     pub fn displacements(&self) -> Vec<Vec3> {
         self.positions.iter().zip(&self.mesh.rest_positions).map(|(x, x0)| x - x0).collect()
     }
+}
+
+/// An element the NaN guard names: block, index in the block, one of its non-finite nodes, and
+/// what went wrong.
+#[derive(Clone, Copy, Debug)]
+struct BadElement {
+    block: usize,
+    element: usize,
+    node: u32,
+    origin: &'static str,
+}
+
+/// The guard's wording when an element's projection turned finite positions into non-finite ones.
+const ORIGIN_PROJECTION: &str = "the projection of";
+/// … when the element was handed a non-finite position (by an effect or the caller).
+const ORIGIN_INPUT: &str = "a non-finite position handed to";
+/// … when the check after the substep finds a non-finite position or velocity.
+const ORIGIN_STATE: &str = "a non-finite position or velocity in";
+
+impl BadElement {
+    /// Element `e` of block `block` produced non-finite corrections at `node`; `read` gives the
+    /// (unchanged) positions it was handed, to tell its own failure from bad input.
+    fn projected(block: usize, element: usize, node: u32, nodes: &[u32], read: impl Fn(usize) -> Vec3) -> Self {
+        let input_finite = nodes.iter().all(|&n| read(n as usize).iter().all(|c| c.is_finite()));
+        Self { block, element, node, origin: if input_finite { ORIGIN_PROJECTION } else { ORIGIN_INPUT } }
+    }
+}
+
+/// The first node of an element whose gathered position `x` is not finite.
+#[inline]
+fn non_finite_node(x: &[Vec3], nodes: &[u32]) -> Option<u32> {
+    x.iter().zip(nodes).find(|(xi, _)| !xi.iter().all(|c| c.is_finite())).map(|(_, &n)| n)
 }
 
 /// Fewest elements a parallel task gets: below this, splitting costs more than it saves.

@@ -90,19 +90,9 @@ pub enum GmshError {
         "{file}: a surface-only mesh ({count} elements of dimension at most {max_dim}, no volume elements); hox simulates solids: mesh the volume too (Gmsh: Mesh → 3D, or gmsh -3) and save again"
     )]
     SurfaceOnly { file: String, count: usize, max_dim: u8 },
-    #[error(
-        "{file}: element {element_tag} ({element_type}) is {what}: det J = {det_j:.3e} at quadrature point {point} (reference coordinates {reference:?}); its nodes (file tags) are {node_tags:?}"
-    )]
-    BadElement {
-        file: String,
-        element_tag: u64,
-        element_type: String,
-        what: &'static str,
-        det_j: f64,
-        point: usize,
-        reference: [f64; 3],
-        node_tags: Vec<u64>,
-    },
+    /// `detail`: `det J` and where, and the element's nodes.
+    #[error("{file}: element {element_tag} ({element_type}) is {what}: {detail}")]
+    BadElement { file: String, element_tag: u64, element_type: String, what: &'static str, detail: String },
     #[error("{file}: {message}")]
     Mesh { file: String, message: String },
     #[error("{file}: physical group \"{name}\" does not exist (the file's groups: {available})")]
@@ -322,10 +312,10 @@ fn build(raw: RawMsh, file: &str) -> Result<ImportedMesh, GmshError> {
                     element_tag: element_tags[b][element],
                     element_type,
                     what,
-                    det_j,
-                    point,
-                    reference,
-                    node_tags: nodes.iter().map(|&n| node_tags[n as usize]).collect(),
+                    detail: format!(
+                        "det J = {det_j:.3e} at quadrature point {point} (reference coordinates {reference:?}); its nodes (file tags) are {:?}",
+                        nodes.iter().map(|&n| node_tags[n as usize]).collect::<Vec<_>>()
+                    ),
                 },
                 other => GmshError::Mesh { file: file_s, message: other.to_string() },
             });

@@ -1,0 +1,825 @@
+//! The robustness suite (issue #8): hard cases stay numerically stable. `docs/STABILITY.md`
+//! explains each case, what happens and why, the safeguards, and has the pass/fail table per
+//! element type and formulation that these tests print (`PASS`/`FAIL` lines on stderr:
+//! `cargo test -p hox-tests --test robustness -- --nocapture`).
+//!
+//! Every case runs headless on small meshes (a few cells per direction) and asserts, with the
+//! tolerances stated at each test:
+//! - no NaN or infinity anywhere (the solver's NaN guard would also stop the run);
+//! - bounded total energy `H = T + U + V_g` ([`hox_tests::Health`]) at every frame;
+//! - once the loads are gone (gravity, prescribed motion and contact removed, velocity damping
+//!   added), no element inverted (`det F > 0` at every quadrature point) and the body back at its
+//!   rest shape within `REST_TOLERANCE × size` (size: the rest bounding-box diagonal);
+//! - a clear error where the input itself is invalid.
+//!
+//! The 10,000-frame long run is `#[ignore]`d here and run in release by `.ci/run`.
+
+use hox_sim::Vec3;
+use hox_sim::constraint::Formulation;
+use hox_sim::effect::{AxisRotation, ContactPlane, Damping, Effect, EffectState, Gravity, Prescribed};
+use hox_sim::material::{Material, MaterialModel};
+use hox_sim::mesh::Mesh;
+use hox_sim::solver::{SimError, Simulation};
+use hox_tests::*;
+
+const SNH: MaterialModel = MaterialModel::StableNeoHookean;
+const STVK: MaterialModel = MaterialModel::StVenantKirchhoff;
+const NH: MaterialModel = MaterialModel::NeoHookean;
+const BOTH: [Formulation; 2] = Formulation::ALL;
+
+/// After release, every node within this fraction of the body's size of its rest position (or,
+/// for a body free to move, of the rigidly aligned rest shape).
+const REST_TOLERANCE: f64 = 1e-3;
+
+/// Reference points per unit length where `det F` is sampled besides the quadrature points
+/// ([`min_det_f_sampled`]).
+const SAMPLE_LEVELS: usize = 12;
+
+/// Runs `run` for every element type in `types` and formulation in `formulations`, prints a
+/// `PASS`/`FAIL` line per configuration with its figures (docs/STABILITY.md's table), and fails
+/// on any failure not listed in `known` ("p3 energy", …) — and on a listed one that now passes,
+/// so the list (and the table) cannot go stale.
+fn each_configuration(case: &str, types: &[&str], formulations: &[Formulation], known: &[&str], run: impl Fn(&str, Formulation) -> Result<String, String>) {
+    let problems = configurations(case, types, formulations, known, run);
+    assert!(problems.is_empty(), "{case}: {} configuration(s):\n{}", problems.len(), problems.join("\n"));
+}
+
+/// [`each_configuration`]'s runs, returning the problems instead of failing.
+fn configurations(case: &str, types: &[&str], formulations: &[Formulation], known: &[&str], run: impl Fn(&str, Formulation) -> Result<String, String>) -> Vec<String> {
+    let mut problems = Vec::new();
+    for et in types {
+        for &f in formulations {
+            let label = format!("{et} {f}");
+            let expected_to_fail = known.contains(&label.as_str());
+            match (run(et, f), expected_to_fail) {
+                (Ok(figures), false) => eprintln!("PASS {case} | {et} | {f} | {figures}"),
+                (Ok(figures), true) => {
+                    eprintln!("FIXED {case} | {et} | {f} | {figures}");
+                    problems.push(format!("{label}: listed as a known failure but passes now ({figures}): update the list and docs/STABILITY.md"));
+                }
+                (Err(why), true) => eprintln!("FAIL (known) {case} | {et} | {f} | {why}"),
+                (Err(why), false) => {
+                    eprintln!("FAIL {case} | {et} | {f} | {why}");
+                    problems.push(format!("{case}, {label}: {why}"));
+                }
+            }
+        }
+    }
+    problems
+}
+
+/// After the release: no element inverted and back at the rest shape (absolute, or after rigid
+/// alignment for a `free` body) within [`REST_TOLERANCE`] × size.
+fn recovered(sim: &Simulation, after: &Health, free: bool) -> Result<String, String> {
+    let size = size_m(sim.mesh());
+    let distance = if free { distance_to_rest_shape_m(&sim.mesh().rest_positions, &sim.positions) } else { after.max_displacement_m };
+    let m = after.min_det_f;
+    if !(m.det_f > 0.0) {
+        return Err(format!("element {} of block {} left inverted after release: det F = {:.3e} at quadrature point {}", m.element, m.block, m.det_f, m.point));
+    }
+    let (sampled, block, element, r) = min_det_f_sampled(sim.mesh(), &sim.positions, SAMPLE_LEVELS);
+    if !(sampled > 0.0) {
+        return Err(format!(
+            "element {element} of block {block} left inverted between its quadrature points after release: det F = {sampled:.3e} at r = {r:.3?} (min over quadrature points {:.3})",
+            m.det_f
+        ));
+    }
+    if !(distance <= REST_TOLERANCE * size) {
+        return Err(format!("{:.2e} × size from the rest shape after release (tolerance {REST_TOLERANCE:e}), min det F {:.3}", distance / size, m.det_f));
+    }
+    Ok(format!("back to rest within {:.1e} × size, min det F {:.4}", distance / size, m.det_f.min(sampled)))
+}
+
+/// `[0, L] × [0, L/4] × [0, L/4]` cut into `cells_x × 1 × 1` cells.
+fn beam(et: &str, length_m: f64, cells_x: usize) -> Mesh {
+    box_mesh(et, [length_m, 0.25 * length_m, 0.25 * length_m], [cells_x, 1, 1])
+}
+
+fn sim(mesh: Mesh, material: Material, formulation: Formulation, substeps: u32, fps: f64, effects: Vec<Box<dyn Effect>>) -> Simulation {
+    Simulation::new(mesh, material, settings(formulation, substeps, fps), effects).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Frames in `secs` seconds at `fps`.
+fn frames(secs: f64, fps: f64) -> u64 {
+    (secs * fps).round() as u64
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 1: elements inverted at the start.
+
+/// A cantilever `[0, 0.5] × [0, 0.125]²` (2 cells) clamped at x = 0 with velocity damping
+/// `damping_per_sec`, every node mirrored through the clamped face (`x → −x`): every element
+/// inverted, `F = diag(−1, 1, 1)`.
+fn mirrored_cantilever(et: &str, model: MaterialModel, formulation: Formulation, damping_per_sec: f64) -> Simulation {
+    let mesh = beam(et, 0.5, 2);
+    let clamp = clamp_x0(&mesh);
+    let damping: Box<dyn Effect> = Box::new(Damping { rate_per_sec: damping_per_sec });
+    let mut s = sim(mesh, material(model, 1.0e5, 0.3), formulation, 50, 60.0, vec![clamp, damping]);
+    s.positions.iter_mut().for_each(|x| x.x = -x.x);
+    s
+}
+
+/// The free corner `(L, 0, 0)` of the same cantilever (damped at 10/s) mirrored through the cell
+/// face `x = L − h` (h: the cell length) to `(L − 2h, 0, 0)`: the elements holding it are
+/// inverted (curved and partly inverted for P2/P3, whose edge nodes stay put).
+fn corner_pushed_through(et: &str, model: MaterialModel, formulation: Formulation) -> Simulation {
+    let mut s = mirrored_cantilever(et, model, formulation, 10.0);
+    let rest = s.mesh().rest_positions.clone();
+    s.positions.copy_from_slice(&rest);
+    let (l, h) = (0.5, 0.25);
+    let corner = rest.iter().position(|p| (p - Vec3::new(l, 0.0, 0.0)).norm() < 1e-12).expect("corner node");
+    s.positions[corner].x = 2.0 * (l - h) - l;
+    s
+}
+
+/// Runs an inverted start for `secs`. No external work is done, so the total energy may not
+/// grow: bound `growth × H(0) + 1 nJ` (`growth` = 1 + 1e-6 unless stated).
+fn run_inverted(mut s: Simulation, secs: f64, growth: f64) -> Result<(Simulation, Health, Health, Trace), String> {
+    let start = health(&s, Vec3::zeros());
+    if !(start.min_det_f.det_f < 0.0) {
+        return Err(format!("the start is not inverted: min det F = {}", start.min_det_f.det_f));
+    }
+    let trace = run_checked(&mut s, frames(secs, 60.0), Vec3::zeros(), growth * start.total_j() + 1e-9)?;
+    let end = health(&s, Vec3::zeros());
+    Ok((s, start, end, trace))
+}
+
+/// Stable Neo-Hookean is defined for `J ≤ 0` and pushes inverted elements back: the mirrored
+/// cantilever unfolds through the clamped face to its rest shape within 5 s at a damping of
+/// 10/s — except P3, which needs the lighter damping of 2/s (8 s) to get through; see
+/// [`p3_mirrored_under_strong_damping_is_trapped_inverted_between_its_quadrature_points`].
+#[test]
+fn stable_neo_hookean_recovers_from_elements_mirrored_through_a_face() {
+    each_configuration("1 mirrored, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        let (damping, secs) = if et == "p3" { (2.0, 8.0) } else { (10.0, 5.0) };
+        let (s, start, end, _) = run_inverted(mirrored_cantilever(et, SNH, f, damping), secs, 1.0 + 1e-6)?;
+        Ok(format!("damping {damping}/s, U(0) = {:.3e} J; {}", start.elastic_j, recovered(&s, &end, false)?))
+    });
+}
+
+/// A known limitation, kept visible: under strong damping (10/s) the mirrored P3 cantilever
+/// stops in a state where every quadrature point has `det F > 0` but the element is inverted
+/// between them — a local minimum of the quadrature-sampled energy, not a solver instability
+/// (the same state with both formulations, and with quadrature degree 6 or 8). If this test
+/// starts failing, the trap is gone: update docs/STABILITY.md.
+#[test]
+fn p3_mirrored_under_strong_damping_is_trapped_inverted_between_its_quadrature_points() {
+    for f in BOTH {
+        let (s, _, end, _) = run_inverted(mirrored_cantilever("p3", SNH, f, 10.0), 5.0, 1.0 + 1e-6).unwrap();
+        let why = recovered(&s, &end, false).expect_err("P3 mirrored at 10/s damping was expected to be trapped");
+        assert!(end.min_det_f.det_f > 0.0 && why.contains("between its quadrature points"), "{f}: {why}");
+        eprintln!("KNOWN 1 mirrored, snh, damping 10/s | p3 | {f} | {why}");
+    }
+}
+
+#[test]
+fn stable_neo_hookean_recovers_from_a_corner_pushed_through_its_element() {
+    each_configuration("1 corner through, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        let (s, start, end, _) = run_inverted(corner_pushed_through(et, SNH, f), 3.0, 1.0 + 1e-6)?;
+        Ok(format!("min det F(0) = {:.3}; {}", start.min_det_f.det_f, recovered(&s, &end, false)?))
+    });
+}
+
+/// StVK's known weakness: `ψ` depends on `FᵀF` only, so a mirrored element (`F = diag(−1,1,1)`,
+/// `FᵀF = I`) has zero energy and no restoring force — the mirrored cantilever is a rest state
+/// and stays inverted. The suite checks it stays bounded (finite, energy not growing) and that
+/// it does stay mirrored, as documented.
+#[test]
+fn stvk_mirrored_through_a_face_is_a_rest_state_it_stays_in_bounded() {
+    each_configuration("1 mirrored, stvk", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        let (_, start, end, _) = run_inverted(mirrored_cantilever(et, STVK, f, 10.0), 1.0, 1.0 + 1e-6)?;
+        if !(start.elastic_j.abs() < 1e-9 && end.max_displacement_m > 0.4) {
+            return Err(format!("expected the zero-energy mirrored rest state to stay: U(0) = {:.3e}, displacement {:.3}", start.elastic_j, end.max_displacement_m));
+        }
+        Ok(format!("stays mirrored, U = {:.1e} J, min det F {:.3}", end.elastic_j, end.min_det_f.det_f))
+    });
+}
+
+/// A corner pushed through its element with StVK: bounded (finite, energy not growing); whether
+/// it recovers is reported, not required (docs/STABILITY.md).
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn stvk_corner_pushed_through_its_element_stays_bounded() {
+    each_configuration("1 corner through, stvk", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        let (s, _, end, _) = run_inverted(corner_pushed_through(et, STVK, f), 3.0, 1.0 + 1e-6)?;
+        Ok(match recovered(&s, &end, false) {
+            Ok(r) => format!("recovers: {r}"),
+            Err(e) => format!("bounded, does not recover: {e}"),
+        })
+    });
+}
+
+/// Compressible Neo-Hookean below its `J` floor (`ln J` continued linearly from `J = 10⁻⁶`):
+/// an inverted element carries an enormous, steep penalty (`U(0) ≈ 2·10¹⁴ J` here), and the
+/// first projections overshoot into neighbours: the energy may spike to `10⁴ × U(0)` before it
+/// falls. Bounded by that; recovery reported, not required: use stable Neo-Hookean.
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn neo_hookean_inverted_starts_stay_bounded() {
+    each_configuration("1 inverted, nh", &ELEMENT_TYPES, &BOTH, &["p3 energy"], |et, f| {
+        let mut out = Vec::new();
+        for (what, s) in [("mirrored", mirrored_cantilever(et, NH, f, 10.0)), ("corner", corner_pushed_through(et, NH, f))] {
+            let (s, start, end, trace) = run_inverted(s, 3.0, 1e4)?;
+            let spike = trace.max_total_j / start.total_j();
+            out.push(match recovered(&s, &end, false) {
+                Ok(r) => format!("{what}: peak H/H(0) {spike:.2e}, recovers, {r}"),
+                Err(e) => format!("{what}: peak H/H(0) {spike:.2e}, bounded, does not recover: {e}"),
+            });
+        }
+        Ok(out.join("; "))
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loaded cantilevers: gravity, then release.
+
+/// A cantilever `[0, L] × [0, L/4]²` of `cells_x` cells, clamped at x = 0, under gravity.
+fn gravity_cantilever(et: &str, length_m: f64, cells_x: usize, material: Material, formulation: Formulation, substeps: u32, fps: f64) -> Simulation {
+    let mesh = beam(et, length_m, cells_x);
+    let clamp = clamp_x0(&mesh);
+    sim(mesh, material, formulation, substeps, fps, vec![clamp, Box::new(Gravity::new(GRAVITY_M_S2))])
+}
+
+/// Gravity for `load_secs` (no damping), then released (gravity removed, damping
+/// `damping_per_sec`) for `release_secs`. Bound while loaded: `H ≤ 0.01 × |V_g|max` — the
+/// body starts at rest with `H = 0` and XPBD only dissipates, so 1 % of the work scale of gravity
+/// is the allowance for a non-monotone numerical energy; after release `H` may not exceed its
+/// value at release (+1 nJ).
+fn load_and_release(s: Simulation, load_secs: f64, damping_per_sec: f64, release_secs: f64) -> Result<String, String> {
+    load_and_release_within(s, load_secs, damping_per_sec, release_secs, 0.01)
+}
+
+/// [`load_and_release`] with the allowance `H ≤ allowance × |V_g|max` while loaded.
+fn load_and_release_within(mut s: Simulation, load_secs: f64, damping_per_sec: f64, release_secs: f64, allowance: f64) -> Result<String, String> {
+    let fps = s.settings().frames_per_second;
+    // a first pass without a bound finds the work scale; the same run is then checked frame by frame
+    let mut probe_run = Simulation::new(s.mesh().clone(), *s.material(), *s.settings(), vec![clamp_x0(s.mesh()), Box::new(Gravity::new(GRAVITY_M_S2))]).map_err(|e| e.to_string())?;
+    let scale = run_checked(&mut probe_run, frames(load_secs, fps), GRAVITY_M_S2, f64::INFINITY)?.max_gravity_work_j;
+    let loaded = run_checked(&mut s, frames(load_secs, fps), GRAVITY_M_S2, allowance * scale)?;
+    let at_release = health(&s, Vec3::zeros());
+    let after = release(&mut s, &["gravity"], damping_per_sec, frames(release_secs, fps), at_release.total_j() + 1e-9)?;
+    Ok(format!(
+        "max sag {:.3e} m, max H {:.2e} J ({:+.1e} of |V_g| {:.2e} J), min det F loaded {:.3}; {}",
+        loaded.max_displacement_m,
+        loaded.max_total_j,
+        loaded.max_total_j / scale,
+        scale,
+        loaded.min_det_f,
+        recovered(&s, &after, false)?
+    ))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 2: near incompressibility.
+
+/// ν = 0.45, 0.49, 0.499 (λ/μ = 9, 49, 499): a cantilever (1 m, 4 cells, E = 10⁶ Pa) under
+/// gravity for 1 s, released (damping 10/s, 3 s); stable Neo-Hookean and StVK. The stiff
+/// volumetric response (`h ω_max` grows as `√λ`) lets the energy overshoot by a few % of the
+/// work of gravity in the first frames (measured up to 3 %): the bound here is 10 % of `|V_g|max`. P1's locking shows as a much smaller sag (figures
+/// printed; the static comparison is in docs/STABILITY.md).
+#[test]
+fn near_incompressible_cantilevers_do_not_blow_up() {
+    near_incompressible(SNH);
+}
+
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn near_incompressible_stvk_cantilevers_do_not_blow_up() {
+    near_incompressible(STVK);
+}
+
+fn near_incompressible(model: MaterialModel) {
+    let mut problems = Vec::new();
+    // measured with stable Neo-Hookean: the energy formulation overshoots the 10 % bound
+    let known: [(f64, &[&str]); 3] = [
+        (0.45, &["p3 energy"]),
+        (0.49, &["p2 energy", "p3 energy"]),
+        (0.499, &["p1 energy", "p2 energy", "p3 energy", "p3 split", "q1 energy", "q2 energy", "pyramid energy"]),
+    ];
+    for (nu, known) in known {
+        let known = if model == SNH { known } else { &[] };
+        problems.extend(configurations(&format!("2 ν = {nu}, {model}"), &ELEMENT_TYPES, &BOTH, known, |et, f| {
+            load_and_release_within(gravity_cantilever(et, 1.0, 4, material(model, 1.0e6, nu), f, 50, 60.0), 1.0, 10.0, 3.0, 0.1)
+        }));
+    }
+    if model != SNH {
+        // StVK: reported (PASS/FAIL lines); only a solver stop (NaN) fails the test
+        problems.retain(|p| p.contains("solver:"));
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 3: stiffness extremes.
+
+/// Runs a gravity-loaded cantilever (1 m, 4 cells, stable Neo-Hookean, ν = 0.3) for 3 s and
+/// returns the largest `H / |V_g|max` (1 % is the bound of the passing cases; NaN when the
+/// solver's guard stopped it).
+fn energy_gain(et: &str, f: Formulation, youngs_modulus_pa: f64, substeps: u32, fps: f64) -> f64 {
+    let mut s = gravity_cantilever(et, 1.0, 4, material(SNH, youngs_modulus_pa, 0.3), f, substeps, fps);
+    run_checked(&mut s, frames(3.0, fps), GRAVITY_M_S2, f64::INFINITY).map(|t| t.max_total_j / t.max_gravity_work_j).unwrap_or(f64::NAN)
+}
+
+/// **Known failure (case 3), kept visible.** E = 10⁹ Pa with a single substep per frame at
+/// 60 fps (`h ω_max ≈ 10²`): the element constraints are effectively hard and one Gauss–Seidel
+/// sweep per frame pumps energy in — the total energy grows by orders of magnitude over the
+/// work gravity did, and the beam collapses (positions stay finite over these 3 s). See
+/// docs/STABILITY.md for the measured stability limit `h ω_max ≲ 1`. If this test fails, the
+/// instability is fixed: update docs/STABILITY.md and turn it into a passing case.
+#[test]
+fn known_failure_a_stiff_cantilever_with_one_substep_per_frame_gains_energy() {
+    for et in ["p1", "p2", "q1"] {
+        for f in BOTH {
+            let gain = energy_gain(et, f, 1.0e9, 1, 60.0);
+            eprintln!("KNOWN 3 E = 1e9 Pa, 1 substep, snh | {et} | {f} | H/|V_g| up to {gain:.2e}");
+            assert!(!(gain <= 1.0), "{et} {f}: E = 1e9 Pa at 1 substep no longer gains energy ({gain:.2e}): update docs/STABILITY.md");
+        }
+    }
+}
+
+/// The same cantilever is stable at 1 substep per frame below the stability limit: P1 at
+/// E = 10⁴ Pa (`h ω_max ≈ 0.4`, with `ω_max ≈ 2 c/ℓ`, `c = √(E/ρ)`, `ℓ` = 0.25 m).
+#[test]
+fn the_one_substep_cantilever_is_stable_below_the_stability_limit() {
+    for f in BOTH {
+        let gain = energy_gain("p1", f, 1.0e4, 1, 60.0);
+        eprintln!("PASS 3 E = 1e4 Pa, 1 substep, snh | p1 | {f} | H/|V_g| up to {gain:.2e}");
+        assert!(gain <= 0.01, "{f}: {gain}");
+    }
+}
+
+/// E = 10³ Pa (a jelly): a 0.1 m cantilever hangs down under its own weight (strains of order
+/// one), then springs back (damping 5/s, 6 s).
+#[test]
+fn a_very_soft_cantilever_hangs_and_springs_back() {
+    for model in [SNH] {
+        each_configuration(&format!("3 E = 1e3 Pa, {model}"), &ELEMENT_TYPES, &BOTH, &["p1 energy", "p1 split"], |et, f| {
+            load_and_release(gravity_cantilever(et, 0.1, 4, material(model, 1.0e3, 0.3), f, 50, 60.0), 2.0, 5.0, 6.0)
+        });
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 4: extreme deformation.
+
+/// Drives the face x = L of a clamped beam (`[0, 1] × [0, 0.25]²`, 4 cells, E = 10⁵ Pa,
+/// ν = 0.3, light damping 2/s) by `drive` over `ramp_secs`, holds it 0.5 s, releases it
+/// (the prescribed nodes get their mass back, damping 5/s) for 5 s. Bound on `H = T + U`:
+/// `10 μ V s²`, `s` the load's characteristic strain (the elastic energy of a uniform strain `s`
+/// is of order `μ V s²`; a blow-up exceeds it by orders of magnitude).
+fn drive_and_release(et: &str, model: MaterialModel, f: Formulation, drive: impl Fn(Vec<u32>) -> Prescribed, ramp_secs: f64, strain: f64) -> Result<String, String> {
+    let mesh = beam(et, 1.0, 4);
+    let end = nodes_on_plane(&mesh, 0, 1.0);
+    let clamp = clamp_x0(&mesh);
+    let mat = material(model, 1.0e5, 0.3);
+    let volume_m3 = 0.0625;
+    let bound_j = 10.0 * mat.lame().mu_pa * volume_m3 * strain * strain;
+    let mut s = sim(mesh, mat, f, 50, 60.0, vec![clamp, Box::new(drive(end)), Box::new(Damping { rate_per_sec: 2.0 })]);
+    let driven = run_checked(&mut s, frames(ramp_secs + 0.5, 60.0), Vec3::zeros(), bound_j)?;
+    let after = release(&mut s, &["prescribed", "damping"], 5.0, frames(5.0, 60.0), bound_j)?;
+    Ok(format!("max U {:.3e} J (bound {bound_j:.2e}), min det F driven {:.3}; {}", driven.max_elastic_j, driven.min_det_f, recovered(&s, &after, false)?))
+}
+
+fn twist(turns_deg: f64, ramp_secs: f64) -> impl Fn(Vec<u32>) -> Prescribed {
+    move |nodes| Prescribed {
+        nodes,
+        translation_m: Vec3::zeros(),
+        rotation: Some(AxisRotation { axis: Vec3::x(), origin_m: Vec3::new(1.0, 0.125, 0.125), angle_rad: turns_deg.to_radians() }),
+        ramp_secs,
+    }
+}
+
+fn stretch(by_m: f64, ramp_secs: f64) -> impl Fn(Vec<u32>) -> Prescribed {
+    move |nodes| Prescribed { nodes, translation_m: Vec3::new(by_m, 0.0, 0.0), rotation: None, ramp_secs }
+}
+
+/// Torsion to 720°: shear strain `θ r / L` = 4π × 0.177 ≈ 2.2 at the corners.
+#[test]
+fn torsion_to_720_degrees_and_back() {
+    each_configuration("4 torsion 720°, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| drive_and_release(et, SNH, f, twist(720.0, 2.0), 2.0, 4.0 * std::f64::consts::PI * 0.177));
+}
+
+/// Stretch to three times the length (strain 2).
+#[test]
+fn stretch_to_three_times_the_length_and_back() {
+    each_configuration("4 stretch 3×, snh", &ELEMENT_TYPES, &BOTH, &["p2 energy", "p2 split", "p3 energy", "p3 split"], |et, f| drive_and_release(et, SNH, f, stretch(2.0, 1.0), 1.0, 2.0));
+}
+
+/// StVK under the same extreme drives: bounded (finite, energy within the bound); recovery
+/// reported, not required (StVK softens under compression and can collapse).
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn stvk_under_extreme_drives_stays_bounded() {
+    each_configuration("4 torsion 720° and stretch 3×, stvk", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        let mut out = Vec::new();
+        for (what, result) in [
+            ("torsion", drive_and_release(et, STVK, f, twist(720.0, 2.0), 2.0, 4.0 * std::f64::consts::PI * 0.177)),
+            ("stretch", drive_and_release(et, STVK, f, stretch(2.0, 1.0), 1.0, 2.0)),
+        ] {
+            out.push(match result {
+                Ok(r) => format!("{what}: {r}"),
+                Err(e) if e.contains("after release") => format!("{what}: bounded, does not recover: {e}"),
+                Err(e) => return Err(format!("{what}: {e}")),
+            });
+        }
+        Ok(out.join("; "))
+    });
+}
+
+/// A free block `[0, 0.25]³` (2 × 2 × 2 cells) squashed to 10 % of its height between two
+/// plates with friction 0.5 (the top plate moves down 0.225 m in 1 s, then stays), held 0.5 s,
+/// released (plates removed, damping 10/s) for 3 s; compared with its rest shape after rigid
+/// alignment. Bound: `10 μ V s²` with `s` = 0.9.
+fn squash(et: &str, model: MaterialModel, f: Formulation) -> Result<String, String> {
+        let mesh = box_mesh(et, [0.25; 3], [2, 2, 2]);
+        let mat = material(model, 1.0e5, 0.3);
+        let bound_j = 10.0 * mat.lame().mu_pa * 0.25f64.powi(3) * 0.81;
+        let effects: Vec<Box<dyn Effect>> = vec![
+            Box::new(ContactPlane::new(Vec3::zeros(), Vec3::z(), Vec3::zeros(), f64::INFINITY, 0.5)),
+            Box::new(ContactPlane::new(Vec3::new(0.0, 0.0, 0.25), -Vec3::z(), Vec3::new(0.0, 0.0, -0.225), 1.0, 0.5)),
+            Box::new(Damping { rate_per_sec: 2.0 }),
+        ];
+        let mut s = sim(mesh, mat, f, 50, 60.0, effects);
+        let squashed = run_checked(&mut s, frames(1.5, 60.0), Vec3::zeros(), bound_j)?;
+        let height = s.positions.iter().map(|x| x.z).fold(f64::NEG_INFINITY, f64::max) - s.positions.iter().map(|x| x.z).fold(f64::INFINITY, f64::min);
+        if !(height < 0.1 * 0.25 * 1.05) {
+            return Err(format!("squashed height {height:.4} m, not 10 % of 0.25 m"));
+        }
+        let after = release(&mut s, &["contact", "damping"], 10.0, frames(3.0, 60.0), bound_j)?;
+        Ok(format!("height {height:.4} m, max U {:.3e} J, min det F squashed {:.3}; {}", squashed.max_elastic_j, squashed.min_det_f, recovered(&s, &after, true)?))
+}
+
+/// Compressible Neo-Hookean's `ln J` term is a barrier against collapse: squashed to 10 % and
+/// back.
+#[test]
+fn squash_to_ten_percent_between_plates_and_back() {
+    each_configuration("4 squash to 10 %, nh", &ELEMENT_TYPES, &BOTH, &["p2 energy", "p2 split", "p3 energy", "p3 split", "q2 energy", "q2 split"], |et, f| squash(et, NH, f));
+}
+
+/// **Known failure (case 4, squash), kept visible.** Stable Neo-Hookean without Smith et al.'s
+/// `log(I_C + 1)` term has a spurious local minimum at `F = 0` (for `F = sI`,
+/// `dψ/ds = 3μs + 3λ̂s²(s³ − α) > 0` for small `s`): elements squashed past the barrier
+/// (uniform `s ≈ 0.29` at ν = 0.3) collapse to a point and stay there after release.
+#[test]
+fn known_failure_stable_neo_hookean_squashed_to_ten_percent_keeps_collapsed_elements() {
+    for et in ["p1", "q1"] {
+        for f in BOTH {
+            let why = squash(et, SNH, f).expect_err("SNH squash was expected to leave collapsed elements");
+            eprintln!("KNOWN 4 squash to 10 %, snh | {et} | {f} | {why}");
+            assert!(why.contains("left inverted"), "{et} {f}: {why}");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 5: mass and size ratios.
+
+/// A smooth initial deformation: bending `u_z = 0.2 x²/L` and a twist of 0.3 rad per length.
+fn bent_and_twisted(rest: &[Vec3], length_m: f64) -> Vec<Vec3> {
+    rest.iter()
+        .map(|p| {
+            let angle = 0.3 * p.x / length_m;
+            let (c, s) = (angle.cos(), angle.sin());
+            let (y, z) = (p.y - 0.125 * length_m, p.z - 0.125 * length_m);
+            Vec3::new(p.x, 0.125 * length_m + c * y - s * z, 0.125 * length_m + s * y + c * z + 0.2 * p.x * p.x / length_m)
+        })
+        .collect()
+}
+
+/// A free beam `[0, 0.5] × [0, 0.125]²` (2 cells) whose free corner `(0.5, 0, 0)` weighs 10⁴
+/// times its lumped mass, started bent and twisted, damped at 10/s for 4 s: back to its rest
+/// shape (after rigid alignment). No external work: `H ≤ H(0)`.
+#[test]
+fn a_node_ten_thousand_times_heavier_than_its_neighbours() {
+    each_configuration("5 heavy node ×1e4, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        let mesh = beam(et, 0.5, 2);
+        let corner = mesh.rest_positions.iter().position(|p| (p - Vec3::new(0.5, 0.0, 0.0)).norm() < 1e-12).expect("corner");
+        let start = bent_and_twisted(&mesh.rest_positions, 0.5);
+        let mut s = sim(mesh, material(SNH, 1.0e5, 0.3), f, 50, 60.0, vec![Box::new(Damping { rate_per_sec: 10.0 })]);
+        let heavy_kg = 1e4 * s.masses_kg()[corner];
+        s.set_mass_kg(corner, heavy_kg).map_err(|e| e.to_string())?;
+        s.positions.copy_from_slice(&start);
+        let h0 = health(&s, Vec3::zeros()).total_j();
+        run_checked(&mut s, frames(4.0, 60.0), Vec3::zeros(), h0 * (1.0 + 1e-6))?;
+        let after = health(&s, Vec3::zeros());
+        Ok(format!("heavy node {heavy_kg:.1} kg, U(0) = {h0:.3e} J; {}", recovered(&s, &after, true)?))
+    });
+}
+
+/// Elements 1 mm next to elements 1 m: the box `[0, 2]³` of 2 × 2 × 2 cells mapped per axis
+/// (`[0, 1] → [0, 1 mm]`, `[1, 2] → [1 mm, 1.001 m]`), so cells range from 1 mm³ to 1 m³ with
+/// 1000:1 slabs between; clamped at x = 0, gravity for 1 s, released. Node masses span nine
+/// orders of magnitude and the 1 mm elements have `h ω ≈ 3`: the energy may overshoot up to
+/// `|V_g|max` (bound), and several configurations fail (listed, docs/STABILITY.md).
+#[test]
+fn elements_one_millimetre_next_to_elements_one_metre() {
+    each_configuration("5 sizes 1 mm – 1 m, snh", &ELEMENT_TYPES, &BOTH, &["p1 split", "p2 energy", "p2 split", "p3 energy", "p3 split", "q2 energy", "q2 split", "prism split"], |et, f| {
+        let mut mesh = box_mesh(et, [2.0; 3], [2, 2, 2]);
+        let map = |c: f64| if c <= 1.0 { 1e-3 * c } else { 1e-3 + (c - 1.0) };
+        mesh.rest_positions.iter_mut().for_each(|p| *p = p.map(map));
+        let s = gravity_cantilever_from(mesh, material(SNH, 1.0e5, 0.3), f);
+        let masses = s.masses_kg();
+        let ratio = masses.iter().cloned().fold(0.0, f64::max) / masses.iter().cloned().fold(f64::INFINITY, f64::min);
+        Ok(format!("mass ratio {ratio:.1e}; {}", load_and_release_within(s, 1.0, 10.0, 3.0, 1.0)?))
+    });
+}
+
+fn gravity_cantilever_from(mesh: Mesh, material: Material, formulation: Formulation) -> Simulation {
+    let clamp = clamp_x0(&mesh);
+    sim(mesh, material, formulation, 50, 60.0, vec![clamp, Box::new(Gravity::new(GRAVITY_M_S2))])
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 6: large steps.
+
+/// **Known failure (case 6), kept visible.** 10 frames per second with one substep
+/// (`h` = 0.1 s) on the cantilever at E = 10⁵ Pa (`h ω_max ≈ 8` for P1, 16 for P2): the energy
+/// grows by orders of magnitude (see [`known_failure_a_stiff_cantilever_with_one_substep_per_frame_gains_energy`]).
+#[test]
+fn known_failure_ten_frames_per_second_with_one_substep_gains_energy() {
+    for et in ["p1", "p2", "q1"] {
+        for f in BOTH {
+            let gain = energy_gain(et, f, 1.0e5, 1, 10.0);
+            eprintln!("KNOWN 6 10 fps × 1 substep, E = 1e5 Pa, snh | {et} | {f} | H/|V_g| up to {gain:.2e}");
+            assert!(!(gain <= 1.0), "{et} {f}: 10 fps × 1 substep no longer gains energy ({gain:.2e}): update docs/STABILITY.md");
+        }
+    }
+}
+
+/// 10 fps × 1 substep is stable for a soft enough body (`h ω_max ≲ 0.5`): E = 10³ Pa, P1,
+/// split formulation; the energy formulation at E = 10³ Pa already gains energy.
+#[test]
+fn ten_frames_per_second_is_stable_for_a_soft_p1_cantilever_with_the_split_formulation() {
+    let gain = energy_gain("p1", Formulation::Split, 1.0e3, 1, 10.0);
+    eprintln!("PASS 6 10 fps × 1 substep, E = 1e3 Pa, snh | p1 | split | H/|V_g| up to {gain:.2e}");
+    assert!(gain <= 0.01, "{gain}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 7: random perturbations of valid rest meshes (property-based).
+
+mod perturbed {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The rest mesh moved by a smooth random field (three sinusoids per component, amplitude up
+    /// to `amplitude` × the cell size, so that high-order nodes stay consistent with their
+    /// elements), plus an independent jitter of the vertex nodes of up to `jitter` × the cell size.
+    fn perturb(mesh: &mut Mesh, seed: &[f64], amplitude: f64, jitter: f64, cell_m: f64) {
+        let vertex = mesh.vertex_nodes();
+        for (i, p) in mesh.rest_positions.iter_mut().enumerate() {
+            let q = *p;
+            let mut d = Vec3::zeros();
+            for c in 0..3 {
+                for k in 0..3 {
+                    let a = seed[c * 9 + k * 3..c * 9 + k * 3 + 3].to_vec();
+                    d[c] += a[0] * (std::f64::consts::PI * (a[1] * q.x + a[2] * q.y + a[0] * q.z) / cell_m).sin() / 3.0;
+                }
+            }
+            *p += d * (amplitude * cell_m);
+            if vertex[i] {
+                let h = (i as f64 * 12.9898 + seed[27] * 78.233).sin() * 43758.5453;
+                let r = [h.fract(), (h * 1.37).fract(), (h * 1.91).fract()];
+                *p += Vec3::from(r) * (jitter * cell_m);
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, .. ProptestConfig::default() })]
+        /// A valid perturbed mesh (or a clear error naming the bad element) that, loaded by gravity
+        /// for 0.5 s and released (damping 10/s, 2 s), stays finite, within the energy bound
+        /// (`H ≤ 5 % of |V_g|max`) and returns to its rest shape. Stable Neo-Hookean, E = 10⁶ Pa,
+        /// ν = 0.3.
+        #[test]
+        fn randomly_perturbed_rest_meshes_stay_stable(
+            et in 0..ELEMENT_TYPES.len(),
+            split in any::<bool>(),
+            seed in proptest::collection::vec(-1.0..1.0f64, 28),
+            amplitude in 0.0..0.3f64,
+            jitter in 0.0..0.2f64,
+        ) {
+            let et = ELEMENT_TYPES[et];
+            let f = if split { Formulation::Split } else { Formulation::Energy };
+            let mut mesh = beam(et, 0.5, 2);
+            perturb(&mut mesh, &seed, amplitude, jitter, 0.125);
+            // keep the clamped face planar so the clamp selects it
+            let clamped: Vec<u32> = mesh.rest_positions.iter().enumerate().filter(|(_, p)| p.x.abs() < 0.2 * 0.125).map(|(i, _)| i as u32).collect();
+            let effects: Vec<Box<dyn Effect>> = vec![Box::new(hox_sim::effect::Clamp { nodes: clamped }), Box::new(Gravity::new(GRAVITY_M_S2))];
+            let s = match Simulation::new(mesh, material(SNH, 1.0e6, 0.3), settings(f, 50, 60.0), effects) {
+                Ok(s) => s,
+                Err(e) => {
+                    let message = e.to_string();
+                    prop_assert!(message.contains("at rest") && message.contains("element"), "unclear error: {message}");
+                    return Ok(());
+                }
+            };
+            // P3 with the energy formulation overshoots 1 % of |V_g| slightly (1.2 %) even unperturbed
+            let result = load_and_release_within(s, 0.5, 10.0, 2.0, 0.05);
+            prop_assert!(result.is_ok(), "{et} {f}: {}", result.unwrap_err());
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 8: the long run.
+
+/// 10,000 frames (167 s) of the bending scene (P2 8×2×2, StVK, 50 substeps, 60 fps) with no
+/// damping, both formulations: the total energy `H = T + U + V_g` (0 at the start) never exceeds
+/// 1 % of the largest `|V_g|` — XPBD's numerical dissipation only takes energy out.
+#[test]
+#[ignore = "release: CI runs it with --release --ignored (about a minute)"]
+fn ten_thousand_frames_of_the_undamped_bending_scene_do_not_gain_energy() {
+    for formulation in ["energy", "split"] {
+        let scene = hox_scenes::by_name("bending").unwrap().with_overrides(&hox_scenes::SceneOverrides { formulation: Some(formulation.into()), ..Default::default() }).unwrap();
+        let mut instance = hox_scenes::Instance::new(scene).unwrap();
+        let clock = std::time::Instant::now();
+        let mut max_ratio = f64::NEG_INFINITY;
+        let mut last = health(&instance.sim, GRAVITY_M_S2);
+        let mut work_j: f64 = 0.0;
+        for frame in 1..=10_000u64 {
+            instance.sim.step_frame().unwrap();
+            last = health(&instance.sim, GRAVITY_M_S2);
+            assert!(last.finite, "{formulation}: frame {frame}");
+            work_j = work_j.max(last.gravity_potential_j.abs());
+            max_ratio = max_ratio.max(last.total_j() / work_j);
+            assert!(last.total_j() <= 0.01 * work_j, "{formulation}: H = {:.4e} J > 1 % of |V_g| = {work_j:.4e} J at frame {frame}", last.total_j());
+        }
+        eprintln!(
+            "PASS 8 10,000 frames, bending, no damping | p2 | {formulation} | max H/|V_g|max {max_ratio:.2e}, H at the end {:.3e} J (|V_g|max {work_j:.3e} J), {:.1} s",
+            last.total_j(),
+            clock.elapsed().as_secs_f64()
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 9: invalid input is a clear error (the CLI's side: app/tests/cli.rs).
+
+fn scene_error(edit: impl Fn(&mut String)) -> String {
+    let mut text = hox_scenes::BUILTIN.iter().find(|(n, _)| *n == "bending").unwrap().1.to_string();
+    edit(&mut text);
+    match hox_scenes::Scene::from_toml(&text, "test.toml").and_then(hox_scenes::Instance::new) {
+        Ok(_) => panic!("accepted an invalid scene"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn invalid_materials_are_clear_errors_naming_the_parameter() {
+    for model in MaterialModel::ALL {
+        for (e, nu, rho, needle) in [
+            (1e6, 0.5, 1000.0, "Poisson ratio"),
+            (1e6, 0.7, 1000.0, "Poisson ratio"),
+            (1e6, f64::NAN, 1000.0, "Poisson ratio"),
+            (0.0, 0.3, 1000.0, "Young's modulus"),
+            (-1e6, 0.3, 1000.0, "Young's modulus"),
+            (f64::INFINITY, 0.3, 1000.0, "Young's modulus"),
+            (1e6, 0.3, 0.0, "density"),
+            (1e6, 0.3, -5.0, "density"),
+            (1e6, 0.3, f64::NAN, "density"),
+        ] {
+            let err = Material::new(model, e, nu, rho).expect_err("invalid").to_string();
+            assert!(err.contains(needle), "{model} E={e} ν={nu} ρ={rho}: {err}");
+        }
+    }
+}
+
+#[test]
+fn non_finite_and_invalid_scene_values_are_clear_errors() {
+    let cases: [(&str, &str, &str); 8] = [
+        ("poisson_ratio = 0.35", "poisson_ratio = 0.5", "material.poisson_ratio"),
+        ("poisson_ratio = 0.35", "poisson_ratio = nan", "material.poisson_ratio"),
+        ("youngs_modulus_pa = 3.0e6", "youngs_modulus_pa = inf", "material.youngs_modulus_pa"),
+        ("youngs_modulus_pa = 3.0e6", "youngs_modulus_pa = -3.0e6", "material.youngs_modulus_pa"),
+        ("density_kg_m3 = 1000.0", "density_kg_m3 = 0.0", "material.density_kg_m3"),
+        ("substeps = 50", "substeps = 0", "solver.substeps"),
+        ("acceleration_m_s2 = [0.0, 0.0, -9.81]", "acceleration_m_s2 = [0.0, nan, -9.81]", "acceleration_m_s2"),
+        ("point_m = [2.0, 0.25, 0.25]", "point_m = [3.0, 0.25, 0.25]", "outside the body"),
+    ];
+    for (from, to, needle) in cases {
+        let err = scene_error(|t| {
+            assert!(t.contains(from), "the bending scene no longer has `{from}`");
+            *t = t.replace(from, to);
+        });
+        assert!(err.contains(needle) && err.contains("test.toml"), "{to}: {err}");
+    }
+    let err = scene_error(|t| *t = t.replace("grid = [8, 2, 2]", "grid = [8, 0, 2]"));
+    assert!(err.contains("mesh.grid"), "{err}");
+    let err = scene_error(|t| *t = t.replace("box_max_m = [2.0, 0.5, 0.5]", "box_max_m = [2.0, 0.0, 0.5]"));
+    assert!(err.contains("box_max_m"), "{err}");
+}
+
+#[test]
+fn degenerate_inverted_and_empty_meshes_and_zero_substeps_are_clear_errors() {
+    use hox_sim::mesh::ElementBlock;
+    let mat = material(SNH, 1e6, 0.3);
+    let tet = |points: [[f64; 3]; 4]| Mesh { rest_positions: points.map(Vec3::from).to_vec(), blocks: vec![ElementBlock::new(element_type("p1"), vec![0, 1, 2, 3])] };
+    let new = |mesh: Mesh, st| Simulation::new(mesh, mat, st, Vec::new()).map(|_| ()).expect_err("invalid").to_string();
+    let ok = settings(Formulation::Energy, 50, 60.0);
+    let flat = new(tet([[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]), ok);
+    assert!(flat.contains("element 0") && flat.contains("flat"), "{flat}");
+    let inverted = new(tet([[0.0; 3], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]), ok);
+    assert!(inverted.contains("element 0") && inverted.contains("inverted"), "{inverted}");
+    // a P2 element whose edge node is pulled through the opposite face: inverted at a quadrature point
+    let mut curved = box_mesh("p2", [1.0; 3], [1, 1, 1]);
+    let n = curved.blocks[0].element(0)[4] as usize;
+    curved.rest_positions[n] += Vec3::new(3.0, 3.0, 3.0);
+    let curved = new(curved, ok);
+    assert!(curved.contains("inverted") || curved.contains("flat"), "{curved}");
+    let empty = new(Mesh { rest_positions: Vec::new(), blocks: Vec::new() }, ok);
+    assert!(empty.contains("no elements"), "{empty}");
+    let empty_block = new(Mesh { rest_positions: vec![Vec3::zeros()], blocks: vec![ElementBlock::new(element_type("p1"), Vec::new())] }, ok);
+    assert!(empty_block.contains("no elements"), "{empty_block}");
+    let nan_node = new(tet([[0.0; 3], [1.0, 0.0, 0.0], [0.0, f64::NAN, 0.0], [0.0, 0.0, 1.0]]), ok);
+    assert!(nan_node.contains("non-finite") && nan_node.contains("node 2"), "{nan_node}");
+    let unit = tet([[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+    let zero = new(unit.clone(), settings(Formulation::Energy, 0, 60.0));
+    assert!(zero.contains("substeps"), "{zero}");
+    let fps = new(unit.clone(), settings(Formulation::Energy, 50, f64::NAN));
+    assert!(fps.contains("frames per second"), "{fps}");
+    let probe = hox_sim::probe::Probe::locate(&unit, "far", Vec3::new(5.0, 0.0, 0.0)).expect_err("outside").to_string();
+    assert!(probe.contains("outside the body"), "{probe}");
+    let probe = hox_sim::probe::Probe::locate(&unit, "nan", Vec3::new(f64::NAN, 0.0, 0.0)).expect_err("non-finite").to_string();
+    assert!(probe.contains("non-finite"), "{probe}");
+    let mut s = Simulation::new(unit, mat, ok, Vec::new()).unwrap();
+    let mass = s.set_mass_kg(0, -1.0).expect_err("negative mass").to_string();
+    assert!(mass.contains("node 0") && mass.contains("mass"), "{mass}");
+    let mass = s.set_mass_kg(9, 1.0).expect_err("no such node").to_string();
+    assert!(mass.contains("node 9"), "{mass}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Case 10: the runtime NaN guard.
+
+/// An effect that writes a NaN into one node's position at a given time (a stand-in for any
+/// bug or extreme input that brings a NaN into the state).
+struct NanAt {
+    node: usize,
+    at_secs: f64,
+}
+
+impl Effect for NanAt {
+    fn name(&self) -> &'static str {
+        "nan"
+    }
+    fn after_prediction(&mut self, s: &mut EffectState<'_>) {
+        if s.time_secs >= self.at_secs {
+            s.positions[self.node].y = f64::NAN;
+        }
+    }
+}
+
+fn guarded(parallel: bool, effects: Vec<Box<dyn Effect>>) -> Simulation {
+    let mesh = beam("p2", 1.0, 4);
+    let mut st = settings(Formulation::Energy, 50, 60.0);
+    st.parallel = parallel;
+    let mut all: Vec<Box<dyn Effect>> = vec![clamp_x0(&mesh), Box::new(Gravity::new(GRAVITY_M_S2))];
+    all.extend(effects);
+    Simulation::new(mesh, material(SNH, 1e6, 0.3), st, all).unwrap()
+}
+
+/// A NaN appearing in frame 3, substep 7 stops the scene with an error naming the element
+/// (block and index), the node, the frame and the substep; the state is put back to the last
+/// finite positions, further steps refuse with the same error, and a reset starts over.
+#[test]
+fn a_nan_stops_the_scene_with_the_element_and_the_step_and_a_reset_recovers() {
+    for parallel in [false, true] {
+        let h = 1.0 / 3000.0;
+        let at_secs = (2.0 * 50.0 + 7.0) * h - 0.5 * h; // substep 7 of frame 3
+        let mut s = guarded(parallel, vec![Box::new(NanAt { node: 40, at_secs })]);
+        s.step_frame().unwrap();
+        s.step_frame().unwrap();
+        let err = s.step_frame().expect_err("the NaN must stop the scene");
+        let SimError::NonFinite { block, element, node, frame, substep_in_frame, substeps_per_frame, .. } = &err else {
+            panic!("not the NaN guard: {err}");
+        };
+        assert_eq!((*block, *node, *frame, *substep_in_frame, *substeps_per_frame), (0, 40, 3, 7, 50), "{err}");
+        assert!(s.mesh().blocks[0].element(*element).contains(&40), "{err}");
+        let message = err.to_string();
+        for needle in ["frame 3", "substep 7 of 50", &format!("element {element} of block 0 (p2)"), "node 40", "reset"] {
+            assert!(message.contains(needle), "'{needle}' missing from: {message}");
+        }
+        eprintln!("PASS 10 NaN guard | p2 | energy{} | {message}", if parallel { " (parallel)" } else { "" });
+        assert!(s.positions.iter().all(|x| x.iter().all(|c| c.is_finite())), "the last finite state is kept");
+        assert_eq!(s.failure(), Some(&err));
+        assert_eq!(s.step_frame().expect_err("stays stopped"), err);
+        s.remove_effects_named("nan");
+        s.reset();
+        assert!(s.failure().is_none());
+        for _ in 0..5 {
+            s.step_frame().unwrap();
+        }
+    }
+}
+
+/// A non-finite position written from outside (a caller) is named the same way at the next
+/// substep.
+#[test]
+fn a_non_finite_position_from_outside_is_named() {
+    let mut s = guarded(false, Vec::new());
+    s.step_frame().unwrap();
+    s.positions[40].z = f64::INFINITY;
+    let message = s.step_frame().expect_err("stopped").to_string();
+    assert!(message.contains("node 40") && message.contains("frame 2") && message.contains("substep 1 of 50"), "{message}");
+}
