@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Prepares a fresh machine for building and testing hox. Idempotent; safe to run again.
-# The simulation core needs only the Rust toolchain (rustc ≥ 1.95); later parts (the app's
-# window under Xvfb, the Rerun viewer) add their Debian packages here.
+# Needs the Rust toolchain (rustc ≥ 1.95); the Debian packages the app's window needs under Xvfb
+# (and the Rerun viewer) are installed below when missing.
 set -euo pipefail
 
 need_rust="1.95"
@@ -15,3 +15,24 @@ if [ "$(printf '%s\n%s\n' "$need_rust" "$have" | sort -V | head -n1)" != "$need_
     exit 1
 fi
 echo "setup: rustc $have OK"
+
+# The app's window and its headless screenshots run under Xvfb with Mesa's software OpenGL; the
+# stock Rerun viewer needs Vulkan (lavapipe). Building needs none of these: all GUI libraries
+# are loaded at run time. Installed once, as root, from Debian's packages.
+gui_packages="xvfb xauth libgl1 libegl1 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6"
+missing=""
+for p in $gui_packages; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        echo "setup: installing$missing"
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing >/dev/null
+    else
+        echo "setup: the app's window needs these Debian packages:$missing" >&2
+        echo "setup: install them with: sudo apt-get install -y$missing" >&2
+    fi
+else
+    echo "setup: GUI packages present"
+fi

@@ -10,6 +10,8 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 mod gmsh;
+mod record;
+pub use record::check_writable;
 
 #[derive(Parser)]
 #[command(name = "hox", version, about = "hox: see, measure and teach high-order finite elements in XPBD")]
@@ -88,6 +90,14 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Record a scene to a Rerun file (.rrd) without a display: the deformed surface coloured by
+    /// displacement, element edges, probes and time series; --compare records several
+    /// configurations side by side.
+    Record(record::RecordArgs),
+    /// Read a Rerun recording back and list its entities, components and frame counts.
+    Inspect(record::InspectArgs),
+    /// Open the interactive app (the default when no command is given).
+    App(crate::gui::AppArgs),
 }
 
 #[derive(Args)]
@@ -170,13 +180,16 @@ fn parse_grid(s: &str) -> Result<[usize; 3], String> {
 }
 
 pub fn main(cli: Cli) -> Result<()> {
-    match cli.command.unwrap_or(Command::Elements { json: false }) {
+    match cli.command.unwrap_or(Command::App(crate::gui::AppArgs::default())) {
         Command::Elements { json } => elements(json),
         Command::Scenes { json } => scenes(json),
         Command::Mesh { scene, mesh, json } => mesh_command(&scene, &mesh, json),
         Command::Simulate { scene, mesh, physics, seconds, settle, vtk, json } => simulate(&scene, &mesh, &physics, seconds, settle, &vtk, json),
         Command::Study { quick, out } => study(quick, &out),
         Command::Static { scene, mesh, physics, tolerance, load_steps, json } => static_command(&scene, &mesh, &physics, tolerance, load_steps, json),
+        Command::Record(args) => record::record(&args),
+        Command::Inspect(args) => record::inspect(&args),
+        Command::App(args) => crate::gui::run(args),
     }
 }
 

@@ -47,7 +47,7 @@ mod tests {
         for (t, want) in [(0.0, [0x44, 0x01, 0x54]), (0.5, [0x21, 0x91, 0x8c]), (1.0, [0xfd, 0xe7, 0x25])] {
             let got = viridis(t);
             for k in 0..3 {
-                assert!((got[k] as i32 - want[k] as i32).abs() <= 5, "t = {t}: {got:?} vs {want:?}");
+                assert!((got[k] as i32 - want[k]).abs() <= 5, "t = {t}: {got:?} vs {want:?}");
             }
         }
         assert_eq!(viridis(f64::NAN), viridis(0.0));

@@ -8,6 +8,9 @@
 //! Errors are printed as one clear message on stderr with a non-zero exit.
 
 mod cli;
+mod colour;
+mod gui;
+mod recording;
 
 use clap::Parser;
 

@@ -42,7 +42,12 @@ fn paper_scenes_record_and_read_back() {
             assert_eq!(surface["frames_per_component"][component].as_array().unwrap().len(), 16, "{scene}: {component}");
         }
         // every probe component and the energies are time series on the frame timeline
-        for quantity in ["probe_tip_u_z_m", "kinetic_energy_j", "elastic_energy_j", "ms_per_frame", "min_det_f"] {
+        let probe_series: Vec<&String> = e.as_object().unwrap().keys().filter(|k| k.starts_with("plots/probe_") && k.ends_with(&format!("/{c}"))).collect();
+        assert!(probe_series.len() >= 3 && probe_series.len().is_multiple_of(3), "{scene}: three components per probe: {probe_series:?}");
+        for series in probe_series {
+            assert_eq!(e[series]["frames_per_component"]["Scalars:scalars"].as_array().map(Vec::len), Some(16), "{scene}: {series}");
+        }
+        for quantity in ["kinetic_energy_j", "elastic_energy_j", "ms_per_frame", "min_det_f"] {
             let series = &e[format!("plots/{quantity}/{c}")]["frames_per_component"]["Scalars:scalars"];
             assert_eq!(series.as_array().map(Vec::len), Some(16), "{scene}: plots/{quantity}/{c}");
         }

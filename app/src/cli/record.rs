@@ -281,7 +281,7 @@ pub fn read_rrd(path: &Path) -> Result<BTreeMap<String, EntitySummary>> {
         }
     }
     if messages == 0 {
-        bail!("{} is empty: not a Rerun recording", path.display());
+        bail!("{} is not a readable Rerun recording: it holds no Rerun messages", path.display());
     }
     Ok(entities)
 }

@@ -78,7 +78,7 @@ fn link_ui(app: &mut HoxApp, ui: &mut egui::Ui, field: &str) {
         return;
     }
     let linked = app.links.linked(field);
-    let text = if linked { "🔗" } else { "⛓‍💥" };
+    let text = if linked { "linked" } else { "free" };
     if ui.selectable_label(linked, text).on_hover_text("Linked: the other configuration follows this control. Click to unlink.").clicked() {
         app.links.0.insert(field.to_string(), !linked);
     }
@@ -124,6 +124,7 @@ pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Scene");
     let current = app.scene.label();
     let mut chosen = None;
+    let l = ui.label("Scene file or built-in scene");
     egui::ComboBox::from_id_salt("scene").selected_text(&current).show_ui(ui, |ui| {
         for name in hox_scenes::BUILTIN.iter().map(|(n, _)| *n) {
             if ui.selectable_label(current == name, name).clicked() {
@@ -132,6 +133,7 @@ pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         }
     })
     .response
+    .labelled_by(l.id)
     .on_hover_text("The scene: its mesh, material, effects (gravity, clamps, motion…) and probes.");
     if let Some(source) = chosen
         && let Err(e) = app.load_scene(source, None)
@@ -176,13 +178,15 @@ fn mesh_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         return;
     }
     ui.horizontal(|ui| {
-        label(ui, "Element", "The element type: P1/P2/P3 tetrahedra (order 1–3), Q1/Q2 hexahedra, prisms, pyramids.");
+        let l = label(ui, "Element", "The element type: P1/P2/P3 tetrahedra (order 1–3), Q1/Q2 hexahedra, prisms, pyramids.");
         let mut element = c.element.clone();
         egui::ComboBox::from_id_salt(("element", app.active)).selected_text(element.to_uppercase()).show_ui(ui, |ui| {
             for e in ElementType::all() {
                 ui.selectable_value(&mut element, e.name().to_string(), format!("{} — {}", e.name().to_uppercase(), e.description()));
             }
-        });
+        })
+        .response
+        .labelled_by(l.id);
         if element != c.element {
             let mut n = c.clone();
             n.element = element;
@@ -207,10 +211,10 @@ fn mesh_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         link_ui(app, ui, "split");
     });
     ui.horizontal(|ui| {
-        label(ui, "Grid", "Hexahedral cells along x, y and z before any splitting (each 1–64).");
+        let l = label(ui, "Grid", "Hexahedral cells along x, y and z before any splitting (each 1–64).");
         let mut grid = c.grid;
         for g in &mut grid {
-            ui.add(egui::DragValue::new(g).range(1..=64)).on_hover_text("Cells in this direction (1–64).");
+            ui.add(egui::DragValue::new(g).range(1..=64)).labelled_by(l.id).on_hover_text("Cells in this direction (1–64).");
         }
         if grid != c.grid {
             let mut n = c.clone();
@@ -221,9 +225,9 @@ fn mesh_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     });
     refusal_ui(app, ui, "grid");
     ui.horizontal(|ui| {
-        label(ui, "Refine", "1-to-8 refinements of the tetrahedra (each multiplies the element count by 8; tetrahedra only).");
+        let l = label(ui, "Refine", "1-to-8 refinements of the tetrahedra (each multiplies the element count by 8; tetrahedra only).");
         let mut refine = c.refine;
-        ui.add_enabled(tets, egui::Slider::new(&mut refine, 0..=3));
+        ui.add_enabled(tets, egui::Slider::new(&mut refine, 0..=3)).labelled_by(l.id);
         if refine != c.refine {
             let mut n = c.clone();
             n.refine = refine;
@@ -238,13 +242,15 @@ fn material_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Material");
     let c = app.sessions[app.active].config.clone();
     ui.horizontal(|ui| {
-        label(ui, "Model", "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean or Neo-Hookean.");
+        let l = label(ui, "Model", "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean or Neo-Hookean.");
         let mut model = c.material.clone();
         egui::ComboBox::from_id_salt(("model", app.active)).selected_text(MaterialModel::from_name(&model).map_or(model.clone(), |m| m.long_name().to_string())).show_ui(ui, |ui| {
             for m in MaterialModel::ALL {
                 ui.selectable_value(&mut model, m.name().to_string(), m.long_name());
             }
-        });
+        })
+        .response
+        .labelled_by(l.id);
         if model != c.material {
             let mut n = c.clone();
             n.material = model;
@@ -275,14 +281,16 @@ fn solver_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     });
     refusal_ui(app, ui, "formulation");
     ui.horizontal(|ui| {
-        label(ui, "Quadrature", "Degree of polynomials the element quadrature integrates exactly (default: the element's own).");
+        let l = label(ui, "Quadrature", "Degree of polynomials the element quadrature integrates exactly (default: the element's own).");
         let mut q = c.quadrature_degree;
         egui::ComboBox::from_id_salt(("quadrature", app.active)).selected_text(q.map_or("element default".to_string(), |d| format!("degree {d}"))).show_ui(ui, |ui| {
             ui.selectable_value(&mut q, None, "element default");
             for d in 1..=8 {
                 ui.selectable_value(&mut q, Some(d), format!("degree {d}"));
             }
-        });
+        })
+        .response
+        .labelled_by(l.id);
         if q != c.quadrature_degree {
             let mut n = c.clone();
             n.quadrature_degree = q;
@@ -293,9 +301,9 @@ fn solver_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     refusal_ui(app, ui, "quadrature");
     let slider = |app: &mut HoxApp, ui: &mut egui::Ui, field: &str, text: &str, tip: &str, value: u32, range: std::ops::RangeInclusive<u32>, set: fn(&mut Config, u32)| {
         ui.horizontal(|ui| {
-            label(ui, text, tip);
+            let l = label(ui, text, tip);
             let mut v = value;
-            ui.add(egui::Slider::new(&mut v, range).logarithmic(true)).on_hover_text(tip);
+            ui.add(egui::Slider::new(&mut v, range).logarithmic(true)).labelled_by(l.id).on_hover_text(tip);
             if v != value {
                 let mut n = app.sessions[app.active].config.clone();
                 set(&mut n, v);
@@ -308,9 +316,9 @@ fn solver_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     slider(app, ui, "substeps", "Substeps", "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.", c.substeps, 1..=500, |c, v| c.substeps = v);
     slider(app, ui, "iterations", "Iterations", "Constraint sweeps per substep (the paper: 1).", c.iterations, 1..=20, |c, v| c.iterations = v);
     ui.horizontal(|ui| {
-        label(ui, "Frames per second", "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.");
+        let l = label(ui, "Frames per second", "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.");
         let mut fps = c.frames_per_second;
-        ui.add(egui::Slider::new(&mut fps, 10.0..=240.0).logarithmic(true).suffix(" fps"));
+        ui.add(egui::Slider::new(&mut fps, 10.0..=240.0).logarithmic(true).suffix(" fps")).labelled_by(l.id);
         if fps != c.frames_per_second {
             let mut n = c.clone();
             n.frames_per_second = fps;
@@ -336,8 +344,8 @@ fn playback_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         }
     });
     ui.horizontal(|ui| {
-        label(ui, "Time scale", "Simulated seconds per real second (1 = real time; the simulation slows down by itself when a frame costs more than real time).");
-        ui.add(egui::Slider::new(&mut app.time_scale, 0.05..=4.0).logarithmic(true).suffix("×"));
+        let l = label(ui, "Time scale", "Simulated seconds per real second (1 = real time; the simulation slows down by itself when a frame costs more than real time).");
+        ui.add(egui::Slider::new(&mut app.time_scale, 0.05..=4.0).logarithmic(true).suffix("×")).labelled_by(l.id);
     });
 }
 
@@ -354,8 +362,8 @@ fn view_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     });
     let mut segments = v.segments;
     ui.horizontal(|ui| {
-        label(ui, "Curved-face pieces", "Pieces per edge when drawing curved (high-order) and quadrilateral faces.");
-        ui.add(egui::Slider::new(&mut segments, 1..=12));
+        let l = label(ui, "Curved-face pieces", "Pieces per edge when drawing curved (high-order) and quadrilateral faces.");
+        ui.add(egui::Slider::new(&mut segments, 1..=12)).labelled_by(l.id);
     });
     if segments != app.view.segments {
         app.view.segments = segments;
@@ -365,11 +373,11 @@ fn view_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     }
     let mut auto = app.view.colour_max_m.is_none();
     ui.horizontal(|ui| {
-        label(ui, "Colour range", "Top of the displacement colour map, metres (auto: a fifth of the body's largest extent).");
+        let l = label(ui, "Colour range", "Top of the displacement colour map, metres (auto: a fifth of the body's largest extent).");
         ui.checkbox(&mut auto, "auto");
         let mut max = app.view.colour_max_m.unwrap_or_else(|| super::viewport::Viewport::colour_range(&app.sessions, &app.view).max_m);
         if !auto {
-            ui.add(egui::DragValue::new(&mut max).range(1e-6..=1e3).speed(0.01).suffix(" m"));
+            ui.add(egui::DragValue::new(&mut max).range(1e-6..=1e3).speed(0.01).suffix(" m")).labelled_by(l.id);
         }
         app.view.colour_max_m = (!auto).then_some(max);
     });
@@ -379,12 +387,12 @@ fn rerun_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Rerun");
     let on = app.rerun_target().is_some();
     ui.horizontal(|ui| {
-        label(ui, "Viewer", "A running Rerun viewer 0.36.3 to stream to (start one with scripts/rerun.sh).");
-        ui.add_enabled(!on, egui::TextEdit::singleline(&mut app.rerun_url).desired_width(200.0));
+        let l = label(ui, "Viewer", "A running Rerun viewer 0.36.3 to stream to (start one with scripts/rerun.sh).");
+        ui.add_enabled(!on, egui::TextEdit::singleline(&mut app.rerun_url).desired_width(200.0)).labelled_by(l.id);
     });
     ui.horizontal(|ui| {
-        label(ui, "File", "An .rrd file to save the recording to.");
-        ui.add_enabled(!on, egui::TextEdit::singleline(&mut app.rerun_file).desired_width(200.0));
+        let l = label(ui, "File", "An .rrd file to save the recording to.");
+        ui.add_enabled(!on, egui::TextEdit::singleline(&mut app.rerun_file).desired_width(200.0)).labelled_by(l.id);
     });
     ui.horizontal(|ui| {
         if on {
@@ -413,13 +421,13 @@ pub fn open_dialog_ui(app: &mut HoxApp, ctx: &egui::Context) {
     let title = if dialog.mesh { "Open mesh file" } else { "Open scene file" };
     egui::Window::new(title).open(&mut open).collapsible(false).show(ctx, |ui| {
         ui.horizontal(|ui| {
-            ui.label("Path");
-            ui.add(egui::TextEdit::singleline(&mut dialog.path).desired_width(320.0));
+            let l = ui.label("Path");
+            ui.add(egui::TextEdit::singleline(&mut dialog.path).desired_width(320.0)).labelled_by(l.id);
         });
         if dialog.mesh {
             ui.horizontal(|ui| {
-                ui.label("Clamp group").on_hover_text("The physical group (named node set) held fixed.");
-                ui.add(egui::TextEdit::singleline(&mut dialog.clamp_group).desired_width(120.0));
+                let l = ui.label("Clamp group").on_hover_text("The physical group (named node set) held fixed.");
+                ui.add(egui::TextEdit::singleline(&mut dialog.clamp_group).desired_width(120.0)).labelled_by(l.id);
             });
         }
         // quick picks from the project's assets

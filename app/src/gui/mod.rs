@@ -679,3 +679,6 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
     }
     result.map_err(|e| anyhow::anyhow!("the window could not be opened: {e} (no display? run the headless commands, e.g. `hox simulate`, or use Xvfb: scripts/xvfb-run.sh)"))
 }
+
+#[cfg(test)]
+mod tests;

@@ -232,7 +232,7 @@ fn project(vp: &Mat4, w: usize, h: usize, p: [f32; 3]) -> Option<[f32; 3]> {
         return None;
     }
     let ndc = c.truncate() / c.w;
-    if !(ndc.z > -1.0 && ndc.z < 1.0) || !ndc.x.is_finite() || !ndc.y.is_finite() {
+    if !(ndc.z > -1.0 && ndc.z < 1.0 && ndc.x.is_finite() && ndc.y.is_finite()) {
         return None;
     }
     Some([(0.5 * (ndc.x + 1.0)) * w as f32, (0.5 * (1.0 - ndc.y)) * h as f32, ndc.z])

@@ -133,10 +133,10 @@ impl Viewport {
             let delta = response.drag_delta();
             self.camera.pan(delta.x, delta.y, rect.height());
         }
-        if response.drag_stopped() || !ui.input(|i| i.pointer.primary_down()) {
-            if let Some((k, _, _)) = self.dragging.take() {
-                sessions[k].drag = None;
-            }
+        if (response.drag_stopped() || !ui.input(|i| i.pointer.primary_down()))
+            && let Some((k, _, _)) = self.dragging.take()
+        {
+            sessions[k].drag = None;
         }
 
         // --- scene

@@ -1,0 +1,109 @@
+//! Headless UI tests of the app (egui_kittest: the real widgets, driven through AccessKit; no
+//! window, no GPU).
+
+use super::*;
+use egui_kittest::Harness;
+use egui_kittest::kittest::{NodeT, Queryable};
+
+fn harness(args: AppArgs) -> Harness<'static, HoxApp> {
+    let app = HoxApp::new(&AppArgs { fresh: true, ..args }, None).expect("the app starts on bending");
+    Harness::builder().with_size(egui::vec2(1400.0, 900.0)).allow_missing_glyphs().with_step_dt(1.0 / 60.0).build_ui_state(|ui, app: &mut HoxApp| app.ui_all(ui), app)
+}
+
+/// The text of the one node whose text contains `needle`.
+fn text(h: &Harness<'_, HoxApp>, needle: &str) -> String {
+    let n = h.get_by_label_contains(needle);
+    n.accesskit_node().label().or_else(|| n.accesskit_node().value()).unwrap_or_default()
+}
+
+fn status(h: &Harness<'_, HoxApp>) -> String {
+    text(h, "nodes,")
+}
+
+#[test]
+fn app_starts_on_bending_with_its_p2_beam() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(3);
+    assert_eq!(h.state().scene, SceneSource::Builtin("bending".into()));
+    let s = status(&h);
+    assert!(s.starts_with("P2 8×2×2 five: 393 nodes, 160 elements"), "{s}");
+    h.get_by_label("Young's modulus E (Pa)");
+    assert_eq!(h.get_all_by_label("Play").count(), 2, "in the menu bar and the playback controls");
+}
+
+#[test]
+fn switching_element_type_rebuilds_the_mesh_and_the_node_count_shown() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    h.get_by_label("Element").click();
+    h.run_steps(2);
+    h.get_by_label_contains("Q2 —").click();
+    h.run_steps(3);
+    let s = status(&h);
+    assert!(s.starts_with("Q2 8×2×2: 425 nodes, 32 elements"), "{s}");
+    assert_eq!(h.state().sessions[0].instance.sim.mesh().num_nodes(), 17 * 5 * 5);
+}
+
+#[test]
+fn play_advances_time_and_space_pauses() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    assert_eq!(h.state().sessions[0].instance.sim.time_secs(), 0.0);
+    h.get_all_by_label("Play").next().unwrap().click();
+    h.run_steps(30);
+    let t = h.state().sessions[0].instance.sim.time_secs();
+    assert!(t > 0.2, "30 displayed frames at 60 Hz advance about 0.5 s of simulated time, got {t}");
+    h.key_press(egui::Key::Space);
+    h.run_steps(2);
+    let paused = h.state().sessions[0].instance.sim.time_secs();
+    h.run_steps(10);
+    assert_eq!(h.state().sessions[0].instance.sim.time_secs(), paused, "space paused");
+    h.key_press(egui::Key::S);
+    h.run_steps(2);
+    let stepped = h.state().sessions[0].instance.sim.time_secs();
+    assert!((stepped - paused - 1.0 / 60.0).abs() < 1e-9, "S steps exactly one frame");
+}
+
+#[test]
+fn a_bad_value_is_refused_with_the_reason_and_changes_nothing() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    let field = h.get_by_label("Poisson ratio ν");
+    field.focus();
+    h.run_steps(1);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.get_by_label("Poisson ratio ν").type_text("0.5");
+    h.run_steps(1);
+    h.key_press(egui::Key::Enter);
+    h.run_steps(3);
+    let refusal = text(&h, "refused:");
+    assert!(refusal.to_lowercase().contains("poisson"), "{refusal}");
+    assert_eq!(h.state().sessions[0].config.poisson_ratio, 0.35);
+    assert_eq!(h.state().sessions[0].instance.sim.material().poisson_ratio, 0.35);
+}
+
+#[test]
+fn compare_mode_links_controls_and_shows_both_errors() {
+    let mut h = harness(AppArgs { compare: true, ..Default::default() });
+    h.run_steps(2);
+    let labels: Vec<String> = h.state().sessions.iter().map(|s| s.config.label()).collect();
+    assert_eq!(labels, ["P1 8×2×2 five r1", "P2 8×2×2 five"]);
+    // a linked material change reaches both; an unlinked element change only the active one
+    let app = h.state_mut();
+    let mut c = app.sessions[0].config.clone();
+    c.youngs_modulus_pa = 6e6;
+    app.apply("youngs", c);
+    assert!(app.sessions.iter().all(|s| s.instance.sim.material().youngs_modulus_pa == 6e6));
+    let mut c = app.sessions[0].config.clone();
+    c.element = "p3".into();
+    c.refine = 0;
+    app.apply("element", c);
+    assert_eq!(app.sessions[0].config.element, "p3");
+    assert_eq!(app.sessions[1].config.element, "p2");
+    h.run_steps(2);
+    assert!(status_count(&h) == 2);
+}
+
+fn status_count(h: &Harness<'_, HoxApp>) -> usize {
+    h.query_all_by_label_contains("nodes,").count()
+}
