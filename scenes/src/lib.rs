@@ -121,6 +121,29 @@ impl Instance {
     }
 }
 
+/// Solves the static equilibrium of `scene` on `mesh` ([`static_problem`] with
+/// [`hox_sim::statics::solve`]); `progress` as there.
+pub fn solve_static(
+    scene: &Scene,
+    mesh: &hox_sim::mesh::Mesh,
+    tolerance: f64,
+    load_steps: usize,
+    progress: hox_sim::statics::Progress<'_>,
+) -> Result<hox_sim::statics::StaticSolution, SceneError> {
+    let (acceleration_m_s2, dirichlet) = static_problem(scene, mesh)?;
+    let problem = hox_sim::statics::StaticProblem {
+        mesh,
+        material: scene.material,
+        quadrature_degree: scene.settings.quadrature_degree,
+        acceleration_m_s2,
+        dirichlet,
+        tolerance,
+        load_steps,
+    };
+    hox_sim::statics::solve(&problem, progress)
+        .map_err(|e| SceneError::Simulation { source_name: scene.source.clone(), message: format!("static solve: {e}") })
+}
+
 /// The static problem of a scene: body acceleration and Dirichlet conditions (clamped nodes at
 /// rest, prescribed ones moved to their final, fully ramped positions). Contact has no static
 /// counterpart here and is refused; damping does not change the equilibrium.

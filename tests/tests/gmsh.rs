@@ -84,17 +84,7 @@ fn the_msh22_and_msh41_copies_of_a_mesh_are_the_same() {
 /// Static tip deflection (tip probe at the end face's centre) of a bending-scene-like problem.
 fn static_tip_uz(scene: &Scene) -> f64 {
     let mesh = scene.build_mesh().unwrap();
-    let (acceleration, dirichlet) = hox_scenes::static_problem(scene, &mesh).unwrap();
-    let problem = hox_sim::statics::StaticProblem {
-        mesh: &mesh,
-        material: scene.material,
-        quadrature_degree: scene.settings.quadrature_degree,
-        acceleration_m_s2: acceleration,
-        dirichlet,
-        tolerance: 1e-10,
-        load_steps: 1,
-    };
-    let solution = hox_sim::statics::solve(&problem, &mut |_, _, _| {}).unwrap();
+    let solution = hox_scenes::solve_static(scene, &mesh, 1e-10, 1, &mut |_, _, _| {}).unwrap();
     let probe = hox_sim::probe::Probe::locate(&mesh, "tip", Vec3::new(LENGTH_M, 0.25, 0.25)).unwrap();
     probe.displacement(&solution.positions, &mesh.rest_positions).z
 }
