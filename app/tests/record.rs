@@ -60,7 +60,18 @@ fn paper_scenes_record_and_read_back() {
 fn compare_records_p1_and_p2_side_by_side() {
     let file = temp("compare.rrd");
     let f = file.to_str().unwrap();
-    let summary = ok_json(&["record", "--scene", "bending", "--seconds", "0.1", "--out", f, "--compare", "element=p1,refine=1", "--compare", "element=p2", "--quadrature-points", "--json"]);
+    let vtk = temp("compare-vtk");
+    let summary = ok_json(&[
+        "record", "--scene", "bending", "--seconds", "0.1", "--out", f, "--compare", "element=p1,refine=1", "--compare", "element=p2", "--quadrature-points", "--vtk", vtk.to_str().unwrap(), "--json",
+    ]);
+    // a VTK series per configuration beside the recording: 7 frames each
+    let indexes: Vec<&str> = summary["vtk"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
+    assert_eq!(indexes.len(), 2);
+    for (index, c) in indexes.iter().zip(["p1_1280", "p2_160"]) {
+        assert!(index.contains(c), "{index}");
+        let pvd = std::fs::read_to_string(index).unwrap();
+        assert_eq!(pvd.matches("<DataSet").count(), 7, "{index}");
+    }
     let entities: Vec<&str> = summary["configurations"].as_array().unwrap().iter().map(|c| c["entity"].as_str().unwrap()).collect();
     assert_eq!(entities, ["world/p1_1280", "world/p2_160"]);
     let checked = ok_json(&["inspect", f, "--expect-frames", "7", "--json"]);

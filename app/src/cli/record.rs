@@ -42,6 +42,8 @@ pub struct RecordArgs {
     /// Also log every quadrature point.
     #[arg(long)]
     pub quadrature_points: bool,
+    #[command(flatten)]
+    pub vtk: super::gmsh::VtkArgs,
     /// Print a JSON summary on stdout.
     #[arg(long)]
     pub json: bool,
@@ -158,6 +160,13 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         loggers.push(SimLogger::new(&rec, &name, inst, offset, &settings)?);
     }
 
+    // VTK series beside the recording (one folder per configuration when comparing)
+    let mut vtk_writers = Vec::new();
+    for (inst, logger) in instances.iter().zip(&loggers) {
+        let dir = args.vtk.vtk.as_ref().map(|d| if instances.len() > 1 { d.join(logger.name()) } else { d.clone() });
+        vtk_writers.push(super::gmsh::VtkWriter::create(&super::gmsh::VtkArgs { vtk: dir, vtk_every: args.vtk.vtk_every }, inst)?);
+    }
+
     let interrupted = Arc::new(AtomicBool::new(false));
     {
         let flag = interrupted.clone();
@@ -188,6 +197,9 @@ pub fn record(args: &RecordArgs) -> Result<()> {
             let t1 = Instant::now();
             logger.log_frame(&rec, inst, ms)?;
             log_ms.push(t1.elapsed().as_secs_f64() * 1e3);
+            if let Some(w) = &mut vtk_writers[k] {
+                w.frame(inst)?;
+            }
         }
         done = frame;
         bar.reveal("{spinner} {bar:40} {percent}% {msg} (eta {eta})");
@@ -197,6 +209,12 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     bar.bar.finish_and_clear();
     rec.flush_blocking().with_context(|| format!("cannot finish writing {}", args.out.display()))?;
     drop(rec);
+    let mut vtk_indexes = Vec::new();
+    for (w, inst) in vtk_writers.into_iter().zip(&instances) {
+        if let Some(w) = w {
+            vtk_indexes.push(w.finish(inst)?.display().to_string());
+        }
+    }
     let bytes = std::fs::metadata(&args.out).map(|m| m.len()).unwrap_or(0);
     if let Some(e) = failure {
         eprintln!("{}: kept frames 0..={done} before the failure", args.out.display());
@@ -228,6 +246,7 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         "log_ms_per_frame": hox_scenes::median(&mut log_ms),
         "wall_seconds": started.elapsed().as_secs_f64(),
         "configurations": configs,
+        "vtk": vtk_indexes,
     });
     if args.json {
         println!("{summary}");
@@ -242,6 +261,9 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         );
         for c in summary["configurations"].as_array().into_iter().flatten() {
             println!("  {}: {} elements, {} nodes, {:.2} ms per frame", c["entity"].as_str().unwrap_or_default(), c["elements"], c["nodes"], c["ms_per_frame"].as_f64().unwrap_or_default());
+        }
+        for index in &vtk_indexes {
+            println!("  VTK series for ParaView: {index}");
         }
         println!("play it back with the Rerun viewer {}: rerun {}", rerun::build_info().version, args.out.display());
     }

@@ -194,6 +194,8 @@ pub struct HoxApp {
     pub edits: std::collections::HashMap<String, String>,
     pub open_dialog: Option<controls::OpenDialog>,
     ui_frame_ms: f64,
+    /// Wall time of our own part of a frame (stepping, controls, viewport, plots), milliseconds.
+    app_ms: f64,
     last_ui_frame: Option<Instant>,
     screenshot: Option<(PathBuf, f64)>,
     screenshot_requested: bool,
@@ -240,6 +242,7 @@ impl HoxApp {
             edits: Default::default(),
             open_dialog: None,
             ui_frame_ms: 0.0,
+            app_ms: 0.0,
             last_ui_frame: None,
             screenshot: args.screenshot.clone().map(|p| (p, args.after_secs)),
             screenshot_requested: false,
@@ -526,7 +529,7 @@ impl HoxApp {
                 }
                 ui.separator();
             }
-            ui.label(egui::RichText::new(format!("display {:.0} fps, render {:.1} ms", 1000.0 / self.ui_frame_ms.max(1e-3), self.viewport.render_ms)).monospace());
+            ui.label(egui::RichText::new(format!("display {:.0} fps, view {:.1} ms, app {:.1} ms", 1000.0 / self.ui_frame_ms.max(1e-3), self.viewport.render_ms, self.app_ms)).monospace());
         });
     }
 
@@ -561,6 +564,8 @@ impl HoxApp {
         if self.playing || self.sessions.iter().any(|s| s.drag.is_some()) {
             ctx.request_repaint();
         }
+        let ms = now.elapsed().as_secs_f64() * 1e3;
+        self.app_ms = if self.app_ms == 0.0 { ms } else { 0.9 * self.app_ms + 0.1 * ms };
         self.after_frame(&ctx, now);
     }
 
@@ -589,6 +594,7 @@ impl HoxApp {
                         "sim_frames": m.sim_frames,
                         "sim_ms_per_frame": s.ms_per_frame,
                         "render_ms": self.viewport.render_ms,
+                        "app_ms": self.app_ms,
                     })
                 );
                 if self.screenshot.is_none() {
