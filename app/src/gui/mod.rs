@@ -149,6 +149,9 @@ pub struct AppArgs {
     /// Window size in points, WIDTHxHEIGHT.
     #[arg(long, default_value = "1400x900")]
     pub size: String,
+    /// Do not wait for the display's vertical sync (frame-rate measurements).
+    #[arg(long)]
+    pub no_vsync: bool,
 }
 
 /// Live Rerun output through the shared logging module.
@@ -196,6 +199,8 @@ pub struct HoxApp {
     ui_frame_ms: f64,
     /// Wall time of our own part of a frame (stepping, controls, viewport, plots), milliseconds.
     app_ms: f64,
+    /// CPU time of a whole frame (ours, egui's layout and painting; not waiting for vsync), ms.
+    frame_cpu_ms: f64,
     last_ui_frame: Option<Instant>,
     screenshot: Option<(PathBuf, f64)>,
     screenshot_requested: bool,
@@ -243,6 +248,7 @@ impl HoxApp {
             open_dialog: None,
             ui_frame_ms: 0.0,
             app_ms: 0.0,
+            frame_cpu_ms: 0.0,
             last_ui_frame: None,
             screenshot: args.screenshot.clone().map(|p| (p, args.after_secs)),
             screenshot_requested: false,
@@ -595,6 +601,7 @@ impl HoxApp {
                         "sim_ms_per_frame": s.ms_per_frame,
                         "render_ms": self.viewport.render_ms,
                         "app_ms": self.app_ms,
+                        "frame_cpu_ms": self.frame_cpu_ms,
                     })
                 );
                 if self.screenshot.is_none() {
@@ -634,7 +641,11 @@ pub fn save_png(path: &std::path::Path, image: &egui::ColorImage) -> Result<(), 
 }
 
 impl eframe::App for HoxApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
+        if let Some(cpu) = frame.info().cpu_usage {
+            let ms = cpu as f64 * 1e3;
+            self.frame_cpu_ms = if self.frame_cpu_ms == 0.0 { ms } else { 0.9 * self.frame_cpu_ms + 0.1 * ms };
+        }
         self.ui_all(ui);
     }
 
@@ -663,6 +674,7 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
     }
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default().with_inner_size([w, h]).with_title("hox — high-order elements in XPBD"),
+        glow_options: eframe::egui_glow::GlowConfiguration { vsync: !args.no_vsync, ..Default::default() },
         ..Default::default()
     };
     let mut error = None;
