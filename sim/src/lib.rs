@@ -17,16 +17,20 @@
 //! - [`probe`]: material points located in the rest mesh, followed through the deformation.
 //! - [`energy`]: total elastic energy, gradient and Hessian of a mesh.
 //! - [`constraint`]: pure XPBD constraint kernels (energy and split formulations).
+//! - [`kernels`]: the hot loop, specialised per node count, and the colour-packed element data.
 //! - [`statics`]: static equilibrium by Newton's method (the reference XPBD must settle to).
 //! - [`solver`]: the stateful XPBD solver and the opt-in [`effect`]s it runs.
 //! - [`surface`]: the tessellated boundary surface and material points for display.
+//! - [`benchmark`]: timing the paper's Table 1 beams (`hox bench`, `sim/benches/`).
 
+pub mod benchmark;
 pub mod colouring;
 pub mod constraint;
 pub mod effect;
 pub mod element;
 pub mod energy;
 pub mod geometry;
+pub mod kernels;
 pub mod mass;
 pub mod material;
 pub mod mesh;

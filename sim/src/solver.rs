@@ -128,8 +128,8 @@ pub struct Simulation {
     effects: Vec<Box<dyn Effect>>,
     /// Per block, the elements grouped by colour (no two elements of a colour share a node).
     colours: Vec<Vec<Vec<u32>>>,
-    /// Per block, the element data reordered colour by colour for the parallel sweep.
-    packed: Vec<crate::kernels::ColourPacked>,
+    /// Per block, the element data packed for the sweeps (element order and colour order).
+    packed: crate::kernels::SolverData,
     time_secs: f64,
     frames: u64,
     /// Substeps taken in the frame being advanced.
@@ -169,7 +169,7 @@ impl Simulation {
             lambdas,
             effects: Vec::with_capacity(effects.len()),
             colours: Vec::new(),
-            packed: Vec::new(),
+            packed: crate::kernels::SolverData::default(),
             time_secs: 0.0,
             frames: 0,
             substeps_in_frame: 0,
@@ -185,7 +185,7 @@ impl Simulation {
     }
 
     fn pack_colours(&mut self) {
-        self.packed = self.mesh.blocks.iter().zip(&self.geometry).zip(&self.colours).map(|((b, g), c)| crate::kernels::ColourPacked::new(b, g, c)).collect();
+        self.packed = crate::kernels::SolverData::new(&self.mesh.blocks, &self.geometry, &self.colours);
     }
 
     fn multipliers(geometry: &[BlockGeometry], formulation: Formulation) -> Vec<Vec<f64>> {
@@ -411,8 +411,8 @@ impl Simulation {
             let block = &self.mesh.blocks[bi];
             let n = block.nodes_per_element();
             if self.settings.formulation == Formulation::Energy {
-                use crate::kernels::{BlockData, Multipliers, Positions, energy_sweep};
-                let data = BlockData::of(block, &self.geometry[bi]);
+                use crate::kernels::{Multipliers, Positions, energy_sweep};
+                let data = self.packed.serial[bi].data();
                 // SAFETY: one thread; the mesh was validated, so its node indices fit positions,
                 // and lambdas holds one multiplier per element.
                 let fast = unsafe { energy_sweep(n, &self.material, Positions::new(&mut self.positions), &self.mesh.rest_positions, &self.inv_mass, &data, 0..block.len(), Multipliers::new(lambdas), inv_dt2) };
@@ -457,7 +457,7 @@ impl Simulation {
                 // SAFETY of the aliasing: the specialised sweep writes positions through its own
                 // pointer, and nothing else touches them meanwhile.
                 let all = unsafe { positions.slice_mut(0, positions.len) };
-                match crate::kernels::parallel_energy_block(n, &self.material, all, &self.mesh.rest_positions, &self.inv_mass, &self.packed[bi], lambdas, inv_dt2) {
+                match crate::kernels::parallel_energy_block(n, &self.material, all, &self.mesh.rest_positions, &self.inv_mass, &self.packed.colour[bi], lambdas, inv_dt2) {
                     Some(Ok(projected)) => {
                         self.counters.element_projections += projected;
                         continue;

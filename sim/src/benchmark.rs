@@ -1,0 +1,198 @@
+//! Timing the XPBD loop on the paper's bending beam (Saillant et al., Table 1): the five
+//! configurations of Table 1 plus Q1, Q2, prism and pyramid beams, at the paper's settings
+//! (StVK E = 3 MPa, ν = 0.35, ρ = 1000 kg/m³, 50 substeps × 1 iteration, 60 fps, energy
+//! formulation, gravity, clamped at x = 0), ms per frame as the median of timed frames.
+//!
+//! **Flop count.** Per element and substep, with `N` nodes and `Q` quadrature points, the energy
+//! kernel ([`crate::kernels`]) does, counting a fused multiply–add as 2 flops:
+//! - per point: `F = I + Σ_i u_i ⊗ ∇N_i` (18N), StVK `E`, `S`, `ψ`, `P = F S` (165), and
+//!   `∇_i U += V P ∇N_i` (18N + 9);
+//! - per element: displacements `u_i = x_i − X_i` (3N), `Σ_i w_i |∇_i U|²` (6N), the update
+//!   (10, one square root and one division counted as 1 each) and `x_i += w_i step ∇_i U` (7N).
+//!
+//! So `flops = Q (36 N + 174) + 16 N + 10`: 384 for P1. Achieved GFLOP/s = flops × elements ×
+//! substeps / time. The machine's peak is stated in [`PEAK_GFLOPS_PER_CORE`].
+
+use crate::Vec3;
+use crate::effect::{Clamp, Effect, Gravity};
+use crate::element::ElementType;
+use crate::material::{Material, MaterialModel};
+use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+use crate::solver::{SimError, Simulation, SolverSettings};
+use std::time::Instant;
+
+/// Peak double-precision rate of one core of this machine, GFLOP/s: 2.7 GHz (the TSC rate the
+/// kernel reports) × 2 FMA units × 8 doubles (AVX-512) × 2 flops per FMA. The scalar peak
+/// (no SIMD) is 8× lower, [`SCALAR_PEAK_GFLOPS_PER_CORE`].
+pub const PEAK_GFLOPS_PER_CORE: f64 = 2.7 * 2.0 * 8.0 * 2.0;
+/// 2.7 GHz × 2 FMA units × 1 double × 2 flops.
+pub const SCALAR_PEAK_GFLOPS_PER_CORE: f64 = 2.7 * 2.0 * 2.0;
+
+/// One benchmarked beam.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BenchCase {
+    pub element: &'static str,
+    pub grid: [usize; 3],
+    pub refine: usize,
+    /// The paper's Table 1 time, ms per frame (its own machine), where it has one.
+    pub paper_ms_per_frame: Option<f64>,
+}
+
+impl BenchCase {
+    pub fn label(&self) -> String {
+        let [x, y, z] = self.grid;
+        let r = if self.refine > 0 { format!(" r{}", self.refine) } else { String::new() };
+        format!("{} {x}x{y}x{z}{r}", self.element.to_uppercase())
+    }
+}
+
+/// The five rows of Table 1, then Q1, Q2, prism and pyramid beams of comparable node count
+/// (the meshes of the study, `scenes/src/study.rs`).
+pub const CASES: [BenchCase; 9] = [
+    BenchCase { element: "p1", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: Some(43.6) },
+    BenchCase { element: "p1", grid: [16, 4, 4], refine: 1, paper_ms_per_frame: Some(363.0) },
+    BenchCase { element: "p1", grid: [16, 4, 4], refine: 2, paper_ms_per_frame: Some(3116.0) },
+    BenchCase { element: "p2", grid: [8, 2, 2], refine: 0, paper_ms_per_frame: Some(20.9) },
+    BenchCase { element: "p3", grid: [4, 2, 2], refine: 0, paper_ms_per_frame: Some(28.1) },
+    BenchCase { element: "q1", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: None },
+    BenchCase { element: "q2", grid: [8, 2, 2], refine: 0, paper_ms_per_frame: None },
+    BenchCase { element: "prism", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: None },
+    BenchCase { element: "pyramid", grid: [12, 3, 3], refine: 0, paper_ms_per_frame: None },
+];
+
+/// The paper's bending beam for `case`, at rest; `parallel` selects the colour sweep.
+pub fn bending_beam(case: &BenchCase, parallel: bool) -> Result<Simulation, SimError> {
+    let element_type = ElementType::from_name(case.element)
+        .ok_or_else(|| SimError::Settings(format!("unknown element type '{}' (known: {})", case.element, ElementType::names())))?;
+    let mesh = BoxMeshSpec {
+        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(2.0, 0.5, 0.5), cells: case.grid },
+        element_type,
+        split: TetSplit::Five,
+        refine: case.refine,
+    }
+    .build()?;
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 3.0e6, 0.35, 1000.0).map_err(|e| SimError::Settings(e.to_string()))?;
+    let clamped = mesh.nodes_where(|p| p.x.abs() < 1e-12);
+    let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))), Box::new(Clamp { nodes: clamped })];
+    Simulation::new(mesh, material, SolverSettings { parallel, ..SolverSettings::default() }, effects)
+}
+
+/// Flops of one energy-constraint projection of an element with `nodes` nodes and `points`
+/// quadrature points (see the module doc).
+pub fn flops_per_element(nodes: usize, points: usize) -> f64 {
+    (points * (36 * nodes + 174) + 16 * nodes + 10) as f64
+}
+
+/// One measured row.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchRow {
+    pub case: BenchCase,
+    pub elements: usize,
+    pub nodes: usize,
+    pub points_per_element: usize,
+    /// 1: the serial sweep in element order; more: the parallel colour sweep on that many
+    /// rayon threads.
+    pub threads: usize,
+    pub ms_per_frame: f64,
+    /// `ms_per_frame / (elements × substeps)`, in ns.
+    pub ns_per_element_substep: f64,
+    pub gflops: f64,
+}
+
+impl BenchRow {
+    /// The paper's time over ours.
+    pub fn speedup_over_paper(&self) -> Option<f64> {
+        self.case.paper_ms_per_frame.map(|p| p / self.ms_per_frame)
+    }
+}
+
+/// Median of `values` (sorted in place); NaN for none.
+pub fn median(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) }
+}
+
+/// Times `case` on `threads` threads (1: serial sweep; more: parallel sweep in a pool of that
+/// size): `warmup_frames` untimed, then the median of `frames` timed frames. Frames are also
+/// capped by `budget_secs` of timed work (at least 3 frames).
+pub fn measure(case: &BenchCase, threads: usize, warmup_frames: usize, frames: usize, budget_secs: f64) -> Result<BenchRow, SimError> {
+    let threads = threads.max(1);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| SimError::Settings(e.to_string()))?;
+    pool.install(|| {
+        let mut sim = bending_beam(case, threads > 1)?;
+        for _ in 0..warmup_frames {
+            sim.step_frame()?;
+        }
+        let mut times_ms = Vec::with_capacity(frames);
+        let start = Instant::now();
+        for i in 0..frames.max(1) {
+            let clock = Instant::now();
+            sim.step_frame()?;
+            times_ms.push(clock.elapsed().as_secs_f64() * 1e3);
+            if i >= 2 && start.elapsed().as_secs_f64() > budget_secs {
+                break;
+            }
+        }
+        let ms_per_frame = median(&mut times_ms);
+        let elements = sim.mesh().num_elements();
+        let substeps = sim.settings().substeps as f64;
+        let g = &sim.geometry()[0];
+        let flops = flops_per_element(g.nodes_per_element, g.points_per_element) * elements as f64 * substeps;
+        Ok(BenchRow {
+            case: *case,
+            elements,
+            nodes: sim.mesh().num_nodes(),
+            points_per_element: g.points_per_element,
+            threads,
+            ms_per_frame,
+            ns_per_element_substep: ms_per_frame * 1e6 / (elements as f64 * substeps),
+            gflops: flops / (ms_per_frame * 1e6),
+        })
+    })
+}
+
+/// The table `hox bench` prints: per case, one row per thread count.
+pub fn markdown(rows: &[BenchRow]) -> String {
+    let mut s = String::from(
+        "| configuration | elements | threads | paper ms/frame | ours ms/frame | paper / ours | ns per element·substep | GFLOP/s | % of peak (SIMD) | % of scalar peak |\n|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let paper = r.case.paper_ms_per_frame.map_or(String::new(), |p| format!("{p}"));
+        let ratio = r.speedup_over_paper().map_or(String::new(), |x| format!("{x:.1}×"));
+        let peak = PEAK_GFLOPS_PER_CORE * r.threads as f64;
+        let scalar_peak = SCALAR_PEAK_GFLOPS_PER_CORE * r.threads as f64;
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {:.2} | {} | {:.1} | {:.2} | {:.1} % | {:.1} % |\n",
+            r.case.label(),
+            r.elements,
+            r.threads,
+            paper,
+            r.ms_per_frame,
+            ratio,
+            r.ns_per_element_substep,
+            r.gflops,
+            100.0 * r.gflops / peak,
+            100.0 * r.gflops / scalar_peak,
+        ));
+    }
+    s
+}
+
+/// Measures every case whose label contains `filter` (ignoring case) on each of `threads`,
+/// reporting each row to `progress` as it is measured (what `hox bench` runs).
+pub fn run(filter: &str, threads: &[usize], frames: usize, progress: &mut dyn FnMut(&BenchRow)) -> Result<Vec<BenchRow>, SimError> {
+    let filter = filter.to_uppercase();
+    let mut rows = Vec::new();
+    for case in CASES.iter().filter(|c| c.label().to_uppercase().contains(&filter)) {
+        for &t in threads {
+            let row = measure(case, t, 5, frames, 10.0)?;
+            progress(&row);
+            rows.push(row);
+        }
+    }
+    Ok(rows)
+}

@@ -1,0 +1,500 @@
+//! The hot loop of the solver, specialised per element node count: the energy-constraint sweep
+//! over a block (serial in element order, or one colour's contiguous range in the parallel sweep).
+//!
+//! It computes exactly what [`crate::constraint::project_energy_constraint`] computes — for each
+//! element, `F_q = I + Σ_i (x_i − X_i) ⊗ ∇_X N_i(r_q)`, `U_e = Σ_q V_q ψ(F_q)`,
+//! `∇_i U_e = Σ_q V_q P(F_q) ∇_X N_i(r_q)`, `C = √(2U_e)` and the XPBD update of
+//! [`crate::constraint::xpbd_step`] (the paper's `Δλ = −2U / (Σ_i w_i |∇_i U|² + 2U α̃)` with
+//! λ = 0, Saillant et al. §3) — but with the node count `N` a compile-time constant, so that
+//! every per-node loop is unrolled and every scratch array lives in registers or a fixed-size
+//! stack array of exactly `N` entries; and with the material's Lamé parameters computed once per
+//! sweep instead of once per quadrature point ([`Stvk`]). Results equal the generic kernel's up
+//! to the order of floating-point operations.
+//!
+//! Both sweeps read the element data from a [`PackedBlock`] copy: connectivity, material
+//! gradients (as structure of arrays per element and point, so the loops over the `N` nodes
+//! vectorise) and quadrature volumes; for the parallel sweep reordered colour by colour, so that each colour is a
+//! contiguous range of memory handed to the threads in contiguous chunks (the elements of a
+//! colour keep their increasing element order, so the result is bitwise the one of the
+//! element-indexed colour sweep).
+
+use crate::Vec3;
+use crate::constraint::xpbd_step;
+use crate::geometry::BlockGeometry;
+use crate::material::{Mat3, Material, MaterialModel};
+use crate::mesh::ElementBlock;
+
+/// `(ψ(F), P(F))` at one quadrature point: the material law the kernel is generic over.
+pub trait PointMaterial: Sync {
+    fn energy_and_pk1(&self, f: &Mat3) -> (f64, Mat3);
+}
+
+/// Saint-Venant–Kirchhoff with its Lamé parameters precomputed: `E = ½(H + Hᵀ + HᵀH)`,
+/// `H = F − I`, `S = 2μE + λ tr(E) I`, `ψ = μ E:E + λ/2 tr(E)²`, `P = F S` (as
+/// [`crate::material::stvk`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Stvk {
+    pub mu_pa: f64,
+    pub lambda_pa: f64,
+}
+
+impl PointMaterial for Stvk {
+    #[inline(always)]
+    fn energy_and_pk1(&self, f: &Mat3) -> (f64, Mat3) {
+        let h = f - Mat3::identity();
+        let e = (h + h.transpose() + h.tr_mul(&h)) * 0.5;
+        let tr = e.trace();
+        let mut s = e * (2.0 * self.mu_pa);
+        let lt = self.lambda_pa * tr;
+        s[(0, 0)] += lt;
+        s[(1, 1)] += lt;
+        s[(2, 2)] += lt;
+        let psi = self.mu_pa * e.norm_squared() + 0.5 * self.lambda_pa * tr * tr;
+        (psi, f * s)
+    }
+}
+
+/// Any material, through [`Material::energy_density_and_pk1`].
+#[derive(Clone, Copy, Debug)]
+pub struct AnyMaterial<'a>(pub &'a Material);
+
+impl PointMaterial for AnyMaterial<'_> {
+    #[inline(always)]
+    fn energy_and_pk1(&self, f: &Mat3) -> (f64, Mat3) {
+        self.0.energy_density_and_pk1(f)
+    }
+}
+
+/// One block's element data as the sweep reads it (a view of a [`PackedBlock`]).
+#[derive(Clone, Copy, Debug)]
+pub struct BlockData<'a> {
+    /// `N` node indices per element.
+    pub nodes: &'a [u32],
+    /// Material gradients, structure of arrays per element and point: for packed element `k`
+    /// and point `q`, the `3P` values from `(k Q + q) 3P` (`P` = [`padded`]`(N)`) are
+    /// `∂N_i/∂X` for `i < P` (zero for `i ≥ N`), then `∂N_i/∂Y`, then `∂N_i/∂Z`, so that the
+    /// loops over nodes run in whole vector registers.
+    pub grads: &'a [f64],
+    /// `Q` quadrature volumes per element.
+    pub volumes: &'a [f64],
+    pub points: usize,
+    /// `element_ids[k]`: the block's element index of packed element `k` (its multiplier and
+    /// the name the NaN guard reports). None: packed element `k` is element `k`.
+    pub element_ids: Option<&'a [u32]>,
+}
+
+/// What the sweep hands back when an element's corrections come out non-finite: its element
+/// index in the block and its first non-finite node (nothing was scattered for it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NonFiniteElement {
+    pub element: usize,
+    pub node: u32,
+}
+
+/// A slice the sweep reads and writes through a raw pointer, shared across the threads of one
+/// colour, which touch disjoint entries.
+pub struct SharedMut<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+impl<T> Clone for SharedMut<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for SharedMut<T> {}
+
+// SAFETY: shared across the threads of one colour, which touch disjoint entries.
+unsafe impl<T: Send> Send for SharedMut<T> {}
+unsafe impl<T: Send> Sync for SharedMut<T> {}
+
+impl<T> SharedMut<T> {
+    pub fn new(slice: &mut [T]) -> Self {
+        Self { ptr: slice.as_mut_ptr(), len: slice.len() }
+    }
+}
+
+/// Node positions as the sweep reads and writes them.
+pub type Positions = SharedMut<Vec3>;
+/// Multipliers λ as the sweep writes them (one per element, indexed by the block's element index).
+pub type Multipliers = SharedMut<f64>;
+
+/// Node counts with a specialised sweep (P1, pyramid, prism, Q1, P2, P3, Q2).
+pub const SPECIALISED_NODE_COUNTS: [usize; 7] = [4, 5, 6, 8, 10, 20, 27];
+
+/// The sweep of the energy formulation over packed elements `range` of `data`, in order.
+/// Returns the number of elements projected (those with a free node), or the first element
+/// whose corrections came out non-finite. None when `nodes_per_element` has no specialised
+/// sweep (the caller falls back to the generic kernel).
+///
+/// # Safety
+/// `positions` and `lambdas` must be valid for the whole sweep, every node index of `data` must
+/// be below `positions.len`, every element id below `lambdas.len`, and no other thread may
+/// touch the nodes and multipliers of the elements in `range` meanwhile.
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn energy_sweep(
+    nodes_per_element: usize,
+    material: &Material,
+    positions: Positions,
+    rest: &[Vec3],
+    inv_mass: &[f64],
+    data: &BlockData<'_>,
+    range: std::ops::Range<usize>,
+    lambdas: Multipliers,
+    inv_dt2: f64,
+) -> Option<Result<u64, NonFiniteElement>> {
+    let io = SweepIo { positions, rest, inv_mass, data, lambdas, inv_dt2 };
+    #[cfg(target_arch = "x86_64")]
+    let wide = std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma");
+    macro_rules! dispatch {
+        ($(($n:literal, $p:literal)),*) => {
+            match nodes_per_element {
+                $($n => Some(match material.model {
+                    MaterialModel::StVenantKirchhoff => {
+                        let l = material.lame();
+                        let m = Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa };
+                        #[cfg(target_arch = "x86_64")]
+                        if wide {
+                            // SAFETY: forwarded from the caller; AVX2 and FMA were detected.
+                            return Some(unsafe { sweep_avx2::<$n, $p, _>(&m, io, range) });
+                        }
+                        // SAFETY: forwarded from the caller.
+                        unsafe { sweep::<$n, $p, false, _>(&m, io, range) }
+                    }
+                    // SAFETY: as above.
+                    _ => unsafe { sweep::<$n, $p, false, _>(&AnyMaterial(material), io, range) },
+                }),)*
+                _ => None,
+            }
+        };
+    }
+    dispatch!((4, 4), (5, 8), (6, 8), (8, 8), (10, 12), (20, 20), (27, 28))
+}
+
+/// `a b + c`, fused (one rounding) when `FMA` (only where the CPU has it: in software it is slow).
+#[inline(always)]
+fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
+    if FMA { a.mul_add(b, c) } else { a * b + c }
+}
+
+/// What a sweep reads and writes, besides the material and the range of packed elements.
+#[derive(Clone, Copy)]
+struct SweepIo<'a> {
+    positions: Positions,
+    rest: &'a [Vec3],
+    inv_mass: &'a [f64],
+    data: &'a BlockData<'a>,
+    lambdas: Multipliers,
+    inv_dt2: f64,
+}
+
+/// `N` rounded up to a multiple of [`LANES`]: the padded length of the per-node arrays.
+pub const fn padded(n: usize) -> usize {
+    n.div_ceil(LANES) * LANES
+}
+
+/// Width of the partial sums of the node loops (four doubles: one 256-bit register).
+pub const LANES: usize = 4;
+
+/// [`sweep`] compiled for AVX2 with FMA (selected at run time).
+///
+/// # Safety
+/// See [`energy_sweep`]; the CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn sweep_avx2<const N: usize, const P: usize, M: PointMaterial>(
+    material: &M,
+    io: SweepIo<'_>,
+    range: std::ops::Range<usize>,
+) -> Result<u64, NonFiniteElement> {
+    // SAFETY: forwarded.
+    unsafe { sweep::<N, P, true, M>(material, io, range) }
+}
+
+/// [`energy_sweep`] for `N` nodes per element and material law `M`.
+///
+/// # Safety
+/// See [`energy_sweep`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMaterial>(
+    material: &M,
+    io: SweepIo<'_>,
+    range: std::ops::Range<usize>,
+) -> Result<u64, NonFiniteElement> {
+    let SweepIo { positions, rest, inv_mass, data, lambdas, inv_dt2 } = io;
+    let q = data.points;
+    let mut projected = 0;
+    for k in range {
+        let nodes: &[u32; N] = data.nodes[k * N..(k + 1) * N].try_into().expect("N nodes");
+        let w: [f64; N] = std::array::from_fn(|i| inv_mass[nodes[i] as usize]);
+        if w.iter().all(|&wi| wi == 0.0) {
+            continue;
+        }
+        let e = data.element_ids.map_or(k, |ids| ids[k] as usize);
+        assert!(e < lambdas.len);
+        // SAFETY: node indices are checked against the length; the caller guarantees no other
+        // thread touches these nodes and this multiplier.
+        let mut x: [Vec3; N] = std::array::from_fn(|i| {
+            let n = nodes[i] as usize;
+            assert!(n < positions.len);
+            unsafe { positions.ptr.add(n).read() }
+        });
+        let mut u = [[0.0; P]; 3];
+        for i in 0..N {
+            let d = x[i] - rest[nodes[i] as usize];
+            for a in 0..3 {
+                u[a][i] = d[a];
+            }
+        }
+        let lambda = unsafe { &mut *lambdas.ptr.add(e) };
+        let grads = &data.grads[k * q * 3 * P..(k + 1) * q * 3 * P];
+        let volumes = &data.volumes[k * q..(k + 1) * q];
+        project_energy::<N, P, FMA, M>(&mut x, &u, &w, grads, volumes, material, inv_dt2, lambda);
+        // x·0 is 0 for a finite x and NaN otherwise: one sum checks every coordinate
+        let mut check = 0.0;
+        for xi in &x {
+            check += xi.x * 0.0 + xi.y * 0.0 + xi.z * 0.0;
+        }
+        if check != 0.0 {
+            let i = x.iter().position(|xi| !xi.iter().all(|c| c.is_finite())).unwrap_or(0);
+            return Err(NonFiniteElement { element: e, node: nodes[i] });
+        }
+        for i in 0..N {
+            // SAFETY: as above.
+            unsafe { positions.ptr.add(nodes[i] as usize).write(x[i]) };
+        }
+        projected += 1;
+    }
+    Ok(projected)
+}
+
+/// Projects one element's energy constraint `C = √(2U_e)` (compliance 1): `x` gathered
+/// positions (updated), `u[a][i] = x_ia − X_ia` the displacements (zero for `N ≤ i < P`), `w` inverse masses,
+/// `grads` (`points × 3P`, structure of arrays, see [`BlockData::grads`]) and `volumes` its
+/// rest data. Returns the element energy before projection.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn project_energy<const N: usize, const P: usize, const FMA: bool, M: PointMaterial>(
+    x: &mut [Vec3; N],
+    u: &[[f64; P]; 3],
+    w: &[f64; N],
+    grads: &[f64],
+    volumes: &[f64],
+    material: &M,
+    inv_dt2: f64,
+    lambda: &mut f64,
+) -> f64 {
+    let mut grad = [[0.0; P]; 3];
+    let mut energy = 0.0;
+    for (gq, v) in grads.chunks_exact(3 * P).zip(volumes) {
+        let g: [&[f64; P]; 3] = std::array::from_fn(|b| gq[b * P..(b + 1) * P].try_into().expect("P gradients"));
+        // F_ab = δ_ab + Σ_i u_ai g_bi, summed in LANES partial sums (one vector register)
+        let mut acc = [[[0.0; LANES]; 3]; 3];
+        for c in 0..P / LANES {
+            for a in 0..3 {
+                for b in 0..3 {
+                    for l in 0..LANES {
+                        acc[a][b][l] = madd::<FMA>(u[a][c * LANES + l], g[b][c * LANES + l], acc[a][b][l]);
+                    }
+                }
+            }
+        }
+        let mut f = Mat3::identity();
+        for a in 0..3 {
+            for b in 0..3 {
+                let s = &acc[a][b];
+                f[(a, b)] += (s[0] + s[1]) + (s[2] + s[3]);
+            }
+        }
+    let (psi, p) = material.energy_and_pk1(&f);
+        energy += v * psi;
+        let vp = p * *v;
+        for a in 0..3 {
+            let (p0, p1, p2) = (vp[(a, 0)], vp[(a, 1)], vp[(a, 2)]);
+            for i in 0..P {
+                grad[a][i] = madd::<FMA>(p2, g[2][i], madd::<FMA>(p1, g[1][i], madd::<FMA>(p0, g[0][i], grad[a][i])));
+            }
+        }
+    }
+    // as the generic kernel: the stable Neo-Hookean energy can dip below its rest value
+    let energy = energy.max(0.0);
+    let c = (2.0 * energy).sqrt();
+    let mut sum_w_grad2 = 0.0;
+    for i in 0..N {
+        sum_w_grad2 += w[i] * (grad[0][i] * grad[0][i] + grad[1][i] * grad[1][i] + grad[2][i] * grad[2][i]);
+    }
+    if let Some((d_lambda, step)) = xpbd_step(c, c, sum_w_grad2, inv_dt2, *lambda) {
+        *lambda += d_lambda;
+        for i in 0..N {
+            let s = step * w[i];
+            x[i] += Vec3::new(grad[0][i], grad[1][i], grad[2][i]) * s;
+        }
+    }
+    energy
+}
+
+/// Fewest elements a thread gets in the parallel sweep: below this, splitting a colour costs
+/// more than it saves.
+pub const PARALLEL_MIN_ELEMENTS: usize = 256;
+
+/// The parallel sweep of the energy formulation over one block: colour after colour, each
+/// colour's packed range cut into one contiguous chunk per thread of rayon's current pool (at
+/// least [`PARALLEL_MIN_ELEMENTS`] elements each). Same-colour elements share no node, so the
+/// result is the same for any thread count and scheduling; on a non-finite correction the
+/// colour is finished (other chunks may have been scattered) and the error of the first such
+/// chunk is returned. None when the node count has no specialised sweep.
+pub fn parallel_energy_block(
+    nodes_per_element: usize,
+    material: &Material,
+    positions: &mut [Vec3],
+    rest: &[Vec3],
+    inv_mass: &[f64],
+    packed: &PackedBlock,
+    lambdas: &mut [f64],
+    inv_dt2: f64,
+) -> Option<Result<u64, NonFiniteElement>> {
+    use rayon::prelude::*;
+    if !SPECIALISED_NODE_COUNTS.contains(&nodes_per_element) {
+        return None;
+    }
+    let (positions, lambdas) = (Positions::new(positions), Multipliers::new(lambdas));
+    let data = packed.data();
+    let threads = rayon::current_num_threads().max(1);
+    let mut projected = 0;
+    for c in 0..packed.num_colours() {
+        let range = packed.colour(c);
+        let chunks = threads.min(range.len().div_ceil(PARALLEL_MIN_ELEMENTS)).max(1);
+        let chunk = |i: usize| range.start + range.len() * i / chunks..range.start + range.len() * (i + 1) / chunks;
+        // SAFETY: the chunks of a colour are disjoint ranges of elements that share no node
+        // (crate::colouring) and own their multipliers; node and element indices come from the
+        // mesh the positions and multipliers were sized for.
+        let run = |i: usize| unsafe {
+            energy_sweep(nodes_per_element, material, positions, rest, inv_mass, &data, chunk(i), lambdas, inv_dt2)
+                .expect("specialised node count")
+        };
+        let result = if chunks == 1 {
+            run(0)
+        } else {
+            (0..chunks)
+                .into_par_iter()
+                .map(|i| (i, run(i)))
+                .reduce(|| (usize::MAX, Ok(0)), |a, b| match (a, b) {
+                    ((i, Ok(x)), (j, Ok(y))) => (i.min(j), Ok(x + y)),
+                    ((i, Err(x)), (j, Err(y))) => if i < j { (i, Err(x)) } else { (j, Err(y)) },
+                    ((i, Err(x)), _) | (_, (i, Err(x))) => (i, Err(x)),
+                })
+                .1
+        };
+        match result {
+            Ok(k) => projected += k,
+            Err(bad) => return Some(Err(bad)),
+        }
+    }
+    Some(Ok(projected))
+}
+
+/// A block's element data packed for the sweep: in element order (the serial sweep), or
+/// reordered colour by colour (the parallel sweep; see the module doc), gradients as structure
+/// of arrays ([`BlockData::grads`]). Packed element `k` is element `element_ids[k]`; colour `c`
+/// is the packed range `colour_starts[c]..colour_starts[c + 1]` (one range for element order).
+#[derive(Clone, Debug, Default)]
+pub struct PackedBlock {
+    pub nodes: Vec<u32>,
+    pub grads: Vec<f64>,
+    pub volumes: Vec<f64>,
+    /// None in element order.
+    pub element_ids: Option<Vec<u32>>,
+    pub colour_starts: Vec<usize>,
+    pub points: usize,
+}
+
+impl PackedBlock {
+    /// `block`'s data in element order.
+    pub fn in_element_order(block: &ElementBlock, geometry: &BlockGeometry) -> Self {
+        let all: Vec<u32> = (0..block.len() as u32).collect();
+        let mut packed = Self::new(block, geometry, std::slice::from_ref(&all));
+        packed.element_ids = None;
+        packed
+    }
+
+    /// `block`'s data in the order of `colours` (element indices per colour).
+    pub fn in_colour_order(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>]) -> Self {
+        Self::new(block, geometry, colours)
+    }
+
+    fn new(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>]) -> Self {
+        let (n, q) = (block.nodes_per_element(), geometry.points_per_element);
+        let total: usize = colours.iter().map(Vec::len).sum();
+        let mut ids = Vec::with_capacity(total);
+        let mut packed = Self {
+            nodes: Vec::with_capacity(total * n),
+            grads: Vec::with_capacity(total * 3 * padded(n) * q),
+            volumes: Vec::with_capacity(total * q),
+            element_ids: None,
+            colour_starts: Vec::with_capacity(colours.len() + 1),
+            points: q,
+        };
+        packed.colour_starts.push(0);
+        for colour in colours {
+            for &e in colour {
+                let e = e as usize;
+                packed.nodes.extend_from_slice(block.element(e));
+                for p in 0..q {
+                    let g = geometry.gradients(e, p);
+                    for axis in 0..3 {
+                        packed.grads.extend(g.iter().map(|gi| gi[axis]));
+                        packed.grads.extend(std::iter::repeat_n(0.0, padded(n) - n));
+                    }
+                }
+                packed.volumes.extend_from_slice(geometry.volumes(e));
+                ids.push(e as u32);
+            }
+            packed.colour_starts.push(ids.len());
+        }
+        packed.element_ids = Some(ids);
+        packed
+    }
+
+    pub fn data(&self) -> BlockData<'_> {
+        BlockData { nodes: &self.nodes, grads: &self.grads, volumes: &self.volumes, points: self.points, element_ids: self.element_ids.as_deref() }
+    }
+
+    pub fn len(&self) -> usize {
+        self.colour_starts.last().copied().unwrap_or(0)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The packed range of colour `c`.
+    pub fn colour(&self, c: usize) -> std::ops::Range<usize> {
+        self.colour_starts[c]..self.colour_starts[c + 1]
+    }
+
+    pub fn num_colours(&self) -> usize {
+        self.colour_starts.len().saturating_sub(1)
+    }
+}
+
+/// The packed data of every block of a simulation: element order and colour order.
+#[derive(Clone, Debug, Default)]
+pub struct SolverData {
+    pub serial: Vec<PackedBlock>,
+    pub colour: Vec<PackedBlock>,
+}
+
+impl SolverData {
+    pub fn new(blocks: &[ElementBlock], geometry: &[BlockGeometry], colours: &[Vec<Vec<u32>>]) -> Self {
+        Self {
+            serial: blocks.iter().zip(geometry).map(|(b, g)| PackedBlock::in_element_order(b, g)).collect(),
+            colour: blocks.iter().zip(geometry).zip(colours).map(|((b, g), c)| PackedBlock::in_colour_order(b, g, c)).collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
