@@ -463,7 +463,7 @@ pub fn open_dialog_ui(app: &mut HoxApp, ctx: &egui::Context) {
 
 /// A scene file for a mesh file: the mesh, its `clamp_group` clamped, gravity, the paper
 /// beam's material; written next to the user's settings so it can be reopened.
-fn mesh_scene_file(mesh: &std::path::Path, clamp_group: &str) -> Result<std::path::PathBuf, String> {
+pub(super) fn mesh_scene_file(mesh: &std::path::Path, clamp_group: &str) -> Result<std::path::PathBuf, String> {
     let mesh = std::fs::canonicalize(mesh).map_err(|e| format!("{}: {e}", mesh.display()))?;
     let name = mesh.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().to_string());
     let text = format!(

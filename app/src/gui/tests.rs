@@ -107,3 +107,18 @@ fn compare_mode_links_controls_and_shows_both_errors() {
 fn status_count(h: &Harness<'_, HoxApp>) -> usize {
     h.query_all_by_label_contains("nodes,").count()
 }
+
+#[test]
+fn open_mesh_runs_a_gmsh_file_with_its_clamp_group() {
+    let beam = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/meshes/beam-tet10.msh");
+    let mut app = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap();
+    let scene = controls::mesh_scene_file(&beam, "clamp").expect("a scene for the mesh");
+    app.load_scene(SceneSource::File(scene), None).unwrap();
+    let sim = &app.sessions[0].instance.sim;
+    assert_eq!((sim.mesh().num_nodes(), sim.mesh().num_elements()), (495, 218));
+    assert!(!app.sessions[0].clamped.is_empty(), "the clamp group holds nodes");
+    app.step(5);
+    assert!(app.sessions[0].instance.sim.time_secs() > 0.0);
+    let err = controls::mesh_scene_file(&beam, "no-such-group").unwrap_err();
+    assert!(err.contains("no-such-group"), "{err}");
+}
