@@ -170,6 +170,46 @@ pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     rerun_ui(app, ui);
 }
 
+/// One control row: its label (with tooltip), a widget editing a copy of the value, the link
+/// toggle, and under it the reason of a refused change. A changed value goes through
+/// [`HoxApp::apply`].
+fn row_ui<T: Clone + PartialEq>(
+    app: &mut HoxApp,
+    ui: &mut egui::Ui,
+    field: &str,
+    text: &str,
+    tip: &str,
+    get: impl Fn(&Config) -> T,
+    set: impl Fn(&mut Config, T),
+    widget: impl FnOnce(&mut egui::Ui, &mut T) -> egui::Response,
+) {
+    let current = app.sessions[app.active].config.clone();
+    ui.horizontal(|ui| {
+        let l = label(ui, text, tip);
+        let mut value = get(&current);
+        widget(ui, &mut value).labelled_by(l.id).on_hover_text(tip);
+        if value != get(&current) {
+            let mut n = current.clone();
+            set(&mut n, value);
+            app.apply(field, n);
+        }
+        link_ui(app, ui, field);
+    });
+    refusal_ui(app, ui, field);
+}
+
+/// A combo box over `options` (value, text).
+fn combo<T: Clone + PartialEq>(ui: &mut egui::Ui, id: (&str, usize), value: &mut T, shown: String, options: Vec<(T, String)>) -> egui::Response {
+    egui::ComboBox::from_id_salt(id)
+        .selected_text(shown)
+        .show_ui(ui, |ui| {
+            for (v, text) in options {
+                ui.selectable_value(value, v, text);
+            }
+        })
+        .response
+}
+
 fn mesh_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Mesh");
     let c = app.sessions[app.active].config.clone();
@@ -177,88 +217,44 @@ fn mesh_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         ui.label("from a mesh file (element type and grid are the file's)");
         return;
     }
-    ui.horizontal(|ui| {
-        let l = label(ui, "Element", "The element type: P1/P2/P3 tetrahedra (order 1–3), Q1/Q2 hexahedra, prisms, pyramids.");
-        let mut element = c.element.clone();
-        egui::ComboBox::from_id_salt(("element", app.active)).selected_text(element.to_uppercase()).show_ui(ui, |ui| {
-            for e in ElementType::all() {
-                ui.selectable_value(&mut element, e.name().to_string(), format!("{} — {}", e.name().to_uppercase(), e.description()));
-            }
-        })
-        .response
-        .labelled_by(l.id);
-        if element != c.element {
-            let mut n = c.clone();
-            n.element = element;
-            app.apply("element", n);
-        }
-        link_ui(app, ui, "element");
+    let k = app.active;
+    row_ui(app, ui, "element", "Element", "The element type: P1/P2/P3 tetrahedra (order 1–3), Q1/Q2 hexahedra, prisms, pyramids.", |c| c.element.clone(), |c, v| c.element = v, |ui, v| {
+        let shown = v.to_uppercase();
+        combo(ui, ("element", k), v, shown, ElementType::all().map(|e| (e.name().to_string(), format!("{} — {}", e.name().to_uppercase(), e.description()))).collect())
     });
-    refusal_ui(app, ui, "element");
     let tets = ["p1", "p2", "p3"].contains(&c.element.as_str());
-    ui.horizontal(|ui| {
-        label(ui, "Tet split", "How each hexahedral cell is cut into tetrahedra: five (unbiased, alternating) or six (biased along one diagonal).");
-        let mut split = c.split.clone();
+    row_ui(app, ui, "split", "Tet split", "How each hexahedral cell is cut into tetrahedra: five (unbiased, alternating) or six (biased along one diagonal).", |c| c.split.clone(), |c, v| c.split = v, |ui, v| {
         ui.add_enabled_ui(tets, |ui| {
-            ui.radio_value(&mut split, "five".to_string(), "five (unbiased)");
-            ui.radio_value(&mut split, "six".to_string(), "six (biased)");
-        });
-        if split != c.split {
-            let mut n = c.clone();
-            n.split = split;
-            app.apply("split", n);
-        }
-        link_ui(app, ui, "split");
+            ui.radio_value(v, "five".to_string(), "five (unbiased)");
+            ui.radio_value(v, "six".to_string(), "six (biased)")
+        })
+        .inner
     });
-    ui.horizontal(|ui| {
-        let l = label(ui, "Grid", "Hexahedral cells along x, y and z before any splitting (each 1–64).");
-        let mut grid = c.grid;
-        for g in &mut grid {
-            ui.add(egui::DragValue::new(g).range(1..=64)).labelled_by(l.id).on_hover_text("Cells in this direction (1–64).");
+    row_ui(app, ui, "grid", "Grid", "Hexahedral cells along x, y and z before any splitting (each 1–64).", |c| c.grid, |c, v| c.grid = v, |ui, g| {
+        let mut response: Option<egui::Response> = None;
+        for (cells, axis) in g.iter_mut().zip(["x", "y", "z"]) {
+            let l = ui.label(axis);
+            let r = ui.add(egui::DragValue::new(cells).range(1..=64)).labelled_by(l.id);
+            response = Some(match response {
+                Some(prev) => prev | r,
+                None => r,
+            });
         }
-        if grid != c.grid {
-            let mut n = c.clone();
-            n.grid = grid;
-            app.apply("grid", n);
-        }
-        link_ui(app, ui, "grid");
+        response.expect("three cells")
     });
-    refusal_ui(app, ui, "grid");
-    ui.horizontal(|ui| {
-        let l = label(ui, "Refine", "1-to-8 refinements of the tetrahedra (each multiplies the element count by 8; tetrahedra only).");
-        let mut refine = c.refine;
-        ui.add_enabled(tets, egui::Slider::new(&mut refine, 0..=3)).labelled_by(l.id);
-        if refine != c.refine {
-            let mut n = c.clone();
-            n.refine = refine;
-            app.apply("refine", n);
-        }
-        link_ui(app, ui, "refine");
+    row_ui(app, ui, "refine", "Refine", "1-to-8 refinements of the tetrahedra (each multiplies the element count by 8; tetrahedra only).", |c| c.refine, |c, v| c.refine = v, |ui, v| {
+        ui.add_enabled(tets, egui::Slider::new(v, 0..=3))
     });
-    refusal_ui(app, ui, "refine");
 }
 
 fn material_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Material");
     let c = app.sessions[app.active].config.clone();
-    ui.horizontal(|ui| {
-        let l = label(ui, "Model", "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean or Neo-Hookean.");
-        let mut model = c.material.clone();
-        egui::ComboBox::from_id_salt(("model", app.active)).selected_text(MaterialModel::from_name(&model).map_or(model.clone(), |m| m.long_name().to_string())).show_ui(ui, |ui| {
-            for m in MaterialModel::ALL {
-                ui.selectable_value(&mut model, m.name().to_string(), m.long_name());
-            }
-        })
-        .response
-        .labelled_by(l.id);
-        if model != c.material {
-            let mut n = c.clone();
-            n.material = model;
-            app.apply("material", n);
-        }
-        link_ui(app, ui, "material");
+    let k = app.active;
+    row_ui(app, ui, "material", "Model", "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean or Neo-Hookean.", |c| c.material.clone(), |c, v| c.material = v, |ui, v| {
+        let shown = MaterialModel::from_name(v).map_or(v.clone(), |m| m.long_name().to_string());
+        combo(ui, ("model", k), v, shown, MaterialModel::ALL.iter().map(|m| (m.name().to_string(), m.long_name().to_string())).collect())
     });
-    refusal_ui(app, ui, "material");
     number_ui(app, ui, "youngs", "Young's modulus E (Pa)", "Stiffness in pascals, > 0 (rubber ~1e6, the paper's beam 3e6).", c.youngs_modulus_pa, |c, v| c.youngs_modulus_pa = v);
     number_ui(app, ui, "poisson", "Poisson ratio ν", "Lateral contraction, between −1 and 0.5 (exclusive); near 0.5 is nearly incompressible.", c.poisson_ratio, |c, v| c.poisson_ratio = v);
     number_ui(app, ui, "density", "Density ρ (kg/m³)", "Mass per volume in kg/m³, > 0 (water 1000).", c.density_kg_m3, |c, v| c.density_kg_m3 = v);
@@ -266,67 +262,25 @@ fn material_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
 
 fn solver_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Solver");
-    let c = app.sessions[app.active].config.clone();
-    ui.horizontal(|ui| {
-        label(ui, "Formulation", "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.");
-        let mut f = c.formulation.clone();
-        ui.radio_value(&mut f, "energy".to_string(), "energy");
-        ui.radio_value(&mut f, "split".to_string(), "split");
-        if f != c.formulation {
-            let mut n = c.clone();
-            n.formulation = f;
-            app.apply("formulation", n);
-        }
-        link_ui(app, ui, "formulation");
+    let k = app.active;
+    row_ui(app, ui, "formulation", "Formulation", "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.", |c| c.formulation.clone(), |c, v| c.formulation = v, |ui, v| {
+        ui.radio_value(v, "energy".to_string(), "energy") | ui.radio_value(v, "split".to_string(), "split")
     });
-    refusal_ui(app, ui, "formulation");
-    ui.horizontal(|ui| {
-        let l = label(ui, "Quadrature", "Degree of polynomials the element quadrature integrates exactly (default: the element's own).");
-        let mut q = c.quadrature_degree;
-        egui::ComboBox::from_id_salt(("quadrature", app.active)).selected_text(q.map_or("element default".to_string(), |d| format!("degree {d}"))).show_ui(ui, |ui| {
-            ui.selectable_value(&mut q, None, "element default");
-            for d in 1..=8 {
-                ui.selectable_value(&mut q, Some(d), format!("degree {d}"));
-            }
-        })
-        .response
-        .labelled_by(l.id);
-        if q != c.quadrature_degree {
-            let mut n = c.clone();
-            n.quadrature_degree = q;
-            app.apply("quadrature", n);
-        }
-        link_ui(app, ui, "quadrature");
+    row_ui(app, ui, "quadrature", "Quadrature", "Degree of polynomials the element quadrature integrates exactly (default: the element's own).", |c| c.quadrature_degree, |c, v| c.quadrature_degree = v, |ui, v| {
+        let shown = v.map_or("element default".to_string(), |d| format!("degree {d}"));
+        let mut options = vec![(None, "element default".to_string())];
+        options.extend((1..=8).map(|d| (Some(d), format!("degree {d}"))));
+        combo(ui, ("quadrature", k), v, shown, options)
     });
-    refusal_ui(app, ui, "quadrature");
-    let slider = |app: &mut HoxApp, ui: &mut egui::Ui, field: &str, text: &str, tip: &str, value: u32, range: std::ops::RangeInclusive<u32>, set: fn(&mut Config, u32)| {
-        ui.horizontal(|ui| {
-            let l = label(ui, text, tip);
-            let mut v = value;
-            ui.add(egui::Slider::new(&mut v, range).logarithmic(true)).labelled_by(l.id).on_hover_text(tip);
-            if v != value {
-                let mut n = app.sessions[app.active].config.clone();
-                set(&mut n, v);
-                app.apply(field, n);
-            }
-            link_ui(app, ui, field);
-        });
-        refusal_ui(app, ui, field);
-    };
-    slider(app, ui, "substeps", "Substeps", "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.", c.substeps, 1..=500, |c, v| c.substeps = v);
-    slider(app, ui, "iterations", "Iterations", "Constraint sweeps per substep (the paper: 1).", c.iterations, 1..=20, |c, v| c.iterations = v);
-    ui.horizontal(|ui| {
-        let l = label(ui, "Frames per second", "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.");
-        let mut fps = c.frames_per_second;
-        ui.add(egui::Slider::new(&mut fps, 10.0..=240.0).logarithmic(true).suffix(" fps")).labelled_by(l.id);
-        if fps != c.frames_per_second {
-            let mut n = c.clone();
-            n.frames_per_second = fps;
-            app.apply("fps", n);
-        }
-        link_ui(app, ui, "fps");
+    row_ui(app, ui, "substeps", "Substeps", "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.", |c| c.substeps, |c, v| c.substeps = v, |ui, v| {
+        ui.add(egui::Slider::new(v, 1..=500).logarithmic(true))
     });
-    refusal_ui(app, ui, "fps");
+    row_ui(app, ui, "iterations", "Iterations", "Constraint sweeps per substep (the paper: 1).", |c| c.iterations, |c, v| c.iterations = v, |ui, v| {
+        ui.add(egui::Slider::new(v, 1..=20).logarithmic(true))
+    });
+    row_ui(app, ui, "fps", "Frames per second", "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.", |c| c.frames_per_second, |c, v| c.frames_per_second = v, |ui, v| {
+        ui.add(egui::Slider::new(v, 10.0..=240.0).logarithmic(true).suffix(" fps"))
+    });
 }
 
 fn playback_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
