@@ -95,6 +95,7 @@ impl Session {
             segments,
         };
         s.mesh_changed();
+        s.residual = s.force_residual();
         Ok(s)
     }
 
@@ -115,6 +116,7 @@ impl Session {
                 self.failure = None;
                 self.drag = None;
                 self.mesh_changed();
+                self.residual = self.force_residual();
             }
             Invalidates::Material => {
                 self.instance.sim.set_material(scene.material).map_err(|e| e.to_string())?;
