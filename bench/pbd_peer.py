@@ -4,7 +4,9 @@ three P1 beams as `hox bench` (the paper's Table 1 bending beam: 2 x 0.5 x 0.5 m
 x = 0, gravity, 50 substeps x 1 iteration per 1/60 s frame), timed, then `hox`'s own timing of
 the same beams run right after, so the ratio is measured in one run.
 
-    python3 bench/pbd_peer.py [--frames 20] [--method 3] [--hox CMD]
+    python3 bench/pbd_peer.py [--frames 20] [--method 3]
+
+(set HOX_CARGO="flock /tmp/hox-cargo.lock cargo" where builds must take turns).
 
 Installs pypbd into bench/.venv (a virtualenv) on first use. The meshes come from hox itself
 (`cargo run --release -p hox-sim --example beam_mesh -- LABEL`), so both solve identical meshes.
@@ -37,9 +39,14 @@ def ensure_venv() -> Path:
     return python
 
 
+def cargo() -> list:
+    """The cargo command (HOX_CARGO, e.g. "flock /tmp/hox-cargo.lock cargo" on a shared machine)."""
+    return os.environ.get("HOX_CARGO", "cargo").split()
+
+
 def beam_mesh(label: str) -> dict:
     out = subprocess.run(
-        ["cargo", "run", "--quiet", "--release", "-p", "hox-sim", "--example", "beam_mesh", "--", label],
+        cargo() + ["run", "--quiet", "--release", "-p", "hox-sim", "--example", "beam_mesh", "--", label],
         cwd=ROOT, check=True, capture_output=True, text=True,
     ).stdout
     return json.loads(out)
@@ -91,8 +98,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--frames", type=int, default=20)
     parser.add_argument("--method", type=int, default=3, help="PBD solid method (3: XPBD FEM tetrahedra)")
-    parser.add_argument("--hox", default="cargo run --quiet --release -p hox-sim --example bench_table --",
-                        help="command printing the hox bench table (e.g. 'hox bench --')")
+    parser.add_argument("--hox", default="run --quiet --release -p hox-sim --example bench_table --",
+                        help="cargo arguments that print the hox bench table for FRAMES THREADS FILTER")
     parser.add_argument("--inner", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.inner:
@@ -109,8 +116,8 @@ def main() -> None:
         out = subprocess.run([str(python), __file__, "--inner", str(path), "--frames", str(args.frames), "--method", str(args.method)],
                              env=env, check=True, capture_output=True, text=True).stdout
         pbd_ms = json.loads(out.strip().splitlines()[-1])["ms_per_frame"]
-        hox_out = subprocess.run(args.hox.split() + [str(args.frames), "1", label], cwd=ROOT, check=True, capture_output=True, text=True).stdout
-        hox_ms = next(float(line.split("|")[5]) for line in hox_out.splitlines() if line.startswith("| P1"))
+        hox_out = subprocess.run(cargo() + args.hox.split() + [str(args.frames), "1", label], cwd=ROOT, check=True, capture_output=True, text=True).stdout
+        hox_ms = next(float(line.split("|")[6]) for line in hox_out.splitlines() if line.startswith("| P1"))
         rows.append((label, len(mesh["tets"]) // 4, pbd_ms, hox_ms))
         print(f"{label}: PBD {pbd_ms:.2f} ms/frame, hox {hox_ms:.2f} ms/frame", file=sys.stderr)
     print("| beam | tetrahedra | PBD ms/frame (1 thread) | hox ms/frame (1 thread) | hox / PBD |")

@@ -70,6 +70,22 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Time the XPBD loop on the paper's Table 1 beams and the other element types: ms per
+    /// frame against the paper's, ns per element per substep, GFLOP/s (docs/PERFORMANCE.md).
+    Bench {
+        /// Timed frames per configuration (the median is reported).
+        #[arg(long, default_value_t = 20)]
+        frames: usize,
+        /// Thread counts, comma-separated (1: the serial sweep; more: the parallel colour sweep).
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+        /// Only the configurations whose label contains this (e.g. "p1", "r2").
+        #[arg(long, default_value = "")]
+        only: String,
+        /// Also time the parallel colour sweep on one thread (its cost without parallelism).
+        #[arg(long)]
+        colour_on_one: bool,
+    },
     /// Run a scene (for --seconds, or until it --settle-s) and print the probe displacements.
     Simulate {
         #[command(flatten)]
@@ -186,6 +202,7 @@ pub fn main(cli: Cli) -> Result<()> {
         Command::Mesh { scene, mesh, json } => mesh_command(&scene, &mesh, json),
         Command::Simulate { scene, mesh, physics, seconds, settle, vtk, json } => simulate(&scene, &mesh, &physics, seconds, settle, &vtk, json),
         Command::Study { quick, out } => study(quick, &out),
+        Command::Bench { frames, threads, only, colour_on_one } => bench(frames, &threads, &only, colour_on_one),
         Command::Static { scene, mesh, physics, tolerance, load_steps, json } => static_command(&scene, &mesh, &physics, tolerance, load_steps, json),
         Command::Record(args) => record::record(&args),
         Command::Inspect(args) => record::inspect(&args),
@@ -397,6 +414,20 @@ fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tol
             println!("  group {name}: mean u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
         }
     }
+    Ok(())
+}
+
+fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool) -> Result<()> {
+    if frames == 0 || threads.contains(&0) {
+        bail!("--frames and every --threads count must be at least 1");
+    }
+    let rows = hox_sim::benchmark::run(only, threads, colour_on_one, frames, &mut |r| {
+        eprintln!("{} on {} thread(s), parallel {}: {:.2} ms/frame", r.case.label(), r.threads, r.parallel, r.ms_per_frame)
+    })?;
+    if rows.is_empty() {
+        bail!("no configuration matches '{only}'");
+    }
+    print!("{}", hox_sim::benchmark::markdown(&rows));
     Ok(())
 }
 

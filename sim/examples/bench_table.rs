@@ -1,6 +1,7 @@
 //! Prints the `hox bench` table without building the app:
 //! `cargo run --release -p hox-sim --example bench_table [-- FRAMES [THREADS [FILTER]]]`
-//! (THREADS: comma-separated, default 1,2; FILTER: a substring of the configuration label).
+//! (THREADS: comma-separated, default 1,2; FILTER: a substring of the configuration label;
+//! HOX_BENCH_COLOUR_ON_ONE=1 also times the colour sweep on one thread).
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -10,8 +11,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => vec![1, 2],
     };
     let filter = args.next().unwrap_or_default();
-    let rows = hox_sim::benchmark::run(&filter, &threads, frames, &mut |r| {
-        eprintln!("{} on {} thread(s): {:.2} ms/frame", r.case.label(), r.threads, r.ms_per_frame)
+    let rows = hox_sim::benchmark::run(&filter, &threads, std::env::var_os("HOX_BENCH_COLOUR_ON_ONE").is_some(), frames, &mut |r| {
+        eprintln!("{} on {} thread(s), parallel {}: {:.2} ms/frame", r.case.label(), r.threads, r.parallel, r.ms_per_frame)
     })?;
     print!("{}", hox_sim::benchmark::markdown(&rows));
     Ok(())

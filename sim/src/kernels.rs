@@ -26,7 +26,20 @@ use crate::mesh::ElementBlock;
 
 /// `(ψ(F), P(F))` at one quadrature point: the material law the kernel is generic over.
 pub trait PointMaterial: Sync {
-    fn energy_and_pk1(&self, f: &Mat3) -> (f64, Mat3);
+    /// `FMA`: products may use fused multiply–adds ([`mul3`]).
+    fn energy_and_pk1<const FMA: bool>(&self, f: &Mat3) -> (f64, Mat3);
+}
+
+/// `a b` for 3×3 matrices with `madd::<FMA>` (nalgebra's product never fuses).
+#[inline(always)]
+pub fn mul3<const FMA: bool>(a: &Mat3, b: &Mat3) -> Mat3 {
+    Mat3::from_fn(|r, c| madd::<FMA>(a[(r, 2)], b[(2, c)], madd::<FMA>(a[(r, 1)], b[(1, c)], a[(r, 0)] * b[(0, c)])))
+}
+
+/// `aᵀ b` for 3×3 matrices, as [`mul3`].
+#[inline(always)]
+pub fn tr_mul3<const FMA: bool>(a: &Mat3, b: &Mat3) -> Mat3 {
+    Mat3::from_fn(|r, c| madd::<FMA>(a[(2, r)], b[(2, c)], madd::<FMA>(a[(1, r)], b[(1, c)], a[(0, r)] * b[(0, c)])))
 }
 
 /// Saint-Venant–Kirchhoff with its Lamé parameters precomputed: `E = ½(H + Hᵀ + HᵀH)`,
@@ -40,9 +53,9 @@ pub struct Stvk {
 
 impl PointMaterial for Stvk {
     #[inline(always)]
-    fn energy_and_pk1(&self, f: &Mat3) -> (f64, Mat3) {
+    fn energy_and_pk1<const FMA: bool>(&self, f: &Mat3) -> (f64, Mat3) {
         let h = f - Mat3::identity();
-        let e = (h + h.transpose() + h.tr_mul(&h)) * 0.5;
+        let e = (h + h.transpose() + tr_mul3::<FMA>(&h, &h)) * 0.5;
         let tr = e.trace();
         let mut s = e * (2.0 * self.mu_pa);
         let lt = self.lambda_pa * tr;
@@ -50,7 +63,7 @@ impl PointMaterial for Stvk {
         s[(1, 1)] += lt;
         s[(2, 2)] += lt;
         let psi = self.mu_pa * e.norm_squared() + 0.5 * self.lambda_pa * tr * tr;
-        (psi, f * s)
+        (psi, mul3::<FMA>(f, &s))
     }
 }
 
@@ -60,7 +73,7 @@ pub struct AnyMaterial<'a>(pub &'a Material);
 
 impl PointMaterial for AnyMaterial<'_> {
     #[inline(always)]
-    fn energy_and_pk1(&self, f: &Mat3) -> (f64, Mat3) {
+    fn energy_and_pk1<const FMA: bool>(&self, f: &Mat3) -> (f64, Mat3) {
         self.0.energy_density_and_pk1(f)
     }
 }
@@ -189,6 +202,42 @@ struct SweepIo<'a> {
     inv_dt2: f64,
 }
 
+/// `acc ← acc + a ∘ b` on [`LANES`] lanes (`a`, `b`: at least `LANES` long): one AVX2 fused
+/// multiply–add when `FMA` (set only by [`sweep_avx2`], where the CPU has both).
+#[inline(always)]
+fn fma_lanes<const FMA: bool>(acc: &mut [f64; LANES], a: &[f64], b: &[f64]) {
+    let (a, b): (&[f64; LANES], &[f64; LANES]) = (a[..LANES].try_into().expect("LANES"), b[..LANES].try_into().expect("LANES"));
+    #[cfg(target_arch = "x86_64")]
+    if FMA {
+        // SAFETY: FMA is true only under sweep_avx2, which runs where AVX2 and FMA were detected.
+        unsafe { lanes_avx2(acc, a, b) };
+        return;
+    }
+    for l in 0..LANES {
+        acc[l] = madd::<FMA>(a[l], b[l], acc[l]);
+    }
+}
+
+/// `acc ← acc + s b` on [`LANES`] lanes, as [`fma_lanes`].
+#[inline(always)]
+fn axpy_lanes<const FMA: bool>(acc: &mut [f64; LANES], s: f64, b: &[f64]) {
+    fma_lanes::<FMA>(acc, &[s; LANES], b);
+}
+
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn lanes_avx2(acc: &mut [f64; LANES], a: &[f64; LANES], b: &[f64; LANES]) {
+    use std::arch::x86_64::{_mm256_fmadd_pd, _mm256_loadu_pd, _mm256_storeu_pd};
+    // SAFETY: each pointer covers four f64.
+    unsafe {
+        let r = _mm256_fmadd_pd(_mm256_loadu_pd(a.as_ptr()), _mm256_loadu_pd(b.as_ptr()), _mm256_loadu_pd(acc.as_ptr()));
+        _mm256_storeu_pd(acc.as_mut_ptr(), r);
+    }
+}
+
 /// `N` rounded up to a multiple of [`LANES`]: the padded length of the per-node arrays.
 pub const fn padded(n: usize) -> usize {
     n.div_ceil(LANES) * LANES
@@ -242,17 +291,24 @@ unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMateria
             assert!(n < positions.len);
             unsafe { positions.ptr.add(n).read() }
         });
-        let mut u = [[0.0; P]; 3];
-        for i in 0..N {
-            let d = x[i] - rest[nodes[i] as usize];
-            for a in 0..3 {
-                u[a][i] = d[a];
-            }
-        }
+        let d: [Vec3; N] = std::array::from_fn(|i| x[i] - rest[nodes[i] as usize]);
         let lambda = unsafe { &mut *lambdas.ptr.add(e) };
         let grads = &data.grads[k * q * 3 * P..(k + 1) * q * 3 * P];
         let volumes = &data.volumes[k * q..(k + 1) * q];
-        project_energy::<N, P, FMA, M>(&mut x, &u, &w, grads, volumes, material, inv_dt2, lambda);
+        if N == 4 && q == 1 {
+            // the linear tetrahedron: one point, constant gradients
+            let x4: &mut [Vec3; 4] = (&mut x[..]).try_into().expect("4 nodes");
+            let (d4, w4): (&[Vec3; 4], &[f64; 4]) = (d[..].try_into().expect("4 nodes"), w[..].try_into().expect("4 nodes"));
+            project_p1::<FMA, M>(x4, d4, w4, grads, volumes[0], material, inv_dt2, lambda);
+        } else {
+            let mut u = [[0.0; P]; 3];
+            for i in 0..N {
+                for a in 0..3 {
+                    u[a][i] = d[i][a];
+                }
+            }
+            project_energy::<N, P, FMA, M>(&mut x, &u, &w, grads, volumes, material, inv_dt2, lambda);
+        }
         // x·0 is 0 for a finite x and NaN otherwise: one sum checks every coordinate
         let mut check = 0.0;
         for xi in &x {
@@ -269,6 +325,35 @@ unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMateria
         projected += 1;
     }
     Ok(projected)
+}
+
+/// [`project_energy`] for the linear tetrahedron (one quadrature point, constant gradients
+/// `g_i = ∇_X N_i`, `Σ_i g_i = 0`): `F = I + Σ_{i=1..3} (u_i − u_0) ⊗ g_i` (the paper's
+/// `F = D_s D_m⁻¹` written in displacements), `∇_i U = V P g_i` for `i = 1..3` and
+/// `∇_0 U = −Σ_{i≥1} ∇_i U` (Bender et al.'s FEM tetrahedron), all as 3×3 products.
+/// `grads` is the point's `3 × 4` structure-of-arrays block; `v` its volume.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn project_p1<const FMA: bool, M: PointMaterial>(x: &mut [Vec3; 4], u: &[Vec3; 4], w: &[f64; 4], grads: &[f64], v: f64, material: &M, inv_dt2: f64, lambda: &mut f64) -> f64 {
+    // g[(i − 1, b)] = ∂N_i/∂X_b
+    let g = Mat3::new(grads[1], grads[5], grads[9], grads[2], grads[6], grads[10], grads[3], grads[7], grads[11]);
+    let du = Mat3::from_columns(&[u[1] - u[0], u[2] - u[0], u[3] - u[0]]);
+    let f = Mat3::identity() + mul3::<FMA>(&du, &g);
+    let (psi, p) = material.energy_and_pk1::<FMA>(&f);
+    // columns: ∇_1 U, ∇_2 U, ∇_3 U
+    let h = mul3::<FMA>(&(p * v), &g.transpose());
+    let g0 = -(h.column(0) + h.column(1) + h.column(2));
+    let grad = [g0, h.column(0).into_owned(), h.column(1).into_owned(), h.column(2).into_owned()];
+    let energy = (v * psi).max(0.0);
+    let c = (2.0 * energy).sqrt();
+    let sum_w_grad2 = w[0] * grad[0].norm_squared() + w[1] * grad[1].norm_squared() + w[2] * grad[2].norm_squared() + w[3] * grad[3].norm_squared();
+    if let Some((d_lambda, step)) = xpbd_step(c, c, sum_w_grad2, inv_dt2, *lambda) {
+        *lambda += d_lambda;
+        for i in 0..4 {
+            x[i] += grad[i] * (step * w[i]);
+        }
+    }
+    energy
 }
 
 /// Projects one element's energy constraint `C = √(2U_e)` (compliance 1): `x` gathered
@@ -296,9 +381,8 @@ pub fn project_energy<const N: usize, const P: usize, const FMA: bool, M: PointM
         for c in 0..P / LANES {
             for a in 0..3 {
                 for b in 0..3 {
-                    for l in 0..LANES {
-                        acc[a][b][l] = madd::<FMA>(u[a][c * LANES + l], g[b][c * LANES + l], acc[a][b][l]);
-                    }
+                    let r = c * LANES..(c + 1) * LANES;
+                    fma_lanes::<FMA>(&mut acc[a][b], &u[a][r.clone()], &g[b][r]);
                 }
             }
         }
@@ -309,13 +393,17 @@ pub fn project_energy<const N: usize, const P: usize, const FMA: bool, M: PointM
                 f[(a, b)] += (s[0] + s[1]) + (s[2] + s[3]);
             }
         }
-    let (psi, p) = material.energy_and_pk1(&f);
+    let (psi, p) = material.energy_and_pk1::<FMA>(&f);
         energy += v * psi;
         let vp = p * *v;
         for a in 0..3 {
             let (p0, p1, p2) = (vp[(a, 0)], vp[(a, 1)], vp[(a, 2)]);
-            for i in 0..P {
-                grad[a][i] = madd::<FMA>(p2, g[2][i], madd::<FMA>(p1, g[1][i], madd::<FMA>(p0, g[0][i], grad[a][i])));
+            for c in 0..P / LANES {
+                let r = c * LANES..(c + 1) * LANES;
+                let out: &mut [f64; LANES] = (&mut grad[a][r.clone()]).try_into().expect("LANES");
+                for (pb, gb) in [p0, p1, p2].into_iter().zip(g) {
+                    axpy_lanes::<FMA>(out, pb, &gb[r.clone()]);
+                }
             }
         }
     }
