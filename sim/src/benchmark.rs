@@ -186,14 +186,17 @@ pub fn markdown(rows: &[BenchRow]) -> String {
     s
 }
 
-/// Measures every case whose label contains `filter` (ignoring case) on each of `threads`
+/// Measures the case labelled `filter`, or else every case whose label contains it (ignoring
+/// case), on each of `threads`
 /// (1: the serial sweep; more: the parallel colour sweep; with `colour_on_one`, also the
 /// colour sweep on one thread), reporting each row to `progress` as it is measured (what
 /// `hox bench` runs).
 pub fn run(filter: &str, threads: &[usize], colour_on_one: bool, frames: usize, progress: &mut dyn FnMut(&BenchRow)) -> Result<Vec<BenchRow>, SimError> {
     let filter = filter.to_uppercase();
+    // a whole label picks that case alone ("P1 16x4x4" is also part of its refinements' labels)
+    let exact = CASES.iter().any(|c| c.label().to_uppercase() == filter);
     let mut rows = Vec::new();
-    for case in CASES.iter().filter(|c| c.label().to_uppercase().contains(&filter)) {
+    for case in CASES.iter().filter(|c| if exact { c.label().to_uppercase() == filter } else { c.label().to_uppercase().contains(&filter) }) {
         for &t in threads {
             let sweeps: &[bool] = if t == 1 && colour_on_one { &[false, true] } else { &[t > 1] };
             for &parallel in sweeps {
