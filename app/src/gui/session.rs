@@ -65,6 +65,12 @@ pub struct Session {
     /// Why the simulation stopped (the NaN guard), until reset.
     pub failure: Option<String>,
     pub drag: Option<Drag>,
+    /// The attachment currently in the simulation (follows `drag` at the next step).
+    attached: Option<Drag>,
+    /// The display vertices at rest (the ghost) and which mesh nodes are element corners;
+    /// fixed for a mesh, so computed when it is built.
+    pub rest_vertices: Vec<Vec3>,
+    pub corner_nodes: Vec<bool>,
     /// Nodes held by clamps and moved by prescribed motions (for display).
     pub clamped: Vec<u32>,
     pub driven: Vec<u32>,
@@ -89,6 +95,9 @@ impl Session {
             residual: f64::NAN,
             failure: None,
             drag: None,
+            attached: None,
+            rest_vertices: Vec::new(),
+            corner_nodes: Vec::new(),
             clamped: Vec::new(),
             driven: Vec::new(),
             quadrature: std::cell::OnceCell::new(),
@@ -115,6 +124,7 @@ impl Session {
                 self.history = History::default();
                 self.failure = None;
                 self.drag = None;
+                self.attached = None;
                 self.mesh_changed();
                 self.residual = self.force_residual();
             }
@@ -150,6 +160,8 @@ impl Session {
             }
         }
         self.quadrature = std::cell::OnceCell::new();
+        self.corner_nodes = mesh.vertex_nodes();
+        self.surface.vertices.eval_into(&mesh.rest_positions, &mut self.rest_vertices);
         self.record();
     }
 
@@ -163,6 +175,7 @@ impl Session {
         if segments != self.segments {
             self.segments = segments;
             self.surface = Surface::new(self.instance.sim.mesh(), segments);
+            self.surface.vertices.eval_into(&self.instance.sim.mesh().rest_positions, &mut self.rest_vertices);
         }
     }
 
@@ -171,6 +184,7 @@ impl Session {
         self.instance.sim.reset();
         self.instance.sim.remove_effects_named("attachment");
         self.drag = None;
+        self.attached = None;
         self.failure = None;
         self.history = History::default();
         self.record();
@@ -181,11 +195,8 @@ impl Session {
         if self.failure.is_some() {
             return;
         }
+        self.sync_drag();
         for _ in 0..frames {
-            self.instance.sim.remove_effects_named("attachment");
-            if let Some(d) = self.drag {
-                let _ = self.instance.sim.add_effect(Box::new(Attachment::new(d.node, d.target_m, DRAG_COMPLIANCE_M_PER_N)));
-            }
             let t0 = Instant::now();
             let result = self.instance.sim.step_frame();
             let ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -196,10 +207,22 @@ impl Session {
             }
             self.record();
         }
-        if self.drag.is_none() {
+        self.residual = self.force_residual();
+    }
+
+    /// Makes the simulation's mouse attachment match `drag`: replaced when the target moved,
+    /// removed on release, untouched otherwise (no effect churn on the stepping path).
+    fn sync_drag(&mut self) {
+        if self.attached == self.drag {
+            return;
+        }
+        if self.attached.is_some() {
             self.instance.sim.remove_effects_named("attachment");
         }
-        self.residual = self.force_residual();
+        if let Some(d) = self.drag {
+            let _ = self.instance.sim.add_effect(Box::new(Attachment::new(d.node, d.target_m, DRAG_COMPLIANCE_M_PER_N)));
+        }
+        self.attached = self.drag;
     }
 
     fn record(&mut self) {

@@ -165,8 +165,7 @@ impl Viewport {
                 }
             }
             if opts.ghost {
-                let mut rest = Vec::new();
-                s.surface.vertices.eval_into(&mesh.rest_positions, &mut rest);
+                let rest = &s.rest_vertices;
                 for e in &s.surface.edges {
                     for pair in e.windows(2) {
                         overlay.lines.push((f32s(&(rest[pair[0] as usize] + o)), f32s(&(rest[pair[1] as usize] + o)), GHOST));
@@ -174,9 +173,8 @@ impl Viewport {
                 }
             }
             if opts.nodes {
-                let corner = mesh.vertex_nodes();
                 for (i, p) in sim.positions.iter().enumerate() {
-                    let (half, c) = if corner[i] { (3.0, CORNER_NODE) } else { (2.5, HIGH_ORDER_NODE) };
+                    let (half, c) = if s.corner_nodes[i] { (3.0, CORNER_NODE) } else { (2.5, HIGH_ORDER_NODE) };
                     overlay.points.push((f32s(&(p + o)), half, c));
                 }
             }
