@@ -11,6 +11,7 @@
 
 pub mod config;
 pub mod controls;
+pub mod gl_view;
 pub mod plots;
 pub mod raster;
 pub mod session;
@@ -146,9 +147,9 @@ pub struct AppArgs {
     /// Delay before --screenshot, seconds.
     #[arg(long, default_value_t = 3.0)]
     pub after_secs: f64,
-    /// Window size in points, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1400x900")]
-    pub size: String,
+    /// Window size in points, WIDTHxHEIGHT (default: the size of the last run, else 1400x900).
+    #[arg(long)]
+    pub size: Option<String>,
     /// Do not wait for the display's vertical sync (frame-rate measurements).
     #[arg(long)]
     pub no_vsync: bool,
@@ -205,6 +206,14 @@ pub struct HoxApp {
     screenshot: Option<(PathBuf, f64)>,
     screenshot_requested: bool,
     measure: Option<Measure>,
+    /// The window has an OpenGL context (false in the headless UI tests).
+    gl_available: bool,
+    /// The OpenGL renderer's name (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"), if known.
+    pub renderer: Option<String>,
+    /// Frames to step once this frame's UI is built (in the background while the window paints).
+    deferred_frames: usize,
+    /// Sessions being stepped in the background, and how many frames.
+    background: Option<(std::thread::JoinHandle<Vec<Session>>, usize)>,
     started: Instant,
 }
 
@@ -253,6 +262,10 @@ impl HoxApp {
             screenshot: args.screenshot.clone().map(|p| (p, args.after_secs)),
             screenshot_requested: false,
             measure: args.measure_secs.map(|s| Measure { until_secs: s, started: None, frames: 0, sim_frames: 0, frame_ms: Vec::new(), last: None }),
+            gl_available: false,
+            renderer: None,
+            deferred_frames: 0,
+            background: None,
             started: Instant::now(),
         };
         let configs = saved.filter(|_| same_scene).map(|s| (s.configs, s.compare));
@@ -382,17 +395,53 @@ impl HoxApp {
 
     /// Advances every session by `frames` frames (in parallel in compare mode).
     pub fn step(&mut self, frames: usize) {
-        use rayon::prelude::*;
+        self.join_background();
         for _ in 0..frames {
-            if self.sessions.len() > 1 {
-                self.sessions.par_iter_mut().for_each(|s| s.step(1));
-            } else {
-                self.sessions[0].step(1);
-            }
+            step_sessions(&mut self.sessions);
             self.log_rerun();
             if let Some(m) = &mut self.measure {
                 m.sim_frames += 1;
             }
+        }
+    }
+
+    /// Steps the frames `advance` deferred on a background thread, so that the simulation runs
+    /// while the window paints (the paint is the longer part of a frame with a software renderer;
+    /// docs/APP.md). The next frame starts by taking the sessions back.
+    fn start_background_step(&mut self) {
+        let frames = std::mem::take(&mut self.deferred_frames);
+        if frames == 0 || self.background.is_some() || self.sessions.is_empty() {
+            return;
+        }
+        let mut sessions = std::mem::take(&mut self.sessions);
+        let handle = std::thread::spawn(move || {
+            for _ in 0..frames {
+                step_sessions(&mut sessions);
+            }
+            sessions
+        });
+        self.background = Some((handle, frames));
+    }
+
+    /// Takes back the sessions stepped in the background (no-op if none are).
+    pub fn join_background(&mut self) {
+        let Some((handle, frames)) = self.background.take() else { return };
+        match handle.join() {
+            Ok(sessions) => self.sessions = sessions,
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
+        if let Some(m) = &mut self.measure {
+            m.sim_frames += frames as u64;
+        }
+    }
+
+    /// Steps now, or after the UI is built when the window can overlap stepping with painting
+    /// (not with a live Rerun link, which logs every frame in order).
+    fn step_or_defer(&mut self, frames: usize) {
+        if self.gl_available && self.rerun.is_none() {
+            self.deferred_frames += frames;
+        } else {
+            self.step(frames);
         }
     }
 
@@ -502,13 +551,13 @@ impl HoxApp {
         let frame_secs = 1.0 / self.sessions[0].config.frames_per_second;
         if self.measure.is_some() {
             // measuring: one simulation frame per displayed frame
-            self.step(1);
+            self.step_or_defer(1);
             return;
         }
         self.frame_budget_secs += real_dt_secs.min(0.25) * self.time_scale;
         let frames = ((self.frame_budget_secs / frame_secs).floor() as usize).min(4);
         self.frame_budget_secs = (self.frame_budget_secs - frames as f64 * frame_secs).min(frame_secs);
-        self.step(frames);
+        self.step_or_defer(frames);
     }
 
     fn status_line_ui(&self, ui: &mut egui::Ui) {
@@ -535,7 +584,11 @@ impl HoxApp {
                 }
                 ui.separator();
             }
-            ui.label(egui::RichText::new(format!("display {:.0} fps, view {:.1} ms, app {:.1} ms", 1000.0 / self.ui_frame_ms.max(1e-3), self.viewport.render_ms, self.app_ms)).monospace());
+            ui.label(egui::RichText::new(format!("display {:.0} fps, view {:.1} ms, app {:.1} ms", 1000.0 / self.ui_frame_ms.max(1e-3), self.viewport.render_ms, self.app_ms)).monospace())
+                .on_hover_text(format!("Displayed frames per second; CPU milliseconds of the 3D view's preparation and of the app's whole frame. Renderer: {}.", self.renderer.as_deref().unwrap_or("none (no OpenGL: CPU rasteriser)")));
+            if let Some(e) = self.viewport.gl_error() {
+                ui.colored_label(egui::Color32::from_rgb(255, 170, 60), format!("OpenGL view unavailable, drawn on the CPU: {e}"));
+            }
         });
     }
 
@@ -548,13 +601,17 @@ impl HoxApp {
         if dt > 0.0 {
             self.ui_frame_ms = if self.ui_frame_ms == 0.0 { dt * 1e3 } else { 0.9 * self.ui_frame_ms + 0.1 * dt * 1e3 };
         }
+        self.join_background();
         self.shortcuts(&ctx);
         self.advance(dt);
 
-        egui::Panel::top("menu").show(ui, |ui| controls::menu_bar_ui(self, ui));
-        egui::Panel::bottom("status").show(ui, |ui| self.status_line_ui(ui));
-        egui::Panel::bottom("plots").resizable(true).default_size(230.0).show(ui, |ui| plots::plots_ui(self, ui));
-        egui::Panel::left("controls").resizable(true).default_size(330.0).show(ui, |ui| {
+        // The panels are not filled: the window is cleared to the panel colour (`clear_color`), and
+        // a software renderer pays per blended pixel for each fill (docs/APP.md).
+        let frame = egui::Frame::side_top_panel(ui.style()).fill(egui::Color32::TRANSPARENT);
+        egui::Panel::top("menu").frame(frame).show(ui, |ui| controls::menu_bar_ui(self, ui));
+        egui::Panel::bottom("status").frame(frame).show(ui, |ui| self.status_line_ui(ui));
+        egui::Panel::bottom("plots").frame(frame).resizable(true).default_size(230.0).show(ui, |ui| plots::plots_ui(self, ui));
+        egui::Panel::left("controls").frame(frame).resizable(true).default_size(330.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| controls::controls_ui(self, ui));
         });
         if self.show_reference_element {
@@ -565,7 +622,7 @@ impl HoxApp {
         controls::open_dialog_ui(self, &ctx);
         egui::CentralPanel::no_frame().show(ui, |ui| {
             let offsets = self.offsets();
-            self.viewport.ui(ui, &mut self.sessions, &offsets, &self.view);
+            self.viewport.ui(ui, &mut self.sessions, &offsets, &self.view, self.gl_available);
         });
         if self.playing || self.sessions.iter().any(|s| s.drag.is_some()) {
             ctx.request_repaint();
@@ -573,6 +630,7 @@ impl HoxApp {
         let ms = now.elapsed().as_secs_f64() * 1e3;
         self.app_ms = if self.app_ms == 0.0 { ms } else { 0.9 * self.app_ms + 0.1 * ms };
         self.after_frame(&ctx, now);
+        self.start_background_step();
     }
 
     /// Screenshot and measurement bookkeeping.
@@ -602,6 +660,10 @@ impl HoxApp {
                         "render_ms": self.viewport.render_ms,
                         "app_ms": self.app_ms,
                         "frame_cpu_ms": self.frame_cpu_ms,
+                        "window_points": ctx.input(|i| i.viewport().inner_rect.map(|r| [r.width(), r.height()])),
+                        "pixels_per_point": ctx.pixels_per_point(),
+                        "renderer": self.renderer,
+                        "feathering": ctx.tessellation_options(|o| o.feathering),
                     })
                 );
                 if self.screenshot.is_none() {
@@ -646,22 +708,49 @@ impl eframe::App for HoxApp {
             let ms = cpu as f64 * 1e3;
             self.frame_cpu_ms = if self.frame_cpu_ms == 0.0 { ms } else { 0.9 * self.frame_cpu_ms + 0.1 * ms };
         }
+        self.gl_available = frame.gl().is_some();
         self.ui_all(ui);
     }
 
+    /// The panels' colour, opaque: the panels themselves are drawn unfilled over it.
+    fn clear_color(&self, visuals: &egui::Visuals) -> [f32; 4] {
+        visuals.panel_fill.to_opaque().to_normalized_gamma_f32()
+    }
+
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        self.join_background();
         eframe::set_value(storage, eframe::APP_KEY, &self.persisted());
     }
 }
 
+/// One frame of every session (in parallel in compare mode).
+fn step_sessions(sessions: &mut [Session]) {
+    use rayon::prelude::*;
+    if sessions.len() > 1 {
+        sessions.par_iter_mut().for_each(|s| s.step(1));
+    } else if let Some(s) = sessions.first_mut() {
+        s.step(1);
+    }
+}
+
+/// Whether an OpenGL renderer name is a software rasteriser (Mesa's llvmpipe or softpipe,
+/// SwiftShader, Microsoft's GDI renderer).
+pub fn is_software_renderer(name: &str) -> bool {
+    let n = name.to_ascii_lowercase();
+    ["llvmpipe", "softpipe", "swiftshader", "software rasterizer", "gdi generic"].iter().any(|k| n.contains(k))
+}
+
+/// Window size in points when neither --size nor a saved geometry gives one.
+const DEFAULT_WINDOW_SIZE: &str = "1400x900";
+
 /// Opens the window (blocking until it is closed).
 pub fn run(args: AppArgs) -> anyhow::Result<()> {
-    let (w, h) = args
-        .size
+    let size = args.size.as_deref().unwrap_or(DEFAULT_WINDOW_SIZE);
+    let (w, h) = size
         .split_once(['x', 'X'])
         .and_then(|(w, h)| Some((w.trim().parse::<f32>().ok()?, h.trim().parse::<f32>().ok()?)))
         .filter(|(w, h)| *w >= 320.0 && *h >= 240.0)
-        .ok_or_else(|| anyhow::anyhow!("--size must be WIDTHxHEIGHT in points, at least 320x240, got '{}'", args.size))?;
+        .ok_or_else(|| anyhow::anyhow!("--size must be WIDTHxHEIGHT in points, at least 320x240, got '{size}'"))?;
     if let Some(p) = &args.screenshot {
         crate::cli::check_writable(p)?;
     }
@@ -675,6 +764,13 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default().with_inner_size([w, h]).with_title("hox — high-order elements in XPBD"),
         glow_options: eframe::egui_glow::GlowConfiguration { vsync: !args.no_vsync, ..Default::default() },
+        // an explicit --size (or --fresh) wins over the window geometry eframe saved last time
+        persist_window: args.size.is_none() && !args.fresh,
+        // egui's dithering costs a noise function per pixel in the software renderer and buys
+        // nothing for a flat-shaded 3D view and 8-bit widgets
+        dithering: false,
+        // the 3D view is drawn with depth testing (gui/gl_view.rs)
+        depth_buffer: 24,
         ..Default::default()
     };
     let mut error = None;
@@ -682,9 +778,30 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
         "hox",
         options,
         Box::new(|cc| {
+            // eframe restores the last window geometry before this point; an explicit --size or
+            // --fresh asks for the given (or default) size instead
+            if args.size.is_some() || args.fresh {
+                cc.egui_ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(egui::vec2(w, h)));
+            }
+            if args.fresh {
+                // egui's own saved state too (panel sizes, open windows)
+                cc.egui_ctx.memory_mut(|m| *m = egui::Memory::default());
+            }
+            let renderer = cc.gl.as_ref().map(|gl| {
+                use eframe::glow::HasContext;
+                // SAFETY: a plain query on the context eframe has just made current
+                unsafe { gl.get_parameter_string(eframe::glow::RENDERER) }
+            });
+            // Anti-aliasing feathers double the triangles egui hands to the driver; a software
+            // renderer pays for each one on the CPU (docs/APP.md), so shapes go without there.
+            let software = renderer.as_deref().is_some_and(is_software_renderer);
+            cc.egui_ctx.tessellation_options_mut(|o| o.feathering = !software);
             let saved = cc.storage.and_then(|s| eframe::get_value::<Persisted>(s, eframe::APP_KEY));
             match HoxApp::new(&args, saved) {
-                Ok(app) => Ok(Box::new(app) as Box<dyn eframe::App>),
+                Ok(mut app) => {
+                    app.renderer = renderer;
+                    Ok(Box::new(app) as Box<dyn eframe::App>)
+                }
                 Err(e) => {
                     error = Some(e.clone());
                     Err(e.into())

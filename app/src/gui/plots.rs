@@ -14,6 +14,39 @@ pub enum Tab {
     Study,
 }
 
+/// Most points per plotted line: a long run keeps 20,000 samples, which would cost the
+/// renderer more than the rest of the window; min/max pairs per bucket keep the envelope.
+const MAX_PLOT_POINTS: usize = 1200;
+
+/// The samples `(t[i], y(i))`, reduced to at most about `max_points` by keeping each bucket's
+/// minimum and maximum in time order (oscillations keep their full amplitude).
+pub fn decimate(t: &[f64], y: impl Fn(usize) -> f64, max_points: usize) -> Vec<egui_plot::PlotPoint> {
+    let n = t.len();
+    if n <= max_points {
+        return (0..n).map(|i| egui_plot::PlotPoint::new(t[i], y(i))).collect();
+    }
+    let bucket = n.div_ceil((max_points / 2).max(1));
+    let mut out = Vec::with_capacity(2 * n.div_ceil(bucket));
+    for start in (0..n).step_by(bucket) {
+        let end = (start + bucket).min(n);
+        let (mut lo, mut hi) = (start, start);
+        for i in start..end {
+            if y(i) < y(lo) {
+                lo = i;
+            }
+            if y(i) > y(hi) {
+                hi = i;
+            }
+        }
+        let (a, b) = if lo <= hi { (lo, hi) } else { (hi, lo) };
+        out.push(egui_plot::PlotPoint::new(t[a], y(a)));
+        if b != a {
+            out.push(egui_plot::PlotPoint::new(t[b], y(b)));
+        }
+    }
+    out
+}
+
 pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         ui.selectable_value(&mut app.bottom_tab, Tab::Probe, "Probe displacement").on_hover_text("The first probe's displacement components over simulated time, metres.");
@@ -28,7 +61,7 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 for (k, s) in app.sessions.iter().enumerate() {
                     let h = &s.history;
                     for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate() {
-                        let points: PlotPoints = h.time_secs.iter().zip(&h.probe_m).map(|(t, u)| [*t, u[axis]]).collect();
+                        let points = PlotPoints::Owned(decimate(&h.time_secs, |i| h.probe_m[i][axis], MAX_PLOT_POINTS));
                         let name = if app.compare { format!("{} {} {label}", names[k], s.config.label()) } else { label.to_string() };
                         plot.line(Line::new(name, points));
                     }
@@ -47,8 +80,8 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 for (k, s) in app.sessions.iter().enumerate() {
                     let h = &s.history;
                     let prefix = if app.compare { format!("{} ", names[k]) } else { String::new() };
-                    plot.line(Line::new(format!("{prefix}kinetic"), h.time_secs.iter().zip(&h.kinetic_j).map(|(t, e)| [*t, *e]).collect::<PlotPoints>()));
-                    plot.line(Line::new(format!("{prefix}elastic"), h.time_secs.iter().zip(&h.elastic_j).map(|(t, e)| [*t, *e]).collect::<PlotPoints>()));
+                    plot.line(Line::new(format!("{prefix}kinetic"), PlotPoints::Owned(decimate(&h.time_secs, |i| h.kinetic_j[i], MAX_PLOT_POINTS))));
+                    plot.line(Line::new(format!("{prefix}elastic"), PlotPoints::Owned(decimate(&h.time_secs, |i| h.elastic_j[i], MAX_PLOT_POINTS))));
                 }
             });
         }
@@ -60,5 +93,26 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 .collect();
             study_chart_ui(ui, app.sessions[0].base.name(), &current);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::decimate;
+
+    #[test]
+    fn decimation_keeps_short_series_and_the_envelope_of_long_ones() {
+        let t: Vec<f64> = (0..100).map(|i| i as f64).collect();
+        assert_eq!(decimate(&t, |i| t[i] * 2.0, 1200).len(), 100);
+        // 20,000 samples of a fast oscillation: at most 1,200 points, extremes kept, time ordered
+        let t: Vec<f64> = (0..20_000).map(|i| i as f64 * 1e-3).collect();
+        let y = |i: usize| (t[i] * 40.0).sin() * (1.0 + t[i]);
+        let d = decimate(&t, y, 1200);
+        assert!(d.len() <= 1200 && d.len() > 500, "{}", d.len());
+        assert!(d.windows(2).all(|w| w[0].x < w[1].x));
+        let max = (0..t.len()).map(y).fold(f64::MIN, f64::max);
+        let min = (0..t.len()).map(y).fold(f64::MAX, f64::min);
+        assert_eq!(d.iter().map(|p| p.y).fold(f64::MIN, f64::max), max);
+        assert_eq!(d.iter().map(|p| p.y).fold(f64::MAX, f64::min), min);
     }
 }

@@ -105,7 +105,7 @@ struct ScreenTriangle {
     max_y: i32,
 }
 
-const BACKGROUND: [u8; 4] = [24, 26, 32, 255];
+pub const BACKGROUND: [u8; 4] = [24, 26, 32, 255];
 
 impl Image {
     pub fn new(width: usize, height: usize) -> Image {
@@ -133,27 +133,26 @@ impl Image {
         p[2] <= self.depth[y as usize * self.width + x as usize] + 2e-3
     }
 
+    /// Takes `camera` for [`Image::project`] and [`Image::unproject`] without drawing.
+    pub fn set_camera(&mut self, camera: &Camera) {
+        self.view_projection = camera.view_projection(self.width as f32 / self.height.max(1) as f32);
+    }
+
+    /// The view-projection matrix of the last camera, column-major.
+    pub fn view_projection(&self) -> [f32; 16] {
+        self.view_projection.to_cols_array()
+    }
+
     /// Clears and draws `layers` then `overlay` seen by `camera`.
     pub fn render(&mut self, camera: &Camera, layers: &[&TriangleLayer], overlay: &Overlay) {
         let (w, h) = (self.width, self.height);
-        self.view_projection = camera.view_projection(w as f32 / h.max(1) as f32);
+        self.set_camera(camera);
         let vp = self.view_projection;
         let eye = camera.eye();
         let mut tris = Vec::new();
         for layer in layers {
             let screen: Vec<Option<[f32; 3]>> = layer.positions.iter().map(|&p| project(&vp, w, h, p)).collect();
-            let shade: Vec<[f32; 3]> = layer
-                .positions
-                .iter()
-                .zip(&layer.normals)
-                .zip(&layer.colours)
-                .map(|((&p, &n), &c)| {
-                    let to_eye = (eye - Vec3::from(p)).normalize_or_zero();
-                    let lambert = Vec3::from(n).dot(to_eye).abs();
-                    let k = 0.35 + 0.65 * lambert;
-                    [c[0] as f32 * k, c[1] as f32 * k, c[2] as f32 * k]
-                })
-                .collect();
+            let shade: Vec<[f32; 3]> = layer.positions.iter().zip(&layer.normals).zip(&layer.colours).map(|((&p, &n), &c)| shade(p, n, c, eye)).collect();
             for t in &layer.triangles {
                 let [a, b, c] = t.map(|i| i as usize);
                 let (Some(pa), Some(pb), Some(pc)) = (screen[a], screen[b], screen[c]) else { continue };
@@ -224,6 +223,15 @@ impl Image {
             }
         }
     }
+}
+
+/// Lambert shading with a head light, both sides lit: the colour of a surface vertex at `p`
+/// with normal `n` and base colour `c` seen from `eye`, 0…255 per channel.
+pub fn shade(p: [f32; 3], n: [f32; 3], c: [u8; 3], eye: Vec3) -> [f32; 3] {
+    let to_eye = (eye - Vec3::from(p)).normalize_or_zero();
+    let lambert = Vec3::from(n).dot(to_eye).abs();
+    let k = 0.35 + 0.65 * lambert;
+    [c[0] as f32 * k, c[1] as f32 * k, c[2] as f32 * k]
 }
 
 fn project(vp: &Mat4, w: usize, h: usize, p: [f32; 3]) -> Option<[f32; 3]> {

@@ -122,3 +122,22 @@ fn open_mesh_runs_a_gmsh_file_with_its_clamp_group() {
     let err = controls::mesh_scene_file(&beam, "no-such-group").unwrap_err();
     assert!(err.contains("no-such-group"), "{err}");
 }
+
+#[test]
+fn stepping_in_the_background_while_the_window_paints_gives_the_same_motion() {
+    // as in the real window (an OpenGL context): the frames are stepped after the UI is built
+    let mut h = harness(AppArgs { play: true, ..Default::default() });
+    h.state_mut().gl_available = true;
+    h.run_steps(20);
+    assert!(h.state().background.is_some(), "the last frame's step runs in the background");
+    h.state_mut().join_background();
+    let app = h.state();
+    let t = app.sessions[0].instance.sim.time_secs();
+    assert!(t > 0.1, "{t}");
+    // the same number of frames stepped in place
+    let mut reference = harness(AppArgs::default());
+    reference.state_mut().step((t * 60.0).round() as usize);
+    let r = &reference.state().sessions[0].instance.sim;
+    assert!((r.time_secs() - t).abs() < 1e-12);
+    assert_eq!(r.positions, app.sessions[0].instance.sim.positions);
+}

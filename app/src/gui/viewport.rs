@@ -7,11 +7,13 @@
 //! Every displayed point is a material point `r` of an element, drawn at `x(r) = Σ N_i(r) x_i`
 //! ([`hox_sim::surface`]), so curved high-order faces and edges bend as the elements do.
 
-use super::raster::{Camera, Image, Overlay, TriangleLayer};
+use super::gl_view::{GlScene, GlState, paint_callback};
+use super::raster::{BACKGROUND, Camera, Image, Overlay, TriangleLayer, shade};
 use super::session::{Drag, Session};
 use crate::colour::ColourRange;
 use eframe::egui;
 use hox_sim::Vec3;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// What the viewport shows.
@@ -54,11 +56,13 @@ pub struct Viewport {
     /// Node picked for dragging: session index and node.
     dragging: Option<(usize, u32, f32)>,
     fitted: bool,
+    /// The OpenGL view's objects, shared with its paint callbacks.
+    gl_state: GlState,
 }
 
 impl Viewport {
     pub fn new(camera: Option<Camera>) -> Viewport {
-        Viewport { fitted: camera.is_some(), camera: camera.unwrap_or(Camera::framing([0.0; 3], [1.0; 3])), image: Image::new(1, 1), texture: None, layers: Vec::new(), render_ms: 0.0, dragging: None }
+        Viewport { fitted: camera.is_some(), camera: camera.unwrap_or(Camera::framing([0.0; 3], [1.0; 3])), image: Image::new(1, 1), texture: None, layers: Vec::new(), render_ms: 0.0, dragging: None, gl_state: GlState::default() }
     }
 
     /// Frames the sessions' bodies again.
@@ -84,7 +88,10 @@ impl Viewport {
         ColourRange { max_m: opts.colour_max_m.unwrap_or(0.2 * extent.unwrap_or(1.0)) }
     }
 
-    pub fn ui(&mut self, ui: &mut egui::Ui, sessions: &mut [Session], offsets: &[Vec3], opts: &ViewOptions) {
+    /// Shows the view; `gl` says whether the frame has an OpenGL context to draw it with (else,
+    /// or if the GL view failed to build, the CPU rasteriser draws it).
+    pub fn ui(&mut self, ui: &mut egui::Ui, sessions: &mut [Session], offsets: &[Vec3], opts: &ViewOptions, gl: bool) {
+        let use_gl = gl && self.gl_error().is_none();
         if !self.fitted {
             self.reset_camera(sessions, offsets);
         }
@@ -113,6 +120,11 @@ impl Viewport {
             && !shift
             && let Some(pos) = response.interact_pointer_pos()
         {
+            if use_gl {
+                // picking needs the depth buffer on the CPU: draw the last frame's surfaces once
+                let layer_refs: Vec<&TriangleLayer> = self.layers.iter().collect();
+                self.image.render(&self.camera, &layer_refs, &Overlay::default());
+            }
             self.dragging = self.pick_node(sessions, offsets, to_px(pos));
         }
         if response.dragged_by(egui::PointerButton::Primary) {
@@ -201,18 +213,26 @@ impl Viewport {
                 overlay.points.push((f32s(&(d.target_m + o)), 4.0, [255, 255, 0, 255]));
             }
         }
-        let layer_refs: Vec<&TriangleLayer> = self.layers.iter().collect();
-        self.image.render(&self.camera, &layer_refs, &overlay);
-        let pixels: Vec<egui::Color32> = self.image.rgba.iter().map(|c| egui::Color32::from_rgb(c[0], c[1], c[2])).collect();
-        let image = egui::ColorImage { size: [w, h], source_size: egui::vec2(w as f32, h as f32), pixels };
-        match &mut self.texture {
-            Some(t) => t.set(image, egui::TextureOptions::LINEAR),
-            None => self.texture = Some(ui.ctx().load_texture("hox-viewport", image, egui::TextureOptions::LINEAR)),
-        }
-        self.render_ms = started.elapsed().as_secs_f64() * 1e3;
         let painter = ui.painter_at(rect);
-        if let Some(t) = &self.texture {
-            painter.image(t.id(), rect, egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)), egui::Color32::WHITE);
+        if use_gl {
+            self.image.set_camera(&self.camera);
+            let eye = self.camera.eye();
+            let mut scene = GlScene { view_projection: self.image.view_projection(), background: BACKGROUND, ..Default::default() };
+            for layer in &self.layers {
+                let shaded: Vec<[u8; 3]> = layer.positions.iter().zip(&layer.normals).zip(&layer.colours).map(|((&p, &n), &c)| shade(p, n, c, eye).map(|v| v.clamp(0.0, 255.0) as u8)).collect();
+                scene.add_triangles(&layer.positions, &shaded, &layer.triangles);
+            }
+            for &(a, b, colour) in &overlay.lines {
+                scene.add_line(a, b, colour);
+            }
+            for &(p, half, colour) in &overlay.points {
+                scene.add_point(p, half, colour);
+            }
+            painter.add(paint_callback(rect, self.gl_state.clone(), Arc::new(scene)));
+            self.render_ms = started.elapsed().as_secs_f64() * 1e3;
+        } else {
+            self.cpu_view(&painter, rect, w, h, scale, &overlay);
+            self.render_ms = started.elapsed().as_secs_f64() * 1e3;
         }
         // labels above each body in compare mode
         if sessions.len() > 1 {
@@ -229,6 +249,32 @@ impl Viewport {
             }
         }
         legend_ui(&painter, rect, &colours);
+    }
+
+    /// Draws the view with the CPU rasteriser and shows it as a texture.
+    fn cpu_view(&mut self, painter: &egui::Painter, rect: egui::Rect, w: usize, h: usize, scale: f32, overlay: &Overlay) {
+        let layer_refs: Vec<&TriangleLayer> = self.layers.iter().collect();
+        self.image.render(&self.camera, &layer_refs, overlay);
+        let pixels: Vec<egui::Color32> = self.image.rgba.iter().map(|c| egui::Color32::from_rgb(c[0], c[1], c[2])).collect();
+        // one texel per screen pixel unless the view is capped: nearest sampling is exact there and
+        // cheaper than bilinear in a software renderer
+        let sampling = if scale < 1.0 { egui::TextureOptions::LINEAR } else { egui::TextureOptions::NEAREST };
+        let image = egui::ColorImage { size: [w, h], source_size: egui::vec2(w as f32, h as f32), pixels };
+        match &mut self.texture {
+            Some(t) => t.set(image, sampling),
+            None => self.texture = Some(painter.ctx().load_texture("hox-viewport", image, sampling)),
+        }
+        if let Some(t) = &self.texture {
+            painter.image(t.id(), rect, egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)), egui::Color32::WHITE);
+        }
+    }
+
+    /// Why the OpenGL view could not be made (the CPU rasteriser is used instead), if it failed.
+    pub fn gl_error(&self) -> Option<String> {
+        match self.gl_state.lock().ok()?.as_ref()? {
+            Err(e) => Some(e.clone()),
+            Ok(_) => None,
+        }
     }
 
     /// The visible mesh node nearest to pixel `px` (within 12 px): session, node, its NDC depth.
