@@ -4,9 +4,10 @@
 #   scripts/app-headless.sh --screenshot docs/app.png --after-secs 4 --play
 #   scripts/app-headless.sh --measure-secs 10
 # Any `hox app` option may be given; --fresh (ignore saved settings) is always added.
+# The virtual screen is 1920x1200 unless HOX_XVFB_SCREEN (e.g. 2560x1440x24) says otherwise.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
 cargo build --release -q -p hox
 target="${CARGO_TARGET_DIR:-target}"
-exec xvfb-run -a -s "-screen 0 1600x1000x24" "$target/release/hox" app --fresh "$@"
+exec xvfb-run -a -s "-screen 0 ${HOX_XVFB_SCREEN:-1920x1200x24}" "$target/release/hox" app --fresh "$@"

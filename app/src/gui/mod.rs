@@ -812,7 +812,7 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
     if let Some(e) = error {
         anyhow::bail!(e);
     }
-    result.map_err(|e| anyhow::anyhow!("the window could not be opened: {e} (no display? run the headless commands, e.g. `hox simulate`, or use Xvfb: scripts/xvfb-run.sh)"))
+    result.map_err(|e| anyhow::anyhow!("the window could not be opened: {e} (no display? run the headless commands, e.g. `hox simulate`, or run the app in a virtual display: scripts/app-headless.sh)"))
 }
 
 #[cfg(test)]

@@ -57,7 +57,7 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     match app.bottom_tab {
         Tab::Probe => {
             let probe = app.sessions[0].instance.probes.first().map_or("probe".to_string(), |p| p.name.clone());
-            Plot::new("probe").legend(Legend::default()).x_axis_label("t (s)").y_axis_label(format!("{probe} u (m)")).show(ui, |plot| {
+            Plot::new("probe").show_background(false).legend(Legend::default()).x_axis_label("t (s)").y_axis_label(format!("{probe} u (m)")).show(ui, |plot| {
                 for (k, s) in app.sessions.iter().enumerate() {
                     let h = &s.history;
                     for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate() {
@@ -76,7 +76,7 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
             });
         }
         Tab::Energy => {
-            Plot::new("energy").legend(Legend::default()).x_axis_label("t (s)").y_axis_label("energy (J)").show(ui, |plot| {
+            Plot::new("energy").show_background(false).legend(Legend::default()).x_axis_label("t (s)").y_axis_label("energy (J)").show(ui, |plot| {
                 for (k, s) in app.sessions.iter().enumerate() {
                     let h = &s.history;
                     let prefix = if app.compare { format!("{} ", names[k]) } else { String::new() };

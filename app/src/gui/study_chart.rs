@@ -274,6 +274,7 @@ pub fn study_chart_ui(ui: &mut egui::Ui, scene: &str, current: &[StudyPoint]) {
     };
     let height = ui.available_height().clamp(200.0, 600.0);
     Plot::new("hox-study-chart")
+        .show_background(false)
         .height(height)
         .legend(Legend::default())
         .x_axis_label("ms per frame (one thread)")
