@@ -13,7 +13,9 @@ Installs pypbd into bench/.venv (a virtualenv) on first use. The meshes come fro
 PBD's solid method 3 is its XPBD FEM tetrahedron (the constitutive model of Bender et al.
 2014 / PBD's `FEMTetConstraint`): one constraint per tetrahedron, like hox's energy
 formulation; stiffness is Young's modulus, 3 MPa, Poisson ratio 0.35. Times are medians of ms
-per frame on one thread (PBD's OpenMP loop is limited with OMP_NUM_THREADS=1).
+per frame on one thread (PBD's OpenMP loop is limited with OMP_NUM_THREADS=1); hox is timed
+with both of its sweeps: serial (element order, the default) and colour (four tetrahedra of one
+colour per 256-bit register, `SolverSettings::parallel`).
 """
 import argparse
 import json
@@ -116,14 +118,16 @@ def main() -> None:
         out = subprocess.run([str(python), __file__, "--inner", str(path), "--frames", str(args.frames), "--method", str(args.method)],
                              env=env, check=True, capture_output=True, text=True).stdout
         pbd_ms = json.loads(out.strip().splitlines()[-1])["ms_per_frame"]
-        hox_out = subprocess.run(cargo() + args.hox.split() + [str(args.frames), "1", label], cwd=ROOT, check=True, capture_output=True, text=True).stdout
-        hox_ms = next(float(line.split("|")[6]) for line in hox_out.splitlines() if line.startswith("| P1"))
-        rows.append((label, len(mesh["tets"]) // 4, pbd_ms, hox_ms))
-        print(f"{label}: PBD {pbd_ms:.2f} ms/frame, hox {hox_ms:.2f} ms/frame", file=sys.stderr)
-    print("| beam | tetrahedra | PBD ms/frame (1 thread) | hox ms/frame (1 thread) | hox / PBD |")
-    print("|---|---|---|---|---|")
-    for label, n, p, h in rows:
-        print(f"| {label} | {n} | {p:.2f} | {h:.2f} | {h / p:.2f} |")
+        hox_out = subprocess.run(cargo() + args.hox.split() + [str(args.frames), "1", label], cwd=ROOT, check=True, capture_output=True, text=True,
+                                 env=dict(os.environ, HOX_BENCH_COLOUR_ON_ONE="1")).stdout
+        # one row per sweep: serial (element order) and colour (four tetrahedra per register)
+        hox = {line.split("|")[4].strip(): float(line.split("|")[6]) for line in hox_out.splitlines() if line.startswith("| P1")}
+        rows.append((label, len(mesh["tets"]) // 4, pbd_ms, hox["serial"], hox.get("colour", float("nan"))))
+        print(f"{label}: PBD {pbd_ms:.2f} ms/frame, hox serial {hox['serial']:.2f}, colour sweep {hox.get('colour', float('nan')):.2f} ms/frame", file=sys.stderr)
+    print("| beam | tetrahedra | PBD ms/frame (1 thread) | hox serial sweep ms/frame | hox / PBD | hox colour sweep (SIMD ×4) ms/frame | hox / PBD |")
+    print("|---|---|---|---|---|---|---|")
+    for label, n, p, h, c in rows:
+        print(f"| {label} | {n} | {p:.2f} | {h:.2f} | {h / p:.2f} | {c:.2f} | {c / p:.2f} |")
 
 
 if __name__ == "__main__":

@@ -82,8 +82,9 @@ pub enum Command {
         /// Only the configurations whose label contains this (e.g. "p1", "r2").
         #[arg(long, default_value = "")]
         only: String,
-        /// Also time the parallel colour sweep on one thread (its cost without parallelism).
-        #[arg(long)]
+        /// Also time the colour sweep on one thread (linear tetrahedra four per 256-bit
+        /// register; `--colour-on-one false`: the serial sweep only).
+        #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
         colour_on_one: bool,
     },
     /// Run a scene (for --seconds, or until it --settle-s) and print the probe displacements.

@@ -1,6 +1,8 @@
 //! Criterion benches: ms per frame (50 substeps × 1 iteration) of the paper's Table 1 beams and
-//! the Q1, Q2, prism and pyramid beams, on 1 thread (serial sweep) and 2 threads (parallel
-//! colour sweep); and the specialised energy kernel against the generic one on P1 and P2.
+//! the Q1, Q2, prism and pyramid beams, on 1 thread (serial sweep and colour sweep, the latter
+//! with linear tetrahedra four per 256-bit register) and 2 threads (parallel colour sweep); the
+//! specialised energy kernel against the generic one on P1 and P2; and on P1 the colour sweep
+//! one element at a time against four per register.
 //!
 //! `cargo bench -p hox-sim --bench table1` (all), or with a filter: `… -- "P1 16x4x4 r2"`.
 
@@ -9,24 +11,26 @@ use hox_sim::Vec3;
 use hox_sim::benchmark::{CASES, bending_beam};
 use hox_sim::constraint::project_energy_constraint;
 use hox_sim::energy::{element_grads, gather};
-use hox_sim::kernels::{Multipliers, PackedBlock, Positions, energy_sweep};
+use hox_sim::kernels::{Multipliers, PackedBlock, Positions, colour_sweep, energy_sweep};
 use std::time::Duration;
 
 fn frames(c: &mut Criterion) {
     for case in &CASES {
         let mut group = c.benchmark_group(format!("frame/{}", case.label()));
         group.sampling_mode(SamplingMode::Flat).sample_size(10).warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(4));
-        for threads in [1, 2] {
+        // (threads, colour sweep): 1 thread serial and colour (P1: four per register), 2 colour
+        for (threads, colour) in [(1, false), (1, true), (2, true)] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
             let mut sim = pool.install(|| {
-                let mut sim = bending_beam(case, threads > 1).expect("beam");
+                let mut sim = bending_beam(case, colour).expect("beam");
                 for _ in 0..5 {
                     sim.step_frame().expect("frame");
                 }
                 sim
             });
             // each frame runs inside the pool (one hand-over to it per frame)
-            group.bench_function(format!("{threads} thread(s)"), |b| b.iter(|| pool.install(|| sim.step_frame().expect("frame"))));
+            let name = format!("{threads} thread(s), {}", if colour { "colour" } else { "serial" });
+            group.bench_function(name, |b| b.iter(|| pool.install(|| sim.step_frame().expect("frame"))));
         }
         group.finish();
     }
@@ -82,5 +86,38 @@ fn kernels(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, kernels, frames);
+/// One colour sweep over every element of the sagged P1 beam: one element at a time against
+/// four same-colour elements per 256-bit register (`hox_sim::kernels::p1x4`).
+fn colour_batches(c: &mut Criterion) {
+    let mut sim = bending_beam(&CASES[0], true).expect("beam");
+    for _ in 0..5 {
+        sim.step_frame().expect("frame");
+    }
+    let (mesh, g, material) = (sim.mesh().clone(), sim.geometry()[0].clone(), *sim.material());
+    let block = &mesh.blocks[0];
+    let colours = hox_sim::colouring::colour_elements(block, mesh.num_nodes());
+    let packed = PackedBlock::in_colour_order(block, &g, &colours);
+    let inv_mass = sim.inv_mass().to_vec();
+    let start = sim.positions.clone();
+    let inv_dt2 = (60.0f64 * 50.0).powi(2);
+    let mut group = c.benchmark_group(format!("colour sweep/{}", CASES[0].label()));
+    for (name, batched) in [("one at a time", false), ("four per register", true)] {
+        group.bench_function(name, |b| {
+            b.iter_batched_ref(
+                || (start.clone(), vec![0.0; block.len()]),
+                |(x, lambdas)| {
+                    for k in 0..packed.num_colours() {
+                        // SAFETY: one thread, sizes from the mesh.
+                        let r = unsafe { colour_sweep(4, &material, Positions::new(x), &mesh.rest_positions, &inv_mass, &packed, k, packed.colour(k), Multipliers::new(lambdas), inv_dt2, batched) };
+                        r.expect("P1").expect("finite");
+                    }
+                },
+                BatchSize::LargeInput,
+            )
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, kernels, colour_batches, frames);
 criterion_main!(benches);

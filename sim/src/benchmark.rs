@@ -189,7 +189,8 @@ pub fn markdown(rows: &[BenchRow]) -> String {
 /// Measures the case labelled `filter`, or else every case whose label contains it (ignoring
 /// case), on each of `threads`
 /// (1: the serial sweep; more: the parallel colour sweep; with `colour_on_one`, also the
-/// colour sweep on one thread), reporting each row to `progress` as it is measured (what
+/// colour sweep on one thread, which projects linear tetrahedra four per 256-bit register:
+/// `crate::kernels::p1x4`), reporting each row to `progress` as it is measured (what
 /// `hox bench` runs).
 pub fn run(filter: &str, threads: &[usize], colour_on_one: bool, frames: usize, progress: &mut dyn FnMut(&BenchRow)) -> Result<Vec<BenchRow>, SimError> {
     let filter = filter.to_uppercase();

@@ -424,13 +424,93 @@ pub fn project_energy<const N: usize, const P: usize, const FMA: bool, M: PointM
     energy
 }
 
+/// Doubles stored per batch of four linear tetrahedra in [`PackedBlock::p1x4`]: 9 gradient
+/// entries and the volume, four lanes each.
+pub const BATCH_VALUES: usize = 40;
+
+/// The colour sweep over packed range `range` of colour `colour` of `packed` (a colour-ordered
+/// block), whose start is a multiple of 4 elements from the colour's start: as [`energy_sweep`],
+/// but with `batched` the linear tetrahedra with StVK go four at a time through
+/// [`p1x4::batches_avx2`] where the CPU has AVX2 and FMA (the colour's last `len mod 4`
+/// elements, and every other case, through the scalar sweep). Which elements are batched
+/// depends only on the colour, not on how its range is cut, so the result does not depend on
+/// the thread count.
+///
+/// # Safety
+/// As [`energy_sweep`].
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn colour_sweep(
+    nodes_per_element: usize,
+    material: &Material,
+    positions: Positions,
+    rest: &[Vec3],
+    inv_mass: &[f64],
+    packed: &PackedBlock,
+    colour: usize,
+    range: std::ops::Range<usize>,
+    lambdas: Multipliers,
+    inv_dt2: f64,
+    batched: bool,
+) -> Option<Result<u64, NonFiniteElement>> {
+    let data = packed.data();
+    let colour_start = packed.colour_starts[colour];
+    assert!((range.start - colour_start).is_multiple_of(4) && range.end <= packed.colour_starts[colour + 1]);
+    let mut tail = range.clone();
+    let mut projected = 0;
+    #[cfg(target_arch = "x86_64")]
+    if batched
+        && nodes_per_element == 4
+        && packed.points == 1
+        && material.model == MaterialModel::StVenantKirchhoff
+        && packed.colour_batches.len() == packed.colour_starts.len()
+        && std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+    {
+        let first = packed.colour_batches[colour] + (range.start - colour_start) / 4;
+        let batches = (range.len() / 4).min(packed.colour_batches[colour + 1] - first);
+        let ids = data.element_ids.expect("colour order");
+        let io = p1x4::BatchIo {
+            positions,
+            rest,
+            inv_mass,
+            nodes: &data.nodes[range.start * 4..(range.start + 4 * batches) * 4],
+            values: &packed.p1x4[first * BATCH_VALUES..(first + batches) * BATCH_VALUES],
+            element_ids: &ids[range.start..range.start + 4 * batches],
+            lambdas,
+            inv_dt2,
+        };
+        let l = material.lame();
+        // SAFETY: forwarded from the caller; AVX2 and FMA were detected; the elements of a
+        // batch are of one colour.
+        match unsafe { p1x4::batches_avx2(&Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa }, io, batches) } {
+            Ok(k) => projected = k,
+            Err(bad) => return Some(Err(bad)),
+        }
+        tail.start += 4 * batches;
+    }
+    // SAFETY: forwarded from the caller.
+    let rest_of = unsafe { energy_sweep(nodes_per_element, material, positions, rest, inv_mass, &data, tail, lambdas, inv_dt2) }?;
+    Some(rest_of.map(|k| k + projected))
+}
+
 /// Fewest elements a thread gets in the parallel sweep: below this, splitting a colour costs
 /// more than it saves.
 pub const PARALLEL_MIN_ELEMENTS: usize = 256;
 
-/// The parallel sweep of the energy formulation over one block: colour after colour, each
+/// How [`parallel_energy_block`] sweeps a block.
+#[derive(Clone, Copy, Debug)]
+pub enum BlockSweep<'a> {
+    /// Colour after colour (the block packed in colour order).
+    Colours(&'a PackedBlock),
+    /// Slab by slab, then the interface ([`Partition`]).
+    Slabs(&'a Partition),
+}
+
+/// The parallel sweep of the energy formulation over one block, by slabs (see [`Partition`]) or
+/// else colour after colour, each
 /// colour's packed range cut into one contiguous chunk per thread of rayon's current pool (at
-/// least [`PARALLEL_MIN_ELEMENTS`] elements each). Same-colour elements share no node, so the
+/// least [`PARALLEL_MIN_ELEMENTS`] elements each, cut at multiples of 4 elements from the
+/// colour's start; see [`colour_sweep`] for `batched`). Same-colour elements share no node, so the
 /// result is the same for any thread count and scheduling; on a non-finite correction the
 /// colour is finished (other chunks may have been scattered) and the error of the first such
 /// chunk is returned. None when the node count has no specialised sweep.
@@ -440,27 +520,33 @@ pub fn parallel_energy_block(
     positions: &mut [Vec3],
     rest: &[Vec3],
     inv_mass: &[f64],
-    packed: &PackedBlock,
+    sweep: BlockSweep<'_>,
     lambdas: &mut [f64],
     inv_dt2: f64,
+    batched: bool,
 ) -> Option<Result<u64, NonFiniteElement>> {
     use rayon::prelude::*;
     if !SPECIALISED_NODE_COUNTS.contains(&nodes_per_element) {
         return None;
     }
     let (positions, lambdas) = (Positions::new(positions), Multipliers::new(lambdas));
-    let data = packed.data();
+    let packed = match sweep {
+        BlockSweep::Colours(packed) => packed,
+        BlockSweep::Slabs(partition) => return Some(slab_sweep(nodes_per_element, material, positions, rest, inv_mass, partition, lambdas, inv_dt2, batched)),
+    };
     let threads = rayon::current_num_threads().max(1);
     let mut projected = 0;
     for c in 0..packed.num_colours() {
         let range = packed.colour(c);
         let chunks = threads.min(range.len().div_ceil(PARALLEL_MIN_ELEMENTS)).max(1);
-        let chunk = |i: usize| range.start + range.len() * i / chunks..range.start + range.len() * (i + 1) / chunks;
+        let fours = range.len().div_ceil(4);
+        let cut = |i: usize| range.start + (4 * (fours * i / chunks)).min(range.len());
+        let chunk = |i: usize| cut(i)..cut(i + 1);
         // SAFETY: the chunks of a colour are disjoint ranges of elements that share no node
         // (crate::colouring) and own their multipliers; node and element indices come from the
         // mesh the positions and multipliers were sized for.
         let run = |i: usize| unsafe {
-            energy_sweep(nodes_per_element, material, positions, rest, inv_mass, &data, chunk(i), lambdas, inv_dt2)
+            colour_sweep(nodes_per_element, material, positions, rest, inv_mass, packed, c, chunk(i), lambdas, inv_dt2, batched)
                 .expect("specialised node count")
         };
         let result = if chunks == 1 {
@@ -469,11 +555,7 @@ pub fn parallel_energy_block(
             (0..chunks)
                 .into_par_iter()
                 .map(|i| (i, run(i)))
-                .reduce(|| (usize::MAX, Ok(0)), |a, b| match (a, b) {
-                    ((i, Ok(x)), (j, Ok(y))) => (i.min(j), Ok(x + y)),
-                    ((i, Err(x)), (j, Err(y))) => if i < j { (i, Err(x)) } else { (j, Err(y)) },
-                    ((i, Err(x)), _) | (_, (i, Err(x))) => (i, Err(x)),
-                })
+                .reduce(|| (usize::MAX, Ok(0)), lowest_error)
                 .1
         };
         match result {
@@ -482,6 +564,120 @@ pub fn parallel_energy_block(
         }
     }
     Some(Ok(projected))
+}
+
+/// Fewest elements per thread for which the parallel sweep cuts a block into slabs
+/// ([`Partition`]) instead of synchronising the threads after every colour.
+pub const PARTITION_MIN_ELEMENTS_PER_THREAD: usize = 2048;
+
+/// A block cut for `threads` threads: its nodes split into one slab per thread along the longest
+/// axis of the rest shape (cuts at the quantiles of the element centroids, so each slab holds
+/// about as many elements); the elements whose nodes all lie in slab `s` are `slabs[s]`, the
+/// others (touching two slabs) `interface`, each packed colour by colour (the block's colouring
+/// restricted to them, element order kept inside a colour).
+///
+/// One Gauss–Seidel sweep ([`parallel_energy_block`] with [`BlockSweep::Slabs`]) is then every slab swept colour after
+/// colour by its own thread with no synchronisation (no two slabs share a node), one join, and
+/// the interface elements swept on one thread: two synchronisations per sweep instead of one per
+/// colour. The order (and so the result, bitwise) depends on the thread count, not on the
+/// scheduling.
+#[derive(Clone, Debug, Default)]
+pub struct Partition {
+    pub threads: usize,
+    pub slabs: Vec<PackedBlock>,
+    pub interface: PackedBlock,
+}
+
+impl Partition {
+    pub fn new(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>], rest: &[Vec3], threads: usize) -> Self {
+        let threads = threads.max(1);
+        let n = block.nodes_per_element();
+        let centroid = |e: usize| block.element(e).iter().map(|&i| rest[i as usize]).sum::<Vec3>() / n as f64;
+        let (lo, hi) = block.elements().flatten().fold((Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)), |(lo, hi), &i| {
+            (lo.inf(&rest[i as usize]), hi.sup(&rest[i as usize]))
+        });
+        let axis = (hi - lo).iamax();
+        let mut along: Vec<f64> = (0..block.len()).map(|e| centroid(e)[axis]).collect();
+        along.sort_by(f64::total_cmp);
+        // slab s holds the nodes with cuts[s − 1] ≤ coordinate < cuts[s]
+        let cuts: Vec<f64> = (1..threads).map(|s| along[along.len() * s / threads]).collect();
+        let slab_of_node = |i: u32| cuts.partition_point(|&c| c <= rest[i as usize][axis]);
+        let slab_of_element = |e: u32| {
+            let nodes = block.element(e as usize);
+            let s = slab_of_node(nodes[0]);
+            nodes.iter().all(|&i| slab_of_node(i) == s).then_some(s)
+        };
+        let owner: Vec<Option<usize>> = (0..block.len() as u32).map(slab_of_element).collect();
+        let restricted = |keep: &dyn Fn(Option<usize>) -> bool| -> Vec<Vec<u32>> {
+            colours.iter().map(|c| c.iter().copied().filter(|&e| keep(owner[e as usize])).collect::<Vec<u32>>()).filter(|c| !c.is_empty()).collect()
+        };
+        Self {
+            threads,
+            slabs: (0..threads).map(|s| PackedBlock::in_colour_order(block, geometry, &restricted(&|o| o == Some(s)))).collect(),
+            interface: PackedBlock::in_colour_order(block, geometry, &restricted(&|o| o.is_none())),
+        }
+    }
+}
+
+/// Reduces `(chunk, result)` pairs: the counts summed, or the error of the lowest chunk.
+fn lowest_error(a: (usize, Result<u64, NonFiniteElement>), b: (usize, Result<u64, NonFiniteElement>)) -> (usize, Result<u64, NonFiniteElement>) {
+    match (a, b) {
+        ((i, Ok(x)), (j, Ok(y))) => (i.min(j), Ok(x + y)),
+        ((i, Err(x)), (j, Err(y))) => if i < j { (i, Err(x)) } else { (j, Err(y)) },
+        ((i, Err(x)), _) | (_, (i, Err(x))) => (i, Err(x)),
+    }
+}
+
+/// Every colour of `packed` in turn on the calling thread, as [`colour_sweep`].
+///
+/// # Safety
+/// As [`energy_sweep`], for all of `packed`.
+#[allow(clippy::too_many_arguments)]
+unsafe fn all_colours(
+    nodes_per_element: usize,
+    material: &Material,
+    positions: Positions,
+    rest: &[Vec3],
+    inv_mass: &[f64],
+    packed: &PackedBlock,
+    lambdas: Multipliers,
+    inv_dt2: f64,
+    batched: bool,
+) -> Result<u64, NonFiniteElement> {
+    let mut projected = 0;
+    for c in 0..packed.num_colours() {
+        // SAFETY: forwarded.
+        let r = unsafe { colour_sweep(nodes_per_element, material, positions, rest, inv_mass, packed, c, packed.colour(c), lambdas, inv_dt2, batched) };
+        projected += r.expect("specialised node count")?;
+    }
+    Ok(projected)
+}
+
+/// One Gauss–Seidel sweep of the energy formulation over a block cut by `partition` (see
+/// [`Partition`]): the slabs in parallel on rayon's current pool, then the interface. On a
+/// non-finite correction the slabs finish, and the error of the lowest slab that had one (or of
+/// the interface) is returned.
+#[allow(clippy::too_many_arguments)]
+fn slab_sweep(
+    nodes_per_element: usize,
+    material: &Material,
+    positions: Positions,
+    rest: &[Vec3],
+    inv_mass: &[f64],
+    partition: &Partition,
+    lambdas: Multipliers,
+    inv_dt2: f64,
+    batched: bool,
+) -> Result<u64, NonFiniteElement> {
+    use rayon::prelude::*;
+    // SAFETY (both sweeps): the slabs' elements touch disjoint nodes (each node is in one slab)
+    // and own their multipliers; the interface runs after the join, alone; node and element
+    // indices come from the mesh the positions and multipliers were sized for.
+    let slab = |s: usize| unsafe { all_colours(nodes_per_element, material, positions, rest, inv_mass, &partition.slabs[s], lambdas, inv_dt2, batched) };
+    let slabs = (0..partition.slabs.len()).into_par_iter().with_max_len(1).map(|s| (s, slab(s))).reduce(|| (usize::MAX, Ok(0)), lowest_error).1?;
+    // SAFETY: see above.
+    let interface = unsafe { all_colours(nodes_per_element, material, positions, rest, inv_mass, &partition.interface, lambdas, inv_dt2, batched) }?;
+    Ok(slabs + interface)
 }
 
 /// A block's element data packed for the sweep: in element order (the serial sweep), or
@@ -497,23 +693,29 @@ pub struct PackedBlock {
     pub element_ids: Option<Vec<u32>>,
     pub colour_starts: Vec<usize>,
     pub points: usize,
+    /// Linear tetrahedra in colour order only: the gradients and volumes of each colour's
+    /// first `4 ⌊len/4⌋` elements in batches of four, lane-interleaved (`p1x4::BATCH_VALUES`
+    /// per batch; see [`colour_sweep`]). Empty otherwise.
+    pub p1x4: Vec<f64>,
+    /// The first batch of colour `c` in [`PackedBlock::p1x4`] (one more entry than colours).
+    pub colour_batches: Vec<usize>,
 }
 
 impl PackedBlock {
     /// `block`'s data in element order.
     pub fn in_element_order(block: &ElementBlock, geometry: &BlockGeometry) -> Self {
         let all: Vec<u32> = (0..block.len() as u32).collect();
-        let mut packed = Self::new(block, geometry, std::slice::from_ref(&all));
+        let mut packed = Self::new(block, geometry, std::slice::from_ref(&all), false);
         packed.element_ids = None;
         packed
     }
 
     /// `block`'s data in the order of `colours` (element indices per colour).
     pub fn in_colour_order(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>]) -> Self {
-        Self::new(block, geometry, colours)
+        Self::new(block, geometry, colours, true)
     }
 
-    fn new(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>]) -> Self {
+    fn new(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>], batches: bool) -> Self {
         let (n, q) = (block.nodes_per_element(), geometry.points_per_element);
         let total: usize = colours.iter().map(Vec::len).sum();
         let mut ids = Vec::with_capacity(total);
@@ -524,6 +726,8 @@ impl PackedBlock {
             element_ids: None,
             colour_starts: Vec::with_capacity(colours.len() + 1),
             points: q,
+            p1x4: Vec::new(),
+            colour_batches: vec![0],
         };
         packed.colour_starts.push(0);
         for colour in colours {
@@ -541,6 +745,17 @@ impl PackedBlock {
                 ids.push(e as u32);
             }
             packed.colour_starts.push(ids.len());
+            if batches && n == 4 && q == 1 {
+                for four in colour.chunks_exact(4) {
+                    for r in 1..4 {
+                        for c in 0..3 {
+                            packed.p1x4.extend(four.iter().map(|&e| geometry.gradients(e as usize, 0)[r][c]));
+                        }
+                    }
+                    packed.p1x4.extend(four.iter().map(|&e| geometry.volumes(e as usize)[0]));
+                }
+                packed.colour_batches.push(packed.p1x4.len() / BATCH_VALUES);
+            }
         }
         packed.element_ids = Some(ids);
         packed
@@ -583,6 +798,9 @@ impl SolverData {
         }
     }
 }
+
+#[cfg(target_arch = "x86_64")]
+pub mod p1x4;
 
 #[cfg(test)]
 mod tests;

@@ -29,7 +29,10 @@ static GLOBAL: Counting = Counting;
 
 /// Allocations made by `frames` frames after two warm-up frames.
 fn allocations_per_run(parallel: bool, element: &str) -> u64 {
-    let case = CASES.iter().find(|c| c.element == element).expect("case");
+    allocations_of(CASES.iter().find(|c| c.element == element).expect("case"), parallel)
+}
+
+fn allocations_of(case: &hox_sim::benchmark::BenchCase, parallel: bool) -> u64 {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     pool.install(|| {
         let mut sim = bending_beam(case, parallel).unwrap();
@@ -51,4 +54,6 @@ fn frames_do_not_allocate() {
         assert_eq!(allocations_per_run(false, element), 0, "{element}, serial sweep");
         assert_eq!(allocations_per_run(true, element), 0, "{element}, parallel sweep");
     }
+    // 10,240 tetrahedra: on two threads the block is cut into slabs (kernels::Partition)
+    assert_eq!(allocations_of(&CASES[1], true), 0, "P1 r1, slab sweep");
 }

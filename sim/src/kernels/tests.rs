@@ -62,23 +62,30 @@ fn a_non_finite_correction_is_reported_and_not_scattered() {
     assert_eq!(x.iter().map(|p| p.x).collect::<Vec<_>>(), before.iter().map(|p| p.x).collect::<Vec<_>>());
 }
 
-/// The colour sweep of a P1 beam over the colour-packed data projects exactly what the generic
-/// kernel does element after element in the same order, up to round-off.
-#[test]
-fn p1_colour_sweep_matches_the_generic_kernel() {
+/// The 2 × 0.5 × 0.5 m P1 beam of 8 × 2 × 2 cells refined `refine` times, its geometry,
+/// colouring and colour-packed block.
+fn p1_beam(refine: usize) -> (crate::mesh::Mesh, Vec<crate::geometry::BlockGeometry>, Vec<Vec<u32>>, PackedBlock) {
     use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
     let mesh = BoxMeshSpec {
         grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(2.0, 0.5, 0.5), cells: [8, 2, 2] },
         element_type: crate::element::ElementType::from_name("p1").unwrap(),
         split: TetSplit::Five,
-        refine: 0,
+        refine,
     }
     .build()
     .unwrap();
     let geo = crate::geometry::precompute(&mesh, None).unwrap();
+    let colours = crate::colouring::colour_elements(&mesh.blocks[0], mesh.num_nodes());
+    let packed = PackedBlock::in_colour_order(&mesh.blocks[0], &geo[0], &colours);
+    (mesh, geo, colours, packed)
+}
+
+/// The colour sweep of a P1 beam over the colour-packed data projects exactly what the generic
+/// kernel does element after element in the same order, up to round-off.
+#[test]
+fn p1_colour_sweep_matches_the_generic_kernel() {
+    let (mesh, geo, colours, packed) = p1_beam(0);
     let block = &mesh.blocks[0];
-    let colours = crate::colouring::colour_elements(block, mesh.num_nodes());
-    let packed = PackedBlock::in_colour_order(block, &geo[0], &colours);
     let material = materials()[0];
     let deformed: Vec<Vec3> = mesh.rest_positions.iter().enumerate().map(|(i, p)| p + 0.02 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin())).collect();
     let w: Vec<f64> = mesh.rest_positions.iter().map(|p| if p.x < 1e-12 { 0.0 } else { 1.0 }).collect();
@@ -114,6 +121,90 @@ fn p1_colour_sweep_matches_the_generic_kernel() {
     let gap = x.iter().zip(&expected).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
     assert!(scale > 0.0 && gap <= 1e-12 * scale.max(1.0), "{gap:e} against {scale:e}");
     for (a, b) in lambdas.iter().zip(&lambdas_expected) {
+        assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{a} {b}");
+    }
+}
+
+/// A P1 beam, its colour-packed block, a deformed state and inverse masses with every node at
+/// x < 0.3 pinned (so whole elements are pinned too).
+fn p1_colour_case() -> (crate::mesh::Mesh, PackedBlock, Vec<Vec3>, Vec<f64>) {
+    let (mesh, _, _, packed) = p1_beam(1);
+    let deformed: Vec<Vec3> = mesh.rest_positions.iter().enumerate().map(|(i, p)| p + 0.02 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin())).collect();
+    let w: Vec<f64> = mesh.rest_positions.iter().enumerate().map(|(i, p)| if p.x < 0.3 { 0.0 } else { 1.0 + 0.01 * (i % 7) as f64 }).collect();
+    (mesh, packed, deformed, w)
+}
+
+/// Every colour of `packed` through [`colour_sweep`], batched or not; the first error stops.
+fn sweep_colours(packed: &PackedBlock, rest: &[Vec3], w: &[f64], x: &mut [Vec3], lambdas: &mut [f64], batched: bool) -> Result<u64, NonFiniteElement> {
+    let material = materials()[0];
+    let mut done = 0;
+    for c in 0..packed.num_colours() {
+        // SAFETY: one thread, sizes from the mesh.
+        done += unsafe { colour_sweep(4, &material, Positions::new(x), rest, w, packed, c, packed.colour(c), Multipliers::new(lambdas), 9e6, batched) }.unwrap()?;
+    }
+    Ok(done)
+}
+
+/// Four same-colour linear tetrahedra per 256-bit register give the one-at-a-time colour
+/// sweep's positions and multipliers up to round-off, skip the same pinned elements, and name
+/// the same element when one comes out non-finite, with the same nodes scattered before it.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn p1_batches_of_four_match_the_scalar_colour_sweep() {
+    if !(std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")) {
+        return;
+    }
+    let (mesh, packed, deformed, w) = p1_colour_case();
+    assert!(packed.colour_batches.last().copied().unwrap_or(0) * 4 > packed.len() / 2, "most elements in batches");
+    let n = mesh.blocks[0].len();
+    let run = |batched: bool, x: &mut Vec<Vec3>, lambdas: &mut Vec<f64>| {
+        let mut done = 0;
+        for _ in 0..5 {
+            lambdas.fill(0.0);
+            done += sweep_colours(&packed, &mesh.rest_positions, &w, x, lambdas, batched).unwrap();
+        }
+        done
+    };
+    let (mut x1, mut l1, mut x4, mut l4) = (deformed.clone(), vec![0.0; n], deformed.clone(), vec![0.0; n]);
+    let (done1, done4) = (run(false, &mut x1, &mut l1), run(true, &mut x4, &mut l4));
+    assert_eq!(done1, done4);
+    assert!(done1 < 5 * n as u64, "some elements are all pinned");
+    let scale = x1.iter().zip(&deformed).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    let gap = x1.iter().zip(&x4).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    assert!(scale > 1e-3 && gap <= 1e-12 * scale, "{gap:e} against {scale:e}");
+    for (a, b) in l1.iter().zip(&l4) {
+        assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{a} {b}");
+    }
+    for (i, (a, b)) in x4.iter().zip(&deformed).enumerate() {
+        if w[i] == 0.0 {
+            assert_eq!(a, b, "a pinned node stays");
+        }
+    }
+
+    // a non-finite node first met (in sweep order) in the third lane of a batch past the first colour
+    let mut first_seen = vec![usize::MAX; mesh.num_nodes()];
+    for (k, four) in packed.nodes.chunks_exact(4).enumerate() {
+        for &nd in four {
+            first_seen[nd as usize] = first_seen[nd as usize].min(k);
+        }
+    }
+    let c = (1..packed.num_colours()).find(|&c| packed.colour(c).len() >= 8).unwrap();
+    let k = (packed.colour(c).start..packed.colour(c).end - 4)
+        .find(|&k| (k - packed.colour(c).start) % 4 == 2 && first_seen[packed.nodes[4 * k + 1] as usize] == k && w[packed.nodes[4 * k + 1] as usize] > 0.0)
+        .expect("a node first met in a third lane");
+    let bad_node = packed.nodes[4 * k + 1];
+    let (mut x1, mut l1, mut x4, mut l4) = (deformed.clone(), vec![0.0; n], deformed.clone(), vec![0.0; n]);
+    x1[bad_node as usize].y = f64::NAN;
+    x4[bad_node as usize].y = f64::NAN;
+    let (r1, r4) = (sweep_colours(&packed, &mesh.rest_positions, &w, &mut x1, &mut l1, false), sweep_colours(&packed, &mesh.rest_positions, &w, &mut x4, &mut l4, true));
+    let bad = r1.unwrap_err();
+    assert_eq!(bad, r4.unwrap_err());
+    assert_eq!(bad.node, bad_node);
+    assert_eq!(bad.element, packed.element_ids.as_ref().unwrap()[k] as usize);
+    for (a, b) in x1.iter().zip(&x4) {
+        assert!((a - b).norm() <= 1e-12 || a.y.is_nan() && b.y.is_nan(), "{a} {b}");
+    }
+    for (a, b) in l1.iter().zip(&l4) {
         assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{a} {b}");
     }
 }

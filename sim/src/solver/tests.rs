@@ -199,35 +199,114 @@ fn parallel_projection_is_deterministic_for_any_thread_count() {
 }
 
 /// Serial and parallel sweeps visit the elements in different orders (Gauss–Seidel), so they
-/// differ slightly along the way and settle on the same static answer.
-#[test]
-fn serial_and_parallel_sweeps_agree_and_settle_on_the_same_static_answer() {
-    let mesh = cantilever(ElementType::from_name("p2").unwrap());
+/// differ slightly along the way and settle on the same static answer: for `mesh` clamped at
+/// x = 0, the serial sweep against the parallel sweep on each `(threads, partition threshold)`.
+fn sweeps_agree_and_settle(mesh: Mesh, parallel_runs: &[(usize, usize)]) {
     let clamped = clamped_at_x0(&mesh);
     let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
     let reference = static_equilibrium(&mesh, &material, None, &clamped);
     let u_max = reference.iter().zip(&mesh.rest_positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
     for formulation in Formulation::ALL {
-        let mut serial = beam_sim(false, formulation);
-        let mut parallel = beam_sim(true, formulation);
-        assert!(parallel.num_colours()[0] > 1);
-        // along the way: close, but not identical (different Gauss–Seidel order)
-        for _ in 0..30 {
-            serial.step_frame().unwrap();
-            parallel.step_frame().unwrap();
+        let sim = |parallel: bool| {
+            let settings = SolverSettings { formulation, parallel, ..SolverSettings::default() };
+            let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.clone() })];
+            Simulation::new(mesh.clone(), material, settings, effects).unwrap()
+        };
+        let mut runs = vec![(rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap(), sim(false))];
+        for &(threads, per_thread) in parallel_runs {
+            let mut parallel = sim(true);
+            parallel.set_partition_threshold(per_thread);
+            assert!(parallel.num_colours()[0] > 1);
+            runs.push((rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap(), parallel));
         }
-        let gap = serial.positions.iter().zip(&parallel.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-        assert!(gap > 0.0 && gap < 0.02 * u_max, "{formulation}: serial and parallel differ by {gap:.3e} m");
-        // settled: both on the static answer, up to XPBD's solver bias at these settings
-        for sim in [&mut serial, &mut parallel] {
+        // along the way: close, but not identical (different Gauss–Seidel order)
+        for (pool, sim) in &mut runs {
+            pool.install(|| (0..30).for_each(|_| sim.step_frame().unwrap()));
+        }
+        let gap = |a: &Simulation, b: &Simulation| a.positions.iter().zip(&b.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        for (_, parallel) in &runs[1..] {
+            let gap = gap(&runs[0].1, parallel);
+            assert!(gap > 0.0 && gap < 0.02 * u_max, "{formulation}: serial and parallel differ by {gap:.3e} m");
+        }
+        // settled: all on the static answer, up to XPBD's solver bias at these settings
+        for (pool, sim) in &mut runs {
             sim.add_effect(Box::new(Damping { rate_per_sec: 20.0 })).unwrap();
-            for _ in 0..600 {
+            pool.install(|| (0..600).for_each(|_| sim.step_frame().unwrap()));
+        }
+        for (_, parallel) in &runs[1..] {
+            let settled_gap = gap(&runs[0].1, parallel);
+            let to_static = parallel.positions.iter().zip(&reference).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+            assert!(settled_gap < 1e-3 * u_max, "{formulation}: settled states differ by {settled_gap:.3e} m");
+            assert!(to_static < 0.02 * u_max, "{formulation}: parallel settles {to_static:.3e} m from the static answer");
+        }
+    }
+}
+
+#[test]
+fn serial_and_parallel_sweeps_agree_and_settle_on_the_same_static_answer() {
+    // P2: colour by colour on one and two threads, and cut into two slabs
+    sweeps_agree_and_settle(cantilever(ElementType::from_name("p2").unwrap()), &[(1, usize::MAX), (2, usize::MAX), (2, 0)]);
+}
+
+/// A P1 beam large enough for slabs with an interior: the colour sweep (four tetrahedra per
+/// register) and the two-slab sweep against the serial one.
+#[test]
+fn serial_colour_and_slab_sweeps_agree_and_settle_on_a_p1_beam() {
+    let mesh = BoxMeshSpec {
+        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 0.25, 0.25), cells: [8, 2, 2] },
+        element_type: ElementType::from_name("p1").unwrap(),
+        split: TetSplit::Five,
+        refine: 0,
+    }
+    .build()
+    .unwrap();
+    sweeps_agree_and_settle(mesh, &[(1, usize::MAX), (2, 0)]);
+}
+
+/// The slab sweep is deterministic for a given thread count, uses its slabs, and keeps every
+/// slab element inside its slab.
+#[test]
+fn slab_sweep_is_deterministic_for_a_thread_count() {
+    let run = || {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        pool.install(|| {
+            let mut sim = crate::benchmark::bending_beam(&crate::benchmark::CASES[0], true).unwrap();
+            sim.set_partition_threshold(0);
+            for _ in 0..3 {
                 sim.step_frame().unwrap();
             }
-        }
-        let settled_gap = serial.positions.iter().zip(&parallel.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-        let to_static = parallel.positions.iter().zip(&reference).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-        assert!(settled_gap < 1e-3 * u_max, "{formulation}: settled states differ by {settled_gap:.3e} m");
-        assert!(to_static < 0.02 * u_max, "{formulation}: parallel settles {to_static:.3e} m from the static answer");
+            let part = &sim.partitions[0];
+            assert_eq!((part.threads, part.slabs.len()), (2, 2));
+            let counts: Vec<usize> = part.slabs.iter().map(|s| s.len()).collect();
+            assert_eq!(counts.iter().sum::<usize>() + part.interface.len(), sim.mesh().num_elements());
+            assert!(counts.iter().all(|&c| c > sim.mesh().num_elements() / 3), "{counts:?}");
+            let mut owner = vec![usize::MAX; sim.mesh().num_nodes()];
+            for (s, slab) in part.slabs.iter().enumerate() {
+                for &n in &slab.nodes {
+                    assert!(owner[n as usize] == usize::MAX || owner[n as usize] == s, "node {n} in two slabs");
+                    owner[n as usize] = s;
+                }
+            }
+            sim.positions
+        })
+    };
+    assert_eq!(run(), run());
+}
+
+/// The colour sweep with four linear tetrahedra per register sags a beam as the one-at-a-time
+/// colour sweep does, up to round-off, over several substeps.
+#[test]
+fn p1_simd_batches_follow_the_scalar_colour_sweep_on_a_sagging_beam() {
+    let case = &crate::benchmark::CASES[0];
+    let mut scalar = crate::benchmark::bending_beam(case, true).unwrap();
+    let mut batched = crate::benchmark::bending_beam(case, true).unwrap();
+    scalar.set_simd_batches(false);
+    for _ in 0..10 {
+        scalar.substep().unwrap();
+        batched.substep().unwrap();
     }
+    assert_eq!(scalar.counters(), batched.counters());
+    let scale = scalar.displacements().iter().map(|d| d.norm()).fold(0.0, f64::max);
+    let gap = scalar.positions.iter().zip(&batched.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    assert!(scale > 1e-6 && gap <= 1e-12 * scale, "{gap:e} against {scale:e}");
 }
