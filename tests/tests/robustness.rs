@@ -584,7 +584,9 @@ mod perturbed {
     }
 
     proptest! {
-        #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, .. ProptestConfig::default() })]
+        // a fixed seed: the same 24 meshes on every run and machine (reproducible failures);
+        // invalid meshes are checked for a clear error and then rejected, so 24 valid meshes run
+        #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, rng_seed: proptest::test_runner::RngSeed::Fixed(0x68_6f_78_08), max_global_rejects: 200, .. ProptestConfig::default() })]
         /// A valid perturbed mesh (or a clear error naming the bad element) that, loaded by gravity
         /// for 0.5 s and released (damping 10/s, 2 s), stays finite, within the energy bound
         /// (`H ≤ 5 % of |V_g|max`) and returns to its rest shape. Stable Neo-Hookean, E = 10⁶ Pa,
@@ -609,7 +611,8 @@ mod perturbed {
                 Err(e) => {
                     let message = e.to_string();
                     prop_assert!(message.contains("at rest") && message.contains("element"), "unclear error: {message}");
-                    return Ok(());
+                    prop_assume!(false, "an invalid rest mesh, refused with a clear error");
+                    unreachable!()
                 }
             };
             // P3 with the energy formulation overshoots 1 % of |V_g| slightly (1.2 %) even unperturbed
