@@ -141,3 +141,43 @@ fn stepping_in_the_background_while_the_window_paints_gives_the_same_motion() {
     assert!((r.time_secs() - t).abs() < 1e-12);
     assert_eq!(r.positions, app.sessions[0].instance.sim.positions);
 }
+
+/// Drags the free top corner of the beam's tip through the 3D view, drawn by the CPU rasteriser
+/// (headless) or by OpenGL (picking then renders the depth buffer on the CPU when the drag
+/// starts): the node is picked, an attachment pulls it while the button is held, none after.
+fn drag_the_tip(gl: bool) {
+    let mut h = harness(AppArgs::default());
+    h.state_mut().gl_available = gl;
+    h.run_steps(3);
+    let (node, at) = {
+        let app = h.state();
+        let sim = &app.sessions[0].instance.sim;
+        let tip = sim.positions.iter().enumerate().filter(|(i, _)| sim.inv_mass()[*i] > 0.0).max_by(|a, b| (a.1.x + a.1.z).total_cmp(&(b.1.x + b.1.z))).expect("free nodes");
+        (tip.0 as u32, app.viewport.screen_position(*tip.1).expect("the tip is in view"))
+    };
+    h.hover_at(at);
+    h.run_steps(1);
+    h.drag_at(at);
+    h.run_steps(1);
+    for k in 1..=5 {
+        h.hover_at(at + egui::vec2(0.0, -8.0 * k as f32));
+        h.run_steps(1);
+    }
+    let drag = h.state().sessions[0].drag.expect("a node is being dragged");
+    assert_eq!(drag.node, node, "the node under the cursor is picked");
+    let start = h.state().sessions[0].instance.sim.positions[node as usize];
+    assert!(drag.target_m.z > start.z, "dragging upwards on screen pulls the node up: {drag:?} from {start}");
+    h.drop_at(at + egui::vec2(0.0, -40.0));
+    h.run_steps(2);
+    assert!(h.state().sessions[0].drag.is_none(), "the attachment exists only while dragging");
+}
+
+#[test]
+fn a_node_can_be_dragged_in_the_cpu_drawn_view() {
+    drag_the_tip(false);
+}
+
+#[test]
+fn a_node_can_be_dragged_in_the_opengl_view() {
+    drag_the_tip(true);
+}

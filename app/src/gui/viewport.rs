@@ -58,11 +58,13 @@ pub struct Viewport {
     fitted: bool,
     /// The OpenGL view's objects, shared with its paint callbacks.
     gl_state: GlState,
+    /// Where the view was last drawn, in points.
+    last_rect: egui::Rect,
 }
 
 impl Viewport {
     pub fn new(camera: Option<Camera>) -> Viewport {
-        Viewport { fitted: camera.is_some(), camera: camera.unwrap_or(Camera::framing([0.0; 3], [1.0; 3])), image: Image::new(1, 1), texture: None, layers: Vec::new(), render_ms: 0.0, dragging: None, gl_state: GlState::default() }
+        Viewport { fitted: camera.is_some(), camera: camera.unwrap_or(Camera::framing([0.0; 3], [1.0; 3])), image: Image::new(1, 1), texture: None, layers: Vec::new(), render_ms: 0.0, dragging: None, gl_state: GlState::default(), last_rect: egui::Rect::NOTHING }
     }
 
     /// Frames the sessions' bodies again.
@@ -96,6 +98,7 @@ impl Viewport {
             self.reset_camera(sessions, offsets);
         }
         let (rect, response) = ui.allocate_exact_size(ui.available_size().max(egui::vec2(64.0, 64.0)), egui::Sense::click_and_drag());
+        self.last_rect = rect;
         let ppp = ui.ctx().pixels_per_point();
         let scale = (1600.0 / (rect.width() * ppp)).min(1000.0 / (rect.height() * ppp)).min(1.0);
         let (w, h) = (((rect.width() * ppp * scale) as usize).max(16), ((rect.height() * ppp * scale) as usize).max(16));
@@ -267,6 +270,14 @@ impl Viewport {
         if let Some(t) = &self.texture {
             painter.image(t.id(), rect, egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)), egui::Color32::WHITE);
         }
+    }
+
+    /// Where the world point `p` was drawn in the last frame, in points (None if behind the
+    /// camera or not drawn yet).
+    pub fn screen_position(&self, p: Vec3) -> Option<egui::Pos2> {
+        let s = self.image.project(f32s(&p))?;
+        let r = self.last_rect;
+        Some(egui::pos2(r.min.x + s[0] / self.image.width as f32 * r.width(), r.min.y + s[1] / self.image.height as f32 * r.height()))
     }
 
     /// Why the OpenGL view could not be made (the CPU rasteriser is used instead), if it failed.
