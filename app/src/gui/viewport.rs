@@ -106,7 +106,6 @@ impl Viewport {
             self.image = Image::new(w, h);
         }
         let to_px = |p: egui::Pos2| -> [f32; 2] { [(p.x - rect.min.x) / rect.width() * w as f32, (p.y - rect.min.y) / rect.height() * h as f32] };
-        let to_point = |s: [f32; 3]| -> egui::Pos2 { egui::pos2(rect.min.x + s[0] / w as f32 * rect.width(), rect.min.y + s[1] / h as f32 * rect.height()) };
 
         // --- input
         if response.hovered() {
@@ -242,12 +241,12 @@ impl Viewport {
             for (s, o) in sessions.iter().zip(offsets) {
                 let (lo, hi) = s.instance.sim.mesh().bounding_box();
                 let top = Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z) + o;
-                if let Some(p) = self.image.project(f32s(&top)) {
+                if let Some(p) = self.screen_position(top) {
                     let mut text = s.config.label();
                     if let Some(e) = s.probe_error_m() {
                         text += &format!("\nprobe error {} m", crate::recording::format_metres(e));
                     }
-                    painter.text(to_point(p) - egui::vec2(0.0, 14.0), egui::Align2::CENTER_BOTTOM, text, egui::FontId::proportional(14.0), egui::Color32::WHITE);
+                    painter.text(p - egui::vec2(0.0, 14.0), egui::Align2::CENTER_BOTTOM, text, egui::FontId::proportional(14.0), egui::Color32::WHITE);
                 }
             }
         }
