@@ -147,7 +147,8 @@ pub struct MeshArgs {
 
 #[derive(Args)]
 pub struct PhysicsArgs {
-    /// Material model: stvk, snh (stable Neo-Hookean) or nh (Neo-Hookean).
+    /// Material model: stvk, snh (stable Neo-Hookean), snh-log (stable Neo-Hookean with
+    /// Smith et al.'s log term) or nh (Neo-Hookean).
     #[arg(long)]
     pub material: Option<String>,
     /// Young's modulus, Pa.
@@ -178,6 +179,10 @@ pub struct PhysicsArgs {
     /// how many).
     #[arg(long)]
     pub parallel: bool,
+    /// Keep the requested substeps even where the stiffest element needs more for stability
+    /// (above h·ω_max = 3 the stability guard raises them to h·ω_max ≤ 1; see docs/STABILITY.md).
+    #[arg(long)]
+    pub no_stability_guard: bool,
 }
 
 fn parse_grid(s: &str) -> Result<[usize; 3], String> {
@@ -264,6 +269,7 @@ fn overrides(mesh: &MeshArgs, physics: Option<&PhysicsArgs>) -> SceneOverrides {
         o.iterations = p.iterations;
         o.frames_per_second = p.fps;
         o.parallel = p.parallel.then_some(true);
+        o.stability_guard = p.no_stability_guard.then_some(false);
     }
     o
 }
@@ -313,6 +319,10 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
         RunMode::Seconds(t)
     };
     let mut instance = Instance::new(scene)?;
+    let stability = instance.sim.stability();
+    if stability.raised() {
+        eprintln!("note: {}", stability.summary());
+    }
     let mut vtk_writer = gmsh::VtkWriter::create(vtk, &instance)?;
     let mut bar = DelayedBar::new();
     let mut on_frame = |i: &Instance| vtk_writer.as_mut().map_or(Ok(()), |w| w.frame(i));
@@ -335,6 +345,8 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
         if let Some(index) = &vtk_index {
             out["vtk"] = index.display().to_string().into();
         }
+        out["substeps_per_frame"] = stability.substeps.into();
+        out["h_omega_max"] = stability.requested_h_omega.into();
         println!("{out}");
     } else {
         println!(

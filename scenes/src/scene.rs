@@ -13,7 +13,7 @@
 //! split = "five"          # five (unbiased) | six (biased): tetrahedra per cell
 //! refine = 0              # 1-to-8 refinements of the tetrahedra
 //! [material]
-//! model = "stvk"          # stvk | snh | nh
+//! model = "stvk"          # stvk | snh | snh-log | nh
 //! youngs_modulus_pa = 3e6
 //! poisson_ratio = 0.35
 //! density_kg_m3 = 1000
@@ -134,6 +134,8 @@ pub struct SolverSpec {
     pub settle_damping_per_sec: f64,
     /// Project elements in parallel, colour by colour.
     pub parallel: bool,
+    /// Take more substeps when the stiffest element needs them (`hox_sim::stability`).
+    pub stability_guard: bool,
 }
 
 impl Default for SolverSpec {
@@ -147,6 +149,7 @@ impl Default for SolverSpec {
             duration_secs: 3.0,
             settle_damping_per_sec: 10.0,
             parallel: false,
+            stability_guard: true,
         }
     }
 }
@@ -346,6 +349,7 @@ pub struct SceneOverrides {
     pub iterations: Option<u32>,
     pub frames_per_second: Option<f64>,
     pub parallel: Option<bool>,
+    pub stability_guard: Option<bool>,
 }
 
 impl Scene {
@@ -386,7 +390,7 @@ impl Scene {
         let mesh = mesh_of(&file.mesh, source, base_dir.as_deref(), cached, &invalid)?;
         let mm = &file.material;
         let model = MaterialModel::from_name(&mm.model)
-            .ok_or_else(|| invalid("material.model", format!("{:?}", mm.model), "expected stvk, snh or nh"))?;
+            .ok_or_else(|| invalid("material.model", format!("{:?}", mm.model), "expected stvk, snh, snh-log or nh"))?;
         let material = Material::new(model, mm.youngs_modulus_pa, mm.poisson_ratio, mm.density_kg_m3).map_err(|e| {
             use hox_sim::material::MaterialError as E;
             let (key, value) = match &e {
@@ -434,6 +438,7 @@ impl Scene {
             formulation,
             quadrature_degree: s.quadrature_degree,
             parallel: s.parallel,
+            stability_guard: s.stability_guard,
         };
         for (k, e) in file.effects.iter().enumerate() {
             validate_effect(k, e, &invalid)?;
@@ -551,6 +556,9 @@ impl Scene {
         }
         if let Some(v) = o.parallel {
             f.solver.parallel = v;
+        }
+        if let Some(v) = o.stability_guard {
+            f.solver.stability_guard = v;
         }
         Scene::validate(f, &self.source, self.base_dir.clone(), Some(&self.mesh))
     }

@@ -132,3 +132,14 @@ fn overrides_change_the_scene_and_are_validated() {
     let split_negative = SceneOverrides { formulation: Some("split".into()), poisson_ratio: Some(-0.2), ..Default::default() };
     assert!(s.with_overrides(&split_negative).unwrap_err().to_string().contains("split formulation"));
 }
+
+/// The stability guard leaves every built-in scene at the substeps it asks for (the paper's
+/// scenes run at h·ω_max ≤ 0.91; `docs/STABILITY.md`).
+#[test]
+fn the_stability_guard_leaves_the_built_in_scenes_as_they_are() {
+    for (name, _) in crate::BUILTIN {
+        let mut instance = crate::Instance::new(crate::by_name(name).unwrap()).unwrap();
+        let r = instance.sim.stability();
+        assert!(!r.raised() && r.requested_h_omega < 1.0, "{name}: {}", r.summary());
+    }
+}

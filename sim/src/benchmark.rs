@@ -141,7 +141,7 @@ pub fn measure(case: &BenchCase, threads: usize, parallel: bool, warmup_frames: 
         }
         let ms_per_frame = median(&mut times_ms);
         let elements = sim.mesh().num_elements();
-        let substeps = sim.settings().substeps as f64;
+        let substeps = sim.substeps_per_frame() as f64;
         let g = &sim.geometry()[0];
         let flops = flops_per_element(g.nodes_per_element, g.points_per_element) * elements as f64 * substeps;
         Ok(BenchRow {

@@ -37,6 +37,7 @@ pub mod mesh;
 pub mod probe;
 pub mod quadrature;
 pub mod solver;
+pub mod stability;
 pub mod statics;
 pub mod surface;
 

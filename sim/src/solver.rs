@@ -28,6 +28,7 @@ use crate::geometry::{BlockGeometry, GeometryError, precompute};
 use crate::mass::lumped_masses_kg;
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshError};
+use crate::stability::{GUARD_H_OMEGA, GUARD_TRIGGER_H_OMEGA, StabilityReport, guarded_substeps, mesh_omega2_max};
 
 /// Time stepping and constraint settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,11 +44,16 @@ pub struct SolverSettings {
     /// threads a large block is cut into one slab per thread instead
     /// ([`Simulation::set_partition_threshold`]); that order depends on the thread count.
     pub parallel: bool,
+    /// The stability guard ([`crate::stability`]): when the requested substep has `h ω_max`
+    /// above [`crate::stability::GUARD_TRIGGER_H_OMEGA`], take enough substeps for
+    /// `h ω_max ≤` [`crate::stability::GUARD_H_OMEGA`]. On by default; the paper's scenes are
+    /// below the trigger and unaffected.
+    pub stability_guard: bool,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        Self { substeps: 50, iterations: 1, frames_per_second: 60.0, formulation: Formulation::Energy, quadrature_degree: None, parallel: false }
+        Self { substeps: 50, iterations: 1, frames_per_second: 60.0, formulation: Formulation::Energy, quadrature_degree: None, parallel: false, stability_guard: true }
     }
 }
 
@@ -66,6 +72,8 @@ impl SolverSettings {
         Ok(())
     }
     /// The substep length `h`, seconds.
+    /// `1/(fps · substeps)`: the requested substep; the one taken may be shorter
+    /// ([`Simulation::substep_dt_secs`], the stability guard).
     pub fn substep_dt_secs(&self) -> f64 {
         1.0 / (self.frames_per_second * self.substeps as f64)
     }
@@ -146,6 +154,13 @@ pub struct Simulation {
     /// Set when the NaN guard stopped the simulation; cleared by reset or warm start.
     failure: Option<SimError>,
     counters: SolverCounters,
+    /// The stability guard's `ω_max² ρ / E` (it scales exactly with E/ρ) and where it is;
+    /// None until needed after a change of ν, model, quadrature or a node's mass.
+    omega2_per_e_over_rho: Option<(f64, usize, usize)>,
+    /// A node's mass was set by hand since the masses were last computed from the density.
+    masses_overridden: bool,
+    /// Substeps per frame being taken (the requested ones or the guard's).
+    substeps_per_frame: u32,
 }
 
 impl Simulation {
@@ -187,12 +202,16 @@ impl Simulation {
             substeps_in_frame: 0,
             failure: None,
             counters: SolverCounters::default(),
+            omega2_per_e_over_rho: None,
+            masses_overridden: false,
+            substeps_per_frame: settings.substeps,
         };
         for e in effects {
             sim.add_effect(e)?;
         }
         sim.colours = sim.mesh.blocks.iter().map(|b| crate::colouring::colour_elements(b, sim.mesh.num_nodes())).collect();
         sim.pack_colours();
+        sim.update_guard();
         Ok(sim)
     }
 
@@ -314,6 +333,9 @@ impl Simulation {
         if self.inv_mass[node] > 0.0 {
             self.inv_mass[node] = 1.0 / mass_kg;
         }
+        self.masses_overridden = true;
+        self.omega2_per_e_over_rho = None;
+        self.update_guard();
         Ok(())
     }
 
@@ -327,8 +349,16 @@ impl Simulation {
                 }
                 *m_old = m;
             }
+            if self.masses_overridden {
+                self.omega2_per_e_over_rho = None;
+                self.masses_overridden = false;
+            }
+        }
+        if (material.model, material.poisson_ratio) != (self.material.model, self.material.poisson_ratio) {
+            self.omega2_per_e_over_rho = None;
         }
         self.material = material;
+        self.update_guard();
         Ok(())
     }
 
@@ -339,9 +369,11 @@ impl Simulation {
         if settings.quadrature_degree != self.settings.quadrature_degree {
             self.geometry = precompute(&self.mesh, settings.quadrature_degree)?;
             self.pack_colours();
+            self.omega2_per_e_over_rho = None;
         }
         self.lambdas = Self::multipliers(&self.geometry, settings.formulation);
         self.settings = settings;
+        self.update_guard();
         Ok(())
     }
 
@@ -367,9 +399,53 @@ impl Simulation {
         self.failure = None;
     }
 
-    /// Advances one frame (`substeps` substeps).
+    /// The stability guard's findings: the fastest element mode, `h ω_max` with the requested
+    /// substeps, and the substeps per frame taken ([`crate::stability`]).
+    pub fn stability(&mut self) -> StabilityReport {
+        let (omega2_normalised, block, element) = self.omega2_normalised();
+        let omega_max_rad_s = (omega2_normalised * self.material.youngs_modulus_pa / self.material.density_kg_m3).sqrt();
+        let s = &self.settings;
+        let (substeps, capped) = if s.stability_guard { guarded_substeps(s.substeps, s.frames_per_second, omega_max_rad_s, GUARD_TRIGGER_H_OMEGA, GUARD_H_OMEGA) } else { (s.substeps, false) };
+        StabilityReport {
+            omega_max_rad_s,
+            block,
+            element,
+            requested_h_omega: omega_max_rad_s * s.substep_dt_secs(),
+            requested_substeps: s.substeps,
+            substeps,
+            guard: s.stability_guard,
+            capped,
+        }
+    }
+
+    /// Substeps per frame being taken: the requested ones, or more (the stability guard).
+    pub fn substeps_per_frame(&self) -> u32 {
+        self.substeps_per_frame
+    }
+
+    /// The substep being taken, `1/(fps · substeps_per_frame)`, seconds.
+    pub fn substep_dt_secs(&self) -> f64 {
+        1.0 / (self.settings.frames_per_second * self.substeps_per_frame as f64)
+    }
+
+    fn omega2_normalised(&mut self) -> (f64, usize, usize) {
+        if let Some(v) = self.omega2_per_e_over_rho {
+            return v;
+        }
+        let (omega2, block, element) = mesh_omega2_max(&self.mesh, &self.geometry, &self.material, &self.masses_kg);
+        let v = (omega2 * self.material.density_kg_m3 / self.material.youngs_modulus_pa, block, element);
+        self.omega2_per_e_over_rho = Some(v);
+        v
+    }
+
+    /// Recomputes the substeps per frame after a change of settings, material or masses.
+    fn update_guard(&mut self) {
+        self.substeps_per_frame = if self.settings.stability_guard { self.stability().substeps } else { self.settings.substeps };
+    }
+
+    /// Advances one frame (`substeps` substeps, or more: the stability guard).
     pub fn step_frame(&mut self) -> Result<(), SimError> {
-        for _ in 0..self.settings.substeps {
+        for _ in 0..self.substeps_per_frame {
             self.substep()?;
         }
         self.frames += 1;
@@ -377,12 +453,12 @@ impl Simulation {
         Ok(())
     }
 
-    /// Advances one substep of `h = 1/(fps · substeps)`.
+    /// Advances one substep of `h = 1/(fps · substeps_per_frame)`.
     pub fn substep(&mut self) -> Result<(), SimError> {
         if let Some(e) = &self.failure {
             return Err(e.clone());
         }
-        let h = self.settings.substep_dt_secs();
+        let h = self.substep_dt_secs();
         self.time_secs += h;
         self.counters.substeps += 1;
         self.substeps_in_frame += 1;
@@ -569,7 +645,7 @@ impl Simulation {
             origin: bad.origin,
             frame: self.frames + 1,
             substep_in_frame: self.substeps_in_frame,
-            substeps_per_frame: self.settings.substeps,
+            substeps_per_frame: self.substeps_per_frame,
             substep: self.counters.substeps,
             time_secs: self.time_secs,
         };

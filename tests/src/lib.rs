@@ -57,7 +57,7 @@ pub fn material(model: MaterialModel, youngs_modulus_pa: f64, poisson_ratio: f64
 /// Solver settings: `substeps` per frame at `frames_per_second`, one iteration, each element
 /// type's default quadrature, serial sweep.
 pub fn settings(formulation: Formulation, substeps: u32, frames_per_second: f64) -> SolverSettings {
-    SolverSettings { substeps, iterations: 1, frames_per_second, formulation, quadrature_degree: None, parallel: false }
+    SolverSettings { substeps, iterations: 1, frames_per_second, formulation, quadrature_degree: None, parallel: false, stability_guard: true }
 }
 
 /// Nodes whose rest coordinate `axis` equals `at_m` (within 1e-9 × the body's size).

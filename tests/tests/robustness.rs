@@ -23,6 +23,7 @@ use hox_sim::solver::{SimError, Simulation};
 use hox_tests::*;
 
 const SNH: MaterialModel = MaterialModel::StableNeoHookean;
+const SNH_LOG: MaterialModel = MaterialModel::StableNeoHookeanLog;
 const STVK: MaterialModel = MaterialModel::StVenantKirchhoff;
 const NH: MaterialModel = MaterialModel::NeoHookean;
 const BOTH: [Formulation; 2] = Formulation::ALL;
@@ -259,7 +260,9 @@ fn load_and_release_within(mut s: Simulation, load_secs: f64, damping_per_sec: f
     let at_release = health(&s, Vec3::zeros());
     let after = release(&mut s, &["gravity"], damping_per_sec, frames(release_secs, fps), at_release.total_j() + 1e-9)?;
     Ok(format!(
-        "max sag {:.3e} m, max H {:.2e} J ({:+.1e} of |V_g| {:.2e} J), min det F loaded {:.3}; {}",
+        "{} substeps (h·ω_max {:.2}), max sag {:.3e} m, max H {:.2e} J ({:+.1e} of |V_g| {:.2e} J), min det F loaded {:.3}; {}",
+        s.substeps_per_frame(),
+        s.stability().requested_h_omega * s.settings().substeps as f64 / s.substeps_per_frame() as f64,
         loaded.max_displacement_m,
         loaded.max_total_j,
         loaded.max_total_j / scale,
@@ -291,11 +294,9 @@ fn near_incompressible_stvk_cantilevers_do_not_blow_up() {
 fn near_incompressible(model: MaterialModel) {
     let mut problems = Vec::new();
     // measured with stable Neo-Hookean: the energy formulation overshoots the 10 % bound
-    let known: [(f64, &[&str]); 3] = [
-        (0.45, &["p3 energy"]),
-        (0.49, &["p2 energy", "p3 energy"]),
-        (0.499, &["p1 energy", "p2 energy", "p3 energy", "p3 split", "q1 energy", "q2 energy", "pyramid energy"]),
-    ];
+    // below the stability guard's trigger (h·ω_max 1.6–2.1 with 50 substeps) the energy
+    // formulation overshoots by 10–17 % of the work of gravity, then decays
+    let known: [(f64, &[&str]); 3] = [(0.45, &["p3 energy"]), (0.49, &["p2 energy"]), (0.499, &["p1 energy", "q1 energy", "pyramid energy"])];
     for (nu, known) in known {
         let known = if model == SNH { known } else { &[] };
         problems.extend(configurations(&format!("2 ν = {nu}, {model}"), &ELEMENT_TYPES, &BOTH, known, |et, f| {
@@ -312,26 +313,57 @@ fn near_incompressible(model: MaterialModel) {
 // ---------------------------------------------------------------------------------------------
 // Case 3: stiffness extremes.
 
-/// Runs a gravity-loaded cantilever (1 m, 4 cells, stable Neo-Hookean, ν = 0.3) for 3 s and
-/// returns the largest `H / |V_g|max` (1 % is the bound of the passing cases; NaN when the
-/// solver's guard stopped it).
+/// Runs a gravity-loaded cantilever (1 m, 4 cells, stable Neo-Hookean, ν = 0.3) for 3 s with
+/// the stability guard off (exactly the substeps asked for) and returns the largest
+/// `H / |V_g|max` (1 % is the bound of the passing cases; NaN when the solver's guard stopped it).
 fn energy_gain(et: &str, f: Formulation, youngs_modulus_pa: f64, substeps: u32, fps: f64) -> f64 {
-    let mut s = gravity_cantilever(et, 1.0, 4, material(SNH, youngs_modulus_pa, 0.3), f, substeps, fps);
+    let mut s = unguarded(gravity_cantilever(et, 1.0, 4, material(SNH, youngs_modulus_pa, 0.3), f, substeps, fps));
     run_checked(&mut s, frames(3.0, fps), GRAVITY_M_S2, f64::INFINITY).map(|t| t.max_total_j / t.max_gravity_work_j).unwrap_or(f64::NAN)
 }
 
-/// **Known failure (case 3), kept visible.** E = 10⁹ Pa with a single substep per frame at
-/// 60 fps (`h ω_max ≈ 10²`): the element constraints are effectively hard and one Gauss–Seidel
-/// sweep per frame pumps energy in — the total energy grows by orders of magnitude over the
-/// work gravity did, and the beam collapses (positions stay finite over these 3 s). See
-/// docs/STABILITY.md for the measured stability limit `h ω_max ≲ 1`. If this test fails, the
-/// instability is fixed: update docs/STABILITY.md and turn it into a passing case.
+/// The same simulation with the stability guard off.
+fn unguarded(mut s: Simulation) -> Simulation {
+    let settings = hox_sim::solver::SolverSettings { stability_guard: false, ..*s.settings() };
+    s.set_settings(settings).unwrap();
+    assert_eq!(s.substeps_per_frame(), settings.substeps);
+    s
+}
+
+/// Case 3 and 6 under the stability guard (on by default): the cantilever of
+/// [`energy_gain`] with `substeps` asked for at `fps`, loaded by gravity 1 s and released
+/// (damping `damping_per_sec` for `release_secs`), with the bound of every gravity case
+/// (`H ≤ 1 %` of the work of gravity). The guard takes the substeps the stiffest element needs
+/// (`h ω_max ≤ 1`).
+fn guarded_cantilever(et: &str, f: Formulation, youngs_modulus_pa: f64, substeps: u32, fps: f64, damping_per_sec: f64, release_secs: f64) -> Result<String, String> {
+    let mut s = gravity_cantilever(et, 1.0, 4, material(SNH, youngs_modulus_pa, 0.3), f, substeps, fps);
+    let guard = s.stability();
+    if !guard.raised() {
+        return Err(format!("the guard did not raise the substeps: {}", guard.summary()));
+    }
+    Ok(format!("{} substeps instead of {substeps} (h·ω_max {:.1} asked); {}", guard.substeps, guard.requested_h_omega, load_and_release(s, 1.0, damping_per_sec, release_secs)?))
+}
+
+/// Case 3: E = 10⁹ Pa asked for with one substep per frame at 60 fps (`h ω_max ≈ 10²–10³`):
+/// the stability guard cuts the frame into the substeps the stiffest element needs, and the
+/// cantilever loads and releases within the bounds of the soft cases.
 #[test]
-fn known_failure_a_stiff_cantilever_with_one_substep_per_frame_gains_energy() {
+#[ignore = "release: CI runs it with --release --ignored (hundreds of substeps per frame)"]
+fn a_stiff_cantilever_with_one_substep_per_frame_is_stable_under_the_stability_guard() {
+    each_configuration("3 E = 1e9 Pa, 1 substep asked, guard, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| guarded_cantilever(et, f, 1.0e9, 1, 60.0, 10.0, 2.0));
+}
+
+/// **Known failure (case 3) without the stability guard, kept visible.** E = 10⁹ Pa with a
+/// single substep per frame at 60 fps (`h ω_max ≈ 10²`): the element constraints are
+/// effectively hard and one Gauss–Seidel sweep per frame pumps energy in — the total energy
+/// grows by orders of magnitude over the work gravity did, and the beam collapses (positions
+/// stay finite over these 3 s). See docs/STABILITY.md for the measured stability limit. If this
+/// test fails, the solver itself became stable there: update docs/STABILITY.md.
+#[test]
+fn known_failure_without_the_guard_a_stiff_cantilever_with_one_substep_per_frame_gains_energy() {
     for et in ["p1", "p2", "q1"] {
         for f in BOTH {
             let gain = energy_gain(et, f, 1.0e9, 1, 60.0);
-            eprintln!("KNOWN 3 E = 1e9 Pa, 1 substep, snh | {et} | {f} | H/|V_g| up to {gain:.2e}");
+            eprintln!("KNOWN 3 E = 1e9 Pa, 1 substep, guard off, snh | {et} | {f} | H/|V_g| up to {gain:.2e}");
             assert!(!(gain <= 1.0), "{et} {f}: E = 1e9 Pa at 1 substep no longer gains energy ({gain:.2e}): update docs/STABILITY.md");
         }
     }
@@ -454,6 +486,13 @@ fn squash_to_ten_percent_between_plates_and_back() {
     each_configuration("4 squash to 10 %, nh", &ELEMENT_TYPES, &BOTH, &["p2 energy", "p2 split", "p3 energy", "p3 split", "q2 energy", "q2 split"], |et, f| squash(et, NH, f));
 }
 
+/// Stable Neo-Hookean with Smith et al.'s `log(I_C + 1)` term (`snh-log`): no spurious minimum
+/// at `F = 0` (`hox_sim::material::stable_neo_hookean_log`), so squashed elements come back.
+#[test]
+fn stable_neo_hookean_with_the_log_term_squashed_to_ten_percent_and_back() {
+    each_configuration("4 squash to 10 %, snh-log", &ELEMENT_TYPES, &BOTH, &[], |et, f| squash(et, SNH_LOG, f));
+}
+
 /// **Known failure (case 4, squash), kept visible.** Stable Neo-Hookean without Smith et al.'s
 /// `log(I_C + 1)` term has a spurious local minimum at `F = 0` (for `F = sI`,
 /// `dψ/ds = 3μs + 3λ̂s²(s³ − α) > 0` for small `s`): elements squashed past the barrier
@@ -511,7 +550,7 @@ fn a_node_ten_thousand_times_heavier_than_its_neighbours() {
 /// `|V_g|max` (bound), and several configurations fail (listed, docs/STABILITY.md).
 #[test]
 fn elements_one_millimetre_next_to_elements_one_metre() {
-    each_configuration("5 sizes 1 mm – 1 m, snh", &ELEMENT_TYPES, &BOTH, &["p1 split", "p2 energy", "p2 split", "p3 energy", "p3 split", "q2 energy", "q2 split", "prism split"], |et, f| {
+    each_configuration("5 sizes 1 mm – 1 m, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
         let mut mesh = box_mesh(et, [2.0; 3], [2, 2, 2]);
         let map = |c: f64| if c <= 1.0 { 1e-3 * c } else { 1e-3 + (c - 1.0) };
         mesh.rest_positions.iter_mut().for_each(|p| *p = p.map(map));
@@ -530,15 +569,24 @@ fn gravity_cantilever_from(mesh: Mesh, material: Material, formulation: Formulat
 // ---------------------------------------------------------------------------------------------
 // Case 6: large steps.
 
-/// **Known failure (case 6), kept visible.** 10 frames per second with one substep
-/// (`h` = 0.1 s) on the cantilever at E = 10⁵ Pa (`h ω_max ≈ 8` for P1, 16 for P2): the energy
-/// grows by orders of magnitude (see [`known_failure_a_stiff_cantilever_with_one_substep_per_frame_gains_energy`]).
+/// Case 6: 10 frames per second with one substep asked for (`h` = 0.1 s) on the cantilever at
+/// E = 10⁵ Pa (`h ω_max` 11–46 asked): the guard's substeps keep it stable; this soft beam hangs
+/// far down (strains of order one) and swings back slowly (its first mode is ≈ 2.5 rad/s), so
+/// the release is lightly damped (5/s) and 6 s long. P3 ends inverted between its quadrature
+/// points (as in cases 1 and 4: a state the quadrature-sampled energy does not see), listed.
 #[test]
-fn known_failure_ten_frames_per_second_with_one_substep_gains_energy() {
+fn ten_frames_per_second_with_one_substep_is_stable_under_the_stability_guard() {
+    each_configuration("6 10 fps × 1 substep asked, E = 1e5 Pa, guard, snh", &ELEMENT_TYPES, &BOTH, &["p3 energy", "p3 split"], |et, f| guarded_cantilever(et, f, 1.0e5, 1, 10.0, 5.0, 6.0));
+}
+
+/// **Known failure (case 6) without the stability guard, kept visible**: the energy grows by
+/// orders of magnitude (see [`known_failure_without_the_guard_a_stiff_cantilever_with_one_substep_per_frame_gains_energy`]).
+#[test]
+fn known_failure_without_the_guard_ten_frames_per_second_with_one_substep_gains_energy() {
     for et in ["p1", "p2", "q1"] {
         for f in BOTH {
             let gain = energy_gain(et, f, 1.0e5, 1, 10.0);
-            eprintln!("KNOWN 6 10 fps × 1 substep, E = 1e5 Pa, snh | {et} | {f} | H/|V_g| up to {gain:.2e}");
+            eprintln!("KNOWN 6 10 fps × 1 substep, E = 1e5 Pa, guard off, snh | {et} | {f} | H/|V_g| up to {gain:.2e}");
             assert!(!(gain <= 1.0), "{et} {f}: 10 fps × 1 substep no longer gains energy ({gain:.2e}): update docs/STABILITY.md");
         }
     }

@@ -86,8 +86,15 @@ pub fn parse_compare(spec: &str, base: &SceneOverrides) -> Result<SceneOverrides
             "substeps" => o.substeps = Some(whole()? as u32),
             "iterations" => o.iterations = Some(whole()? as u32),
             "fps" => o.frames_per_second = Some(number("frames per second")?),
+            "guard" => {
+                o.stability_guard = Some(match value {
+                    "on" | "true" => true,
+                    "off" | "false" => false,
+                    _ => bail!("--compare '{spec}': guard needs on or off, got '{value}'"),
+                })
+            }
             _ => bail!(
-                "--compare '{spec}': unknown option '{key}' (use element, grid, split, refine, material, youngs, poisson, density, formulation, quadrature, substeps, iterations, fps)"
+                "--compare '{spec}': unknown option '{key}' (use element, grid, split, refine, material, youngs, poisson, density, formulation, quadrature, substeps, iterations, fps, guard)"
             ),
         }
     }
@@ -127,7 +134,12 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     let mut instances = Vec::new();
     for (k, o) in configurations.iter().enumerate() {
         let s = scene.with_overrides(o).with_context(|| if args.compare.is_empty() { String::new() } else { format!("--compare '{}'", args.compare[k]) })?;
-        instances.push(Instance::new(s)?);
+        let mut instance = Instance::new(s)?;
+        let stability = instance.sim.stability();
+        if stability.raised() {
+            eprintln!("note: {}", stability.summary());
+        }
+        instances.push(instance);
     }
     let seconds = args.seconds.unwrap_or(instances[0].scene.file.solver.duration_secs);
     if !(seconds.is_finite() && seconds >= 0.0) {

@@ -22,6 +22,13 @@ pub struct Config {
     pub substeps: u32,
     pub iterations: u32,
     pub frames_per_second: f64,
+    /// More substeps where the stiffest element needs them (`hox_sim::stability`).
+    #[serde(default = "guard_on")]
+    pub stability_guard: bool,
+}
+
+fn guard_on() -> bool {
+    true
 }
 
 /// How much of a running simulation a configuration change invalidates.
@@ -60,6 +67,7 @@ impl Config {
             substeps: s.substeps,
             iterations: s.iterations,
             frames_per_second: s.frames_per_second,
+            stability_guard: s.stability_guard,
         }
     }
 
@@ -85,6 +93,7 @@ impl Config {
             iterations: Some(self.iterations),
             frames_per_second: Some(self.frames_per_second),
             parallel: None,
+            stability_guard: Some(self.stability_guard),
         }
     }
 

@@ -251,7 +251,7 @@ fn material_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Material");
     let c = app.sessions[app.active].config.clone();
     let k = app.active;
-    row_ui(app, ui, "material", "Model", "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean or Neo-Hookean.", |c| c.material.clone(), |c, v| c.material = v, |ui, v| {
+    row_ui(app, ui, "material", "Model", "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean (without or with Smith et al.'s log term) or Neo-Hookean.", |c| c.material.clone(), |c, v| c.material = v, |ui, v| {
         let shown = MaterialModel::from_name(v).map_or(v.clone(), |m| m.long_name().to_string());
         combo(ui, ("model", k), v, shown, MaterialModel::ALL.iter().map(|m| (m.name().to_string(), m.long_name().to_string())).collect())
     });
@@ -277,6 +277,9 @@ fn solver_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     });
     row_ui(app, ui, "iterations", "Iterations", "Constraint sweeps per substep (the paper: 1).", |c| c.iterations, |c, v| c.iterations = v, |ui, v| {
         ui.add(egui::Slider::new(v, 1..=20).logarithmic(true))
+    });
+    row_ui(app, ui, "guard", "Stability guard", "More substeps when the stiffest element needs them (above h·ω_max = 3, down to 1); off: exactly the substeps asked for, which may blow up.", |c| c.stability_guard, |c, v| c.stability_guard = v, |ui, v| {
+        ui.checkbox(v, "raise substeps when needed")
     });
     row_ui(app, ui, "fps", "Frames per second", "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.", |c| c.frames_per_second, |c, v| c.frames_per_second = v, |ui, v| {
         ui.add(egui::Slider::new(v, 10.0..=240.0).logarithmic(true).suffix(" fps"))

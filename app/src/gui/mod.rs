@@ -34,8 +34,8 @@ use viewport::{ViewOptions, Viewport};
 pub struct Links(pub std::collections::BTreeMap<String, bool>);
 
 /// The fields a link can tie, in control order.
-pub const LINKABLE: [&str; 13] =
-    ["element", "split", "grid", "refine", "material", "youngs", "poisson", "density", "formulation", "quadrature", "substeps", "iterations", "fps"];
+pub const LINKABLE: [&str; 14] =
+    ["element", "split", "grid", "refine", "material", "youngs", "poisson", "density", "formulation", "quadrature", "substeps", "iterations", "fps", "guard"];
 
 impl Default for Links {
     fn default() -> Self {
@@ -66,6 +66,7 @@ pub fn copy_field(from: &Config, to: &mut Config, field: &str) {
         "substeps" => to.substeps = from.substeps,
         "iterations" => to.iterations = from.iterations,
         "fps" => to.frames_per_second = from.frames_per_second,
+        "guard" => to.stability_guard = from.stability_guard,
         _ => {}
     }
 }
@@ -578,7 +579,19 @@ impl HoxApp {
                 if let Some(e) = s.probe_error_m() {
                     text += &format!(", probe error {} m", crate::recording::format_metres(e));
                 }
-                ui.label(egui::RichText::new(text).monospace());
+                let raised = sim.substeps_per_frame() > s.config.substeps;
+                if raised {
+                    text += &format!(", {} substeps (guard)", sim.substeps_per_frame());
+                }
+                let label = ui.label(egui::RichText::new(text).monospace());
+                if raised {
+                    label.on_hover_text(format!(
+                        "The stability guard takes {} substeps per frame instead of {}: the stiffest element's fastest mode needs h·ω_max ≤ {} (docs/STABILITY.md). Switch it off under Solver to see the instability.",
+                        sim.substeps_per_frame(),
+                        s.config.substeps,
+                        hox_sim::stability::GUARD_H_OMEGA
+                    ));
+                }
                 if let Some(f) = &s.failure {
                     ui.colored_label(egui::Color32::from_rgb(255, 90, 80), f);
                 }

@@ -1,12 +1,13 @@
 //! Hyperelastic material models for the finite-element / XPBD solvers.
 //!
 //! Implements the constitutive laws used by Saillant et al., *High-Order
-//! Elements in Position Based Dynamics*, plus two Neo-Hookean variants:
+//! Elements in Position Based Dynamics*, plus three Neo-Hookean variants:
 //!
 //! | [`MaterialModel`] | short name | energy density ψ(F) | module |
 //! | --- | --- | --- | --- |
 //! | [`MaterialModel::StVenantKirchhoff`] | `stvk` | μ E:E + λ/2 (tr E)², E = ½(FᵀF − I) | [`stvk`] |
 //! | [`MaterialModel::StableNeoHookean`] | `snh` | μ/2 (I_C − 3) + λ̂/2 (J − α)² − μ²/(2λ̂) | [`stable_neo_hookean`] |
+//! | [`MaterialModel::StableNeoHookeanLog`] | `snh-log` | μ̂/2 (I_C − 3) + λ̂/2 (J − α)² − μ̂/2 log(I_C + 1) + c | [`stable_neo_hookean_log`] |
 //! | [`MaterialModel::NeoHookean`] | `nh` | μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)² | [`neo_hookean`] |
 //!
 //! Conventions shared by every model:
@@ -36,6 +37,7 @@ mod testing;
 
 pub mod neo_hookean;
 pub mod stable_neo_hookean;
+pub mod stable_neo_hookean_log;
 pub mod stvk;
 
 pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
@@ -50,25 +52,31 @@ pub type Mat9 = SMatrix<f64, 9, 9>;
 pub enum MaterialModel {
     /// Saint-Venant–Kirchhoff (the model used in Saillant et al.). See [`stvk`].
     StVenantKirchhoff,
-    /// Stable Neo-Hookean (Smith, de Goes & Kim 2018). See [`stable_neo_hookean`].
+    /// Stable Neo-Hookean (Smith, de Goes & Kim 2018) without the log(I_C + 1)
+    /// term, as in Macklin & Müller 2021. See [`stable_neo_hookean`].
     StableNeoHookean,
+    /// Stable Neo-Hookean with Smith et al.'s log(I_C + 1) term (no collapse
+    /// minimum at F = 0). See [`stable_neo_hookean_log`].
+    StableNeoHookeanLog,
     /// Classic compressible Neo-Hookean with a ln J floor. See [`neo_hookean`].
     NeoHookean,
 }
 
 impl MaterialModel {
     /// Every model, in declaration order.
-    pub const ALL: [MaterialModel; 3] = [
+    pub const ALL: [MaterialModel; 4] = [
         MaterialModel::StVenantKirchhoff,
         MaterialModel::StableNeoHookean,
+        MaterialModel::StableNeoHookeanLog,
         MaterialModel::NeoHookean,
     ];
 
-    /// Short, stable identifier: `"stvk"`, `"snh"` or `"nh"`.
+    /// Short, stable identifier: `"stvk"`, `"snh"`, `"snh-log"` or `"nh"`.
     pub fn name(self) -> &'static str {
         match self {
             MaterialModel::StVenantKirchhoff => "stvk",
             MaterialModel::StableNeoHookean => "snh",
+            MaterialModel::StableNeoHookeanLog => "snh-log",
             MaterialModel::NeoHookean => "nh",
         }
     }
@@ -78,11 +86,12 @@ impl MaterialModel {
         match self {
             MaterialModel::StVenantKirchhoff => "Saint-Venant–Kirchhoff",
             MaterialModel::StableNeoHookean => "stable Neo-Hookean",
+            MaterialModel::StableNeoHookeanLog => "stable Neo-Hookean with log term",
             MaterialModel::NeoHookean => "compressible Neo-Hookean",
         }
     }
 
-    /// Parses a short name (`stvk`, `snh`, `nh`), ignoring ASCII case and
+    /// Parses a short name (`stvk`, `snh`, `snh-log`, `nh`), ignoring ASCII case and
     /// surrounding whitespace. The long names are accepted as well.
     pub fn from_name(s: &str) -> Option<Self> {
         let s = s.trim();
@@ -205,7 +214,8 @@ impl Material {
             return Err(MaterialError::Density { density_kg_m3 });
         }
         let lame = Lame::from_youngs_poisson(youngs_modulus_pa, poisson_ratio);
-        // λ + μ = E / (2(1+ν)(1−2ν)) is what stable Neo-Hookean divides by.
+        // λ + μ = E / (2(1+ν)(1−2ν)) is what stable Neo-Hookean divides by
+        // (with the log term, λ + 5μ/6, > 0 for ν > −1 and finite when λ + μ is).
         if !(lame.mu_pa.is_finite()
             && lame.lambda_pa.is_finite()
             && (lame.mu_pa + lame.lambda_pa).is_finite())
@@ -237,6 +247,7 @@ impl Material {
         match self.model {
             MaterialModel::StVenantKirchhoff => stvk::energy_density(l, f),
             MaterialModel::StableNeoHookean => stable_neo_hookean::energy_density(l, f),
+            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::energy_density(l, f),
             MaterialModel::NeoHookean => neo_hookean::energy_density(l, f),
         }
     }
@@ -252,6 +263,9 @@ impl Material {
         match self.model {
             MaterialModel::StVenantKirchhoff => stvk::energy_density_and_pk1(l, f),
             MaterialModel::StableNeoHookean => stable_neo_hookean::energy_density_and_pk1(l, f),
+            MaterialModel::StableNeoHookeanLog => {
+                stable_neo_hookean_log::energy_density_and_pk1(l, f)
+            }
             MaterialModel::NeoHookean => neo_hookean::energy_density_and_pk1(l, f),
         }
     }
@@ -264,6 +278,7 @@ impl Material {
         match self.model {
             MaterialModel::StVenantKirchhoff => stvk::dpdf(l, f),
             MaterialModel::StableNeoHookean => stable_neo_hookean::dpdf(l, f),
+            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::dpdf(l, f),
             MaterialModel::NeoHookean => neo_hookean::dpdf(l, f),
         }
     }
@@ -283,6 +298,7 @@ impl Material {
         match self.model {
             MaterialModel::StVenantKirchhoff => stvk::split_terms(f),
             MaterialModel::StableNeoHookean => stable_neo_hookean::split_terms(l, f),
+            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::split_terms(l, f),
             MaterialModel::NeoHookean => neo_hookean::split_terms(f),
         }
     }
@@ -292,23 +308,27 @@ impl Material {
     /// XPBD compliance is 1/(k_t · V_q).
     ///
     /// The hydrostatic stiffness of `stvk` and `nh` is λ, which is negative
-    /// for ν < 0 (and 0 for ν = 0); `snh` uses λ̂ = λ + μ > 0.
+    /// for ν < 0 (and 0 for ν = 0); `snh` uses λ̂ = λ + μ > 0; `snh-log` uses
+    /// [μ̂, λ̂] = [4μ/3, λ + 5μ/6], both > 0.
     pub fn split_stiffness_pa(&self) -> [f64; 2] {
         let l = self.lame();
         match self.model {
             MaterialModel::StVenantKirchhoff => stvk::split_stiffness_pa(l),
             MaterialModel::StableNeoHookean => stable_neo_hookean::split_stiffness_pa(l),
+            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::split_stiffness_pa(l),
             MaterialModel::NeoHookean => neo_hookean::split_stiffness_pa(l),
         }
     }
 
     /// The constant c (J/m³) with ψ(F) = Σ_t k_t/2 · C_t(F)² + c:
-    /// 0 for `stvk` and `nh`, −3μ/2 − μ²/(2λ̂) for `snh`.
+    /// 0 for `stvk` and `nh`, −3μ/2 − μ²/(2λ̂) for `snh`,
+    /// μ̂ (log 2 − 3/2) − 9μ̂²/(32λ̂) for `snh-log`.
     pub fn split_energy_offset(&self) -> f64 {
         let l = self.lame();
         match self.model {
             MaterialModel::StVenantKirchhoff => stvk::split_energy_offset(l),
             MaterialModel::StableNeoHookean => stable_neo_hookean::split_energy_offset(l),
+            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::split_energy_offset(l),
             MaterialModel::NeoHookean => neo_hookean::split_energy_offset(l),
         }
     }
@@ -410,7 +430,15 @@ mod tests {
         }
         assert_eq!(
             MaterialModel::ALL.map(MaterialModel::name),
-            ["stvk", "snh", "nh"]
+            ["stvk", "snh", "snh-log", "nh"]
+        );
+        assert_eq!(
+            MaterialModel::from_name(" SNH-Log "),
+            Some(MaterialModel::StableNeoHookeanLog)
+        );
+        assert_eq!(
+            MaterialModel::from_name("stable Neo-Hookean with log term"),
+            Some(MaterialModel::StableNeoHookeanLog)
         );
         assert_eq!(
             MaterialModel::from_name(" StVK "),

@@ -126,7 +126,7 @@ pub(super) fn split_energy_offset(_l: Lame) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::super::testing;
-    use super::super::{Mat3, Mat9, Material, MaterialModel};
+    use super::super::{Mat3, Material, MaterialModel};
     use super::NEO_HOOKEAN_J_FLOOR;
     use nalgebra::Vector3;
     use proptest::prelude::*;
@@ -160,20 +160,6 @@ mod tests {
         );
     }
 
-    fn all_finite(m: &Material, f: &Mat3) -> bool {
-        let (psi, p) = m.energy_density_and_pk1(f);
-        let finite9 = |h: Mat9| h.iter().all(|x| x.is_finite());
-        psi.is_finite()
-            && p.iter().all(|x| x.is_finite())
-            && finite9(m.dpdf(f))
-            && finite9(m.dpdf_projected(f))
-            && m.split_terms(f).iter().all(|t| {
-                t.value.is_finite()
-                    && t.scale.is_finite()
-                    && t.grad_f_scaled.iter().all(|x| x.is_finite())
-            })
-    }
-
     #[test]
     fn finite_for_inverted_and_flat_elements() {
         for nu in [-0.3, 0.0, 0.3, 0.49] {
@@ -184,7 +170,7 @@ mod tests {
                 Mat3::from_diagonal(&Vector3::new(-2.0, -3.0, -4.0)),
                 Mat3::zeros(),
             ] {
-                assert!(all_finite(&m, &f), "ν = {nu}, F = {f}");
+                assert!(testing::all_finite(&m, &f), "ν = {nu}, F = {f}");
             }
             // Inverted energy is a steep penalty far above the rest energy.
             let e_inv = m.energy_density(&Mat3::from_diagonal(&Vector3::new(-1.0, 1.0, 1.0)));
@@ -196,7 +182,7 @@ mod tests {
         testing::run(
             (testing::material(MODEL), testing::general_matrix(2.0)),
             |(m, f)| {
-                prop_assert!(all_finite(&m, &f));
+                prop_assert!(testing::all_finite(&m, &f));
                 Ok(())
             },
         );

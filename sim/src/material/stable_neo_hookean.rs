@@ -130,21 +130,7 @@ mod tests {
         testing::run(
             (testing::material(MODEL), testing::general_matrix(1.5)),
             |(m, f)| {
-                let mu = m.lame().mu_pa;
-                let (psi, p) = m.energy_density_and_pk1(&f);
-                prop_assert!(psi.is_finite());
-                let fd = testing::fd_gradient(&f, |g| m.energy_density(g));
-                prop_assert!((p - fd).norm() <= 1e-6 * (p.norm() + mu));
-                let h = m.dpdf(&f);
-                let fd = testing::fd_jacobian(&f, |g| m.pk1(g));
-                prop_assert!((h - fd).norm() <= 1e-6 * (h.norm() + mu));
-                let k = m.split_stiffness_pa();
-                let t = m.split_terms(&f);
-                let split = 0.5 * k[0] * t[0].value.powi(2)
-                    + 0.5 * k[1] * t[1].value.powi(2)
-                    + m.split_energy_offset();
-                prop_assert!((split - psi).abs() <= 1e-9 * (psi.abs() + mu));
-                Ok(())
+                testing::check_derivatives_and_split_at(&m, &f)
             },
         );
         let m = Material::new(MODEL, 1.0e6, 0.45, 1000.0).expect("valid");

@@ -394,3 +394,32 @@ pub fn check_energy_nonnegative(model: MaterialModel, nu_min: f64) {
         },
     );
 }
+
+/// At any `f` (inverted and degenerate ones included): P against finite differences of ψ,
+/// dP/dF against finite differences of P, and the split terms summing to ψ.
+pub fn check_derivatives_and_split_at(m: &Material, f: &Mat3) -> Result<(), TestCaseError> {
+    let mu = m.lame().mu_pa;
+    let (psi, p) = m.energy_density_and_pk1(f);
+    prop_assert!(psi.is_finite());
+    let fd = fd_gradient(f, |g| m.energy_density(g));
+    prop_assert!((p - fd).norm() <= 1e-6 * (p.norm() + mu), "{p} vs {fd}");
+    let h = m.dpdf(f);
+    let fd = fd_jacobian(f, |g| m.pk1(g));
+    prop_assert!((h - fd).norm() <= 1e-6 * (h.norm() + mu));
+    let k = m.split_stiffness_pa();
+    let t = m.split_terms(f);
+    let split = 0.5 * k[0] * t[0].value.powi(2) + 0.5 * k[1] * t[1].value.powi(2) + m.split_energy_offset();
+    prop_assert!((split - psi).abs() <= 1e-9 * (psi.abs() + mu));
+    Ok(())
+}
+
+/// ψ, P, dP/dF (plain and projected) and the split terms are all finite at `f`.
+pub fn all_finite(m: &Material, f: &Mat3) -> bool {
+    let (psi, p) = m.energy_density_and_pk1(f);
+    let finite9 = |h: Mat9| h.iter().all(|x| x.is_finite());
+    psi.is_finite()
+        && p.iter().all(|x| x.is_finite())
+        && finite9(m.dpdf(f))
+        && finite9(m.dpdf_projected(f))
+        && m.split_terms(f).iter().all(|t| t.value.is_finite() && t.scale.is_finite() && t.grad_f_scaled.iter().all(|x| x.is_finite()))
+}

@@ -57,7 +57,7 @@ fn frequency_range(mesh: &Mesh, material: &Material, clamped: &[u32], x: &[Vec3]
 /// Runs XPBD (one iteration per substep, as the paper) with velocity damping until it has
 /// settled, and returns the largest node distance to `reference`.
 fn settled_xpbd_error(mesh: &Mesh, material: &Material, formulation: Formulation, clamped: &[u32], dt_secs: f64, damping_per_sec: f64, settle_secs: f64, reference: &[Vec3]) -> f64 {
-    let settings = SolverSettings { substeps: 1, iterations: 1, frames_per_second: 1.0 / dt_secs, formulation, quadrature_degree: None, parallel: false };
+    let settings = SolverSettings { substeps: 1, iterations: 1, frames_per_second: 1.0 / dt_secs, formulation, quadrature_degree: None, parallel: false, stability_guard: false };
     let effects: Vec<Box<dyn Effect>> = vec![
         Box::new(Gravity::new(G)),
         Box::new(Clamp { nodes: clamped.to_vec() }),
@@ -309,4 +309,38 @@ fn p1_simd_batches_follow_the_scalar_colour_sweep_on_a_sagging_beam() {
     let scale = scalar.displacements().iter().map(|d| d.norm()).fold(0.0, f64::max);
     let gap = scalar.positions.iter().zip(&batched.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
     assert!(scale > 1e-6 && gap <= 1e-12 * scale, "{gap:e} against {scale:e}");
+}
+
+/// The stability guard follows every change that moves ω_max: E and ρ rescale it, ν and a
+/// node's mass recompute it, the settings decide whether it applies; and the substep it takes
+/// is the one the solver steps with.
+#[test]
+fn the_stability_guard_follows_material_mass_and_settings_changes() {
+    let mesh = cantilever(ElementType::from_name("p1").unwrap());
+    let soft = Material::new(MaterialModel::StableNeoHookean, 1.0e5, 0.3, 1000.0).unwrap();
+    let settings = SolverSettings { substeps: 1, ..SolverSettings::default() };
+    let mut sim = Simulation::new(mesh, soft, settings, Vec::new()).unwrap();
+    let r = sim.stability();
+    assert!(!r.raised() && r.requested_h_omega < crate::stability::GUARD_TRIGGER_H_OMEGA, "{}", r.summary());
+    assert_eq!(sim.substeps_per_frame(), 1);
+    // 10⁴ × stiffer: ω × 100, above the trigger
+    sim.set_material(Material::new(MaterialModel::StableNeoHookean, 1.0e9, 0.3, 1000.0).unwrap()).unwrap();
+    let stiff = sim.stability();
+    assert!((stiff.omega_max_rad_s / r.omega_max_rad_s - 100.0).abs() < 1e-9 * 100.0);
+    assert!(stiff.raised() && sim.substeps_per_frame() == stiff.substeps);
+    assert!(sim.substep_dt_secs() * stiff.omega_max_rad_s <= crate::stability::GUARD_H_OMEGA * (1.0 + 1e-12));
+    // a denser material lowers it again (ω ∝ √(E/ρ)), exactly as a recomputation would
+    sim.set_material(Material::new(MaterialModel::StableNeoHookean, 1.0e9, 0.3, 1.0e7).unwrap()).unwrap();
+    let dense = sim.stability().omega_max_rad_s;
+    assert!((dense / r.omega_max_rad_s - 1.0).abs() < 1e-9, "{dense} vs {}", r.omega_max_rad_s);
+    // a light node raises it (recomputed)
+    sim.set_mass_kg(0, sim.masses_kg()[0] * 1e-4).unwrap();
+    assert!(sim.stability().omega_max_rad_s > 10.0 * dense);
+    // switched off: the substeps asked for, even where they are unstable
+    sim.set_material(Material::new(MaterialModel::StableNeoHookean, 1.0e9, 0.3, 1000.0).unwrap()).unwrap();
+    assert!(sim.substeps_per_frame() > 1);
+    sim.set_settings(SolverSettings { stability_guard: false, ..settings }).unwrap();
+    assert_eq!(sim.substeps_per_frame(), 1);
+    sim.step_frame().unwrap();
+    assert_eq!(sim.counters().substeps, 1);
 }
