@@ -222,7 +222,7 @@ pub fn study_one(scene_name: &str, config: &StudyConfig, progress: &mut dyn FnMu
     let all_threads = run(&mut parallel, RunMode::Seconds(1.0), &mut |_, _| {})?.ms_per_frame;
 
     // 3. substeps for a solver error under 1 % (bias ∝ 1/substeps²), warm-started
-    let (mut substeps, mut ms_1pct, mut error_1pct_m) = (scene.settings.substeps, report.ms_per_frame, probe_distance(&xpbd_probes, &reference));
+    let (mut substeps, mut ms_1pct, mut error_1pct_m) = (instance.sim.substeps_per_frame(), report.ms_per_frame, probe_distance(&xpbd_probes, &reference));
     let mut rel = solver_rel;
     let mut positions = instance.sim.positions.clone();
     let mut time = instance.sim.time_secs();

@@ -57,7 +57,7 @@ pub const OMEGA2_SAFETY: f64 = 1.05;
 /// The largest rest frequency² of an element, `λ_max(W^½ K_e W^½)` in rad²/s²: `rest` its
 /// gathered rest positions, `w` its nodes' inverse masses (0: pinned), `grads`/`volumes` its
 /// quadrature data. Power iteration (40 steps) times [`OMEGA2_SAFETY`]; 0 when every node is
-/// pinned.
+/// pinned, infinite when the iteration overflows.
 pub fn element_omega2(rest: &[Vec3], w: &[f64], grads: &[Vec3], volumes: &[f64], material: &Material) -> f64 {
     let n = rest.len();
     if w.iter().all(|&wi| wi == 0.0) {
@@ -71,8 +71,12 @@ pub fn element_omega2(rest: &[Vec3], w: &[f64], grads: &[Vec3], volumes: &[f64],
     let mut estimate = 0.0;
     for _ in 0..40 {
         let norm = y.norm();
-        if norm == 0.0 || !norm.is_finite() {
+        if norm == 0.0 {
             return 0.0;
+        }
+        if !norm.is_finite() {
+            // too stiff or too light to represent: the guard's cap (and its report) apply
+            return f64::INFINITY;
         }
         y /= norm;
         let ay = &a * &y;

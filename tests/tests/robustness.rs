@@ -547,8 +547,10 @@ fn a_node_ten_thousand_times_heavier_than_its_neighbours() {
 /// (`[0, 1] → [0, 1 mm]`, `[1, 2] → [1 mm, 1.001 m]`), so cells range from 1 mm³ to 1 m³ with
 /// 1000:1 slabs between; clamped at x = 0, gravity for 1 s, released. Node masses span nine
 /// orders of magnitude and the 1 mm elements have `h ω ≈ 3`: the energy may overshoot up to
-/// `|V_g|max` (bound), and several configurations fail (listed, docs/STABILITY.md).
+/// `|V_g|max` (bound). The 1 mm elements set `h ω_max` above the stability guard's trigger, and with
+/// its substeps every configuration passes (before the guard, eight failed: docs/STABILITY.md).
 #[test]
+#[ignore = "release: CI runs it with --release --ignored (the guard takes 309–3,911 substeps per frame; about 6 minutes)"]
 fn elements_one_millimetre_next_to_elements_one_metre() {
     each_configuration("5 sizes 1 mm – 1 m, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
         let mut mesh = box_mesh(et, [2.0; 3], [2, 2, 2]);

@@ -29,7 +29,7 @@ pub struct RecordArgs {
     /// Each value lists option=value pairs applied on top of the other options, e.g.
     /// `--compare element=p1,refine=1 --compare element=p2`. Options: element, grid, split,
     /// refine, material, youngs, poisson, density, formulation, quadrature, substeps,
-    /// iterations, fps.
+    /// iterations, fps, guard (on/off: the stability guard).
     #[arg(long, value_name = "OPTION=VALUE,...")]
     pub compare: Vec<String>,
     /// Pieces per edge when tessellating curved (high-order) and quadrilateral faces.

@@ -278,7 +278,7 @@ fn solver_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     row_ui(app, ui, "iterations", "Iterations", "Constraint sweeps per substep (the paper: 1).", |c| c.iterations, |c, v| c.iterations = v, |ui, v| {
         ui.add(egui::Slider::new(v, 1..=20).logarithmic(true))
     });
-    row_ui(app, ui, "guard", "Stability guard", "More substeps when the stiffest element needs them (above h·ω_max = 3, down to 1); off: exactly the substeps asked for, which may blow up.", |c| c.stability_guard, |c, v| c.stability_guard = v, |ui, v| {
+    row_ui(app, ui, "guard", "Stability guard", "More substeps when the stiffest element needs them (when h·ω_max would exceed 3, enough for h·ω_max ≤ 1; just below 3 your substeps are kept); off: exactly the substeps asked for, which may blow up.", |c| c.stability_guard, |c, v| c.stability_guard = v, |ui, v| {
         ui.checkbox(v, "raise substeps when needed")
     });
     row_ui(app, ui, "fps", "Frames per second", "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.", |c| c.frames_per_second, |c, v| c.frames_per_second = v, |ui, v| {

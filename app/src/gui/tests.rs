@@ -181,3 +181,41 @@ fn a_node_can_be_dragged_in_the_cpu_drawn_view() {
 fn a_node_can_be_dragged_in_the_opengl_view() {
     drag_the_tip(true);
 }
+
+/// A teacher pushes E to 10⁹ Pa and the substeps to 1: the stability guard takes the substeps
+/// the stiffest element needs and the status line says so; unticking it gives exactly what was
+/// asked for (docs/STABILITY.md).
+#[test]
+fn a_stiff_material_at_one_substep_runs_under_the_stability_guard_shown_in_the_status_line() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    assert!(!status(&h).contains("(guard)"), "{}", status(&h));
+    let app = h.state_mut();
+    let mut c = app.sessions[0].config.clone();
+    c.substeps = 1;
+    app.apply("substeps", c);
+    h.run_steps(1);
+    let field = h.get_by_label("Young's modulus E (Pa)");
+    field.focus();
+    h.run_steps(1);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.get_by_label("Young's modulus E (Pa)").type_text("1e9");
+    h.run_steps(1);
+    h.key_press(egui::Key::Enter);
+    h.run_steps(3);
+    let sim = &h.state().sessions[0].instance.sim;
+    assert_eq!(sim.material().youngs_modulus_pa, 1e9);
+    let taken = sim.substeps_per_frame();
+    assert!(taken > 100, "{taken}");
+    let s = status(&h);
+    assert!(s.contains(&format!("{taken} substeps (guard)")), "{s}");
+    // the checkbox of the Solver section (below the visible part of the panel at this size)
+    let app = h.state_mut();
+    let mut c = app.sessions[0].config.clone();
+    c.stability_guard = false;
+    app.apply("guard", c);
+    h.run_steps(3);
+    assert!(!h.state().sessions[0].config.stability_guard);
+    assert_eq!(h.state().sessions[0].instance.sim.substeps_per_frame(), 1);
+    assert!(!status(&h).contains("(guard)"), "{}", status(&h));
+}
