@@ -185,6 +185,16 @@ pub struct PhysicsArgs {
     pub no_stability_guard: bool,
 }
 
+/// The stability guard's findings for a built scene; a note on stderr when it raised the
+/// substeps (docs/STABILITY.md).
+pub fn note_stability(instance: &mut Instance) -> hox_sim::stability::StabilityReport {
+    let stability = instance.sim.stability();
+    if stability.raised() {
+        eprintln!("note: {}", stability.summary());
+    }
+    stability
+}
+
 fn parse_grid(s: &str) -> Result<[usize; 3], String> {
     let parts: Vec<&str> = s.split(['x', 'X']).collect();
     let bad = || format!("grid '{s}' must look like NXxNYxNZ with positive whole numbers, e.g. 16x4x4");
@@ -319,10 +329,7 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
         RunMode::Seconds(t)
     };
     let mut instance = Instance::new(scene)?;
-    let stability = instance.sim.stability();
-    if stability.raised() {
-        eprintln!("note: {}", stability.summary());
-    }
+    let stability = note_stability(&mut instance);
     let mut vtk_writer = gmsh::VtkWriter::create(vtk, &instance)?;
     let mut bar = DelayedBar::new();
     let mut on_frame = |i: &Instance| vtk_writer.as_mut().map_or(Ok(()), |w| w.frame(i));

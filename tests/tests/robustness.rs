@@ -262,7 +262,7 @@ fn load_and_release_within(mut s: Simulation, load_secs: f64, damping_per_sec: f
     Ok(format!(
         "{} substeps (h·ω_max {:.2}), max sag {:.3e} m, max H {:.2e} J ({:+.1e} of |V_g| {:.2e} J), min det F loaded {:.3}; {}",
         s.substeps_per_frame(),
-        s.stability().requested_h_omega * s.settings().substeps as f64 / s.substeps_per_frame() as f64,
+        s.stability().omega_max_rad_s * s.substep_dt_secs(),
         loaded.max_displacement_m,
         loaded.max_total_j,
         loaded.max_total_j / scale,

@@ -135,10 +135,7 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     for (k, o) in configurations.iter().enumerate() {
         let s = scene.with_overrides(o).with_context(|| if args.compare.is_empty() { String::new() } else { format!("--compare '{}'", args.compare[k]) })?;
         let mut instance = Instance::new(s)?;
-        let stability = instance.sim.stability();
-        if stability.raised() {
-            eprintln!("note: {}", stability.summary());
-        }
+        super::note_stability(&mut instance);
         instances.push(instance);
     }
     let seconds = args.seconds.unwrap_or(instances[0].scene.file.solver.duration_secs);

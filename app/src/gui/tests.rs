@@ -20,6 +20,17 @@ fn status(h: &Harness<'_, HoxApp>) -> String {
     text(h, "nodes,")
 }
 
+/// Replaces the text of the number field labelled `label` with `value` and presses Enter.
+fn type_into(h: &mut Harness<'_, HoxApp>, label: &str, value: &str) {
+    h.get_by_label(label).focus();
+    h.run_steps(1);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.get_by_label(label).type_text(value);
+    h.run_steps(1);
+    h.key_press(egui::Key::Enter);
+    h.run_steps(3);
+}
+
 #[test]
 fn app_starts_on_bending_with_its_p2_beam() {
     let mut h = harness(AppArgs::default());
@@ -68,14 +79,7 @@ fn play_advances_time_and_space_pauses() {
 fn a_bad_value_is_refused_with_the_reason_and_changes_nothing() {
     let mut h = harness(AppArgs::default());
     h.run_steps(2);
-    let field = h.get_by_label("Poisson ratio ν");
-    field.focus();
-    h.run_steps(1);
-    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
-    h.get_by_label("Poisson ratio ν").type_text("0.5");
-    h.run_steps(1);
-    h.key_press(egui::Key::Enter);
-    h.run_steps(3);
+    type_into(&mut h, "Poisson ratio ν", "0.5");
     let refusal = text(&h, "refused:");
     assert!(refusal.to_lowercase().contains("poisson"), "{refusal}");
     assert_eq!(h.state().sessions[0].config.poisson_ratio, 0.35);
@@ -195,14 +199,7 @@ fn a_stiff_material_at_one_substep_runs_under_the_stability_guard_shown_in_the_s
     c.substeps = 1;
     app.apply("substeps", c);
     h.run_steps(1);
-    let field = h.get_by_label("Young's modulus E (Pa)");
-    field.focus();
-    h.run_steps(1);
-    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
-    h.get_by_label("Young's modulus E (Pa)").type_text("1e9");
-    h.run_steps(1);
-    h.key_press(egui::Key::Enter);
-    h.run_steps(3);
+    type_into(&mut h, "Young's modulus E (Pa)", "1e9");
     let sim = &h.state().sessions[0].instance.sim;
     assert_eq!(sim.material().youngs_modulus_pa, 1e9);
     let taken = sim.substeps_per_frame();

@@ -8,14 +8,12 @@ use nalgebra::DMatrix;
 const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 
 fn cantilever(et: ElementType) -> Mesh {
-    BoxMeshSpec {
-        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 0.25, 0.25), cells: [2, 1, 1] },
-        element_type: et,
-        split: TetSplit::Five,
-        refine: 0,
-    }
-    .build()
-    .unwrap()
+    beam(et, [2, 1, 1])
+}
+
+/// The beam `[0, 1] × [0, 0.25]²` with `cells`, five tetrahedra per cell for P1–P3.
+fn beam(et: ElementType, cells: [usize; 3]) -> Mesh {
+    BoxMeshSpec { grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 0.25, 0.25), cells }, element_type: et, split: TetSplit::Five, refine: 0 }.build().unwrap()
 }
 
 fn clamped_at_x0(mesh: &Mesh) -> Vec<u32> {
@@ -252,15 +250,7 @@ fn serial_and_parallel_sweeps_agree_and_settle_on_the_same_static_answer() {
 /// register) and the two-slab sweep against the serial one.
 #[test]
 fn serial_colour_and_slab_sweeps_agree_and_settle_on_a_p1_beam() {
-    let mesh = BoxMeshSpec {
-        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 0.25, 0.25), cells: [8, 2, 2] },
-        element_type: ElementType::from_name("p1").unwrap(),
-        split: TetSplit::Five,
-        refine: 0,
-    }
-    .build()
-    .unwrap();
-    sweeps_agree_and_settle(mesh, &[(1, usize::MAX), (2, 0)]);
+    sweeps_agree_and_settle(beam(ElementType::from_name("p1").unwrap(), [8, 2, 2]), &[(1, usize::MAX), (2, 0)]);
 }
 
 /// The slab sweep is deterministic for a given thread count, uses its slabs, and keeps every
