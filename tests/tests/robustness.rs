@@ -210,17 +210,18 @@ fn stvk_corner_pushed_through_its_element_stays_bounded() {
     });
 }
 
-/// Compressible Neo-Hookean below its `J` floor (`ln J` continued linearly from `J = 10⁻⁶`):
-/// an inverted element carries an enormous, steep penalty (`U(0) ≈ 2·10¹⁴ J` here), and the
-/// first projections overshoot into neighbours: the energy may spike to `10⁴ × U(0)` before it
-/// falls. Bounded by that; recovery reported, not required: use stable Neo-Hookean.
+/// Compressible Neo-Hookean below its `J` floor (`ln J` continued linearly from `J = 0.2`,
+/// `hox_sim::material::NEO_HOOKEAN_J_FLOOR`): an inverted element carries a quadratic penalty,
+/// which pushes it back. No external work: `H ≤ H(0)` (+ 10⁻⁶) at every frame. Recovery is
+/// reported, not required (curved P2/P3 elements can stay folded between their quadrature
+/// points): use stable Neo-Hookean when elements may invert.
 #[test]
 #[ignore = "release: CI runs it with --release --ignored"]
 fn neo_hookean_inverted_starts_stay_bounded() {
-    each_configuration("1 inverted, nh", &ELEMENT_TYPES, &BOTH, &["p3 energy"], |et, f| {
+    each_configuration("1 inverted, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
         let mut out = Vec::new();
         for (what, s) in [("mirrored", mirrored_cantilever(et, NH, f, 10.0)), ("corner", corner_pushed_through(et, NH, f))] {
-            let (s, start, end, trace) = run_inverted(s, 3.0, 1e4)?;
+            let (s, start, end, trace) = run_inverted(s, 3.0, 1.0 + 1e-6)?;
             let spike = trace.max_total_j / start.total_j();
             out.push(match recovered(&s, &end, false) {
                 Ok(r) => format!("{what}: peak H/H(0) {spike:.2e}, recovers, {r}"),
@@ -479,11 +480,11 @@ fn squash(et: &str, model: MaterialModel, f: Formulation) -> Result<String, Stri
         Ok(format!("height {height:.4} m, max U {:.3e} J, min det F squashed {:.3}; {}", squashed.max_elastic_j, squashed.min_det_f, recovered(&s, &after, true)?))
 }
 
-/// Compressible Neo-Hookean's `ln J` term is a barrier against collapse: squashed to 10 % and
-/// back.
+/// Compressible Neo-Hookean's `ln J` term resists collapse (continued below its `J` floor of
+/// 0.2 by a quadratic penalty that every element type survives): squashed to 10 % and back.
 #[test]
 fn squash_to_ten_percent_between_plates_and_back() {
-    each_configuration("4 squash to 10 %, nh", &ELEMENT_TYPES, &BOTH, &["p2 energy", "p2 split", "p3 energy", "p3 split", "q2 energy", "q2 split"], |et, f| squash(et, NH, f));
+    each_configuration("4 squash to 10 %, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| squash(et, NH, f));
 }
 
 /// Stable Neo-Hookean with Smith et al.'s `log(I_C + 1)` term (`snh-log`): no spurious minimum
