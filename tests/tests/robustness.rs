@@ -382,9 +382,22 @@ fn the_one_substep_cantilever_is_stable_below_the_stability_limit() {
 }
 
 /// E = 10³ Pa (a jelly): a 0.1 m cantilever hangs down under its own weight (strains of order
-/// one), then springs back (damping 5/s, 6 s).
+/// one: `ρ g L / E ≈ 1`, and P1 elements invert, `det F` down to −0.56), then springs back
+/// (damping 5/s, 6 s). Stable Neo-Hookean with Smith et al.'s log term (`snh-log`): the paper's
+/// form is [`known_failure_a_very_soft_p1_cantilever_with_the_papers_stable_neo_hookean_stays_hanging`].
 #[test]
 fn a_very_soft_cantilever_hangs_and_springs_back() {
+    each_configuration("3 E = 1e3 Pa, snh-log", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        load_and_release(gravity_cantilever(et, 0.1, 4, material(SNH_LOG, 1.0e3, 0.3), f, 50, 60.0), 2.0, 5.0, 6.0)
+    });
+}
+
+/// **Known failure (case 3, E = 10³ Pa), kept visible.** With the paper's stable Neo-Hookean (no
+/// `log(I_C + 1)` term), every type but P1 springs back; the P1 jelly, whose elements invert
+/// under its own weight, settles in a non-rest equilibrium about its own length away (min
+/// `det F` ≈ 0.63, not inverted) — the model's energy is not convex there; `snh-log` returns.
+#[test]
+fn known_failure_a_very_soft_p1_cantilever_with_the_papers_stable_neo_hookean_stays_hanging() {
     each_configuration("3 E = 1e3 Pa, snh", &ELEMENT_TYPES, &BOTH, &["p1 energy", "p1 split"], |et, f| {
         load_and_release(gravity_cantilever(et, 0.1, 4, material(SNH, 1.0e3, 0.3), f, 50, 60.0), 2.0, 5.0, 6.0)
     });
