@@ -413,6 +413,17 @@ pub fn check_derivatives_and_split_at(m: &Material, f: &Mat3) -> Result<(), Test
     Ok(())
 }
 
+/// `m`'s energy density and first Piola–Kirchhoff stress at `f` equal `psi` and `p` (a model's
+/// textbook formulas), to `1e-9` of the Lamé scale `μ + |λ|`.
+pub fn check_against_formulas(m: &Material, f: &Mat3, psi: f64, p: Mat3) -> Result<(), TestCaseError> {
+    let (psi_got, p_got) = m.energy_density_and_pk1(f);
+    let l = m.lame();
+    let scale = l.mu_pa + l.lambda_pa.abs();
+    prop_assert!((psi - psi_got).abs() <= 1e-9 * scale, "{psi} vs {psi_got}");
+    prop_assert!((p - p_got).norm() <= 1e-9 * (p.norm() + scale));
+    Ok(())
+}
+
 /// ψ, P, dP/dF (plain and projected) and the split terms are all finite at `f`.
 pub fn all_finite(m: &Material, f: &Mat3) -> bool {
     let (psi, p) = m.energy_density_and_pk1(f);
