@@ -385,6 +385,9 @@ fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tol
     if !(tolerance.is_finite() && tolerance > 0.0) {
         bail!("--tolerance must be a finite positive number, got {tolerance}");
     }
+    if load_steps == 0 {
+        bail!("--load-steps must be at least 1");
+    }
     let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
     let m = scene.build_mesh()?;
     let (acceleration, dirichlet) = hox_scenes::static_problem(&scene, &m)?;

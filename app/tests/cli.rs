@@ -78,6 +78,46 @@ fn bad_input_is_a_clear_error_with_a_non_zero_exit() {
     fails_with(&["frobnicate"], "unrecognized subcommand");
 }
 
+/// NaN, infinite and out-of-range numbers on the command line (issue #8, case 9): each a clear
+/// error naming the option or the scene key, exit 1 or clap's 2, never a run.
+#[test]
+fn non_finite_and_out_of_range_numbers_on_the_command_line_are_clear_errors() {
+    let msh = gmsh_mesh("beam-hex27-v22.msh");
+    let drive = |extra: &[&str]| -> Vec<String> { ["simulate", "--mesh", &msh, "--drive", "tip", "--seconds", "0.05"].iter().chain(extra).map(|s| s.to_string()).collect() };
+    for (args, needle) in [
+        (vec!["simulate", "--scene", "bending", "--youngs", "inf", "--seconds", "0.05"], "Young's modulus"),
+        (vec!["simulate", "--scene", "bending", "--youngs=-inf", "--seconds", "0.05"], "Young's modulus"),
+        (vec!["simulate", "--scene", "bending", "--poisson", "nan", "--seconds", "0.05"], "Poisson ratio"),
+        (vec!["simulate", "--scene", "bending", "--density", "inf", "--seconds", "0.05"], "density"),
+        (vec!["simulate", "--scene", "bending", "--fps", "nan", "--seconds", "0.05"], "frames_per_second"),
+        (vec!["simulate", "--scene", "bending", "--fps", "0", "--seconds", "0.05"], "frames_per_second"),
+        (vec!["simulate", "--scene", "bending", "--iterations", "0", "--seconds", "0.05"], "iterations"),
+        (vec!["simulate", "--scene", "bending", "--quadrature", "0", "--seconds", "0.05"], "quadrature_degree"),
+        (vec!["simulate", "--scene", "bending", "--seconds", "nan"], "--seconds"),
+        (vec!["simulate", "--scene", "bending", "--seconds", "inf"], "--seconds"),
+        (vec!["static", "--scene", "bending", "--tolerance", "nan"], "--tolerance"),
+        (vec!["static", "--scene", "bending", "--load-steps", "0"], "--load-steps"),
+        (vec!["static", "--scene", "bending", "--material", "snh", "--poisson", "0.5"], "Poisson ratio"),
+        (vec!["record", "--scene", "bending", "--seconds", "0.05", "--out", "/tmp/hox-never.rrd", "--colour-max-m", "nan"], "--colour-max-m"),
+        (vec!["record", "--scene", "bending", "--seconds", "0.05", "--out", "/tmp/hox-never.rrd", "--compare", "element=p1", "--compare", "youngs=nan"], "Young's modulus"),
+        (vec!["bench", "--frames", "0"], "--frames"),
+    ] {
+        fails_with(&args, needle);
+    }
+    for (extra, needle) in [
+        (&["--drive-translation-m", "nan,0,0"][..], "three finite numbers"),
+        (&["--drive-translation-m", "inf,0,0"][..], "three finite numbers"),
+        (&["--drive-rotation-deg", "nan"][..], "--drive-rotation-deg"),
+        (&["--drive-rotation-deg", "90", "--drive-origin-m", "nan,0,0"][..], "three finite numbers"),
+        (&["--drive-rotation-deg", "90", "--drive-axis", "0,0,0"][..], "rotation_axis"),
+        (&["--drive-ramp-secs", "nan"][..], "--drive-ramp-secs"),
+    ] {
+        let args = drive(extra);
+        fails_with(&args.iter().map(String::as_str).collect::<Vec<_>>(), needle);
+    }
+    assert!(!std::path::Path::new("/tmp/hox-never.rrd").exists(), "a refused record wrote its output");
+}
+
 /// A committed Gmsh mesh (assets/meshes/).
 fn gmsh_mesh(name: &str) -> String {
     format!("{}/../assets/meshes/{name}", env!("CARGO_MANIFEST_DIR"))
