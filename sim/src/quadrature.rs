@@ -6,6 +6,16 @@
 //!   Mathematics with Applications* 69(10), 2015, 1232–1241 (generated with polyquad), for the
 //!   tetrahedron (degrees 1–10), prism (1–10) and pyramid (1–10): all their points are interior,
 //!   so no rule samples the pyramid apex where its shape-function gradients are singular;
+//! - Gauss–Legendre tensor-product rules for the hexahedron (below), from which hox also builds
+//!   the **collapsed (conical-product) Gauss rules** for the tetrahedron above degree 10
+//!   (degrees 11–21; A. H. Stroud, *Approximate Calculation of Multiple Integrals*, 1971, §2.6;
+//!   M. G. Duffy, SIAM J. Numer. Anal. 19(6), 1982): with `n` Gauss points per direction on
+//!   `[0, 1]³`, `x = u`, `y = (1 − u) v`, `z = (1 − u)(1 − v) t` and the weight times the
+//!   Jacobian `(1 − u)² (1 − v)`. A monomial `x^a y^b z^c` of total degree `d` becomes a
+//!   polynomial of degree `d + 2` in `u`, `≤ d + 1` in `v` and `≤ d` in `t`, so `n = ⌈(d + 3)/2⌉`
+//!   integrates it exactly. Its `n³` points reach to within a few hundredths of every face (used
+//!   to check that a state is an equilibrium of the near-exactly integrated energy,
+//!   docs/STABILITY.md);
 //! - Gauss–Legendre tensor-product rules for the hexahedron: degree `d` in each variable uses
 //!   `⌈(d + 1)/2⌉` points per direction (the integrands of Q1/Q2 elements are tensor-product
 //!   polynomials, which total-degree rules do not integrate exactly).
@@ -50,7 +60,7 @@ pub enum QuadratureError {
 /// The highest degree available per shape.
 pub fn max_degree(shape: ReferenceShape) -> usize {
     match shape {
-        ReferenceShape::Hexahedron => 21,
+        ReferenceShape::Hexahedron | ReferenceShape::Tetrahedron => 21,
         _ => 10,
     }
 }
@@ -65,6 +75,16 @@ pub fn rule(shape: ReferenceShape, degree: usize) -> Result<QuadratureRule, Quad
     use fenris_quadrature::{polyquad, tensor};
     let (weights, points): (Vec<f64>, Vec<[f64; 3]>) = match shape {
         ReferenceShape::Hexahedron => tensor::hexahedron_gauss(degree / 2 + 1),
+        ReferenceShape::Tetrahedron if degree > 10 => {
+            let (w, p) = tensor::hexahedron_gauss((degree + 3).div_ceil(2));
+            w.iter()
+                .zip(&p)
+                .map(|(w, q)| {
+                    let [u, v, t] = [0, 1, 2].map(|d| 0.5 * (q[d] + 1.0));
+                    (w / 8.0 * (1.0 - u) * (1.0 - u) * (1.0 - v), [u, (1.0 - u) * v, (1.0 - u) * (1.0 - v) * t])
+                })
+                .unzip()
+        }
         ReferenceShape::Tetrahedron => {
             let (w, p) = polyquad::tetrahedron(degree).map_err(|_| unavailable())?;
             let p = p.iter().map(|q| q.map(|c| 0.5 * (c + 1.0))).collect();
@@ -121,7 +141,7 @@ mod tests {
     #[test]
     fn every_rule_is_exact_for_every_monomial_up_to_its_degree() {
         for shape in SHAPES {
-            for degree in 1..=max_degree(shape).min(10) {
+            for degree in 1..=max_degree(shape).min(if shape == ReferenceShape::Tetrahedron { 21 } else { 10 }) {
                 let rule = rule(shape, degree).unwrap();
                 // total degree ≤ degree (hexahedra: also each variable ≤ degree)
                 let monomials: Vec<Exponents> = if shape == ReferenceShape::Hexahedron {
@@ -144,7 +164,7 @@ mod tests {
     #[test]
     fn weights_are_positive_points_inside_and_the_pyramid_apex_is_never_sampled() {
         for shape in SHAPES {
-            for degree in 1..=10 {
+            for degree in 1..=max_degree(shape) {
                 let rule = rule(shape, degree).unwrap();
                 assert!(rule.weights.iter().all(|&w| w > 0.0), "{shape:?} {degree}");
                 assert!(rule.points.iter().all(|p| shape.contains(p, 1e-12)), "{shape:?} {degree}");
@@ -162,7 +182,12 @@ mod tests {
         assert_eq!(rule(ReferenceShape::Tetrahedron, 1).unwrap().len(), 1);
         assert_eq!(rule(ReferenceShape::Hexahedron, 3).unwrap().len(), 8);
         assert_eq!(rule(ReferenceShape::Hexahedron, 5).unwrap().len(), 27);
-        let err = rule(ReferenceShape::Tetrahedron, 11).unwrap_err();
+        // above degree 10 on the tetrahedron: the collapsed Gauss rule, n = ⌈(d + 3)/2⌉ per direction
+        assert_eq!(rule(ReferenceShape::Tetrahedron, 11).unwrap().len(), 7 * 7 * 7);
+        assert_eq!(rule(ReferenceShape::Tetrahedron, 17).unwrap().len(), 10 * 10 * 10);
+        let err = rule(ReferenceShape::Tetrahedron, 22).unwrap_err();
+        assert!(err.to_string().contains("degree 22"), "{err}");
+        let err = rule(ReferenceShape::Prism, 11).unwrap_err();
         assert!(err.to_string().contains("degree 11"), "{err}");
     }
 }
