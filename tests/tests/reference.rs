@@ -1,12 +1,13 @@
 //! The committed reference solutions (`assets/reference/*.json`, made by
 //! `scripts/reference.sh`) are reproduced by the static solver from their recipe: the coarse
 //! levels in every test run, the medium and fine levels (minutes) in the release run CI makes with
-//! `--ignored`.
+//! `--ignored`: one test per scene, so that the test harness runs them on both cores (the static
+//! solver itself runs on one; torsion's fine level alone takes about five minutes).
 
 use hox_scenes::SceneOverrides;
 use std::path::PathBuf;
 
-fn reference_files(level: &str) -> Vec<(PathBuf, serde_json::Value)> {
+fn reference_files(scene: Option<&str>, level: &str) -> Vec<(PathBuf, serde_json::Value)> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/reference");
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
@@ -16,15 +17,17 @@ fn reference_files(level: &str) -> Vec<(PathBuf, serde_json::Value)> {
             let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
             (p, v)
         })
-        .filter(|(_, v)| v["level"] == level)
+        .filter(|(_, v)| v["level"] == level && scene.is_none_or(|scene| v["scene"] == scene))
         .collect();
     files.sort_by(|a, b| a.0.cmp(&b.0));
     files
 }
 
-fn reproduce(level: &str) {
-    let files = reference_files(level);
-    assert_eq!(files.len(), 3, "one {level} reference per paper scene");
+/// Solves the `level` reference of `scene` (every paper scene when None) from its recipe and
+/// compares its probes with the committed values.
+fn reproduce(scene: Option<&str>, level: &str) {
+    let files = reference_files(scene, level);
+    assert_eq!(files.len(), if scene.is_some() { 1 } else { 3 }, "one {level} reference per paper scene");
     for (path, reference) in files {
         let scene = hox_scenes::by_name(reference["scene"].as_str().unwrap()).unwrap();
         let grid: Vec<usize> = reference["grid"].as_str().unwrap().split('x').map(|v| v.parse().unwrap()).collect();
@@ -61,12 +64,26 @@ fn reproduce(level: &str) {
 
 #[test]
 fn the_coarse_reference_levels_are_reproduced_from_their_recipe() {
-    reproduce("coarse");
+    reproduce(None, "coarse");
 }
 
 #[test]
 #[ignore = "minutes in release: CI runs it with --release --ignored"]
-fn the_medium_and_fine_reference_levels_are_reproduced_from_their_recipe() {
-    reproduce("medium");
-    reproduce("fine");
+fn the_medium_and_fine_bending_references_are_reproduced_from_their_recipe() {
+    reproduce(Some("bending"), "medium");
+    reproduce(Some("bending"), "fine");
+}
+
+#[test]
+#[ignore = "minutes in release: CI runs it with --release --ignored"]
+fn the_medium_and_fine_tension_references_are_reproduced_from_their_recipe() {
+    reproduce(Some("tension"), "medium");
+    reproduce(Some("tension"), "fine");
+}
+
+#[test]
+#[ignore = "minutes in release: CI runs it with --release --ignored"]
+fn the_medium_and_fine_torsion_references_are_reproduced_from_their_recipe() {
+    reproduce(Some("torsion"), "medium");
+    reproduce(Some("torsion"), "fine");
 }
