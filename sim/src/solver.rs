@@ -28,7 +28,7 @@ use crate::geometry::{BlockGeometry, GeometryError, precompute};
 use crate::mass::lumped_masses_kg;
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshError};
-use crate::stability::{GUARD_H_OMEGA, GUARD_TRIGGER_H_OMEGA, StabilityReport, guarded_substeps, mesh_omega2_max};
+use crate::stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
 
 /// Time stepping and constraint settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,7 +45,8 @@ pub struct SolverSettings {
     /// ([`Simulation::set_partition_threshold`]); that order depends on the thread count.
     pub parallel: bool,
     /// The stability guard ([`crate::stability`]): when the requested substep has `h ω_max`
-    /// above [`crate::stability::GUARD_TRIGGER_H_OMEGA`], take enough substeps for
+    /// above [`crate::stability::guard_trigger_h_omega`] (3; 1.5 for the energy formulation at
+    /// ν ≥ 0.45), take enough substeps for
     /// `h ω_max ≤` [`crate::stability::GUARD_H_OMEGA`]. On by default; the paper's scenes are
     /// below the trigger and unaffected.
     pub stability_guard: bool,
@@ -405,12 +406,14 @@ impl Simulation {
         let (omega2_normalised, block, element) = self.omega2_normalised();
         let omega_max_rad_s = (omega2_normalised * self.material.youngs_modulus_pa / self.material.density_kg_m3).sqrt();
         let s = &self.settings;
-        let (substeps, capped) = if s.stability_guard { guarded_substeps(s.substeps, s.frames_per_second, omega_max_rad_s, GUARD_TRIGGER_H_OMEGA, GUARD_H_OMEGA) } else { (s.substeps, false) };
+        let trigger_h_omega = guard_trigger_h_omega(s.formulation, &self.material);
+        let (substeps, capped) = if s.stability_guard { guarded_substeps(s.substeps, s.frames_per_second, omega_max_rad_s, trigger_h_omega, GUARD_H_OMEGA) } else { (s.substeps, false) };
         StabilityReport {
             omega_max_rad_s,
             block,
             element,
             requested_h_omega: omega_max_rad_s * s.substep_dt_secs(),
+            trigger_h_omega,
             requested_substeps: s.substeps,
             substeps,
             guard: s.stability_guard,

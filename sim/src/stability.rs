@@ -15,7 +15,8 @@
 //! each element's largest rest frequency `ω_e² = λ_max(W^½ K_e W^½)` (`K_e` the element's
 //! Hessian at rest — the same linear-elasticity stiffness for every model —, `W` the inverse
 //! lumped masses of its nodes, all free: pinning a node only lowers it) is found by power
-//! iteration. When the requested substep has `h ω_max` above [`GUARD_TRIGGER_H_OMEGA`] (3), a
+//! iteration. When the requested substep has `h ω_max` above [`GUARD_TRIGGER_H_OMEGA`] (3; 1.5
+//! for the energy formulation at ν ≥ 0.45, [`guard_trigger_h_omega`]), a
 //! frame is cut into `n = ⌈ω_max / (fps · κ)⌉` substeps with [`GUARD_H_OMEGA`] `= κ = 1`. The
 //! two values are measured: the paper's scenes run at `h ω_max` up to 2.8 with a few % of
 //! energy overshoot and are left as they are (their `h ω_max` are listed in
@@ -29,6 +30,7 @@
 //! it; ν, the model, the quadrature or a node's mass recompute it (in parallel over elements).
 
 use crate::Vec3;
+use crate::constraint::Formulation;
 use crate::energy::{element_grads, element_hessian, gather};
 use crate::geometry::BlockGeometry;
 use crate::material::Material;
@@ -40,6 +42,34 @@ use rayon::prelude::*;
 /// benchmark of the paper is below it at its settings (the largest, the 81,920-tetrahedron beam,
 /// at 2.78; `docs/STABILITY.md`), and the split formulation was measured to blow up at 3.
 pub const GUARD_TRIGGER_H_OMEGA: f64 = 3.0;
+
+/// The trigger for the energy formulation with a nearly incompressible material (ν at or above
+/// [`NEAR_INCOMPRESSIBLE_POISSON_RATIO`], `λ ≥ 9 μ`). Its one constraint per element,
+/// `C = √(2U_e)`, steps along `∇U_e` by an amount set by the energy-weighted stiffness
+/// (`s = h²/(1 + h² ρ_e)` above): under nearly isochoric deformation that is the deviatoric
+/// stiffness `∝ μ`, while the step's volumetric part meets `λ ≫ μ`, so the volumetric mode
+/// overshoots at a smaller `h ω_max` than for ν ≤ 0.4. Measured (robustness case 2, cantilever
+/// under gravity, 50 substeps): at ν ≥ 0.45 the energy formulation gains 10–17 % of the work of
+/// gravity from `h ω_max` = 1.57 on (P3 at 0.45, P2 at 0.49, P1, Q1, pyramid at 0.499), and stays
+/// within 5.3 % below 1.45 (Q2 at 0.49: 1.43); the split formulation, which gives the
+/// volumetric term its own compliance, stays within 2.5 % up to 2.09. Every scene and benchmark
+/// of the paper has ν ≤ 0.4 and keeps the trigger of 3.
+pub const GUARD_TRIGGER_NEAR_INCOMPRESSIBLE_ENERGY_H_OMEGA: f64 = 1.5;
+
+/// From this Poisson ratio on (`λ/μ = 2ν/(1 − 2ν) ≥ 9`) the energy formulation uses
+/// [`GUARD_TRIGGER_NEAR_INCOMPRESSIBLE_ENERGY_H_OMEGA`].
+pub const NEAR_INCOMPRESSIBLE_POISSON_RATIO: f64 = 0.45;
+
+/// The `h ω_max` above which the guard steps in, for a formulation and material:
+/// [`GUARD_TRIGGER_H_OMEGA`], or [`GUARD_TRIGGER_NEAR_INCOMPRESSIBLE_ENERGY_H_OMEGA`] for the
+/// energy formulation at ν ≥ [`NEAR_INCOMPRESSIBLE_POISSON_RATIO`].
+pub fn guard_trigger_h_omega(formulation: Formulation, material: &Material) -> f64 {
+    if formulation == Formulation::Energy && material.poisson_ratio >= NEAR_INCOMPRESSIBLE_POISSON_RATIO {
+        GUARD_TRIGGER_NEAR_INCOMPRESSIBLE_ENERGY_H_OMEGA
+    } else {
+        GUARD_TRIGGER_H_OMEGA
+    }
+}
 
 /// Once triggered, the guard cuts the frame into substeps with `h ω_max` at most this: the
 /// measured value at which the stiff cantilevers of the robustness suite load and release within
@@ -140,6 +170,8 @@ pub struct StabilityReport {
     pub element: usize,
     /// `h ω_max` with the requested substeps.
     pub requested_h_omega: f64,
+    /// The `h ω_max` above which the guard steps in ([`guard_trigger_h_omega`]).
+    pub trigger_h_omega: f64,
     /// Substeps per frame asked for and taken.
     pub requested_substeps: u32,
     pub substeps: u32,
@@ -160,8 +192,8 @@ impl StabilityReport {
         let cap = if self.capped { format!(" (capped at {GUARD_MAX_SUBSTEPS}; the scene may still be unstable)") } else { String::new() };
         if self.raised() {
             format!(
-                "stability guard: {} substeps per frame instead of {} (h·ω_max would be {:.3} > {GUARD_TRIGGER_H_OMEGA}, now ≤ {GUARD_H_OMEGA}; ω_max = {:.4e} rad/s in element {} of block {}){cap}",
-                self.substeps, self.requested_substeps, self.requested_h_omega, self.omega_max_rad_s, self.element, self.block
+                "stability guard: {} substeps per frame instead of {} (h·ω_max would be {:.3} > {}, now ≤ {GUARD_H_OMEGA}; ω_max = {:.4e} rad/s in element {} of block {}){cap}",
+                self.substeps, self.requested_substeps, self.requested_h_omega, self.trigger_h_omega, self.omega_max_rad_s, self.element, self.block
             )
         } else {
             format!("h·ω_max = {:.3} with {} substeps per frame{}", self.requested_h_omega, self.substeps, if self.guard { "" } else { " (stability guard off)" })

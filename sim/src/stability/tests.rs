@@ -54,3 +54,19 @@ fn guarded_substeps_keep_the_request_below_the_trigger_and_take_the_target_above
     // a request already finer than the target is kept
     assert_eq!(guarded_substeps(1, 60.0, 600.0, 3.0, 20.0), (1, false));
 }
+
+#[test]
+fn the_energy_formulation_of_a_nearly_incompressible_material_is_guarded_from_h_omega_one_and_a_half() {
+    use crate::material::MaterialModel;
+    let at = |nu: f64| Material::new(MaterialModel::StableNeoHookean, 1e6, nu, 1000.0).unwrap();
+    for model_nu in [0.0, 0.3, 0.4, 0.449] {
+        assert_eq!(guard_trigger_h_omega(Formulation::Energy, &at(model_nu)), GUARD_TRIGGER_H_OMEGA, "ν = {model_nu}");
+    }
+    for nu in [0.45, 0.49, 0.499] {
+        assert_eq!(guard_trigger_h_omega(Formulation::Energy, &at(nu)), GUARD_TRIGGER_NEAR_INCOMPRESSIBLE_ENERGY_H_OMEGA, "ν = {nu}");
+        assert_eq!(guard_trigger_h_omega(Formulation::Split, &at(nu)), GUARD_TRIGGER_H_OMEGA, "ν = {nu}");
+    }
+    // λ/μ = 2ν/(1 − 2ν) = 9 at the threshold
+    let lame = at(NEAR_INCOMPRESSIBLE_POISSON_RATIO).lame();
+    assert!((lame.lambda_pa / lame.mu_pa - 9.0).abs() < 1e-9);
+}
