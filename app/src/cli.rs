@@ -60,8 +60,8 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// The accuracy-versus-time study over the paper scenes: writes study.md, study.csv and
-    /// study.svg to --out.
+    /// The accuracy-versus-time study over the paper scenes: writes study.md, study.csv,
+    /// locking.csv (P1/P2/P3 near incompressibility) and study.svg to --out.
     Study {
         /// Only the coarse configurations (minutes instead of an hour).
         #[arg(long)]
@@ -464,17 +464,20 @@ fn study(quick: bool, out: &std::path::Path) -> Result<()> {
     bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed}] {msg}").expect("valid template"));
     bar.enable_steady_tick(Duration::from_millis(200));
     let started = Instant::now();
-    let rows = hox_scenes::study::run_study(quick, &mut |message| {
+    let mut report = |message: &str| {
         // a log line per step when stderr is not a terminal (CI), the spinner otherwise
         if bar.is_hidden() {
             eprintln!("[{:>6.1} s] {message}", started.elapsed().as_secs_f64());
         }
         bar.set_message(message.to_string());
-    })?;
+    };
+    let rows = hox_scenes::study::run_study(quick, &mut report)?;
+    let locking = hox_scenes::study::locking(quick, &mut report)?;
     bar.finish_and_clear();
     let files = [
-        ("study.md", hox_scenes::study::markdown(&rows, quick)),
+        ("study.md", hox_scenes::study::markdown(&rows, quick) + "\n" + &hox_scenes::study::locking_markdown(&locking)),
         ("study.csv", hox_scenes::study::csv(&rows)),
+        ("locking.csv", hox_scenes::study::locking_csv(&locking)),
         ("study.svg", hox_scenes::study::svg(&rows)),
     ];
     for (name, text) in files {

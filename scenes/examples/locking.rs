@@ -1,0 +1,15 @@
+//! The locking table of `hox study` on its own (the full set of meshes, P1 10,240 included):
+//! static tip deflections of the bending beam at ν = 0.35, 0.45, 0.49, 0.499 against Q2 16×4×4.
+//! Writes the markdown section to stdout and the CSV to the path given, if any.
+//! docs/study/locking.md and locking.csv are its output.
+//!
+//! `cargo run --release -p hox-scenes --example locking -- docs/study/locking.csv > docs/study/locking.md`
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let rows = hox_scenes::study::locking(false, &mut |message| eprintln!("{message}"))?;
+    print!("{}", hox_scenes::study::locking_markdown(&rows));
+    if let Some(path) = std::env::args().nth(1) {
+        std::fs::write(&path, hox_scenes::study::locking_csv(&rows)).map_err(|e| format!("cannot write {path}: {e}"))?;
+    }
+    Ok(())
+}
