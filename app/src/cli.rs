@@ -390,24 +390,13 @@ fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tol
     }
     let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
     let m = scene.build_mesh()?;
-    let (acceleration, dirichlet) = hox_scenes::static_problem(&scene, &m)?;
-    let problem = hox_sim::statics::StaticProblem {
-        mesh: &m,
-        material: scene.material,
-        quadrature_degree: scene.settings.quadrature_degree,
-        acceleration_m_s2: acceleration,
-        dirichlet,
-        tolerance,
-        load_steps,
-    };
     let started = Instant::now();
     let mut bar = DelayedBar::new();
-    let solution = hox_sim::statics::solve(&problem, &mut |fraction, iteration, residual| {
+    let solution = hox_scenes::solve_static(&scene, &m, tolerance, load_steps, &mut |fraction, iteration, residual| {
         bar.reveal("{spinner} load {bar:30} {msg} [{elapsed}]");
         bar.bar.set_position((1000.0 * fraction) as u64);
         bar.bar.set_message(format!("Newton iteration {iteration}, residual {residual:.2e}"));
-    })
-    .with_context(|| format!("{}: static solve", scene.source))?;
+    })?;
     bar.bar.finish_and_clear();
     let dofs = solution.free_dofs;
     let seconds = started.elapsed().as_secs_f64();

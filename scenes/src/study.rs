@@ -190,17 +190,7 @@ pub fn study_one(scene_name: &str, config: &StudyConfig, progress: &mut dyn FnMu
     // 1. the static solution on this mesh
     progress(&format!("{scene_name} {label}: static solution"));
     let mut instance = Instance::new(scene.clone())?;
-    let (acceleration, dirichlet) = crate::static_problem(&scene, instance.sim.mesh())?;
-    let problem = hox_sim::statics::StaticProblem {
-        mesh: instance.sim.mesh(),
-        material: scene.material,
-        quadrature_degree: scene.settings.quadrature_degree,
-        acceleration_m_s2: acceleration,
-        dirichlet,
-        tolerance: 1e-8,
-        load_steps: 1,
-    };
-    let statics = hox_sim::statics::solve(&problem, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
+    let statics = crate::solve_static(&scene, instance.sim.mesh(), 1e-8, 1, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
     let static_probes = probes_of(&instance, &statics.positions);
 
     // 2. XPBD settled at the paper's settings
@@ -330,18 +320,8 @@ fn static_tip_z(scene_name: &str, config: &StudyConfig, nu: f64, progress: &mut 
         ..Default::default()
     })?;
     let mesh = scene.build_mesh()?;
-    let (acceleration, dirichlet) = crate::static_problem(&scene, &mesh)?;
-    let problem = hox_sim::statics::StaticProblem {
-        mesh: &mesh,
-        material: scene.material,
-        quadrature_degree: scene.settings.quadrature_degree,
-        acceleration_m_s2: acceleration,
-        dirichlet,
-        tolerance: 1e-8,
-        load_steps: 4,
-    };
     let fail = |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label} at ν = {nu}"), message: m };
-    let solution = hox_sim::statics::solve(&problem, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
+    let solution = crate::solve_static(&scene, &mesh, 1e-8, 4, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
     let tip = scene.file.probes.iter().find(|p| p.name == "tip").ok_or_else(|| fail("the scene has no probe named tip".into()))?;
     let probe = hox_sim::probe::Probe::locate(&mesh, &tip.name, Vec3::from(tip.point_m)).map_err(|e| fail(e.to_string()))?;
     Ok((probe.displacement(&solution.positions, &mesh.rest_positions).z, mesh.num_elements()))

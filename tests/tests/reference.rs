@@ -39,17 +39,7 @@ fn reproduce(scene: Option<&str>, level: &str) {
             })
             .unwrap();
         let mesh = scene.build_mesh().unwrap();
-        let (acceleration, dirichlet) = hox_scenes::static_problem(&scene, &mesh).unwrap();
-        let problem = hox_sim::statics::StaticProblem {
-            mesh: &mesh,
-            material: scene.material,
-            quadrature_degree: scene.settings.quadrature_degree,
-            acceleration_m_s2: acceleration,
-            dirichlet,
-            tolerance: 1e-10,
-            load_steps: 1,
-        };
-        let solution = hox_sim::statics::solve(&problem, &mut |_, _, _| {}).unwrap();
+        let solution = hox_scenes::solve_static(&scene, &mesh, 1e-10, 1, &mut |_, _, _| {}).unwrap();
         assert_eq!(solution.free_dofs as u64, reference["dofs"].as_u64().unwrap(), "{}", path.display());
         for p in &scene.file.probes {
             let probe = hox_sim::probe::Probe::locate(&mesh, &p.name, hox_sim::Vec3::from(p.point_m)).unwrap();
