@@ -6,10 +6,16 @@
 //! `cargo run --release -p hox-scenes --example locking -- docs/study/locking.csv > docs/study/locking.md`
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    use std::io::Write;
+    // open the CSV first, so that an unwritable path is refused before a minute of solves
+    let csv = match std::env::args().nth(1) {
+        Some(path) => Some((std::fs::File::create(&path).map_err(|e| format!("cannot write {path}: {e}"))?, path)),
+        None => None,
+    };
     let rows = hox_scenes::study::locking(false, &mut |message| eprintln!("{message}"))?;
     print!("{}", hox_scenes::study::locking_markdown(&rows));
-    if let Some(path) = std::env::args().nth(1) {
-        std::fs::write(&path, hox_scenes::study::locking_csv(&rows)).map_err(|e| format!("cannot write {path}: {e}"))?;
+    if let Some((mut file, path)) = csv {
+        file.write_all(hox_scenes::study::locking_csv(&rows).as_bytes()).map_err(|e| format!("cannot write {path}: {e}"))?;
     }
     Ok(())
 }

@@ -52,6 +52,10 @@ impl StudyConfig {
     const fn new(element: &'static str, grid: [usize; 3], split: TetSplit, refine: usize, heavy: bool) -> Self {
         Self { element, grid, split, refine, heavy }
     }
+    /// The scene overrides that build this configuration's mesh.
+    pub fn overrides(&self) -> SceneOverrides {
+        SceneOverrides { element: Some(self.element.into()), grid: Some(self.grid), split: Some(self.split.name().into()), refine: Some(self.refine), ..Default::default() }
+    }
     pub fn label(&self) -> String {
         let is_tet = matches!(self.element, "p1" | "p2" | "p3");
         let mut s = format!("{} {}x{}x{}", self.element.to_uppercase(), self.grid[0], self.grid[1], self.grid[2]);
@@ -177,13 +181,7 @@ pub fn study_one(scene_name: &str, config: &StudyConfig, progress: &mut dyn FnMu
     let reference = reference(scene_name)?;
     let reference_size = reference.iter().map(|(_, u)| u.norm()).fold(0.0, f64::max);
     let base = crate::by_name(scene_name)?;
-    let scene = base.with_overrides(&SceneOverrides {
-        element: Some(config.element.into()),
-        grid: Some(config.grid),
-        split: Some(config.split.name().into()),
-        refine: Some(config.refine),
-        ..Default::default()
-    })?;
+    let scene = base.with_overrides(&config.overrides())?;
     let label = config.label();
     let fail = |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label}"), message: m };
 
@@ -311,14 +309,7 @@ pub fn locking(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<Lockin
 fn static_tip_z(scene_name: &str, config: &StudyConfig, nu: f64, progress: &mut dyn FnMut(&str)) -> Result<(f64, usize), SceneError> {
     let label = config.label();
     progress(&format!("locking: {scene_name} {label} at ν = {nu}: static solution"));
-    let scene = crate::by_name(scene_name)?.with_overrides(&SceneOverrides {
-        element: Some(config.element.into()),
-        grid: Some(config.grid),
-        split: Some(config.split.name().into()),
-        refine: Some(config.refine),
-        poisson_ratio: Some(nu),
-        ..Default::default()
-    })?;
+    let scene = crate::by_name(scene_name)?.with_overrides(&SceneOverrides { poisson_ratio: Some(nu), ..config.overrides() })?;
     let mesh = scene.build_mesh()?;
     let fail = |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label} at ν = {nu}"), message: m };
     let solution = crate::solve_static(&scene, &mesh, 1e-8, 4, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;

@@ -1,8 +1,9 @@
 //! The committed reference solutions (`assets/reference/*.json`, made by
 //! `scripts/reference.sh`) are reproduced by the static solver from their recipe: the coarse
 //! levels in every test run, the medium and fine levels (minutes) in the release run CI makes with
-//! `--ignored`: one test per scene, so that the test harness runs them on both cores (the static
-//! solver itself runs on one; torsion's fine level alone takes about five minutes).
+//! `--ignored`: one test per scene, so that the test harness runs them side by side (the static
+//! solver alone keeps about 1.4 of the 2 cores busy; torsion's fine level takes about five
+//! minutes).
 
 use hox_scenes::SceneOverrides;
 use std::path::PathBuf;
