@@ -216,10 +216,14 @@ pub fn main(cli: Cli) -> Result<()> {
         Command::Elements { json } => elements(json),
         Command::Scenes { json } => scenes(json),
         Command::Mesh { scene, mesh, json } => mesh_command(&scene, &mesh, json),
-        Command::Simulate { scene, mesh, physics, seconds, settle, vtk, json } => simulate(&scene, &mesh, &physics, seconds, settle, &vtk, json),
+        Command::Simulate { scene, mesh, physics, seconds, settle, vtk, json } => {
+            simulate(&scene, &mesh, &physics, seconds, settle, &vtk, json)
+        }
         Command::Study { quick, out } => study(quick, &out),
         Command::Bench { frames, threads, only, colour_on_one } => bench(frames, &threads, &only, colour_on_one),
-        Command::Static { scene, mesh, physics, tolerance, load_steps, json } => static_command(&scene, &mesh, &physics, tolerance, load_steps, json),
+        Command::Static { scene, mesh, physics, tolerance, load_steps, json } => {
+            static_command(&scene, &mesh, &physics, tolerance, load_steps, json)
+        }
         Command::Record(args) => record::record(&args),
         Command::Inspect(args) => record::inspect(&args),
         Command::App(args) => crate::gui::run(args),
@@ -296,7 +300,11 @@ fn mesh_command(scene: &SceneArgs, mesh: &MeshArgs, json: bool) -> Result<()> {
         "volume_m3": hox_sim::geometry::total_volume_m3(&geometry),
     });
     if let Some(imported) = scene.mesh.imported() {
-        out["blocks"] = m.blocks.iter().map(|b| serde_json::json!({"element": b.element_type.name(), "elements": b.len()})).collect();
+        out["blocks"] = m
+            .blocks
+            .iter()
+            .map(|b| serde_json::json!({"element": b.element_type.name(), "elements": b.len()}))
+            .collect();
         out["groups"] = imported.node_sets.iter().map(|(name, nodes)| (name.clone(), serde_json::json!({"nodes": nodes.len(), "elements": imported.element_sets.get(name).map_or(0, Vec::len)}))).collect();
     }
     if json {
@@ -317,7 +325,15 @@ fn mesh_command(scene: &SceneArgs, mesh: &MeshArgs, json: bool) -> Result<()> {
     Ok(())
 }
 
-fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: Option<f64>, settle: bool, vtk: &gmsh::VtkArgs, json: bool) -> Result<()> {
+fn simulate(
+    scene: &SceneArgs,
+    mesh: &MeshArgs,
+    physics: &PhysicsArgs,
+    seconds: Option<f64>,
+    settle: bool,
+    vtk: &gmsh::VtkArgs,
+    json: bool,
+) -> Result<()> {
     let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
     let mode = if settle {
         RunMode::SETTLE
@@ -333,14 +349,23 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
     let mut vtk_writer = gmsh::VtkWriter::create(vtk, &instance)?;
     let mut bar = DelayedBar::new();
     let mut on_frame = |i: &Instance| vtk_writer.as_mut().map_or(Ok(()), |w| w.frame(i));
-    let report = hox_scenes::run_observed(&mut instance, mode, &mut |t, fraction| {
-        let template = if fraction.is_some() { "{spinner} {bar:40} {percent}% {msg} (eta {eta})" } else { "{spinner} settling… {msg}" };
-        bar.reveal(template);
-        if let Some(f) = fraction {
-            bar.bar.set_position((1000.0 * f) as u64);
-        }
-        bar.bar.set_message(format!("t = {t:.2} s"));
-    }, &mut on_frame)?;
+    let report = hox_scenes::run_observed(
+        &mut instance,
+        mode,
+        &mut |t, fraction| {
+            let template = if fraction.is_some() {
+                "{spinner} {bar:40} {percent}% {msg} (eta {eta})"
+            } else {
+                "{spinner} settling… {msg}"
+            };
+            bar.reveal(template);
+            if let Some(f) = fraction {
+                bar.bar.set_position((1000.0 * f) as u64);
+            }
+            bar.bar.set_message(format!("t = {t:.2} s"));
+        },
+        &mut on_frame,
+    )?;
     bar.bar.finish_and_clear();
     let groups = instance.group_displacements();
     let vtk_index = vtk_writer.map(|w| w.finish(&instance)).transpose()?;
@@ -370,7 +395,10 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
         for (name, u) in &groups {
             println!("  group {name}: mean u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
         }
-        println!("  kinetic energy {:.6e} J, elastic energy {:.6e} J", report.kinetic_energy_j, report.elastic_energy_j);
+        println!(
+            "  kinetic energy {:.6e} J, elastic energy {:.6e} J",
+            report.kinetic_energy_j, report.elastic_energy_j
+        );
         if let Some(index) = &vtk_index {
             println!("  ParaView series: {}", index.display());
         }
@@ -381,7 +409,14 @@ fn simulate(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, seconds: 
     Ok(())
 }
 
-fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tolerance: f64, load_steps: usize, json: bool) -> Result<()> {
+fn static_command(
+    scene: &SceneArgs,
+    mesh: &MeshArgs,
+    physics: &PhysicsArgs,
+    tolerance: f64,
+    load_steps: usize,
+    json: bool,
+) -> Result<()> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
         bail!("--tolerance must be a finite positive number, got {tolerance}");
     }
@@ -392,11 +427,12 @@ fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tol
     let m = scene.build_mesh()?;
     let started = Instant::now();
     let mut bar = DelayedBar::new();
-    let solution = hox_scenes::solve_static(&scene, &m, tolerance, load_steps, &mut |fraction, iteration, residual| {
-        bar.reveal("{spinner} load {bar:30} {msg} [{elapsed}]");
-        bar.bar.set_position((1000.0 * fraction) as u64);
-        bar.bar.set_message(format!("Newton iteration {iteration}, residual {residual:.2e}"));
-    })?;
+    let solution =
+        hox_scenes::solve_static(&scene, &m, tolerance, load_steps, &mut |fraction, iteration, residual| {
+            bar.reveal("{spinner} load {bar:30} {msg} [{elapsed}]");
+            bar.bar.set_position((1000.0 * fraction) as u64);
+            bar.bar.set_message(format!("Newton iteration {iteration}, residual {residual:.2e}"));
+        })?;
     bar.bar.finish_and_clear();
     let dofs = solution.free_dofs;
     let seconds = started.elapsed().as_secs_f64();
@@ -418,7 +454,12 @@ fn static_command(scene: &SceneArgs, mesh: &MeshArgs, physics: &PhysicsArgs, tol
     if json {
         println!("{out}");
     } else {
-        println!("{}: static equilibrium, {dofs} DOFs, {} Newton iterations, residual {:.2e}, {seconds:.2} s", scene.name(), solution.newton_iterations, solution.relative_residual);
+        println!(
+            "{}: static equilibrium, {dofs} DOFs, {} Newton iterations, residual {:.2e}, {seconds:.2} s",
+            scene.name(),
+            solution.newton_iterations,
+            solution.relative_residual
+        );
         for (name, u) in &probes {
             println!("  probe {name}: u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
         }
@@ -434,7 +475,13 @@ fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool) -> R
         bail!("--frames and every --threads count must be at least 1");
     }
     let rows = hox_sim::benchmark::run(only, threads, colour_on_one, frames, &mut |r| {
-        eprintln!("{} on {} thread(s), parallel {}: {:.2} ms/frame", r.case.label(), r.threads, r.parallel, r.ms_per_frame)
+        eprintln!(
+            "{} on {} thread(s), parallel {}: {:.2} ms/frame",
+            r.case.label(),
+            r.threads,
+            r.parallel,
+            r.ms_per_frame
+        )
     })?;
     if rows.is_empty() {
         bail!("no configuration matches '{only}'");

@@ -53,7 +53,8 @@ pub struct SimLogger {
 
 /// A name usable as one entity path part: lowercase letters, digits and `_`.
 pub fn entity_name(label: &str) -> String {
-    let s: String = label.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '_' }).collect();
+    let s: String =
+        label.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '_' }).collect();
     let s = s.trim_matches('_').to_string();
     if s.is_empty() { "sim".to_string() } else { s }
 }
@@ -71,11 +72,18 @@ fn f32s(v: &Vec3) -> [f32; 3] {
 
 impl SimLogger {
     /// Logs the static data of `instance` under `world/<name>` offset by `offset_m`.
-    pub fn new(rec: &RecordingStream, name: &str, instance: &Instance, offset_m: Vec3, settings: &LogSettings) -> Result<SimLogger, rerun::RecordingStreamError> {
+    pub fn new(
+        rec: &RecordingStream,
+        name: &str,
+        instance: &Instance,
+        offset_m: Vec3,
+        settings: &LogSettings,
+    ) -> Result<SimLogger, rerun::RecordingStreamError> {
         let name = entity_name(name);
         let mesh = instance.sim.mesh();
         let surface = Surface::new(mesh, settings.segments);
-        let quadrature = settings.quadrature_points.then(|| hox_sim::surface::quadrature_points(mesh, instance.sim.geometry()));
+        let quadrature =
+            settings.quadrature_points.then(|| hox_sim::surface::quadrature_points(mesh, instance.sim.geometry()));
         let (lo, hi) = mesh.bounding_box();
         let extent = hi - lo;
         let colours = ColourRange { max_m: settings.colour_max_m.unwrap_or(0.2 * extent.max()) };
@@ -83,29 +91,40 @@ impl SimLogger {
         rec.log_static(root.as_str(), &rerun::Transform3D::from_translation(f32s(&offset_m)))?;
         rec.log_static(
             format!("{root}/surface"),
-            &rerun::Mesh3D::update_fields().with_triangle_indices(surface.triangles.iter().map(|t| rerun::TriangleIndices::from(*t))),
+            &rerun::Mesh3D::update_fields()
+                .with_triangle_indices(surface.triangles.iter().map(|t| rerun::TriangleIndices::from(*t))),
         )?;
         // the rest shape's edges, a faint ghost
         let mut rest = Vec::new();
         surface.vertices.eval_into(&mesh.rest_positions, &mut rest);
-        let strips: Vec<Vec<[f32; 3]>> = surface.edges.iter().map(|e| e.iter().map(|&i| f32s(&rest[i as usize])).collect()).collect();
+        let strips: Vec<Vec<[f32; 3]>> =
+            surface.edges.iter().map(|e| e.iter().map(|&i| f32s(&rest[i as usize])).collect()).collect();
         rec.log_static(
             format!("{root}/rest_edges"),
-            &rerun::LineStrips3D::new(strips).with_colors([rerun::Color::from_unmultiplied_rgba(160, 160, 160, 90)]).with_radii([rerun::Radius::new_ui_points(0.5)]),
+            &rerun::LineStrips3D::new(strips)
+                .with_colors([rerun::Color::from_unmultiplied_rgba(160, 160, 160, 90)])
+                .with_radii([rerun::Radius::new_ui_points(0.5)]),
         )?;
         let probe_names: Vec<String> = instance.probes.iter().map(|p| p.name.clone()).collect();
         rec.log_static(
             format!("{root}/probes"),
-            &rerun::Points3D::update_fields().with_labels(probe_names.iter().map(String::as_str)).with_colors([rerun::Color::from_rgb(230, 60, 40)]).with_radii([rerun::Radius::new_ui_points(6.0)]),
+            &rerun::Points3D::update_fields()
+                .with_labels(probe_names.iter().map(String::as_str))
+                .with_colors([rerun::Color::from_rgb(230, 60, 40)])
+                .with_radii([rerun::Radius::new_ui_points(6.0)]),
         )?;
         rec.log_static(
             format!("{root}/edges"),
-            &rerun::LineStrips3D::update_fields().with_colors([rerun::Color::from_rgb(20, 20, 20)]).with_radii([rerun::Radius::new_ui_points(0.75)]),
+            &rerun::LineStrips3D::update_fields()
+                .with_colors([rerun::Color::from_rgb(20, 20, 20)])
+                .with_radii([rerun::Radius::new_ui_points(0.75)]),
         )?;
         if quadrature.is_some() {
             rec.log_static(
                 format!("{root}/quadrature_points"),
-                &rerun::Points3D::update_fields().with_colors([rerun::Color::from_rgb(255, 140, 0)]).with_radii([rerun::Radius::new_ui_points(2.5)]),
+                &rerun::Points3D::update_fields()
+                    .with_colors([rerun::Color::from_rgb(255, 140, 0)])
+                    .with_radii([rerun::Radius::new_ui_points(2.5)]),
             )?;
         }
         Self::log_legend(rec, &name, &root, &colours, lo, hi)?;
@@ -114,7 +133,14 @@ impl SimLogger {
 
     /// A vertical colour bar beside the body (its lower end at the body's rest bottom, height the
     /// body's height) with labelled ticks, plus the legend as text.
-    fn log_legend(rec: &RecordingStream, name: &str, root: &str, colours: &ColourRange, lo: Vec3, hi: Vec3) -> Result<(), rerun::RecordingStreamError> {
+    fn log_legend(
+        rec: &RecordingStream,
+        name: &str,
+        root: &str,
+        colours: &ColourRange,
+        lo: Vec3,
+        hi: Vec3,
+    ) -> Result<(), rerun::RecordingStreamError> {
         let extent = hi - lo;
         let height = extent.z.max(0.25 * extent.max());
         let width = 0.08 * height;
@@ -141,13 +167,22 @@ impl SimLogger {
                 triangles.push([k, k + 2, k + 3]);
             }
         }
-        rec.log_static(format!("{root}/legend/bar"), &rerun::Mesh3D::new(positions).with_vertex_colors(vertex_colours).with_triangle_indices(triangles))?;
+        rec.log_static(
+            format!("{root}/legend/bar"),
+            &rerun::Mesh3D::new(positions).with_vertex_colors(vertex_colours).with_triangle_indices(triangles),
+        )?;
         let ticks = colours.ticks_m();
-        let tick_positions: Vec<[f32; 3]> = ticks.iter().map(|t| [(x0 + 1.5 * width) as f32, y as f32, (lo.z + t / colours.max_m * height) as f32]).collect();
+        let tick_positions: Vec<[f32; 3]> = ticks
+            .iter()
+            .map(|t| [(x0 + 1.5 * width) as f32, y as f32, (lo.z + t / colours.max_m * height) as f32])
+            .collect();
         let labels: Vec<String> = ticks.iter().map(|t| format!("{} m", format_metres(*t))).collect();
         rec.log_static(
             format!("{root}/legend/ticks"),
-            &rerun::Points3D::new(tick_positions).with_labels(labels).with_radii([rerun::Radius::new_ui_points(2.0)]).with_colors([rerun::Color::from_rgb(220, 220, 220)]),
+            &rerun::Points3D::new(tick_positions)
+                .with_labels(labels)
+                .with_radii([rerun::Radius::new_ui_points(2.0)])
+                .with_colors([rerun::Color::from_rgb(220, 220, 220)]),
         )?;
         rec.log_static(
             format!("legend/{name}"),
@@ -160,7 +195,12 @@ impl SimLogger {
 
     /// Logs the current state of `instance` at its frame and time. `ms_per_frame` is the wall
     /// time of the last step.
-    pub fn log_frame(&mut self, rec: &RecordingStream, instance: &Instance, ms_per_frame: f64) -> Result<(), rerun::RecordingStreamError> {
+    pub fn log_frame(
+        &mut self,
+        rec: &RecordingStream,
+        instance: &Instance,
+        ms_per_frame: f64,
+    ) -> Result<(), rerun::RecordingStreamError> {
         let sim = &instance.sim;
         let mesh = sim.mesh();
         rec.set_time_sequence("frame", sim.frames() as i64);
@@ -183,9 +223,12 @@ impl SimLogger {
         let x = &self.x;
         rec.log(
             format!("{root}/edges"),
-            &rerun::LineStrips3D::update_fields().with_strips(self.surface.edges.iter().map(|e| e.iter().map(|&i| f32s(&x[i as usize])).collect::<Vec<_>>())),
+            &rerun::LineStrips3D::update_fields().with_strips(
+                self.surface.edges.iter().map(|e| e.iter().map(|&i| f32s(&x[i as usize])).collect::<Vec<_>>()),
+            ),
         )?;
-        let probe_positions: Vec<[f32; 3]> = instance.probes.iter().map(|p| f32s(&p.position(&sim.positions))).collect();
+        let probe_positions: Vec<[f32; 3]> =
+            instance.probes.iter().map(|p| f32s(&p.position(&sim.positions))).collect();
         rec.log(format!("{root}/probes"), &rerun::Points3D::update_fields().with_positions(probe_positions))?;
         if let Some(q) = &self.quadrature {
             q.eval_into(&sim.positions, &mut self.x);
@@ -196,7 +239,10 @@ impl SimLogger {
         }
         for (name, u) in instance.probe_displacements() {
             for (axis, value) in ["u_x_m", "u_y_m", "u_z_m"].iter().zip(u) {
-                rec.log(format!("plots/probe_{}_{axis}/{}", entity_name(&name), self.name), &rerun::Scalars::single(value))?;
+                rec.log(
+                    format!("plots/probe_{}_{axis}/{}", entity_name(&name), self.name),
+                    &rerun::Scalars::single(value),
+                )?;
             }
         }
         let (min_det_f, _) = hox_sim::surface::min_det_f(mesh, sim.geometry(), &sim.positions);

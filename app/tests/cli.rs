@@ -31,7 +31,10 @@ fn elements_lists_all_seven_types_as_json() {
 #[test]
 fn mesh_prints_the_papers_counts() {
     let m = json(&["mesh", "--scene", "bending", "--element", "p1", "--grid", "16x4x4", "--split", "five", "--json"]);
-    assert_eq!((m["element"].as_str().unwrap(), m["elements"].as_u64().unwrap(), m["nodes"].as_u64().unwrap()), ("p1", 1280, 425));
+    assert_eq!(
+        (m["element"].as_str().unwrap(), m["elements"].as_u64().unwrap(), m["nodes"].as_u64().unwrap()),
+        ("p1", 1280, 425)
+    );
     assert!((m["volume_m3"].as_f64().unwrap() - 0.5).abs() < 1e-12);
     let m = json(&["mesh", "--scene", "torsion", "--element", "p3", "--grid", "4x2x2", "--split", "six", "--json"]);
     assert_eq!((m["elements"].as_u64().unwrap(), m["nodes"].as_u64().unwrap()), (96, 637));
@@ -50,7 +53,8 @@ fn simulate_bending_settles_with_the_tip_sagging_between_a_quarter_and_sixty_cen
 
 #[test]
 fn simulate_runs_for_the_given_seconds_and_static_solves() {
-    let r = json(&["simulate", "--scene", "tension", "--element", "p1", "--grid", "6x3x3", "--seconds", "0.5", "--json"]);
+    let r =
+        json(&["simulate", "--scene", "tension", "--element", "p1", "--grid", "6x3x3", "--seconds", "0.5", "--json"]);
     assert_eq!(r["frames"], 30);
     assert!(r["probes"]["side_y"].is_array() && r["probes"]["side_z"].is_array());
     let s = json(&["static", "--scene", "bending", "--element", "p1", "--grid", "8x2x2", "--json"]);
@@ -85,7 +89,13 @@ fn non_finite_and_out_of_range_numbers_on_the_command_line_are_clear_errors() {
     let msh = gmsh_mesh("beam-hex27-v22.msh");
     let rrd = scratch("non-finite").join("never.rrd");
     let rrd = rrd.to_str().expect("utf-8 path");
-    let drive = |extra: &[&str]| -> Vec<String> { ["simulate", "--mesh", &msh, "--drive", "tip", "--seconds", "0.05"].iter().chain(extra).map(|s| s.to_string()).collect() };
+    let drive = |extra: &[&str]| -> Vec<String> {
+        ["simulate", "--mesh", &msh, "--drive", "tip", "--seconds", "0.05"]
+            .iter()
+            .chain(extra)
+            .map(|s| s.to_string())
+            .collect()
+    };
     for (args, needle) in [
         (vec!["simulate", "--scene", "bending", "--youngs", "inf", "--seconds", "0.05"], "Young's modulus"),
         (vec!["simulate", "--scene", "bending", "--youngs=-inf", "--seconds", "0.05"], "Young's modulus"),
@@ -100,8 +110,26 @@ fn non_finite_and_out_of_range_numbers_on_the_command_line_are_clear_errors() {
         (vec!["static", "--scene", "bending", "--tolerance", "nan"], "--tolerance"),
         (vec!["static", "--scene", "bending", "--load-steps", "0"], "--load-steps"),
         (vec!["static", "--scene", "bending", "--material", "snh", "--poisson", "0.5"], "Poisson ratio"),
-        (vec!["record", "--scene", "bending", "--seconds", "0.05", "--out", rrd, "--colour-max-m", "nan"], "--colour-max-m"),
-        (vec!["record", "--scene", "bending", "--seconds", "0.05", "--out", rrd, "--compare", "element=p1", "--compare", "youngs=nan"], "Young's modulus"),
+        (
+            vec!["record", "--scene", "bending", "--seconds", "0.05", "--out", rrd, "--colour-max-m", "nan"],
+            "--colour-max-m",
+        ),
+        (
+            vec![
+                "record",
+                "--scene",
+                "bending",
+                "--seconds",
+                "0.05",
+                "--out",
+                rrd,
+                "--compare",
+                "element=p1",
+                "--compare",
+                "youngs=nan",
+            ],
+            "Young's modulus",
+        ),
         (vec!["bench", "--frames", "0"], "--frames"),
     ] {
         fails_with(&args, needle);
@@ -151,7 +179,18 @@ fn simulate_a_gmsh_mesh_and_write_a_paraview_series() {
     let dir = scratch("vtk");
     let vtk = dir.join("out");
     let r = json(&[
-        "simulate", "--mesh", &gmsh_mesh("beam-tet10.msh"), "--clamp", "clamp", "--seconds", "0.1", "--vtk", vtk.to_str().unwrap(), "--vtk-every", "4", "--json",
+        "simulate",
+        "--mesh",
+        &gmsh_mesh("beam-tet10.msh"),
+        "--clamp",
+        "clamp",
+        "--seconds",
+        "0.1",
+        "--vtk",
+        vtk.to_str().unwrap(),
+        "--vtk-every",
+        "4",
+        "--json",
     ]);
     assert_eq!(r["frames"], 6);
     assert_eq!(r["groups"]["clamp"], serde_json::json!([0.0, 0.0, 0.0]));
@@ -162,7 +201,11 @@ fn simulate_a_gmsh_mesh_and_write_a_paraview_series() {
     assert_eq!(r["vtk"].as_str().unwrap(), vtk.join("beam-tet10.pvd").to_str().unwrap());
     for k in 0..3 {
         let vtu = std::fs::read_to_string(vtk.join(format!("beam-tet10_{k:06}.vtu"))).unwrap();
-        assert!(vtu.contains("NumberOfPoints=\"495\" NumberOfCells=\"218\"") && vtu.contains("Name=\"displacement_m\"") && vtu.contains("Name=\"von_mises_stress_pa\""));
+        assert!(
+            vtu.contains("NumberOfPoints=\"495\" NumberOfCells=\"218\"")
+                && vtu.contains("Name=\"displacement_m\"")
+                && vtu.contains("Name=\"von_mises_stress_pa\"")
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -170,16 +213,40 @@ fn simulate_a_gmsh_mesh_and_write_a_paraview_series() {
 #[test]
 fn a_driven_group_reaches_its_prescribed_position_in_the_static_solution() {
     let s = json(&[
-        "static", "--mesh", &gmsh_mesh("beam-hex8.msh"), "--clamp", "clamp", "--drive", "tip", "--drive-translation-m", "0,0,-0.1", "--no-gravity", "--json",
+        "static",
+        "--mesh",
+        &gmsh_mesh("beam-hex8.msh"),
+        "--clamp",
+        "clamp",
+        "--drive",
+        "tip",
+        "--drive-translation-m",
+        "0,0,-0.1",
+        "--no-gravity",
+        "--json",
     ]);
     let tip = &s["groups"]["tip"];
     assert!((tip[2].as_f64().unwrap() + 0.1).abs() < 1e-12 && tip[0].as_f64().unwrap().abs() < 1e-12, "{tip}");
     assert!(s["groups"]["body"][2].as_f64().unwrap() < 0.0);
     // a rotation about the group's own centre: the tip face turns, its centre stays
     let s = json(&[
-        "static", "--mesh", &gmsh_mesh("beam-hex8.msh"), "--clamp", "clamp", "--drive", "tip", "--drive-rotation-deg", "30", "--no-gravity", "--json",
+        "static",
+        "--mesh",
+        &gmsh_mesh("beam-hex8.msh"),
+        "--clamp",
+        "clamp",
+        "--drive",
+        "tip",
+        "--drive-rotation-deg",
+        "30",
+        "--no-gravity",
+        "--json",
     ]);
-    assert!(s["groups"]["tip"].as_array().unwrap().iter().all(|c| c.as_f64().unwrap().abs() < 1e-12), "{}", s["groups"]["tip"]);
+    assert!(
+        s["groups"]["tip"].as_array().unwrap().iter().all(|c| c.as_f64().unwrap().abs() < 1e-12),
+        "{}",
+        s["groups"]["tip"]
+    );
 }
 
 #[test]
@@ -193,7 +260,10 @@ fn bad_mesh_files_are_clear_errors_naming_the_file_and_the_element() {
     };
     let cases = [
         (write("unknown.msh", "1\n7 99 2 1 1 1 2 3 4\n"), "unknown.msh:17: element 7 has unknown Gmsh element type 99"),
-        (write("hex20.msh", "1\n7 17 2 1 1 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4\n"), "element 7 is a 20-node hexahedron (Gmsh type 17)"),
+        (
+            write("hex20.msh", "1\n7 17 2 1 1 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4\n"),
+            "element 7 is a 20-node hexahedron (Gmsh type 17)",
+        ),
         (write("range.msh", "1\n7 4 2 1 1 1 2 3 44\n"), "range.msh:17: element 7 refers to node 44"),
         (write("inverted.msh", "1\n7 4 2 1 1 2 1 3 4\n"), "element 7 (p1) is inverted"),
         (write("flat.msh", "1\n7 4 2 1 1 1 2 3 3\n"), "element 7 (p1) uses node 3 twice"),
@@ -205,8 +275,14 @@ fn bad_mesh_files_are_clear_errors_naming_the_file_and_the_element() {
         fails_with(&["mesh", "--mesh", path], path);
     }
     let good = write("good.msh", "2\n6 2 2 1 1 1 3 2\n7 4 2 1 1 1 2 3 4\n");
-    fails_with(&["simulate", "--mesh", &good, "--clamp", "wall"], "physical group \"wall\" does not exist (the file's groups: \"1\", \"clamp\") (the clamp group)");
-    fails_with(&["simulate", "--mesh", &good, "--drive", "clamp"], "--drive clamp: give a --drive-translation-m or a --drive-rotation-deg");
+    fails_with(
+        &["simulate", "--mesh", &good, "--clamp", "wall"],
+        "physical group \"wall\" does not exist (the file's groups: \"1\", \"clamp\") (the clamp group)",
+    );
+    fails_with(
+        &["simulate", "--mesh", &good, "--drive", "clamp"],
+        "--drive clamp: give a --drive-translation-m or a --drive-rotation-deg",
+    );
     fails_with(&["simulate", "--mesh", &good, "--drive-translation-m", "1,2"], "three finite numbers");
     fails_with(&["simulate", "--scene", "bending", "--clamp", "x"], "--clamp needs --mesh FILE.msh");
     fails_with(&["simulate", "--scene", "bending", "--vtk-every", "3"], "--vtk-every needs --vtk DIR");
@@ -223,7 +299,10 @@ fn an_unwritable_vtk_folder_is_an_error_before_simulating() {
     let file = dir.join("a-file");
     std::fs::write(&file, "x").unwrap();
     let started = std::time::Instant::now();
-    fails_with(&["simulate", "--scene", "bending", "--seconds", "1000", "--vtk", file.join("out").to_str().unwrap()], "--vtk");
+    fails_with(
+        &["simulate", "--scene", "bending", "--seconds", "1000", "--vtk", file.join("out").to_str().unwrap()],
+        "--vtk",
+    );
     assert!(started.elapsed().as_secs() < 30, "refused before simulating 1000 s");
     std::fs::remove_dir_all(&dir).unwrap();
 }

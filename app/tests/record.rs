@@ -28,7 +28,8 @@ fn entities(file: &Path) -> serde_json::Value {
 fn paper_scenes_record_and_read_back() {
     for scene in ["bending", "tension", "torsion"] {
         let file = temp(&format!("{scene}.rrd"));
-        let summary = ok_json(&["record", "--scene", scene, "--seconds", "0.25", "--out", file.to_str().unwrap(), "--json"]);
+        let summary =
+            ok_json(&["record", "--scene", scene, "--seconds", "0.25", "--out", file.to_str().unwrap(), "--json"]);
         assert_eq!(summary["frames"], 16, "{scene}: 15 steps at 60 fps plus the initial state");
         assert!(summary["bytes"].as_u64().unwrap() > 10_000);
         let checked = ok_json(&["inspect", file.to_str().unwrap(), "--expect-frames", "16", "--json"]);
@@ -39,20 +40,44 @@ fn paper_scenes_record_and_read_back() {
         let surface = &e[format!("world/{c}/surface")];
         assert!(surface["static_components"].as_array().unwrap().iter().any(|v| v == "Mesh3D:triangle_indices"));
         for component in ["Mesh3D:vertex_positions", "Mesh3D:vertex_colors", "Mesh3D:vertex_normals"] {
-            assert_eq!(surface["frames_per_component"][component].as_array().unwrap().len(), 16, "{scene}: {component}");
+            assert_eq!(
+                surface["frames_per_component"][component].as_array().unwrap().len(),
+                16,
+                "{scene}: {component}"
+            );
         }
         // every probe component and the energies are time series on the frame timeline
-        let probe_series: Vec<&String> = e.as_object().unwrap().keys().filter(|k| k.starts_with("plots/probe_") && k.ends_with(&format!("/{c}"))).collect();
-        assert!(probe_series.len() >= 3 && probe_series.len().is_multiple_of(3), "{scene}: three components per probe: {probe_series:?}");
+        let probe_series: Vec<&String> = e
+            .as_object()
+            .unwrap()
+            .keys()
+            .filter(|k| k.starts_with("plots/probe_") && k.ends_with(&format!("/{c}")))
+            .collect();
+        assert!(
+            probe_series.len() >= 3 && probe_series.len().is_multiple_of(3),
+            "{scene}: three components per probe: {probe_series:?}"
+        );
         for series in probe_series {
-            assert_eq!(e[series]["frames_per_component"]["Scalars:scalars"].as_array().map(Vec::len), Some(16), "{scene}: {series}");
+            assert_eq!(
+                e[series]["frames_per_component"]["Scalars:scalars"].as_array().map(Vec::len),
+                Some(16),
+                "{scene}: {series}"
+            );
         }
         for quantity in ["kinetic_energy_j", "elastic_energy_j", "ms_per_frame", "min_det_f"] {
             let series = &e[format!("plots/{quantity}/{c}")]["frames_per_component"]["Scalars:scalars"];
             assert_eq!(series.as_array().map(Vec::len), Some(16), "{scene}: plots/{quantity}/{c}");
         }
-        assert!(e[format!("world/{c}/legend/bar")]["static_components"].as_array().unwrap().iter().any(|v| v == "Mesh3D:vertex_colors"));
-        assert!(e[format!("legend/{c}")]["static_components"].as_array().unwrap().iter().any(|v| v == "TextDocument:text"));
+        assert!(
+            e[format!("world/{c}/legend/bar")]["static_components"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|v| v == "Mesh3D:vertex_colors")
+        );
+        assert!(
+            e[format!("legend/{c}")]["static_components"].as_array().unwrap().iter().any(|v| v == "TextDocument:text")
+        );
     }
 }
 
@@ -62,7 +87,21 @@ fn compare_records_p1_and_p2_side_by_side() {
     let f = file.to_str().unwrap();
     let vtk = temp("compare-vtk");
     let summary = ok_json(&[
-        "record", "--scene", "bending", "--seconds", "0.1", "--out", f, "--compare", "element=p1,refine=1", "--compare", "element=p2", "--quadrature-points", "--vtk", vtk.to_str().unwrap(), "--json",
+        "record",
+        "--scene",
+        "bending",
+        "--seconds",
+        "0.1",
+        "--out",
+        f,
+        "--compare",
+        "element=p1,refine=1",
+        "--compare",
+        "element=p2",
+        "--quadrature-points",
+        "--vtk",
+        vtk.to_str().unwrap(),
+        "--json",
     ]);
     // a VTK series per configuration beside the recording: 7 frames each
     let indexes: Vec<&str> = summary["vtk"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
@@ -72,14 +111,27 @@ fn compare_records_p1_and_p2_side_by_side() {
         let pvd = std::fs::read_to_string(index).unwrap();
         assert_eq!(pvd.matches("<DataSet").count(), 7, "{index}");
     }
-    let entities: Vec<&str> = summary["configurations"].as_array().unwrap().iter().map(|c| c["entity"].as_str().unwrap()).collect();
+    let entities: Vec<&str> =
+        summary["configurations"].as_array().unwrap().iter().map(|c| c["entity"].as_str().unwrap()).collect();
     assert_eq!(entities, ["world/p1_1280", "world/p2_160"]);
     let checked = ok_json(&["inspect", f, "--expect-frames", "7", "--json"]);
     assert_eq!(checked["configurations"], serde_json::json!(["p1_1280", "p2_160"]));
     let e = &checked["entities"];
     for c in ["p1_1280", "p2_160"] {
-        assert!(e[format!("world/{c}")]["static_components"].as_array().unwrap().iter().any(|v| v == "Transform3D:translation"), "{c} is offset");
-        assert_eq!(e[format!("world/{c}/quadrature_points")]["frames_per_component"]["Points3D:positions"].as_array().map(Vec::len), Some(7));
+        assert!(
+            e[format!("world/{c}")]["static_components"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|v| v == "Transform3D:translation"),
+            "{c} is offset"
+        );
+        assert_eq!(
+            e[format!("world/{c}/quadrature_points")]["frames_per_component"]["Points3D:positions"]
+                .as_array()
+                .map(Vec::len),
+            Some(7)
+        );
     }
 }
 
@@ -109,7 +161,11 @@ fn bad_output_or_options_fail_before_simulating_and_keep_existing_files() {
     // and an .rrd that is not one is named as such
     let out = hox(&["inspect", file.to_str().unwrap()]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("not a readable Rerun recording"), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("not a readable Rerun recording"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[cfg(unix)]

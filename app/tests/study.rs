@@ -39,10 +39,16 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
     assert!(md.contains("## Near incompressibility: volumetric locking"), "study.md lacks the locking table");
     let locking = std::fs::read_to_string(out.join("locking.csv")).unwrap();
     let missing = |nu: &str, config: &str| -> f64 {
-        let row = locking.lines().skip(1).map(|l| l.split(',').collect::<Vec<_>>()).find(|r| r[0] == nu && r[1] == config).unwrap_or_else(|| panic!("no locking row {nu} {config}"));
+        let row = locking
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .find(|r| r[0] == nu && r[1] == config)
+            .unwrap_or_else(|| panic!("no locking row {nu} {config}"));
         row[5].parse().unwrap()
     };
-    let (p1, p2, p3) = (missing("0.499", "P1 16x4x4 five"), missing("0.499", "P2 8x2x2 five"), missing("0.499", "P3 4x2x2 five"));
+    let (p1, p2, p3) =
+        (missing("0.499", "P1 16x4x4 five"), missing("0.499", "P2 8x2x2 five"), missing("0.499", "P3 4x2x2 five"));
     assert!(p1 > 3.0 * p2 && p2 > 0.0 && p3 > 0.0 && p3 < p2, "locking at ν = 0.499: P1 {p1} %, P2 {p2} %, P3 {p3} %");
     assert!(p1 > missing("0.35", "P1 16x4x4 five") + 10.0, "P1 must stiffen as ν → 0.5");
     std::fs::remove_dir_all(&out).ok();
@@ -50,7 +56,10 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
 
 #[test]
 fn an_unwritable_output_folder_is_refused_before_any_work() {
-    let out = Command::new(env!("CARGO_BIN_EXE_hox")).args(["study", "--quick", "--out", "/proc/hox-study"]).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_hox"))
+        .args(["study", "--quick", "--out", "/proc/hox-study"])
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("/proc/hox-study"), "{err}");

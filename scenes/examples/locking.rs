@@ -15,7 +15,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rows = hox_scenes::study::locking(false, &mut |message| eprintln!("{message}"))?;
     print!("{}", hox_scenes::study::locking_markdown(&rows));
     if let Some((mut file, path)) = csv {
-        file.write_all(hox_scenes::study::locking_csv(&rows).as_bytes()).map_err(|e| format!("cannot write {path}: {e}"))?;
+        file.write_all(hox_scenes::study::locking_csv(&rows).as_bytes())
+            .map_err(|e| format!("cannot write {path}: {e}"))?;
     }
     Ok(())
 }

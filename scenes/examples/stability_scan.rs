@@ -8,7 +8,10 @@ fn main() {
     println!("| configuration | elements | ω_max (rad/s) | substeps asked | h·ω_max | substeps taken |");
     println!("|---|---|---|---|---|---|");
     let row = |label: String, elements: usize, r: hox_sim::stability::StabilityReport| {
-        println!("| {label} | {elements} | {:.4e} | {} | {:.3} | {} |", r.omega_max_rad_s, r.requested_substeps, r.requested_h_omega, r.substeps);
+        println!(
+            "| {label} | {elements} | {:.4e} | {} | {:.3} | {} |",
+            r.omega_max_rad_s, r.requested_substeps, r.requested_h_omega, r.substeps
+        );
     };
     for (name, _) in hox_scenes::BUILTIN {
         let scene = hox_scenes::by_name(name).expect("built-in scene");

@@ -100,12 +100,21 @@ impl Instance {
     /// Writes the current state as the next frame of `series`: current positions,
     /// `displacement_m` per point and the volume-averaged von Mises stress per cell
     /// (`von_mises_stress_pa`); see [`hox_sim::mesh::vtk`].
-    pub fn write_vtk_frame(&self, series: &mut hox_sim::mesh::vtk::PvdSeries) -> Result<std::path::PathBuf, SceneError> {
+    pub fn write_vtk_frame(
+        &self,
+        series: &mut hox_sim::mesh::vtk::PvdSeries,
+    ) -> Result<std::path::PathBuf, SceneError> {
         use hox_sim::mesh::vtk::{DataArray, von_mises_stress_pa};
         let sim = &self.sim;
         let stress = von_mises_stress_pa(sim.mesh(), sim.geometry(), sim.material(), &sim.positions);
         series
-            .write_frame(sim.time_secs(), sim.mesh(), &sim.positions, &[], &[DataArray::scalars("von_mises_stress_pa", stress)])
+            .write_frame(
+                sim.time_secs(),
+                sim.mesh(),
+                &sim.positions,
+                &[],
+                &[DataArray::scalars("von_mises_stress_pa", stress)],
+            )
             .map_err(|e| SceneError::Simulation { source_name: self.scene.source.clone(), message: e.to_string() })
     }
 
@@ -140,14 +149,19 @@ pub fn solve_static(
         tolerance,
         load_steps,
     };
-    hox_sim::statics::solve(&problem, progress)
-        .map_err(|e| SceneError::Simulation { source_name: scene.source.clone(), message: format!("static solve: {e}") })
+    hox_sim::statics::solve(&problem, progress).map_err(|e| SceneError::Simulation {
+        source_name: scene.source.clone(),
+        message: format!("static solve: {e}"),
+    })
 }
 
 /// The static problem of a scene: body acceleration and Dirichlet conditions (clamped nodes at
 /// rest, prescribed ones moved to their final, fully ramped positions). Contact has no static
 /// counterpart here and is refused; damping does not change the equilibrium.
-pub fn static_problem(scene: &Scene, mesh: &hox_sim::mesh::Mesh) -> Result<(hox_sim::Vec3, Vec<hox_sim::effect::Prescribed>), SceneError> {
+pub fn static_problem(
+    scene: &Scene,
+    mesh: &hox_sim::mesh::Mesh,
+) -> Result<(hox_sim::Vec3, Vec<hox_sim::effect::Prescribed>), SceneError> {
     use scene::EffectSpec;
     let mut acceleration = hox_sim::Vec3::zeros();
     let mut dirichlet = Vec::new();

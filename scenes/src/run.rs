@@ -6,8 +6,8 @@
 //! consecutive frames, after all prescribed ramps and moving planes have stopped; or after
 //! `SETTLE_CAP_SECS` simulated seconds, reported as not settled.
 
-use crate::{Instance, SceneError};
 use crate::scene::EffectSpec;
+use crate::{Instance, SceneError};
 use hox_sim::effect::Damping;
 use std::time::Instant;
 
@@ -22,7 +22,9 @@ pub const SETTLE_CAP_SECS: f64 = 120.0;
 pub enum RunMode {
     Seconds(f64),
     /// Until settled, or for at most `cap_secs` simulated seconds.
-    Settle { cap_secs: f64 },
+    Settle {
+        cap_secs: f64,
+    },
 }
 
 impl RunMode {
@@ -48,7 +50,11 @@ pub struct RunReport {
 
 /// Runs `instance` and reports. `progress(sim_seconds, fraction)` is called after every frame
 /// (`fraction` is None when settling, whose length is not known in advance).
-pub fn run(instance: &mut Instance, mode: RunMode, progress: &mut dyn FnMut(f64, Option<f64>)) -> Result<RunReport, SceneError> {
+pub fn run(
+    instance: &mut Instance,
+    mode: RunMode,
+    progress: &mut dyn FnMut(f64, Option<f64>),
+) -> Result<RunReport, SceneError> {
     run_observed(instance, mode, progress, &mut |_| Ok(()))
 }
 
@@ -62,11 +68,13 @@ pub fn run_observed(
 ) -> Result<RunReport, SceneError> {
     let frame_secs = 1.0 / instance.scene.settings.frames_per_second;
     let source = instance.scene.source.clone();
-    let fail = |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: source.clone(), message: e.to_string() };
+    let fail =
+        |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: source.clone(), message: e.to_string() };
     let mut settled = false;
     let mut frame_ms: Vec<f64> = Vec::new();
     let window = (instance.scene.settings.frames_per_second.round() as usize).max(1);
-    let mut history: std::collections::VecDeque<Vec<(String, [f64; 3])>> = std::collections::VecDeque::with_capacity(window + 1);
+    let mut history: std::collections::VecDeque<Vec<(String, [f64; 3])>> =
+        std::collections::VecDeque::with_capacity(window + 1);
     let mut remember = |instance: &Instance| {
         history.push_back(instance.probe_displacements());
         if history.len() > window {
@@ -96,7 +104,8 @@ pub fn run_observed(
                 instance.sim.add_effect(Box::new(Damping { rate_per_sec: damping })).map_err(fail)?;
             }
             // a warm-started run (positions set by the caller) has its drives already applied
-            let driven_until = if instance.sim.time_secs() > 0.0 { 0.0 } else { driven_until_secs(&instance.scene.file.effects) };
+            let driven_until =
+                if instance.sim.time_secs() > 0.0 { 0.0 } else { driven_until_secs(&instance.scene.file.effects) };
             let (lo, hi) = instance.sim.mesh().bounding_box();
             let tolerance_m = SETTLE_TOLERANCE_REL * (hi - lo).norm();
             let mut quiet = 0;

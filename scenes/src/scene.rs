@@ -220,7 +220,9 @@ pub enum EffectSpec {
 impl EffectSpec {
     /// The prescribed motion this spec describes, acting on `nodes` (None for other effects).
     pub fn prescribed(&self, nodes: Vec<u32>) -> Option<Prescribed> {
-        let EffectSpec::Prescribed { translation_m, rotation_axis, rotation_origin_m, rotation_deg, ramp_secs, .. } = self else {
+        let EffectSpec::Prescribed { translation_m, rotation_axis, rotation_origin_m, rotation_deg, ramp_secs, .. } =
+            self
+        else {
             return None;
         };
         let rotation = rotation_axis.map(|axis| AxisRotation {
@@ -303,7 +305,9 @@ impl SceneMesh {
     pub fn element_names(&self) -> String {
         match self {
             SceneMesh::Box(b) => b.element_type.name().to_string(),
-            SceneMesh::File { imported, .. } => imported.mesh.blocks.iter().map(|b| b.element_type.name()).collect::<Vec<_>>().join("+"),
+            SceneMesh::File { imported, .. } => {
+                imported.mesh.blocks.iter().map(|b| b.element_type.name()).collect::<Vec<_>>().join("+")
+            }
         }
     }
 }
@@ -325,9 +329,18 @@ impl SceneFile {
                 split: None,
                 refine: None,
             },
-            material: MaterialSpec { model: "stvk".into(), youngs_modulus_pa: 3e6, poisson_ratio: 0.35, density_kg_m3: 1000.0 },
+            material: MaterialSpec {
+                model: "stvk".into(),
+                youngs_modulus_pa: 3e6,
+                poisson_ratio: 0.35,
+                density_kg_m3: 1000.0,
+            },
             solver: SolverSpec::default(),
-            effects: if gravity { vec![EffectSpec::Gravity { acceleration_m_s2: [0.0, 0.0, -9.81] }] } else { Vec::new() },
+            effects: if gravity {
+                vec![EffectSpec::Gravity { acceleration_m_s2: [0.0, 0.0, -9.81] }]
+            } else {
+                Vec::new()
+            },
             probes: Vec::new(),
         }
     }
@@ -381,7 +394,12 @@ impl Scene {
     }
 
     /// Validates `file`; `cached` is a mesh file already read for the same path.
-    fn validate(file: SceneFile, source: &str, base_dir: Option<PathBuf>, cached: Option<&SceneMesh>) -> Result<Scene, SceneError> {
+    fn validate(
+        file: SceneFile,
+        source: &str,
+        base_dir: Option<PathBuf>,
+        cached: Option<&SceneMesh>,
+    ) -> Result<Scene, SceneError> {
         let invalid = |key: &str, value: String, reason: &str| SceneError::Invalid {
             source_name: source.to_string(),
             key: key.to_string(),
@@ -395,15 +413,18 @@ impl Scene {
         let material = Material::new(model, mm.youngs_modulus_pa, mm.poisson_ratio, mm.density_kg_m3).map_err(|e| {
             use hox_sim::material::MaterialError as E;
             let (key, value) = match &e {
-                E::YoungsModulus { .. } | E::NonFiniteLame { .. } => ("material.youngs_modulus_pa", mm.youngs_modulus_pa),
+                E::YoungsModulus { .. } | E::NonFiniteLame { .. } => {
+                    ("material.youngs_modulus_pa", mm.youngs_modulus_pa)
+                }
                 E::PoissonRatio { .. } => ("material.poisson_ratio", mm.poisson_ratio),
                 E::Density { .. } => ("material.density_kg_m3", mm.density_kg_m3),
             };
             invalid(key, value.to_string(), &e.to_string())
         })?;
         let s = &file.solver;
-        let formulation = Formulation::from_name(&s.formulation)
-            .ok_or_else(|| invalid("solver.formulation", format!("{:?}", s.formulation), "expected \"energy\" or \"split\""))?;
+        let formulation = Formulation::from_name(&s.formulation).ok_or_else(|| {
+            invalid("solver.formulation", format!("{:?}", s.formulation), "expected \"energy\" or \"split\"")
+        })?;
         if s.substeps == 0 {
             return Err(invalid("solver.substeps", "0".into(), "must be at least 1"));
         }
@@ -421,7 +442,11 @@ impl Scene {
             for element_type in types {
                 let max = hox_sim::quadrature::max_degree(element_type.shape());
                 if d == 0 || d > max {
-                    return Err(invalid("solver.quadrature_degree", d.to_string(), &format!("must lie in 1..={max} for {element_type}")));
+                    return Err(invalid(
+                        "solver.quadrature_degree",
+                        d.to_string(),
+                        &format!("must lie in 1..={max} for {element_type}"),
+                    ));
                 }
             }
         }
@@ -464,7 +489,12 @@ impl Scene {
     /// A scene around a Gmsh mesh file ([`SceneFile::for_mesh_file`]) with its physical groups
     /// `clamps` held and `drives` moved: what `hox simulate --mesh` and the app's "Open mesh"
     /// build. Unknown groups are errors listing the file's groups.
-    pub fn from_mesh_file(path: &Path, clamps: &[String], drives: &[Drive], gravity: bool) -> Result<Scene, SceneError> {
+    pub fn from_mesh_file(
+        path: &Path,
+        clamps: &[String],
+        drives: &[Drive],
+        gravity: bool,
+    ) -> Result<Scene, SceneError> {
         let source = path.display().to_string();
         let base = Scene::from_file(SceneFile::for_mesh_file(path, gravity), &source)?;
         let imported = base.mesh.imported().expect("a mesh-file scene");
@@ -479,7 +509,8 @@ impl Scene {
             // rotate about the group's centre unless told otherwise
             let origin = match (d.rotation_axis, d.rotation_origin_m) {
                 (Some(_), None) => imported.node_set(&d.group).ok().filter(|n| !n.is_empty()).map(|nodes| {
-                    let c: Vec3 = nodes.iter().map(|&n| imported.mesh.rest_positions[n as usize]).sum::<Vec3>() / nodes.len() as f64;
+                    let c: Vec3 = nodes.iter().map(|&n| imported.mesh.rest_positions[n as usize]).sum::<Vec3>()
+                        / nodes.len() as f64;
                     [c.x, c.y, c.z]
                 }),
                 (_, o) => o,
@@ -567,7 +598,9 @@ impl Scene {
     /// Builds the mesh (a mesh file's was read when the scene was validated).
     pub fn build_mesh(&self) -> Result<Mesh, SceneError> {
         match &self.mesh {
-            SceneMesh::Box(b) => b.build().map_err(|e| SceneError::Mesh { source_name: self.source.clone(), message: e.to_string() }),
+            SceneMesh::Box(b) => {
+                b.build().map_err(|e| SceneError::Mesh { source_name: self.source.clone(), message: e.to_string() })
+            }
             SceneMesh::File { imported, .. } => Ok(imported.mesh.clone()),
         }
     }
@@ -605,15 +638,19 @@ impl Scene {
             effects.push(match e {
                 EffectSpec::Gravity { acceleration_m_s2 } => Box::new(Gravity::new(Vec3::from(*acceleration_m_s2))),
                 EffectSpec::Clamp { nodes } => Box::new(Clamp { nodes: select(nodes)? }),
-                EffectSpec::Prescribed { nodes, .. } => Box::new(e.prescribed(select(nodes)?).expect("a prescribed spec")),
+                EffectSpec::Prescribed { nodes, .. } => {
+                    Box::new(e.prescribed(select(nodes)?).expect("a prescribed spec"))
+                }
                 EffectSpec::Damping { rate_per_sec } => Box::new(Damping { rate_per_sec: *rate_per_sec }),
-                EffectSpec::Contact { point_m, normal, velocity_m_s, move_secs, friction } => Box::new(ContactPlane::new(
-                    Vec3::from(*point_m),
-                    Vec3::from(*normal),
-                    Vec3::from(*velocity_m_s),
-                    move_secs.unwrap_or(f64::INFINITY),
-                    *friction,
-                )),
+                EffectSpec::Contact { point_m, normal, velocity_m_s, move_secs, friction } => {
+                    Box::new(ContactPlane::new(
+                        Vec3::from(*point_m),
+                        Vec3::from(*normal),
+                        Vec3::from(*velocity_m_s),
+                        move_secs.unwrap_or(f64::INFINITY),
+                        *friction,
+                    ))
+                }
             });
         }
         Ok(effects)
@@ -687,13 +724,26 @@ fn validate_selector(key: &str, sel: &NodeSelector, invalid: &Invalid<'_>) -> Re
 fn validate_group(key: &str, sel: &NodeSelector, mesh: &SceneMesh, invalid: &Invalid<'_>) -> Result<(), SceneError> {
     let Some(name) = &sel.group else { return Ok(()) };
     match mesh.imported() {
-        None => Err(invalid(&format!("{key}.group"), format!("{name:?}"), "physical groups need a mesh file ([mesh] file = \"….msh\")")),
-        Some(imported) => imported.node_set(name).map(|_| ()).map_err(|e| invalid(&format!("{key}.group"), format!("{name:?}"), &e.to_string())),
+        None => Err(invalid(
+            &format!("{key}.group"),
+            format!("{name:?}"),
+            "physical groups need a mesh file ([mesh] file = \"….msh\")",
+        )),
+        Some(imported) => imported
+            .node_set(name)
+            .map(|_| ())
+            .map_err(|e| invalid(&format!("{key}.group"), format!("{name:?}"), &e.to_string())),
     }
 }
 
 /// The scene's mesh: a box from its fields, or the file (read now, or reused from `cached`).
-fn mesh_of(m: &MeshSpec, source: &str, base_dir: Option<&Path>, cached: Option<&SceneMesh>, invalid: &Invalid<'_>) -> Result<SceneMesh, SceneError> {
+fn mesh_of(
+    m: &MeshSpec,
+    source: &str,
+    base_dir: Option<&Path>,
+    cached: Option<&SceneMesh>,
+    invalid: &Invalid<'_>,
+) -> Result<SceneMesh, SceneError> {
     if let Some(file) = &m.file {
         let box_keys = [
             ("mesh.box_min_m", m.box_min_m.is_some()),
@@ -704,7 +754,13 @@ fn mesh_of(m: &MeshSpec, source: &str, base_dir: Option<&Path>, cached: Option<&
             ("mesh.refine", m.refine.is_some()),
         ];
         if let Some((key, _)) = box_keys.iter().find(|(_, given)| *given) {
-            return Err(invalid(key, "given".into(), &format!("the mesh is read from {file}; box_min_m, box_max_m, element, grid, split and refine describe box meshes")));
+            return Err(invalid(
+                key,
+                "given".into(),
+                &format!(
+                    "the mesh is read from {file}; box_min_m, box_max_m, element, grid, split and refine describe box meshes"
+                ),
+            ));
         }
         let path = match base_dir {
             Some(dir) if Path::new(file).is_relative() => dir.join(file),
@@ -725,20 +781,32 @@ fn mesh_of(m: &MeshSpec, source: &str, base_dir: Option<&Path>, cached: Option<&
         })?;
         return Ok(SceneMesh::File { path, imported: Arc::new(imported) });
     }
-    let missing = |key: &str| invalid(key, "missing".into(), "a box mesh needs box_min_m, box_max_m, element and grid (or give file = \"….msh\")");
+    let missing = |key: &str| {
+        invalid(
+            key,
+            "missing".into(),
+            "a box mesh needs box_min_m, box_max_m, element and grid (or give file = \"….msh\")",
+        )
+    };
     let box_min_m = m.box_min_m.ok_or_else(|| missing("mesh.box_min_m"))?;
     let box_max_m = m.box_max_m.ok_or_else(|| missing("mesh.box_max_m"))?;
     let element = m.element.as_deref().ok_or_else(|| missing("mesh.element"))?;
     let grid = m.grid.ok_or_else(|| missing("mesh.grid"))?;
     let split = m.split.as_deref().unwrap_or("five");
-    let element_type = ElementType::from_name(element)
-        .ok_or_else(|| invalid("mesh.element", format!("{element:?}"), &format!("expected one of {}", ElementType::names())))?;
-    let split = TetSplit::from_name(split).ok_or_else(|| invalid("mesh.split", format!("{split:?}"), "expected \"five\" or \"six\""))?;
+    let element_type = ElementType::from_name(element).ok_or_else(|| {
+        invalid("mesh.element", format!("{element:?}"), &format!("expected one of {}", ElementType::names()))
+    })?;
+    let split = TetSplit::from_name(split)
+        .ok_or_else(|| invalid("mesh.split", format!("{split:?}"), "expected \"five\" or \"six\""))?;
     finite3("mesh.box_min_m", &box_min_m, invalid)?;
     finite3("mesh.box_max_m", &box_max_m, invalid)?;
     for d in 0..3 {
         if box_max_m[d] <= box_min_m[d] {
-            return Err(invalid("mesh.box_max_m", format!("{box_max_m:?}"), "must exceed box_min_m in every direction"));
+            return Err(invalid(
+                "mesh.box_max_m",
+                format!("{box_max_m:?}"),
+                "must exceed box_min_m in every direction",
+            ));
         }
         if grid[d] == 0 {
             return Err(invalid("mesh.grid", format!("{grid:?}"), "needs at least one cell per direction"));

@@ -54,7 +54,13 @@ impl StudyConfig {
     }
     /// The scene overrides that build this configuration's mesh.
     pub fn overrides(&self) -> SceneOverrides {
-        SceneOverrides { element: Some(self.element.into()), grid: Some(self.grid), split: Some(self.split.name().into()), refine: Some(self.refine), ..Default::default() }
+        SceneOverrides {
+            element: Some(self.element.into()),
+            grid: Some(self.grid),
+            split: Some(self.split.name().into()),
+            refine: Some(self.refine),
+            ..Default::default()
+        }
     }
     pub fn label(&self) -> String {
         let is_tet = matches!(self.element, "p1" | "p2" | "p3");
@@ -137,13 +143,17 @@ pub fn reference(scene: &str) -> Result<Vec<(String, Vec3)>, SceneError> {
         name: scene.to_string(),
         available: "bending, tension, torsion".into(),
     })?;
-    let bad = |m: &str| SceneError::Parse { source_name: format!("assets/reference/{scene}-fine.json"), message: m.to_string() };
+    let bad = |m: &str| SceneError::Parse {
+        source_name: format!("assets/reference/{scene}-fine.json"),
+        message: m.to_string(),
+    };
     let v: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(&e.to_string()))?;
     let probes = v["probes"].as_object().ok_or_else(|| bad("no probes"))?;
     probes
         .iter()
         .map(|(name, u)| {
-            let c: Vec<f64> = u.as_array().ok_or_else(|| bad("probe is not an array"))?.iter().filter_map(|x| x.as_f64()).collect();
+            let c: Vec<f64> =
+                u.as_array().ok_or_else(|| bad("probe is not an array"))?.iter().filter_map(|x| x.as_f64()).collect();
             if c.len() != 3 {
                 return Err(bad("probe needs three components"));
             }
@@ -160,7 +170,11 @@ fn probe_distance(a: &[(String, Vec3)], b: &[(String, Vec3)]) -> f64 {
 }
 
 fn probes_of(instance: &Instance, positions: &[Vec3]) -> Vec<(String, Vec3)> {
-    instance.probes.iter().map(|p| (p.name.clone(), p.displacement(positions, &instance.sim.mesh().rest_positions))).collect()
+    instance
+        .probes
+        .iter()
+        .map(|p| (p.name.clone(), p.displacement(positions, &instance.sim.mesh().rest_positions)))
+        .collect()
 }
 
 /// The settled probe displacements of a run, or, when it never settled (XPBD can keep a small
@@ -177,7 +191,11 @@ fn caps(heavy: bool) -> (f64, f64) {
 }
 
 /// Runs one configuration of one scene. `progress(message)` reports what is being done.
-pub fn study_one(scene_name: &str, config: &StudyConfig, progress: &mut dyn FnMut(&str)) -> Result<StudyRow, SceneError> {
+pub fn study_one(
+    scene_name: &str,
+    config: &StudyConfig,
+    progress: &mut dyn FnMut(&str),
+) -> Result<StudyRow, SceneError> {
     let reference = reference(scene_name)?;
     let reference_size = reference.iter().map(|(_, u)| u.norm()).fold(0.0, f64::max);
     let base = crate::by_name(scene_name)?;
@@ -188,7 +206,8 @@ pub fn study_one(scene_name: &str, config: &StudyConfig, progress: &mut dyn FnMu
     // 1. the static solution on this mesh
     progress(&format!("{scene_name} {label}: static solution"));
     let mut instance = Instance::new(scene.clone())?;
-    let statics = crate::solve_static(&scene, instance.sim.mesh(), 1e-8, 1, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
+    let statics = crate::solve_static(&scene, instance.sim.mesh(), 1e-8, 1, &mut |_, _, _| {})
+        .map_err(|e| fail(e.to_string()))?;
     let static_probes = probes_of(&instance, &statics.positions);
 
     // 2. XPBD settled at the paper's settings
@@ -210,7 +229,8 @@ pub fn study_one(scene_name: &str, config: &StudyConfig, progress: &mut dyn FnMu
     let all_threads = run(&mut parallel, RunMode::Seconds(1.0), &mut |_, _| {})?.ms_per_frame;
 
     // 3. substeps for a solver error under 1 % (bias ∝ 1/substeps²), warm-started
-    let (mut substeps, mut ms_1pct, mut error_1pct_m) = (instance.sim.substeps_per_frame(), report.ms_per_frame, probe_distance(&xpbd_probes, &reference));
+    let (mut substeps, mut ms_1pct, mut error_1pct_m) =
+        (instance.sim.substeps_per_frame(), report.ms_per_frame, probe_distance(&xpbd_probes, &reference));
     let mut rel = solver_rel;
     let mut positions = instance.sim.positions.clone();
     let mut time = instance.sim.time_secs();
@@ -292,13 +312,25 @@ pub fn locking(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<Lockin
     use TetSplit::Five;
     let c = StudyConfig::new;
     let q2 = c("q2", [16, 4, 4], Five, 0, false);
-    let meshes = [c("p1", [16, 4, 4], Five, 0, false), c("p1", [16, 4, 4], Five, 1, true), c("p2", [8, 2, 2], Five, 0, false), c("p3", [4, 2, 2], Five, 0, false)];
+    let meshes = [
+        c("p1", [16, 4, 4], Five, 0, false),
+        c("p1", [16, 4, 4], Five, 1, true),
+        c("p2", [8, 2, 2], Five, 0, false),
+        c("p3", [4, 2, 2], Five, 0, false),
+    ];
     let mut rows = Vec::new();
     for nu in LOCKING_POISSON_RATIOS {
         let (q2_tip_z_m, _) = static_tip_z("bending", &q2, nu, progress)?;
         for config in meshes.iter().filter(|m| !(quick && m.heavy)) {
             let (tip_z_m, elements) = static_tip_z("bending", config, nu, progress)?;
-            rows.push(LockingRow { poisson_ratio: nu, config: config.label(), elements, tip_z_m, q2_tip_z_m, missing_pct: 100.0 * (1.0 - tip_z_m / q2_tip_z_m) });
+            rows.push(LockingRow {
+                poisson_ratio: nu,
+                config: config.label(),
+                elements,
+                tip_z_m,
+                q2_tip_z_m,
+                missing_pct: 100.0 * (1.0 - tip_z_m / q2_tip_z_m),
+            });
         }
     }
     Ok(rows)
@@ -306,15 +338,28 @@ pub fn locking(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<Lockin
 
 /// The static vertical displacement of `scene`'s "tip" probe on `config` at Poisson ratio `nu`,
 /// and the element count.
-fn static_tip_z(scene_name: &str, config: &StudyConfig, nu: f64, progress: &mut dyn FnMut(&str)) -> Result<(f64, usize), SceneError> {
+fn static_tip_z(
+    scene_name: &str,
+    config: &StudyConfig,
+    nu: f64,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(f64, usize), SceneError> {
     let label = config.label();
     progress(&format!("locking: {scene_name} {label} at ν = {nu}: static solution"));
-    let scene = crate::by_name(scene_name)?.with_overrides(&SceneOverrides { poisson_ratio: Some(nu), ..config.overrides() })?;
+    let scene = crate::by_name(scene_name)?
+        .with_overrides(&SceneOverrides { poisson_ratio: Some(nu), ..config.overrides() })?;
     let mesh = scene.build_mesh()?;
-    let fail = |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label} at ν = {nu}"), message: m };
+    let fail =
+        |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label} at ν = {nu}"), message: m };
     let solution = crate::solve_static(&scene, &mesh, 1e-8, 4, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
-    let tip = scene.file.probes.iter().find(|p| p.name == "tip").ok_or_else(|| fail("the scene has no probe named tip".into()))?;
-    let probe = hox_sim::probe::Probe::locate(&mesh, &tip.name, Vec3::from(tip.point_m)).map_err(|e| fail(e.to_string()))?;
+    let tip = scene
+        .file
+        .probes
+        .iter()
+        .find(|p| p.name == "tip")
+        .ok_or_else(|| fail("the scene has no probe named tip".into()))?;
+    let probe =
+        hox_sim::probe::Probe::locate(&mesh, &tip.name, Vec3::from(tip.point_m)).map_err(|e| fail(e.to_string()))?;
     Ok((probe.displacement(&solution.positions, &mesh.rest_positions).z, mesh.num_elements()))
 }
 
@@ -355,7 +400,10 @@ pub fn locking_markdown(rows: &[LockingRow]) -> String {
 pub fn locking_csv(rows: &[LockingRow]) -> String {
     let mut s = String::from("poisson_ratio,configuration,elements,tip_z_m,q2_tip_z_m,missing_pct\n");
     for r in rows {
-        s.push_str(&format!("{},{},{},{},{},{}\n", r.poisson_ratio, r.config, r.elements, r.tip_z_m, r.q2_tip_z_m, r.missing_pct));
+        s.push_str(&format!(
+            "{},{},{},{},{},{}\n",
+            r.poisson_ratio, r.config, r.elements, r.tip_z_m, r.q2_tip_z_m, r.missing_pct
+        ));
     }
     s
 }
@@ -401,7 +449,9 @@ pub fn markdown(rows: &[StudyRow], quick: bool) -> String {
 
 /// `study.csv`: the same rows.
 pub fn csv(rows: &[StudyRow]) -> String {
-    let mut s = String::from("scene,configuration,element,split,elements,nodes,constraints,ms_per_frame_1_thread,ms_per_frame_all_threads,error_m,error_pct,discretisation_m,solver_m,solver_pct,substeps_for_1pct,ms_per_frame_1pct,error_1pct_m,settled\n");
+    let mut s = String::from(
+        "scene,configuration,element,split,elements,nodes,constraints,ms_per_frame_1_thread,ms_per_frame_all_threads,error_m,error_pct,discretisation_m,solver_m,solver_pct,substeps_for_1pct,ms_per_frame_1pct,error_1pct_m,settled\n",
+    );
     for r in rows {
         s.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
@@ -453,10 +503,13 @@ pub fn svg(rows: &[StudyRow]) -> String {
     let (w, h, left, right, top, bottom) = (760.0, 520.0, 80.0, 170.0, 40.0, 60.0);
     let px = |x: f64| left + (x.max(1e-300).log10() - x0) / (x1 - x0) * (w - left - right);
     let py = |y: f64| top + (y1 - y.max(1e-300).log10()) / (y1 - y0) * (h - top - bottom);
-    let mut s = format!(r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">
+    let mut s = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">
 <rect width="{w}" height="{h}" fill="white"/>
 <text x="{}" y="22" text-anchor="middle" font-size="15">Bending: tip error vs time per frame (log–log)</text>
-"#, w / 2.0);
+"#,
+        w / 2.0
+    );
     for d in (x0 as i32)..=(x1 as i32) {
         let x = px(10f64.powi(d));
         s.push_str(&format!(r##"<line x1="{x}" y1="{top}" x2="{x}" y2="{}" stroke="#ddd"/><text x="{x}" y="{}" text-anchor="middle">1e{d}</text>
@@ -467,20 +520,41 @@ pub fn svg(rows: &[StudyRow]) -> String {
         s.push_str(&format!(r##"<line x1="{left}" y1="{y}" x2="{}" y2="{y}" stroke="#ddd"/><text x="{}" y="{}" text-anchor="end">1e{d}</text>
 "##, w - right, left - 6.0, y + 4.0));
     }
-    s.push_str(&format!(r#"<rect x="{left}" y="{top}" width="{}" height="{}" fill="none" stroke="black"/>
+    s.push_str(&format!(
+        r#"<rect x="{left}" y="{top}" width="{}" height="{}" fill="none" stroke="black"/>
 <text x="{}" y="{}" text-anchor="middle">ms per frame</text>
 <text x="18" y="{}" text-anchor="middle" transform="rotate(-90 18 {})">tip error vs reference (m)</text>
-"#, w - left - right, h - top - bottom, left + (w - left - right) / 2.0, h - 14.0, top + (h - top - bottom) / 2.0, top + (h - top - bottom) / 2.0));
+"#,
+        w - left - right,
+        h - top - bottom,
+        left + (w - left - right) / 2.0,
+        h - 14.0,
+        top + (h - top - bottom) / 2.0,
+        top + (h - top - bottom) / 2.0
+    ));
     for r in &bending {
         let c = colour(&r.element);
         if positive(&r.error_1pct_m) && r.substeps_for_1pct != 50 {
-            s.push_str(&format!(r#"<line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{c}" stroke-dasharray="3,3"/>
-"#, px(r.ms_per_frame), py(r.error_m), px(r.ms_per_frame_1pct), py(r.error_1pct_m)));
+            s.push_str(&format!(
+                r#"<line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{c}" stroke-dasharray="3,3"/>
+"#,
+                px(r.ms_per_frame),
+                py(r.error_m),
+                px(r.ms_per_frame_1pct),
+                py(r.error_1pct_m)
+            ));
             s.push_str(&format!(r#"<circle cx="{}" cy="{}" r="5" fill="white" stroke="{c}" stroke-width="2"><title>{} at {} substeps: {:.3} ms, {:.2e} m</title></circle>
 "#, px(r.ms_per_frame_1pct), py(r.error_1pct_m), r.config, r.substeps_for_1pct, r.ms_per_frame_1pct, r.error_1pct_m));
         }
-        s.push_str(&format!(r#"<circle cx="{}" cy="{}" r="5" fill="{c}"><title>{} at 50 substeps: {:.3} ms, {:.2e} m</title></circle>
-"#, px(r.ms_per_frame), py(r.error_m), r.config, r.ms_per_frame, r.error_m));
+        s.push_str(&format!(
+            r#"<circle cx="{}" cy="{}" r="5" fill="{c}"><title>{} at 50 substeps: {:.3} ms, {:.2e} m</title></circle>
+"#,
+            px(r.ms_per_frame),
+            py(r.error_m),
+            r.config,
+            r.ms_per_frame,
+            r.error_m
+        ));
     }
     for (label, elements, ms, err) in PAPER_TABLE_1 {
         let c = colour(&label.to_lowercase());
@@ -492,8 +566,14 @@ pub fn svg(rows: &[StudyRow]) -> String {
     let lx = w - right + 15.0;
     let mut ly = top + 10.0;
     for e in ["p1", "p2", "p3", "q1", "q2", "prism", "pyramid"] {
-        s.push_str(&format!(r#"<circle cx="{lx}" cy="{ly}" r="5" fill="{}"/><text x="{}" y="{}">{}</text>
-"#, colour(e), lx + 10.0, ly + 4.0, e.to_uppercase()));
+        s.push_str(&format!(
+            r#"<circle cx="{lx}" cy="{ly}" r="5" fill="{}"/><text x="{}" y="{}">{}</text>
+"#,
+            colour(e),
+            lx + 10.0,
+            ly + 4.0,
+            e.to_uppercase()
+        ));
         ly += 18.0;
     }
     ly += 8.0;

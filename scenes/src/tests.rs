@@ -39,8 +39,10 @@ fn the_paper_scenes_have_the_papers_parameters() {
 
 #[test]
 fn teaching_scenes_each_use_an_effect_the_paper_scenes_do_not() {
-    let paper: std::collections::HashSet<&str> =
-        PAPER_SCENES.iter().flat_map(|n| by_name(n).unwrap().file.effects.iter().map(|e| e.kind()).collect::<Vec<_>>()).collect();
+    let paper: std::collections::HashSet<&str> = PAPER_SCENES
+        .iter()
+        .flat_map(|n| by_name(n).unwrap().file.effects.iter().map(|e| e.kind()).collect::<Vec<_>>())
+        .collect();
     let teaching: Vec<Scene> = registry().unwrap().into_iter().filter(|s| !PAPER_SCENES.contains(&s.name())).collect();
     assert!(teaching.len() >= 3);
     for s in teaching {
@@ -96,8 +98,14 @@ fn bad_scene_files_give_errors_naming_the_file_key_and_value() {
         (bending_text().replace("element = \"p2\"", "element = \"p9\""), "mesh.element"),
         (bending_text().replace("split = \"five\"", "split = \"seven\""), "mesh.split"),
         (bending_text().replace("grid = [8, 2, 2]", "grid = [8, 0, 2]"), "mesh.grid"),
-        (bending_text().replace("acceleration_m_s2 = [0.0, 0.0, -9.81]", "acceleration_m_s2 = [0.0, nan, -9.81]"), "effects[0].acceleration_m_s2"),
-        (bending_text().replace("nodes = { plane = \"x\", at_m = 0.0 }", "nodes = { plane = \"w\", at_m = 0.0 }"), "effects[1].nodes.plane"),
+        (
+            bending_text().replace("acceleration_m_s2 = [0.0, 0.0, -9.81]", "acceleration_m_s2 = [0.0, nan, -9.81]"),
+            "effects[0].acceleration_m_s2",
+        ),
+        (
+            bending_text().replace("nodes = { plane = \"x\", at_m = 0.0 }", "nodes = { plane = \"w\", at_m = 0.0 }"),
+            "effects[1].nodes.plane",
+        ),
         (bending_text().replace("type = \"gravity\"", "type = \"magnetism\""), "magnetism"),
         (bending_text().replace("[material]\nmodel = \"stvk\"\n", "[material]\n"), "model"),
     ];
@@ -123,13 +131,19 @@ fn a_probe_outside_the_body_and_a_clamp_selecting_nothing_are_errors() {
 #[test]
 fn overrides_change_the_scene_and_are_validated() {
     let s = by_name("bending").unwrap();
-    let o = SceneOverrides { element: Some("p1".into()), grid: Some([16, 4, 4]), youngs_modulus_pa: Some(1e6), ..Default::default() };
+    let o = SceneOverrides {
+        element: Some("p1".into()),
+        grid: Some([16, 4, 4]),
+        youngs_modulus_pa: Some(1e6),
+        ..Default::default()
+    };
     let t = s.with_overrides(&o).unwrap();
     assert_eq!(t.build_mesh().unwrap().num_elements(), 1280);
     assert_eq!(t.material.youngs_modulus_pa, 1e6);
     let bad = SceneOverrides { poisson_ratio: Some(0.7), ..Default::default() };
     assert!(s.with_overrides(&bad).unwrap_err().to_string().contains("Poisson"));
-    let split_negative = SceneOverrides { formulation: Some("split".into()), poisson_ratio: Some(-0.2), ..Default::default() };
+    let split_negative =
+        SceneOverrides { formulation: Some("split".into()), poisson_ratio: Some(-0.2), ..Default::default() };
     assert!(s.with_overrides(&split_negative).unwrap_err().to_string().contains("split formulation"));
 }
 

@@ -17,7 +17,11 @@ use std::time::Duration;
 fn frames(c: &mut Criterion) {
     for case in &CASES {
         let mut group = c.benchmark_group(format!("frame/{}", case.label()));
-        group.sampling_mode(SamplingMode::Flat).sample_size(10).warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(4));
+        group
+            .sampling_mode(SamplingMode::Flat)
+            .sample_size(10)
+            .warm_up_time(Duration::from_secs(1))
+            .measurement_time(Duration::from_secs(4));
         // (threads, colour sweep): 1 thread serial and colour (P1: four per register), 2 colour
         for (threads, colour) in [(1, false), (1, true), (2, true)] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
@@ -57,7 +61,19 @@ fn kernels(c: &mut Criterion) {
                 || (start.clone(), vec![0.0; block.len()]),
                 |(x, lambdas)| {
                     // SAFETY: one thread, sizes from the mesh.
-                    unsafe { energy_sweep(n, &material, Positions::new(x), &mesh.rest_positions, &inv_mass, &packed.data(), 0..block.len(), Multipliers::new(lambdas), inv_dt2) }
+                    unsafe {
+                        energy_sweep(
+                            n,
+                            &material,
+                            Positions::new(x),
+                            &mesh.rest_positions,
+                            &inv_mass,
+                            &packed.data(),
+                            0..block.len(),
+                            Multipliers::new(lambdas),
+                            inv_dt2,
+                        )
+                    }
                 },
                 BatchSize::LargeInput,
             )
@@ -73,7 +89,16 @@ fn kernels(c: &mut Criterion) {
                         for (wi, &node) in w.iter_mut().zip(nodes) {
                             *wi = inv_mass[node as usize];
                         }
-                        project_energy_constraint(&mut x, &rest, &w, element_grads(&g, e), g.volumes(e), &material, inv_dt2, &mut lambdas[e]);
+                        project_energy_constraint(
+                            &mut x,
+                            &rest,
+                            &w,
+                            element_grads(&g, e),
+                            g.volumes(e),
+                            &material,
+                            inv_dt2,
+                            &mut lambdas[e],
+                        );
                         for (xi, &node) in x.iter().zip(nodes) {
                             positions[node as usize] = *xi;
                         }
@@ -108,7 +133,21 @@ fn colour_batches(c: &mut Criterion) {
                 |(x, lambdas)| {
                     for k in 0..packed.num_colours() {
                         // SAFETY: one thread, sizes from the mesh.
-                        let r = unsafe { colour_sweep(4, &material, Positions::new(x), &mesh.rest_positions, &inv_mass, &packed, k, packed.colour(k), Multipliers::new(lambdas), inv_dt2, batched) };
+                        let r = unsafe {
+                            colour_sweep(
+                                4,
+                                &material,
+                                Positions::new(x),
+                                &mesh.rest_positions,
+                                &inv_mass,
+                                &packed,
+                                k,
+                                packed.colour(k),
+                                Multipliers::new(lambdas),
+                                inv_dt2,
+                                batched,
+                            )
+                        };
                         r.expect("P1").expect("finite");
                     }
                 },

@@ -13,6 +13,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let positions: Vec<String> = mesh.rest_positions.iter().map(|p| format!("[{},{},{}]", p.x, p.y, p.z)).collect();
     let tets: Vec<String> = mesh.blocks[0].connectivity.iter().map(u32::to_string).collect();
     let clamped: Vec<String> = mesh.nodes_where(|p| p.x.abs() < 1e-12).iter().map(u32::to_string).collect();
-    println!("{{\"positions_m\":[{}],\"tets\":[{}],\"clamped\":[{}]}}", positions.join(","), tets.join(","), clamped.join(","));
+    println!(
+        "{{\"positions_m\":[{}],\"tets\":[{}],\"clamped\":[{}]}}",
+        positions.join(","),
+        tets.join(","),
+        clamped.join(",")
+    );
     Ok(())
 }

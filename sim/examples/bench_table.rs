@@ -12,9 +12,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => vec![1, 2],
     };
     let filter = args.next().unwrap_or_default();
-    let rows = hox_sim::benchmark::run(&filter, &threads, std::env::var("HOX_BENCH_COLOUR_ON_ONE").map_or(true, |v| v != "0"), frames, &mut |r| {
-        eprintln!("{} on {} thread(s), parallel {}: {:.2} ms/frame", r.case.label(), r.threads, r.parallel, r.ms_per_frame)
-    })?;
+    let rows = hox_sim::benchmark::run(
+        &filter,
+        &threads,
+        std::env::var("HOX_BENCH_COLOUR_ON_ONE").map_or(true, |v| v != "0"),
+        frames,
+        &mut |r| {
+            eprintln!(
+                "{} on {} thread(s), parallel {}: {:.2} ms/frame",
+                r.case.label(),
+                r.threads,
+                r.parallel,
+                r.ms_per_frame
+            )
+        },
+    )?;
     print!("{}", hox_sim::benchmark::markdown(&rows));
     Ok(())
 }

@@ -63,8 +63,9 @@ pub const CASES: [BenchCase; 9] = [
 
 /// The paper's bending beam for `case`, at rest; `parallel` selects the colour sweep.
 pub fn bending_beam(case: &BenchCase, parallel: bool) -> Result<Simulation, SimError> {
-    let element_type = ElementType::from_name(case.element)
-        .ok_or_else(|| SimError::Settings(format!("unknown element type '{}' (known: {})", case.element, ElementType::names())))?;
+    let element_type = ElementType::from_name(case.element).ok_or_else(|| {
+        SimError::Settings(format!("unknown element type '{}' (known: {})", case.element, ElementType::names()))
+    })?;
     let mesh = BoxMeshSpec {
         grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(2.0, 0.5, 0.5), cells: case.grid },
         element_type,
@@ -72,9 +73,11 @@ pub fn bending_beam(case: &BenchCase, parallel: bool) -> Result<Simulation, SimE
         refine: case.refine,
     }
     .build()?;
-    let material = Material::new(MaterialModel::StVenantKirchhoff, 3.0e6, 0.35, 1000.0).map_err(|e| SimError::Settings(e.to_string()))?;
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 3.0e6, 0.35, 1000.0)
+        .map_err(|e| SimError::Settings(e.to_string()))?;
     let clamped = mesh.nodes_where(|p| p.x.abs() < 1e-12);
-    let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))), Box::new(Clamp { nodes: clamped })];
+    let effects: Vec<Box<dyn Effect>> =
+        vec![Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))), Box::new(Clamp { nodes: clamped })];
     Simulation::new(mesh, material, SolverSettings { parallel, ..SolverSettings::default() }, effects)
 }
 
@@ -121,9 +124,17 @@ pub fn median(values: &mut [f64]) -> f64 {
 /// Times `case` with the serial sweep or the `parallel` colour sweep, in a rayon pool of
 /// `threads`: `warmup_frames` untimed, then the median of `frames` timed frames. Frames are
 /// also capped by `budget_secs` of timed work (at least 3 frames).
-pub fn measure(case: &BenchCase, threads: usize, parallel: bool, warmup_frames: usize, frames: usize, budget_secs: f64) -> Result<BenchRow, SimError> {
+pub fn measure(
+    case: &BenchCase,
+    threads: usize,
+    parallel: bool,
+    warmup_frames: usize,
+    frames: usize,
+    budget_secs: f64,
+) -> Result<BenchRow, SimError> {
     let threads = threads.max(1);
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| SimError::Settings(e.to_string()))?;
+    let pool =
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| SimError::Settings(e.to_string()))?;
     pool.install(|| {
         let mut sim = bending_beam(case, parallel)?;
         for _ in 0..warmup_frames {
@@ -192,12 +203,21 @@ pub fn markdown(rows: &[BenchRow]) -> String {
 /// colour sweep on one thread, which projects linear tetrahedra four per 256-bit register:
 /// `crate::kernels::p1x4`), reporting each row to `progress` as it is measured (what
 /// `hox bench` runs).
-pub fn run(filter: &str, threads: &[usize], colour_on_one: bool, frames: usize, progress: &mut dyn FnMut(&BenchRow)) -> Result<Vec<BenchRow>, SimError> {
+pub fn run(
+    filter: &str,
+    threads: &[usize],
+    colour_on_one: bool,
+    frames: usize,
+    progress: &mut dyn FnMut(&BenchRow),
+) -> Result<Vec<BenchRow>, SimError> {
     let filter = filter.to_uppercase();
     // a whole label picks that case alone ("P1 16x4x4" is also part of its refinements' labels)
     let exact = CASES.iter().any(|c| c.label().to_uppercase() == filter);
     let mut rows = Vec::new();
-    for case in CASES.iter().filter(|c| if exact { c.label().to_uppercase() == filter } else { c.label().to_uppercase().contains(&filter) }) {
+    for case in CASES
+        .iter()
+        .filter(|c| if exact { c.label().to_uppercase() == filter } else { c.label().to_uppercase().contains(&filter) })
+    {
         for &t in threads {
             let sweeps: &[bool] = if t == 1 && colour_on_one { &[false, true] } else { &[t > 1] };
             for &parallel in sweeps {

@@ -209,13 +209,8 @@ pub fn project_split_constraints(
         let (a, b, d) = (weighted_dot(w, g0, g0), weighted_dot(w, g0, g1), weighted_dot(w, g1, g1));
         let alpha_tilde = [inv_dt2 / (stiffness[0] * v), inv_dt2 / (stiffness[1] * v)];
         let lambda = [lambdas[2 * q], lambdas[2 * q + 1]];
-        let result = xpbd_block_step::<2>(
-            terms.map(|t| t.value),
-            terms.map(|t| t.scale),
-            [[a, b], [b, d]],
-            alpha_tilde,
-            lambda,
-        );
+        let result =
+            xpbd_block_step::<2>(terms.map(|t| t.value), terms.map(|t| t.scale), [[a, b], [b, d]], alpha_tilde, lambda);
         if let Some((d_lambda, step)) = result {
             lambdas[2 * q] += d_lambda[0];
             lambdas[2 * q + 1] += d_lambda[1];

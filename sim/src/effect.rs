@@ -271,8 +271,23 @@ impl Effect for Attachment {
 mod tests {
     use super::*;
 
-    fn state<'a>(t: f64, rest: &'a [Vec3], x: &'a mut [Vec3], prev: &'a [Vec3], v: &'a mut [Vec3], w: &'a [f64]) -> EffectState<'a> {
-        EffectState { time_secs: t, dt_secs: 0.01, rest_positions: rest, positions: x, prev_positions: prev, velocities: v, inv_mass: w }
+    fn state<'a>(
+        t: f64,
+        rest: &'a [Vec3],
+        x: &'a mut [Vec3],
+        prev: &'a [Vec3],
+        v: &'a mut [Vec3],
+        w: &'a [f64],
+    ) -> EffectState<'a> {
+        EffectState {
+            time_secs: t,
+            dt_secs: 0.01,
+            rest_positions: rest,
+            positions: x,
+            prev_positions: prev,
+            velocities: v,
+            inv_mass: w,
+        }
     }
 
     #[test]
@@ -290,7 +305,11 @@ mod tests {
         let p = Prescribed {
             nodes: vec![0],
             translation_m: Vec3::zeros(),
-            rotation: Some(AxisRotation { axis: Vec3::x(), origin_m: Vec3::new(1.0, 0.25, 0.25), angle_rad: std::f64::consts::FRAC_PI_2 }),
+            rotation: Some(AxisRotation {
+                axis: Vec3::x(),
+                origin_m: Vec3::new(1.0, 0.25, 0.25),
+                angle_rad: std::f64::consts::FRAC_PI_2,
+            }),
             ramp_secs: 1.0,
         };
         // +90° about +x takes +y to +z: the corner (1, 0.5, 0.25) goes to (1, 0.25, 0.5)

@@ -65,7 +65,14 @@ pub fn element_energy_and_gradient(
 /// The element Hessian `∂²U_e/∂x∂x` (3n × 3n, node-major: row `3 i + a`). With `projected`,
 /// `dP/dF` is projected to positive semi-definite at each quadrature point, which makes the
 /// element Hessian positive semi-definite (for Newton's method far from equilibrium).
-pub fn element_hessian(x: &[Vec3], rest: &[Vec3], grads: &[Vec3], volumes: &[f64], material: &Material, projected: bool) -> DMatrix<f64> {
+pub fn element_hessian(
+    x: &[Vec3],
+    rest: &[Vec3],
+    grads: &[Vec3],
+    volumes: &[f64],
+    material: &Material,
+    projected: bool,
+) -> DMatrix<f64> {
     let n = x.len();
     let mut h = DMatrix::zeros(3 * n, 3 * n);
     for (q, v) in volumes.iter().enumerate() {

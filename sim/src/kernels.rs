@@ -206,7 +206,8 @@ struct SweepIo<'a> {
 /// multiply–add when `FMA` (set only by [`sweep_avx2`], where the CPU has both).
 #[inline(always)]
 fn fma_lanes<const FMA: bool>(acc: &mut [f64; LANES], a: &[f64], b: &[f64]) {
-    let (a, b): (&[f64; LANES], &[f64; LANES]) = (a[..LANES].try_into().expect("LANES"), b[..LANES].try_into().expect("LANES"));
+    let (a, b): (&[f64; LANES], &[f64; LANES]) =
+        (a[..LANES].try_into().expect("LANES"), b[..LANES].try_into().expect("LANES"));
     #[cfg(target_arch = "x86_64")]
     if FMA {
         use std::arch::x86_64::{_mm256_fmadd_pd, _mm256_loadu_pd, _mm256_storeu_pd};
@@ -216,7 +217,11 @@ fn fma_lanes<const FMA: bool>(acc: &mut [f64; LANES], a: &[f64], b: &[f64]) {
         // incremental) left it out of line, one call per four lanes (82 % of the debug build's
         // `hox study --quick` in it, by perf; 7 min 29 s → 6 min 2 s once inlined, same results).
         unsafe {
-            let r = _mm256_fmadd_pd(_mm256_loadu_pd(a.as_ptr()), _mm256_loadu_pd(b.as_ptr()), _mm256_loadu_pd(acc.as_ptr()));
+            let r = _mm256_fmadd_pd(
+                _mm256_loadu_pd(a.as_ptr()),
+                _mm256_loadu_pd(b.as_ptr()),
+                _mm256_loadu_pd(acc.as_ptr()),
+            );
             _mm256_storeu_pd(acc.as_mut_ptr(), r);
         }
         return;
@@ -292,7 +297,8 @@ unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMateria
         if N == 4 && q == 1 {
             // the linear tetrahedron: one point, constant gradients
             let x4: &mut [Vec3; 4] = (&mut x[..]).try_into().expect("4 nodes");
-            let (d4, w4): (&[Vec3; 4], &[f64; 4]) = (d[..].try_into().expect("4 nodes"), w[..].try_into().expect("4 nodes"));
+            let (d4, w4): (&[Vec3; 4], &[f64; 4]) =
+                (d[..].try_into().expect("4 nodes"), w[..].try_into().expect("4 nodes"));
             project_p1::<FMA, M>(x4, d4, w4, grads, volumes[0], material, inv_dt2, lambda);
         } else {
             let mut u = [[0.0; P]; 3];
@@ -328,7 +334,16 @@ unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMateria
 /// `grads` is the point's `3 × 4` structure-of-arrays block; `v` its volume.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub fn project_p1<const FMA: bool, M: PointMaterial>(x: &mut [Vec3; 4], u: &[Vec3; 4], w: &[f64; 4], grads: &[f64], v: f64, material: &M, inv_dt2: f64, lambda: &mut f64) -> f64 {
+pub fn project_p1<const FMA: bool, M: PointMaterial>(
+    x: &mut [Vec3; 4],
+    u: &[Vec3; 4],
+    w: &[f64; 4],
+    grads: &[f64],
+    v: f64,
+    material: &M,
+    inv_dt2: f64,
+    lambda: &mut f64,
+) -> f64 {
     // g[(i − 1, b)] = ∂N_i/∂X_b
     let g = Mat3::new(grads[1], grads[5], grads[9], grads[2], grads[6], grads[10], grads[3], grads[7], grads[11]);
     let du = Mat3::from_columns(&[u[1] - u[0], u[2] - u[0], u[3] - u[0]]);
@@ -340,7 +355,10 @@ pub fn project_p1<const FMA: bool, M: PointMaterial>(x: &mut [Vec3; 4], u: &[Vec
     let grad = [g0, h.column(0).into_owned(), h.column(1).into_owned(), h.column(2).into_owned()];
     let energy = (v * psi).max(0.0);
     let c = (2.0 * energy).sqrt();
-    let sum_w_grad2 = w[0] * grad[0].norm_squared() + w[1] * grad[1].norm_squared() + w[2] * grad[2].norm_squared() + w[3] * grad[3].norm_squared();
+    let sum_w_grad2 = w[0] * grad[0].norm_squared()
+        + w[1] * grad[1].norm_squared()
+        + w[2] * grad[2].norm_squared()
+        + w[3] * grad[3].norm_squared();
     if let Some((d_lambda, step)) = xpbd_step(c, c, sum_w_grad2, inv_dt2, *lambda) {
         *lambda += d_lambda;
         for i in 0..4 {
@@ -387,7 +405,7 @@ pub fn project_energy<const N: usize, const P: usize, const FMA: bool, M: PointM
                 f[(a, b)] += (s[0] + s[1]) + (s[2] + s[3]);
             }
         }
-    let (psi, p) = material.energy_and_pk1::<FMA>(&f);
+        let (psi, p) = material.energy_and_pk1::<FMA>(&f);
         energy += v * psi;
         let vp = p * *v;
         for a in 0..3 {
@@ -483,7 +501,8 @@ pub unsafe fn colour_sweep(
         tail.start += 4 * batches;
     }
     // SAFETY: forwarded from the caller.
-    let rest_of = unsafe { energy_sweep(nodes_per_element, material, positions, rest, inv_mass, &data, tail, lambdas, inv_dt2) }?;
+    let rest_of =
+        unsafe { energy_sweep(nodes_per_element, material, positions, rest, inv_mass, &data, tail, lambdas, inv_dt2) }?;
     Some(rest_of.map(|k| k + projected))
 }
 
@@ -526,7 +545,19 @@ pub fn parallel_energy_block(
     let (positions, lambdas) = (Positions::new(positions), Multipliers::new(lambdas));
     let packed = match sweep {
         BlockSweep::Colours(packed) => packed,
-        BlockSweep::Slabs(partition) => return Some(slab_sweep(nodes_per_element, material, positions, rest, inv_mass, partition, lambdas, inv_dt2, batched)),
+        BlockSweep::Slabs(partition) => {
+            return Some(slab_sweep(
+                nodes_per_element,
+                material,
+                positions,
+                rest,
+                inv_mass,
+                partition,
+                lambdas,
+                inv_dt2,
+                batched,
+            ));
+        }
     };
     let threads = rayon::current_num_threads().max(1);
     let mut projected = 0;
@@ -540,17 +571,25 @@ pub fn parallel_energy_block(
         // (crate::colouring) and own their multipliers; node and element indices come from the
         // mesh the positions and multipliers were sized for.
         let run = |i: usize| unsafe {
-            colour_sweep(nodes_per_element, material, positions, rest, inv_mass, packed, c, chunk(i), lambdas, inv_dt2, batched)
-                .expect("specialised node count")
+            colour_sweep(
+                nodes_per_element,
+                material,
+                positions,
+                rest,
+                inv_mass,
+                packed,
+                c,
+                chunk(i),
+                lambdas,
+                inv_dt2,
+                batched,
+            )
+            .expect("specialised node count")
         };
         let result = if chunks == 1 {
             run(0)
         } else {
-            (0..chunks)
-                .into_par_iter()
-                .map(|i| (i, run(i)))
-                .reduce(|| (usize::MAX, Ok(0)), lowest_error)
-                .1
+            (0..chunks).into_par_iter().map(|i| (i, run(i))).reduce(|| (usize::MAX, Ok(0)), lowest_error).1
         };
         match result {
             Ok(k) => projected += k,
@@ -583,13 +622,22 @@ pub struct Partition {
 }
 
 impl Partition {
-    pub fn new(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>], rest: &[Vec3], threads: usize) -> Self {
+    pub fn new(
+        block: &ElementBlock,
+        geometry: &BlockGeometry,
+        colours: &[Vec<u32>],
+        rest: &[Vec3],
+        threads: usize,
+    ) -> Self {
         let threads = threads.max(1);
         let n = block.nodes_per_element();
         let centroid = |e: usize| block.element(e).iter().map(|&i| rest[i as usize]).sum::<Vec3>() / n as f64;
-        let (lo, hi) = block.elements().flatten().fold((Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)), |(lo, hi), &i| {
-            (lo.inf(&rest[i as usize]), hi.sup(&rest[i as usize]))
-        });
+        let (lo, hi) = block
+            .elements()
+            .flatten()
+            .fold((Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)), |(lo, hi), &i| {
+                (lo.inf(&rest[i as usize]), hi.sup(&rest[i as usize]))
+            });
         let axis = (hi - lo).iamax();
         let mut along: Vec<f64> = (0..block.len()).map(|e| centroid(e)[axis]).collect();
         along.sort_by(f64::total_cmp);
@@ -603,21 +651,36 @@ impl Partition {
         };
         let owner: Vec<Option<usize>> = (0..block.len() as u32).map(slab_of_element).collect();
         let restricted = |keep: &dyn Fn(Option<usize>) -> bool| -> Vec<Vec<u32>> {
-            colours.iter().map(|c| c.iter().copied().filter(|&e| keep(owner[e as usize])).collect::<Vec<u32>>()).filter(|c| !c.is_empty()).collect()
+            colours
+                .iter()
+                .map(|c| c.iter().copied().filter(|&e| keep(owner[e as usize])).collect::<Vec<u32>>())
+                .filter(|c| !c.is_empty())
+                .collect()
         };
         Self {
             threads,
-            slabs: (0..threads).map(|s| PackedBlock::in_colour_order(block, geometry, &restricted(&|o| o == Some(s)))).collect(),
+            slabs: (0..threads)
+                .map(|s| PackedBlock::in_colour_order(block, geometry, &restricted(&|o| o == Some(s))))
+                .collect(),
             interface: PackedBlock::in_colour_order(block, geometry, &restricted(&|o| o.is_none())),
         }
     }
 }
 
 /// Reduces `(chunk, result)` pairs: the counts summed, or the error of the lowest chunk.
-fn lowest_error(a: (usize, Result<u64, NonFiniteElement>), b: (usize, Result<u64, NonFiniteElement>)) -> (usize, Result<u64, NonFiniteElement>) {
+fn lowest_error(
+    a: (usize, Result<u64, NonFiniteElement>),
+    b: (usize, Result<u64, NonFiniteElement>),
+) -> (usize, Result<u64, NonFiniteElement>) {
     match (a, b) {
         ((i, Ok(x)), (j, Ok(y))) => (i.min(j), Ok(x + y)),
-        ((i, Err(x)), (j, Err(y))) => if i < j { (i, Err(x)) } else { (j, Err(y)) },
+        ((i, Err(x)), (j, Err(y))) => {
+            if i < j {
+                (i, Err(x))
+            } else {
+                (j, Err(y))
+            }
+        }
         ((i, Err(x)), _) | (_, (i, Err(x))) => (i, Err(x)),
     }
 }
@@ -641,7 +704,21 @@ unsafe fn all_colours(
     let mut projected = 0;
     for c in 0..packed.num_colours() {
         // SAFETY: forwarded.
-        let r = unsafe { colour_sweep(nodes_per_element, material, positions, rest, inv_mass, packed, c, packed.colour(c), lambdas, inv_dt2, batched) };
+        let r = unsafe {
+            colour_sweep(
+                nodes_per_element,
+                material,
+                positions,
+                rest,
+                inv_mass,
+                packed,
+                c,
+                packed.colour(c),
+                lambdas,
+                inv_dt2,
+                batched,
+            )
+        };
         projected += r.expect("specialised node count")?;
     }
     Ok(projected)
@@ -667,10 +744,39 @@ fn slab_sweep(
     // SAFETY (both sweeps): the slabs' elements touch disjoint nodes (each node is in one slab)
     // and own their multipliers; the interface runs after the join, alone; node and element
     // indices come from the mesh the positions and multipliers were sized for.
-    let slab = |s: usize| unsafe { all_colours(nodes_per_element, material, positions, rest, inv_mass, &partition.slabs[s], lambdas, inv_dt2, batched) };
-    let slabs = (0..partition.slabs.len()).into_par_iter().with_max_len(1).map(|s| (s, slab(s))).reduce(|| (usize::MAX, Ok(0)), lowest_error).1?;
+    let slab = |s: usize| unsafe {
+        all_colours(
+            nodes_per_element,
+            material,
+            positions,
+            rest,
+            inv_mass,
+            &partition.slabs[s],
+            lambdas,
+            inv_dt2,
+            batched,
+        )
+    };
+    let slabs = (0..partition.slabs.len())
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|s| (s, slab(s)))
+        .reduce(|| (usize::MAX, Ok(0)), lowest_error)
+        .1?;
     // SAFETY: see above.
-    let interface = unsafe { all_colours(nodes_per_element, material, positions, rest, inv_mass, &partition.interface, lambdas, inv_dt2, batched) }?;
+    let interface = unsafe {
+        all_colours(
+            nodes_per_element,
+            material,
+            positions,
+            rest,
+            inv_mass,
+            &partition.interface,
+            lambdas,
+            inv_dt2,
+            batched,
+        )
+    }?;
     Ok(slabs + interface)
 }
 
@@ -756,7 +862,13 @@ impl PackedBlock {
     }
 
     pub fn data(&self) -> BlockData<'_> {
-        BlockData { nodes: &self.nodes, grads: &self.grads, volumes: &self.volumes, points: self.points, element_ids: self.element_ids.as_deref() }
+        BlockData {
+            nodes: &self.nodes,
+            grads: &self.grads,
+            volumes: &self.volumes,
+            points: self.points,
+            element_ids: self.element_ids.as_deref(),
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -788,7 +900,12 @@ impl SolverData {
     pub fn new(blocks: &[ElementBlock], geometry: &[BlockGeometry], colours: &[Vec<Vec<u32>>]) -> Self {
         Self {
             serial: blocks.iter().zip(geometry).map(|(b, g)| PackedBlock::in_element_order(b, g)).collect(),
-            colour: blocks.iter().zip(geometry).zip(colours).map(|((b, g), c)| PackedBlock::in_colour_order(b, g, c)).collect(),
+            colour: blocks
+                .iter()
+                .zip(geometry)
+                .zip(colours)
+                .map(|((b, g), c)| PackedBlock::in_colour_order(b, g, c))
+                .collect(),
         }
     }
 }

@@ -140,9 +140,7 @@ impl Probe {
             }
         }
         match nearest {
-            Some((b, e, r, distance_m)) if distance_m <= SURFACE_TOLERANCE * body_size_m => {
-                Ok(probe(b, e, r))
-            }
+            Some((b, e, r, distance_m)) if distance_m <= SURFACE_TOLERANCE * body_size_m => Ok(probe(b, e, r)),
             _ => Err(ProbeError::Outside {
                 name: name.to_string(),
                 point_m: point,
@@ -302,20 +300,12 @@ fn half_spaces(shape: ReferenceShape) -> &'static [([f64; 3], f64)] {
             ([0., 0., -1.], 1.),
             ([0., 0., 1.], 1.),
         ],
-        ReferenceShape::Prism => &[
-            ([-1., 0., 0.], 0.),
-            ([0., -1., 0.], 0.),
-            ([1., 1., 0.], 1.),
-            ([0., 0., -1.], 1.),
-            ([0., 0., 1.], 1.),
-        ],
-        ReferenceShape::Pyramid => &[
-            ([0., 0., -1.], 0.),
-            ([1., 0., 1.], 1.),
-            ([-1., 0., 1.], 1.),
-            ([0., 1., 1.], 1.),
-            ([0., -1., 1.], 1.),
-        ],
+        ReferenceShape::Prism => {
+            &[([-1., 0., 0.], 0.), ([0., -1., 0.], 0.), ([1., 1., 0.], 1.), ([0., 0., -1.], 1.), ([0., 0., 1.], 1.)]
+        }
+        ReferenceShape::Pyramid => {
+            &[([0., 0., -1.], 0.), ([1., 0., 1.], 1.), ([-1., 0., 1.], 1.), ([0., 1., 1.], 1.), ([0., -1., 1.], 1.)]
+        }
     }
 }
 
@@ -548,8 +538,7 @@ mod tests {
             check_probe(&mesh, &probe);
             assert!((probe.position(&mesh.rest_positions) - p).norm() < 1e-12);
             // A bending-like smooth deformation: the probe follows the interpolated field.
-            let x: Vec<Vec3> =
-                mesh.rest_positions.iter().map(|q| q + Vec3::new(0.0, 0.0, -0.1 * q.x * q.x)).collect();
+            let x: Vec<Vec3> = mesh.rest_positions.iter().map(|q| q + Vec3::new(0.0, 0.0, -0.1 * q.x * q.x)).collect();
             let u = probe.displacement(&x, &mesh.rest_positions);
             assert!((u - Vec3::new(0.0, 0.0, -0.4)).norm() < 1e-9, "{u}"); // P2 reproduces x²
         }

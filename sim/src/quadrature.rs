@@ -131,12 +131,8 @@ mod tests {
         }
     }
 
-    const SHAPES: [ReferenceShape; 4] = [
-        ReferenceShape::Tetrahedron,
-        ReferenceShape::Hexahedron,
-        ReferenceShape::Prism,
-        ReferenceShape::Pyramid,
-    ];
+    const SHAPES: [ReferenceShape; 4] =
+        [ReferenceShape::Tetrahedron, ReferenceShape::Hexahedron, ReferenceShape::Prism, ReferenceShape::Pyramid];
 
     #[test]
     fn every_rule_is_exact_for_every_monomial_up_to_its_degree() {

@@ -54,7 +54,15 @@ pub struct SolverSettings {
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        Self { substeps: 50, iterations: 1, frames_per_second: 60.0, formulation: Formulation::Energy, quadrature_degree: None, parallel: false, stability_guard: true }
+        Self {
+            substeps: 50,
+            iterations: 1,
+            frames_per_second: 60.0,
+            formulation: Formulation::Energy,
+            quadrature_degree: None,
+            parallel: false,
+            stability_guard: true,
+        }
     }
 }
 
@@ -210,7 +218,8 @@ impl Simulation {
         for e in effects {
             sim.add_effect(e)?;
         }
-        sim.colours = sim.mesh.blocks.iter().map(|b| crate::colouring::colour_elements(b, sim.mesh.num_nodes())).collect();
+        sim.colours =
+            sim.mesh.blocks.iter().map(|b| crate::colouring::colour_elements(b, sim.mesh.num_nodes())).collect();
         sim.pack_colours();
         sim.update_guard();
         Ok(sim)
@@ -302,9 +311,11 @@ impl Simulation {
     /// node is dragged); nodes they pinned get their mass back. Returns how many were removed.
     pub fn remove_effects_named(&mut self, name: &str) -> usize {
         let before = self.effects.len();
-        let (removed, kept): (Vec<_>, Vec<_>) = std::mem::take(&mut self.effects).into_iter().partition(|e| e.name() == name);
+        let (removed, kept): (Vec<_>, Vec<_>) =
+            std::mem::take(&mut self.effects).into_iter().partition(|e| e.name() == name);
         self.effects = kept;
-        let still_pinned: std::collections::HashSet<u32> = self.effects.iter().flat_map(|e| e.pinned_nodes(&self.mesh)).collect();
+        let still_pinned: std::collections::HashSet<u32> =
+            self.effects.iter().flat_map(|e| e.pinned_nodes(&self.mesh)).collect();
         for e in &removed {
             for node in e.pinned_nodes(&self.mesh) {
                 if !still_pinned.contains(&node) {
@@ -328,7 +339,10 @@ impl Simulation {
             return Err(SimError::Mass { node, reason: format!("the mesh has {n} nodes") });
         }
         if !(mass_kg.is_finite() && mass_kg > 0.0) {
-            return Err(SimError::Mass { node, reason: format!("a mass must be a finite positive number of kilograms, got {mass_kg}") });
+            return Err(SimError::Mass {
+                node,
+                reason: format!("a mass must be a finite positive number of kilograms, got {mass_kg}"),
+            });
         }
         self.masses_kg[node] = mass_kg;
         if self.inv_mass[node] > 0.0 {
@@ -404,10 +418,15 @@ impl Simulation {
     /// substeps, and the substeps per frame taken ([`crate::stability`]).
     pub fn stability(&mut self) -> StabilityReport {
         let (omega2_normalised, block, element) = self.omega2_normalised();
-        let omega_max_rad_s = (omega2_normalised * self.material.youngs_modulus_pa / self.material.density_kg_m3).sqrt();
+        let omega_max_rad_s =
+            (omega2_normalised * self.material.youngs_modulus_pa / self.material.density_kg_m3).sqrt();
         let s = &self.settings;
         let trigger_h_omega = guard_trigger_h_omega(s.formulation, &self.material);
-        let (substeps, capped) = if s.stability_guard { guarded_substeps(s.substeps, s.frames_per_second, omega_max_rad_s, trigger_h_omega, GUARD_H_OMEGA) } else { (s.substeps, false) };
+        let (substeps, capped) = if s.stability_guard {
+            guarded_substeps(s.substeps, s.frames_per_second, omega_max_rad_s, trigger_h_omega, GUARD_H_OMEGA)
+        } else {
+            (s.substeps, false)
+        };
         StabilityReport {
             omega_max_rad_s,
             block,
@@ -443,7 +462,8 @@ impl Simulation {
 
     /// Recomputes the substeps per frame after a change of settings, material or masses.
     fn update_guard(&mut self) {
-        self.substeps_per_frame = if self.settings.stability_guard { self.stability().substeps } else { self.settings.substeps };
+        self.substeps_per_frame =
+            if self.settings.stability_guard { self.stability().substeps } else { self.settings.substeps };
     }
 
     /// Advances one frame (`substeps` substeps, or more: the stability guard).
@@ -523,20 +543,42 @@ impl Simulation {
                 let data = self.packed.serial[bi].data();
                 // SAFETY: one thread; the mesh was validated, so its node indices fit positions,
                 // and lambdas holds one multiplier per element.
-                let fast = unsafe { energy_sweep(n, &self.material, Positions::new(&mut self.positions), &self.mesh.rest_positions, &self.inv_mass, &data, 0..block.len(), Multipliers::new(lambdas), inv_dt2) };
+                let fast = unsafe {
+                    energy_sweep(
+                        n,
+                        &self.material,
+                        Positions::new(&mut self.positions),
+                        &self.mesh.rest_positions,
+                        &self.inv_mass,
+                        &data,
+                        0..block.len(),
+                        Multipliers::new(lambdas),
+                        inv_dt2,
+                    )
+                };
                 match fast {
                     Some(Ok(projected)) => {
                         self.counters.element_projections += projected;
                         continue;
                     }
-                    Some(Err(bad)) => return Err(BadElement::projected(bi, bad.element, bad.node, block.element(bad.element), |i| self.positions[i])),
+                    Some(Err(bad)) => {
+                        return Err(BadElement::projected(bi, bad.element, bad.node, block.element(bad.element), |i| {
+                            self.positions[i]
+                        }));
+                    }
                     None => {}
                 }
             }
             let per_element = lambdas.len() / block.len().max(1);
             for (e, nodes) in block.elements().enumerate() {
                 let lambda = &mut lambdas[e * per_element..(e + 1) * per_element];
-                let ctx = ProjectionContext { rest: &self.mesh.rest_positions, inv_mass: &self.inv_mass, material: &self.material, formulation: self.settings.formulation, inv_dt2 };
+                let ctx = ProjectionContext {
+                    rest: &self.mesh.rest_positions,
+                    inv_mass: &self.inv_mass,
+                    material: &self.material,
+                    formulation: self.settings.formulation,
+                    inv_dt2,
+                };
                 let positions = &self.positions;
                 if ctx.project(|i| positions[i], &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
                     if let Some(node) = non_finite_node(&x[..n], nodes) {
@@ -571,13 +613,29 @@ impl Simulation {
                 use crate::kernels::BlockSweep;
                 let sweep = if threads >= 2 && block.len() >= threads.saturating_mul(self.partition_min_per_thread) {
                     if self.partitions[bi].threads != threads {
-                        self.partitions[bi] = crate::kernels::Partition::new(block, &self.geometry[bi], &self.colours[bi], &self.mesh.rest_positions, threads);
+                        self.partitions[bi] = crate::kernels::Partition::new(
+                            block,
+                            &self.geometry[bi],
+                            &self.colours[bi],
+                            &self.mesh.rest_positions,
+                            threads,
+                        );
                     }
                     BlockSweep::Slabs(&self.partitions[bi])
                 } else {
                     BlockSweep::Colours(&self.packed.colour[bi])
                 };
-                let result = crate::kernels::parallel_energy_block(n, &self.material, all, &self.mesh.rest_positions, &self.inv_mass, sweep, lambdas, inv_dt2, self.simd_batches);
+                let result = crate::kernels::parallel_energy_block(
+                    n,
+                    &self.material,
+                    all,
+                    &self.mesh.rest_positions,
+                    &self.inv_mass,
+                    sweep,
+                    lambdas,
+                    inv_dt2,
+                    self.simd_batches,
+                );
                 match result {
                     Some(Ok(projected)) => {
                         self.counters.element_projections += projected;
@@ -601,7 +659,13 @@ impl Simulation {
                         // SAFETY: no two elements of a colour share a node (colouring.rs), and
                         // each element owns its multipliers: concurrent writes are disjoint.
                         let lambda = unsafe { lambdas.slice_mut(e * per_element, per_element) };
-                        let ctx = ProjectionContext { rest: &self.mesh.rest_positions, inv_mass: &self.inv_mass, material: &self.material, formulation: self.settings.formulation, inv_dt2 };
+                        let ctx = ProjectionContext {
+                            rest: &self.mesh.rest_positions,
+                            inv_mass: &self.inv_mass,
+                            material: &self.material,
+                            formulation: self.settings.formulation,
+                            inv_dt2,
+                        };
                         let mut x = [Vec3::zeros(); MAX_NODES];
                         // SAFETY: reads only this element's nodes, which no other thread writes.
                         let read = |i: usize| unsafe { positions.read(i) };
@@ -626,7 +690,11 @@ impl Simulation {
 
     /// The first node whose position or velocity is not finite, with an element holding it.
     fn first_non_finite(&self) -> Option<BadElement> {
-        let node = self.positions.iter().zip(&self.velocities).position(|(x, v)| !(x.iter().chain(v.iter()).all(|c| c.is_finite())))?;
+        let node = self
+            .positions
+            .iter()
+            .zip(&self.velocities)
+            .position(|(x, v)| !(x.iter().chain(v.iter()).all(|c| c.is_finite())))?;
         let (block, element) = self
             .mesh
             .blocks
@@ -643,7 +711,12 @@ impl Simulation {
         let err = SimError::NonFinite {
             block: bad.block,
             element: bad.element,
-            element_type: self.mesh.blocks.get(bad.block).map(|b| b.element_type.to_string()).unwrap_or_else(|| "none".into()),
+            element_type: self
+                .mesh
+                .blocks
+                .get(bad.block)
+                .map(|b| b.element_type.to_string())
+                .unwrap_or_else(|| "none".into()),
             node: bad.node as usize,
             origin: bad.origin,
             frame: self.frames + 1,
@@ -652,7 +725,11 @@ impl Simulation {
             substep: self.counters.substeps,
             time_secs: self.time_secs,
         };
-        let last = if self.prev_positions.iter().all(|x| x.iter().all(|c| c.is_finite())) { &self.prev_positions } else { &self.mesh.rest_positions };
+        let last = if self.prev_positions.iter().all(|x| x.iter().all(|c| c.is_finite())) {
+            &self.prev_positions
+        } else {
+            &self.mesh.rest_positions
+        };
         self.positions.clone_from(last);
         self.velocities.iter_mut().for_each(|v| *v = Vec3::zeros());
         self.failure = Some(err.clone());
@@ -723,7 +800,15 @@ impl ProjectionContext<'_> {
     /// Gathers element `e`, projects its constraints into `x` (updating its multipliers) and
     /// returns true, or false when all its nodes are pinned.
     #[inline]
-    fn project(&self, read: impl Fn(usize) -> Vec3, g: &BlockGeometry, e: usize, nodes: &[u32], lambda: &mut [f64], x: &mut [Vec3]) -> bool {
+    fn project(
+        &self,
+        read: impl Fn(usize) -> Vec3,
+        g: &BlockGeometry,
+        e: usize,
+        nodes: &[u32],
+        lambda: &mut [f64],
+        x: &mut [Vec3],
+    ) -> bool {
         let n = x.len();
         let mut w = [0.0; MAX_NODES];
         let mut rest = [Vec3::zeros(); MAX_NODES];
@@ -740,10 +825,28 @@ impl ProjectionContext<'_> {
         gather(self.rest, nodes, rest);
         match self.formulation {
             Formulation::Energy => {
-                project_energy_constraint(x, rest, w, element_grads(g, e), g.volumes(e), self.material, self.inv_dt2, &mut lambda[0]);
+                project_energy_constraint(
+                    x,
+                    rest,
+                    w,
+                    element_grads(g, e),
+                    g.volumes(e),
+                    self.material,
+                    self.inv_dt2,
+                    &mut lambda[0],
+                );
             }
             Formulation::Split => {
-                project_split_constraints(x, rest, w, element_grads(g, e), g.volumes(e), self.material, self.inv_dt2, lambda);
+                project_split_constraints(
+                    x,
+                    rest,
+                    w,
+                    element_grads(g, e),
+                    g.volumes(e),
+                    self.material,
+                    self.inv_dt2,
+                    lambda,
+                );
             }
         }
         true

@@ -118,7 +118,12 @@ pub fn element_omega2(rest: &[Vec3], w: &[f64], grads: &[Vec3], volumes: &[f64],
 
 /// The largest element rest frequency² over the mesh, rad²/s², with every node free
 /// (`masses_kg` the lumped masses), and the block and element where it is.
-pub fn mesh_omega2_max(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, masses_kg: &[f64]) -> (f64, usize, usize) {
+pub fn mesh_omega2_max(
+    mesh: &Mesh,
+    geometry: &[BlockGeometry],
+    material: &Material,
+    masses_kg: &[f64],
+) -> (f64, usize, usize) {
     let mut best = (0.0, 0, 0);
     for (bi, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
         let n = block.nodes_per_element();
@@ -146,7 +151,13 @@ pub fn mesh_omega2_max(mesh: &Mesh, geometry: &[BlockGeometry], material: &Mater
 /// Substeps per frame the guard uses for a mesh whose fastest mode is `omega_max_rad_s`: the
 /// requested ones while their `h ω_max ≤ trigger`, else enough for `h ω_max ≤ target`; and
 /// whether [`GUARD_MAX_SUBSTEPS`] capped it.
-pub fn guarded_substeps(requested: u32, frames_per_second: f64, omega_max_rad_s: f64, trigger: f64, target: f64) -> (u32, bool) {
+pub fn guarded_substeps(
+    requested: u32,
+    frames_per_second: f64,
+    omega_max_rad_s: f64,
+    trigger: f64,
+    target: f64,
+) -> (u32, bool) {
     if !(omega_max_rad_s / (frames_per_second * requested as f64) > trigger) {
         return (requested, false);
     }
@@ -189,14 +200,29 @@ impl StabilityReport {
 
     /// One line for a status bar or a log: the substeps taken and why.
     pub fn summary(&self) -> String {
-        let cap = if self.capped { format!(" (capped at {GUARD_MAX_SUBSTEPS}; the scene may still be unstable)") } else { String::new() };
+        let cap = if self.capped {
+            format!(" (capped at {GUARD_MAX_SUBSTEPS}; the scene may still be unstable)")
+        } else {
+            String::new()
+        };
         if self.raised() {
             format!(
                 "stability guard: {} substeps per frame instead of {} (h·ω_max would be {:.3} > {}, now ≤ {GUARD_H_OMEGA}; ω_max = {:.4e} rad/s in element {} of block {}){cap}",
-                self.substeps, self.requested_substeps, self.requested_h_omega, self.trigger_h_omega, self.omega_max_rad_s, self.element, self.block
+                self.substeps,
+                self.requested_substeps,
+                self.requested_h_omega,
+                self.trigger_h_omega,
+                self.omega_max_rad_s,
+                self.element,
+                self.block
             )
         } else {
-            format!("h·ω_max = {:.3} with {} substeps per frame{}", self.requested_h_omega, self.substeps, if self.guard { "" } else { " (stability guard off)" })
+            format!(
+                "h·ω_max = {:.3} with {} substeps per frame{}",
+                self.requested_h_omega,
+                self.substeps,
+                if self.guard { "" } else { " (stability guard off)" }
+            )
         }
     }
 }

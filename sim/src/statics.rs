@@ -109,7 +109,12 @@ pub fn solve(problem: &StaticProblem<'_>, progress: Progress<'_>) -> Result<Stat
             Err(e) => return Err(e),
         }
     }
-    Ok(StaticSolution { positions: x, newton_iterations: total_iterations, relative_residual: last_residual, free_dofs })
+    Ok(StaticSolution {
+        positions: x,
+        newton_iterations: total_iterations,
+        relative_residual: last_residual,
+        free_dofs,
+    })
 }
 
 fn apply_dirichlet(problem: &StaticProblem<'_>, fraction: f64, x: &mut [Vec3]) {
@@ -218,23 +223,35 @@ impl SparsePattern {
         for_each_entry(mesh, dof_of, |row, col, _, _, _, _| pairs.push(Pair::new(row, col)));
         let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(free_dofs, free_dofs, &pairs)
             .map_err(|e| StaticError::Factorisation(format!("{e:?}")))?;
-        let llt = SymbolicLlt::try_new(symbolic.as_ref(), Side::Lower).map_err(|e| StaticError::Factorisation(format!("{e:?}")))?;
+        let llt = SymbolicLlt::try_new(symbolic.as_ref(), Side::Lower)
+            .map_err(|e| StaticError::Factorisation(format!("{e:?}")))?;
         Ok(Self { free_dofs, symbolic, argsort, llt })
     }
 
     /// Assembles the stiffness at `x`, factors it and solves `K s = r`.
-    fn factor_and_solve(&self, mesh: &Mesh, geo: &[BlockGeometry], material: &Material, x: &[Vec3], dof_of: &[usize], r: &[f64]) -> Result<Vec<f64>, StaticError> {
+    fn factor_and_solve(
+        &self,
+        mesh: &Mesh,
+        geo: &[BlockGeometry],
+        material: &Material,
+        x: &[Vec3],
+        dof_of: &[usize],
+        r: &[f64],
+    ) -> Result<Vec<f64>, StaticError> {
         let hessians: Vec<Vec<DMatrix<f64>>> = mesh
             .blocks
             .iter()
             .zip(geo)
-            .map(|(b, g)| b.elements().enumerate().map(|(e, nodes)| element_hessian_at(mesh, g, e, nodes, material, x)).collect())
+            .map(|(b, g)| {
+                b.elements().enumerate().map(|(e, nodes)| element_hessian_at(mesh, g, e, nodes, material, x)).collect()
+            })
             .collect();
         let mut values = Vec::with_capacity(self.argsort_len_hint());
         for_each_entry(mesh, dof_of, |_, _, b, e, i, j| values.push(hessians[b][e][(i, j)]));
         let k = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, &values)
             .map_err(|e| StaticError::Factorisation(format!("{e:?}")))?;
-        let llt = Llt::try_new_with_symbolic(self.llt.clone(), k.as_ref(), Side::Lower).map_err(|_| StaticError::Singular)?;
+        let llt =
+            Llt::try_new_with_symbolic(self.llt.clone(), k.as_ref(), Side::Lower).map_err(|_| StaticError::Singular)?;
         let mut rhs = faer::Mat::<f64>::from_fn(self.free_dofs, 1, |i, _| r[i]);
         llt.solve_in_place(rhs.as_mut());
         Ok((0..self.free_dofs).map(|i| rhs[(i, 0)]).collect())
@@ -294,7 +311,14 @@ pub fn assemble_dense(mesh: &Mesh, geo: &[BlockGeometry], material: &Material, x
 }
 
 /// The PSD-projected Hessian of element `e` (nodes `nodes`) at positions `x`.
-fn element_hessian_at(mesh: &Mesh, g: &BlockGeometry, e: usize, nodes: &[u32], material: &Material, x: &[Vec3]) -> DMatrix<f64> {
+fn element_hessian_at(
+    mesh: &Mesh,
+    g: &BlockGeometry,
+    e: usize,
+    nodes: &[u32],
+    material: &Material,
+    x: &[Vec3],
+) -> DMatrix<f64> {
     let xl: Vec<Vec3> = nodes.iter().map(|&i| x[i as usize]).collect();
     let rest: Vec<Vec3> = nodes.iter().map(|&i| mesh.rest_positions[i as usize]).collect();
     element_hessian(&xl, &rest, element_grads(g, e), g.volumes(e), material, true)
@@ -328,9 +352,8 @@ mod tests {
             }
             .build()
             .unwrap();
-            let boundary = mesh.nodes_where(|p| {
-                (0..3).any(|d| p[d].abs() < 1e-12 || (p[d] - [1.0, 0.5, 0.5][d]).abs() < 1e-12)
-            });
+            let boundary =
+                mesh.nodes_where(|p| (0..3).any(|d| p[d].abs() < 1e-12 || (p[d] - [1.0, 0.5, 0.5][d]).abs() < 1e-12));
             // a "prescribed motion" realising x = A X + b: rotation-free, so use a translation
             // per node through individual prescribed sets
             let dirichlet: Vec<Prescribed> = boundary
@@ -351,7 +374,12 @@ mod tests {
                     load_steps: 1,
                 };
                 let sol = solve(&problem, &mut |_, _, _| {}).unwrap();
-                let err = sol.positions.iter().zip(&mesh.rest_positions).map(|(x, x0)| (x - (a * x0 + b)).norm()).fold(0.0, f64::max);
+                let err = sol
+                    .positions
+                    .iter()
+                    .zip(&mesh.rest_positions)
+                    .map(|(x, x0)| (x - (a * x0 + b)).norm())
+                    .fold(0.0, f64::max);
                 assert!(err < 1e-9, "{et} {model:?}: {err}");
             }
         }

@@ -79,7 +79,10 @@ impl PointMap {
         out.clear();
         out.extend(self.offsets.windows(2).map(|w| {
             let (a, b) = (w[0] as usize, w[1] as usize);
-            self.nodes[a..b].iter().zip(&self.weights[a..b]).fold(Vec3::zeros(), |acc, (&n, &wt)| acc + node_values[n as usize] * wt)
+            self.nodes[a..b]
+                .iter()
+                .zip(&self.weights[a..b])
+                .fold(Vec3::zeros(), |acc, (&n, &wt)| acc + node_values[n as usize] * wt)
         }));
     }
 
@@ -101,9 +104,18 @@ impl PointMap {
 enum SampleKey {
     Node(u32),
     /// `k`-th of `segments` steps along the edge from the smaller global corner node.
-    Edge { from: u32, to: u32, k: usize, segments: usize },
+    Edge {
+        from: u32,
+        to: u32,
+        k: usize,
+        segments: usize,
+    },
     /// Inside face `face` (index into the boundary-face list), grid point `(i, j)`.
-    Interior { face: usize, i: usize, j: usize },
+    Interior {
+        face: usize,
+        i: usize,
+        j: usize,
+    },
 }
 
 /// The boundary of a mesh as a triangle surface with element edges, for display.
@@ -139,7 +151,9 @@ impl Surface {
         let faces = mesh.boundary_faces();
         // Linear tetrahedra have flat faces: one triangle each. Any other element may curve (or
         // have a bilinear face), and neighbouring faces must be cut alike to meet without gaps.
-        let all_flat = mesh.blocks.iter().all(|b| b.element_type.shape() == crate::element::ReferenceShape::Tetrahedron && b.element_type.order() == 1);
+        let all_flat = mesh.blocks.iter().all(|b| {
+            b.element_type.shape() == crate::element::ReferenceShape::Tetrahedron && b.element_type.order() == 1
+        });
         let mut vertices = PointMap { offsets: vec![0], ..Default::default() };
         let mut node_kind = Vec::new();
         let mut index: HashMap<SampleKey, u32> = HashMap::new();
@@ -159,9 +173,14 @@ impl Surface {
             let sample = |i: usize, j: usize| -> (SampleKey, [f64; 3]) {
                 let (s, t) = (i as f64 / l as f64, j as f64 / l as f64);
                 let r: [f64; 3] = match face.shape {
-                    FaceShape::Triangle => std::array::from_fn(|k| corners[0][k] + s * (corners[1][k] - corners[0][k]) + t * (corners[2][k] - corners[0][k])),
+                    FaceShape::Triangle => std::array::from_fn(|k| {
+                        corners[0][k] + s * (corners[1][k] - corners[0][k]) + t * (corners[2][k] - corners[0][k])
+                    }),
                     FaceShape::Quadrilateral => std::array::from_fn(|k| {
-                        (1.0 - s) * (1.0 - t) * corners[0][k] + s * (1.0 - t) * corners[1][k] + s * t * corners[2][k] + (1.0 - s) * t * corners[3][k]
+                        (1.0 - s) * (1.0 - t) * corners[0][k]
+                            + s * (1.0 - t) * corners[1][k]
+                            + s * t * corners[2][k]
+                            + (1.0 - s) * t * corners[3][k]
                     }),
                 };
                 // which corner or edge of the face the grid point lies on
@@ -283,7 +302,11 @@ pub fn quadrature_points(mesh: &Mesh, geometry: &[crate::geometry::BlockGeometry
 
 /// The smallest `det F` over all quadrature points of the mesh at `positions` (negative: some
 /// element is inverted there), with the `(block, element)` where it occurs.
-pub fn min_det_f(mesh: &Mesh, geometry: &[crate::geometry::BlockGeometry], positions: &[Vec3]) -> (f64, (usize, usize)) {
+pub fn min_det_f(
+    mesh: &Mesh,
+    geometry: &[crate::geometry::BlockGeometry],
+    positions: &[Vec3],
+) -> (f64, (usize, usize)) {
     let mut worst = (f64::INFINITY, (0, 0));
     for (b, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
         for (e, nodes) in block.elements().enumerate() {

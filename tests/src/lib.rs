@@ -57,7 +57,15 @@ pub fn material(model: MaterialModel, youngs_modulus_pa: f64, poisson_ratio: f64
 /// Solver settings: `substeps` per frame at `frames_per_second`, one iteration, each element
 /// type's default quadrature, serial sweep.
 pub fn settings(formulation: Formulation, substeps: u32, frames_per_second: f64) -> SolverSettings {
-    SolverSettings { substeps, iterations: 1, frames_per_second, formulation, quadrature_degree: None, parallel: false, stability_guard: true }
+    SolverSettings {
+        substeps,
+        iterations: 1,
+        frames_per_second,
+        formulation,
+        quadrature_degree: None,
+        parallel: false,
+        stability_guard: true,
+    }
 }
 
 /// Nodes whose rest coordinate `axis` equals `at_m` (within 1e-9 × the body's size).
@@ -101,14 +109,21 @@ impl Health {
 pub fn health(sim: &Simulation, gravity_m_s2: Vec3) -> Health {
     let finite = sim.positions.iter().chain(&sim.velocities).all(|v| v.iter().all(|c| c.is_finite()));
     let rest = &sim.mesh().rest_positions;
-    let gravity_potential_j = -sim.masses_kg().iter().zip(&sim.positions).zip(rest).map(|((m, x), x0)| m * gravity_m_s2.dot(&(x - x0))).sum::<f64>();
+    let gravity_potential_j = -sim
+        .masses_kg()
+        .iter()
+        .zip(&sim.positions)
+        .zip(rest)
+        .map(|((m, x), x0)| m * gravity_m_s2.dot(&(x - x0)))
+        .sum::<f64>();
     let max_displacement_m = sim.positions.iter().zip(rest).map(|(x, x0)| (x - x0).norm()).fold(0.0, f64::max);
     Health {
         finite,
         kinetic_j: sim.kinetic_energy_j(),
         elastic_j: sim.elastic_energy_j(),
         gravity_potential_j,
-        min_det_f: hox_sim::energy::min_det_f(sim.mesh(), sim.geometry(), &sim.positions).expect("a mesh with elements"),
+        min_det_f: hox_sim::energy::min_det_f(sim.mesh(), sim.geometry(), &sim.positions)
+            .expect("a mesh with elements"),
         max_displacement_m,
     }
 }
@@ -152,7 +167,12 @@ impl From<RunFailure> for String {
 
 /// Runs `frames` frames, checking after each that the state is finite and that the total energy
 /// stays at most `energy_bound_j`; returns what it saw.
-pub fn run_checked(sim: &mut Simulation, frames: u64, gravity_m_s2: Vec3, energy_bound_j: f64) -> Result<Trace, RunFailure> {
+pub fn run_checked(
+    sim: &mut Simulation,
+    frames: u64,
+    gravity_m_s2: Vec3,
+    energy_bound_j: f64,
+) -> Result<Trace, RunFailure> {
     let mut trace = Trace { min_det_f: f64::INFINITY, ..Trace::default() };
     for frame in 0..frames {
         sim.step_frame().map_err(RunFailure::Solver)?;
@@ -182,7 +202,13 @@ pub fn run_checked(sim: &mut Simulation, frames: u64, gravity_m_s2: Vec3, energy
 /// The loads gone: removes the effects named in `loads` (gravity, prescribed motion, contact, …),
 /// adds velocity damping `rate_per_sec`, runs `frames` frames checked against `energy_bound_j`
 /// (no body force any more), and returns the final health.
-pub fn release(sim: &mut Simulation, loads: &[&str], damping_per_sec: f64, frames: u64, energy_bound_j: f64) -> Result<Health, RunFailure> {
+pub fn release(
+    sim: &mut Simulation,
+    loads: &[&str],
+    damping_per_sec: f64,
+    frames: u64,
+    energy_bound_j: f64,
+) -> Result<Health, RunFailure> {
     for name in loads {
         sim.remove_effects_named(name);
     }

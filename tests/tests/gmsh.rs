@@ -38,7 +38,10 @@ const MESHES: &[(&str, usize, &[(&str, usize)])] = &[
 
 #[test]
 fn every_gmsh_mesh_imports_with_its_counts_groups_and_the_box_volume() {
-    let on_disk = std::fs::read_dir(mesh_path("")).unwrap().filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "msh")).count();
+    let on_disk = std::fs::read_dir(mesh_path(""))
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "msh"))
+        .count();
     assert_eq!(on_disk, MESHES.len(), "every committed mesh is listed here");
     for &(name, nodes, blocks) in MESHES {
         let m = read(name);
@@ -57,11 +60,17 @@ fn every_gmsh_mesh_imports_with_its_counts_groups_and_the_box_volume() {
         let volume = hox_sim::geometry::total_volume_m3(&geometry);
         assert!((volume - BOX_VOLUME_M3).abs() < 1e-12, "{name}: volume {volume}");
         // the groups: clamp at x = 0, tip at x = L, body = everything
-        let x_of = |group: &str| m.node_set(group).unwrap().iter().map(|&n| m.mesh.rest_positions[n as usize].x).collect::<Vec<_>>();
+        let x_of = |group: &str| {
+            m.node_set(group).unwrap().iter().map(|&n| m.mesh.rest_positions[n as usize].x).collect::<Vec<_>>()
+        };
         assert!(x_of("clamp").iter().all(|&x| x.abs() < 1e-12) && !x_of("clamp").is_empty(), "{name}");
         assert!(x_of("tip").iter().all(|&x| (x - LENGTH_M).abs() < 1e-12) && !x_of("tip").is_empty(), "{name}");
         let at_x0 = m.mesh.nodes_where(|p| p.x.abs() < 1e-12);
-        assert_eq!(m.node_set("clamp").unwrap(), at_x0.as_slice(), "{name}: the clamp group holds every node of the x = 0 face, high-order ones too");
+        assert_eq!(
+            m.node_set("clamp").unwrap(),
+            at_x0.as_slice(),
+            "{name}: the clamp group holds every node of the x = 0 face, high-order ones too"
+        );
         assert_eq!(m.node_set("body").unwrap().len(), nodes, "{name}");
         assert_eq!(m.element_sets["body"].len(), m.mesh.num_elements(), "{name}");
     }
@@ -69,7 +78,11 @@ fn every_gmsh_mesh_imports_with_its_counts_groups_and_the_box_volume() {
 
 #[test]
 fn the_msh22_and_msh41_copies_of_a_mesh_are_the_same() {
-    for (a, b) in [("beam-tet10.msh", "beam-tet10-v22.msh"), ("beam-hex27.msh", "beam-hex27-v22.msh"), ("beam-hex8.msh", "beam-hex8-v22-binary.msh")] {
+    for (a, b) in [
+        ("beam-tet10.msh", "beam-tet10-v22.msh"),
+        ("beam-hex27.msh", "beam-hex27-v22.msh"),
+        ("beam-hex8.msh", "beam-hex8-v22-binary.msh"),
+    ] {
         let (ma, mb) = (read(a), read(b));
         assert_eq!(ma.mesh.blocks, mb.mesh.blocks, "{a} vs {b}");
         assert_eq!(ma.node_sets, mb.node_sets, "{a} vs {b}");
@@ -99,7 +112,11 @@ fn a_p2_beam_from_gmsh_sags_like_the_builtin_p2_beam() {
     // the fine Q2 reference (assets/reference/bending-fine.json)
     let reference = -0.3199131272371426;
     let (e_builtin, e_gmsh) = ((builtin - reference) / reference, (gmsh - reference) / reference);
-    eprintln!("tip u_z: built-in P2 {builtin:.6} m ({:+.2} %), Gmsh P2 {gmsh:.6} m ({:+.2} %), Q2 reference {reference:.6} m", 100.0 * e_builtin, 100.0 * e_gmsh);
+    eprintln!(
+        "tip u_z: built-in P2 {builtin:.6} m ({:+.2} %), Gmsh P2 {gmsh:.6} m ({:+.2} %), Q2 reference {reference:.6} m",
+        100.0 * e_builtin,
+        100.0 * e_gmsh
+    );
     // both coarse P2 meshes are a little too stiff (built-in −1.8 %, Gmsh −1.2 %); they differ
     // by their discretisation only (0.7 %)
     assert!(builtin < 0.0 && gmsh < 0.0);
@@ -114,8 +131,12 @@ fn an_exported_vtu_reads_back_with_the_same_points_and_cells() {
     for &(name, _, _) in MESHES {
         let m = read(name);
         // a smooth made-up deformation: bend down and twist a little
-        let positions: Vec<Vec3> =
-            m.mesh.rest_positions.iter().map(|p| p + Vec3::new(0.01 * p.z, 0.02 * p.x * p.z, -0.05 * p.x * p.x)).collect();
+        let positions: Vec<Vec3> = m
+            .mesh
+            .rest_positions
+            .iter()
+            .map(|p| p + Vec3::new(0.01 * p.z, 0.02 * p.x * p.z, -0.05 * p.x * p.x))
+            .collect();
         let path = dir.join(name.replace(".msh", ".vtu"));
         vtk::write_vtu(&path, &m.mesh, &positions, &[], &[]).unwrap();
         let back = vtk::read_vtu(&path).unwrap();
@@ -142,7 +163,8 @@ fn a_scene_file_can_name_a_mesh_file_and_its_groups() {
     assert_eq!(groups["clamp"], [0.0; 3], "clamped");
     assert!(groups["tip"][2] < 0.0, "the tip falls: {:?}", groups["tip"]);
     // an unknown group is an error naming it and listing the file's groups
-    let text = std::fs::read_to_string(mesh_path("beam.toml")).unwrap().replace("group = \"clamp\"", "group = \"wall\"");
+    let text =
+        std::fs::read_to_string(mesh_path("beam.toml")).unwrap().replace("group = \"clamp\"", "group = \"wall\"");
     let e = Scene::from_toml_in(&text, "beam.toml", Some(&mesh_path(""))).unwrap_err().to_string();
     assert!(e.contains("\"wall\" does not exist") && e.contains("\"body\", \"clamp\", \"tip\""), "{e}");
 }

@@ -45,9 +45,17 @@ fn reproduce(scene: Option<&str>, level: &str) {
         for p in &scene.file.probes {
             let probe = hox_sim::probe::Probe::locate(&mesh, &p.name, hox_sim::Vec3::from(p.point_m)).unwrap();
             let u = probe.displacement(&solution.positions, &mesh.rest_positions);
-            let want: Vec<f64> = reference["probes"][&p.name].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+            let want: Vec<f64> =
+                reference["probes"][&p.name].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
             for d in 0..3 {
-                assert!((u[d] - want[d]).abs() < 1e-8, "{} probe {} component {d}: {} vs committed {}", path.display(), p.name, u[d], want[d]);
+                assert!(
+                    (u[d] - want[d]).abs() < 1e-8,
+                    "{} probe {} component {d}: {} vs committed {}",
+                    path.display(),
+                    p.name,
+                    u[d],
+                    want[d]
+                );
             }
         }
     }

@@ -40,13 +40,25 @@ const SAMPLE_LEVELS: usize = 12;
 /// `PASS`/`FAIL` line per configuration with its figures (docs/STABILITY.md's table), and fails
 /// on any failure not listed in `known` ("p3 energy", …) — and on a listed one that now passes,
 /// so the list (and the table) cannot go stale.
-fn each_configuration(case: &str, types: &[&str], formulations: &[Formulation], known: &[&str], run: impl Fn(&str, Formulation) -> Result<String, String>) {
+fn each_configuration(
+    case: &str,
+    types: &[&str],
+    formulations: &[Formulation],
+    known: &[&str],
+    run: impl Fn(&str, Formulation) -> Result<String, String>,
+) {
     let problems = configurations(case, types, formulations, known, run);
     assert!(problems.is_empty(), "{case}: {} configuration(s):\n{}", problems.len(), problems.join("\n"));
 }
 
 /// [`each_configuration`]'s runs, returning the problems instead of failing.
-fn configurations(case: &str, types: &[&str], formulations: &[Formulation], known: &[&str], run: impl Fn(&str, Formulation) -> Result<String, String>) -> Vec<String> {
+fn configurations(
+    case: &str,
+    types: &[&str],
+    formulations: &[Formulation],
+    known: &[&str],
+    run: impl Fn(&str, Formulation) -> Result<String, String>,
+) -> Vec<String> {
     let mut problems = Vec::new();
     for et in types {
         for &f in formulations {
@@ -73,10 +85,17 @@ fn configurations(case: &str, types: &[&str], formulations: &[Formulation], know
 /// alignment for a `free` body) within [`REST_TOLERANCE`] × size.
 fn recovered(sim: &Simulation, after: &Health, free: bool) -> Result<String, String> {
     let size = size_m(sim.mesh());
-    let distance = if free { distance_to_rest_shape_m(&sim.mesh().rest_positions, &sim.positions) } else { after.max_displacement_m };
+    let distance = if free {
+        distance_to_rest_shape_m(&sim.mesh().rest_positions, &sim.positions)
+    } else {
+        after.max_displacement_m
+    };
     let m = after.min_det_f;
     if !(m.det_f > 0.0) {
-        return Err(format!("element {} of block {} left inverted after release: det F = {:.3e} at quadrature point {}", m.element, m.block, m.det_f, m.point));
+        return Err(format!(
+            "element {} of block {} left inverted after release: det F = {:.3e} at quadrature point {}",
+            m.element, m.block, m.det_f, m.point
+        ));
     }
     let (sampled, block, element, r) = min_det_f_sampled(sim.mesh(), &sim.positions, SAMPLE_LEVELS);
     if !(sampled > 0.0) {
@@ -86,7 +105,11 @@ fn recovered(sim: &Simulation, after: &Health, free: bool) -> Result<String, Str
         ));
     }
     if !(distance <= REST_TOLERANCE * size) {
-        return Err(format!("{:.2e} × size from the rest shape after release (tolerance {REST_TOLERANCE:e}), min det F {:.3}", distance / size, m.det_f));
+        return Err(format!(
+            "{:.2e} × size from the rest shape after release (tolerance {REST_TOLERANCE:e}), min det F {:.3}",
+            distance / size,
+            m.det_f
+        ));
     }
     Ok(format!("back to rest within {:.1e} × size, min det F {:.4}", distance / size, m.det_f.min(sampled)))
 }
@@ -96,7 +119,14 @@ fn beam(et: &str, length_m: f64, cells_x: usize) -> Mesh {
     box_mesh(et, [length_m, 0.25 * length_m, 0.25 * length_m], [cells_x, 1, 1])
 }
 
-fn sim(mesh: Mesh, material: Material, formulation: Formulation, substeps: u32, fps: f64, effects: Vec<Box<dyn Effect>>) -> Simulation {
+fn sim(
+    mesh: Mesh,
+    material: Material,
+    formulation: Formulation,
+    substeps: u32,
+    fps: f64,
+    effects: Vec<Box<dyn Effect>>,
+) -> Simulation {
     Simulation::new(mesh, material, settings(formulation, substeps, fps), effects).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -172,8 +202,16 @@ fn p3_mirrored_under_strong_damping_is_trapped_inverted_between_its_quadrature_p
         let (s, _, end, _) = run_inverted(mirrored_cantilever("p3", SNH, f, 10.0), 5.0, 1.0 + 1e-6).unwrap();
         let why = recovered(&s, &end, false).expect_err("P3 mirrored at 10/s damping was expected to be trapped");
         assert!(end.min_det_f.det_f > 0.0 && why.contains("between its quadrature points"), "{f}: {why}");
-        assert!(end.kinetic_j < 1e-6 * end.elastic_j, "{f}: still moving: T = {:.2e} J, U = {:.2e} J", end.kinetic_j, end.elastic_j);
-        eprintln!("KNOWN 1 mirrored, snh, damping 10/s | p3 | {f} | {why}; at rest: T = {:.1e} J, U = {:.3e} J", end.kinetic_j, end.elastic_j);
+        assert!(
+            end.kinetic_j < 1e-6 * end.elastic_j,
+            "{f}: still moving: T = {:.2e} J, U = {:.2e} J",
+            end.kinetic_j,
+            end.elastic_j
+        );
+        eprintln!(
+            "KNOWN 1 mirrored, snh, damping 10/s | p3 | {f} | {why}; at rest: T = {:.1e} J, U = {:.3e} J",
+            end.kinetic_j, end.elastic_j
+        );
     }
 }
 
@@ -193,7 +231,8 @@ fn trapped_states_are_minima_of_the_near_exactly_integrated_energy() {
     };
     let mut trapped = Vec::new();
     for f in BOTH {
-        let (s, _, end, _) = run_inverted(near_exact(mirrored_cantilever("p3", SNH, f, 10.0)), 5.0, 1.0 + 1e-6).unwrap();
+        let (s, _, end, _) =
+            run_inverted(near_exact(mirrored_cantilever("p3", SNH, f, 10.0)), 5.0, 1.0 + 1e-6).unwrap();
         trapped.push((format!("1 mirrored, damping 10/s | p3 | {f}"), recovered(&s, &end, false), end));
     }
     for et in ["p2", "p3"] {
@@ -206,8 +245,16 @@ fn trapped_states_are_minima_of_the_near_exactly_integrated_energy() {
     }
     for (what, outcome, end) in trapped {
         let why = outcome.expect_err(&format!("{what}: recovered with near-exact integration: the trap is a quadrature artefact after all (update docs/STABILITY.md)"));
-        assert!(end.kinetic_j < 1e-6 * end.elastic_j, "{what}: still moving: T = {:.2e} J, U = {:.2e} J", end.kinetic_j, end.elastic_j);
-        eprintln!("KNOWN trapped with degree-17 quadrature | {what} | {why}; at rest: T = {:.1e} J, U = {:.3e} J", end.kinetic_j, end.elastic_j);
+        assert!(
+            end.kinetic_j < 1e-6 * end.elastic_j,
+            "{what}: still moving: T = {:.2e} J, U = {:.2e} J",
+            end.kinetic_j,
+            end.elastic_j
+        );
+        eprintln!(
+            "KNOWN trapped with degree-17 quadrature | {what} | {why}; at rest: T = {:.1e} J, U = {:.3e} J",
+            end.kinetic_j, end.elastic_j
+        );
     }
 }
 
@@ -228,7 +275,10 @@ fn stvk_mirrored_through_a_face_is_a_rest_state_it_stays_in_bounded() {
     each_configuration("1 mirrored, stvk", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
         let (_, start, end, _) = run_inverted(mirrored_cantilever(et, STVK, f, 10.0), 1.0, 1.0 + 1e-6)?;
         if !(start.elastic_j.abs() < 1e-9 && end.max_displacement_m > 0.4) {
-            return Err(format!("expected the zero-energy mirrored rest state to stay: U(0) = {:.3e}, displacement {:.3}", start.elastic_j, end.max_displacement_m));
+            return Err(format!(
+                "expected the zero-energy mirrored rest state to stay: U(0) = {:.3e}, displacement {:.3}",
+                start.elastic_j, end.max_displacement_m
+            ));
         }
         Ok(format!("stays mirrored, U = {:.1e} J, min det F {:.3}", end.elastic_j, end.min_det_f.det_f))
     });
@@ -258,7 +308,9 @@ fn stvk_corner_pushed_through_its_element_stays_bounded() {
 fn neo_hookean_inverted_starts_stay_bounded() {
     each_configuration("1 inverted, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
         let mut out = Vec::new();
-        for (what, s) in [("mirrored", mirrored_cantilever(et, NH, f, 10.0)), ("corner", corner_pushed_through(et, NH, f))] {
+        for (what, s) in
+            [("mirrored", mirrored_cantilever(et, NH, f, 10.0)), ("corner", corner_pushed_through(et, NH, f))]
+        {
             let (s, start, end, trace) = run_inverted(s, 3.0, 1.0 + 1e-6)?;
             let spike = trace.max_total_j / start.total_j();
             out.push(match recovered(&s, &end, false) {
@@ -274,7 +326,15 @@ fn neo_hookean_inverted_starts_stay_bounded() {
 // Loaded cantilevers: gravity, then release.
 
 /// A cantilever `[0, L] × [0, L/4]²` of `cells_x` cells, clamped at x = 0, under gravity.
-fn gravity_cantilever(et: &str, length_m: f64, cells_x: usize, material: Material, formulation: Formulation, substeps: u32, fps: f64) -> Simulation {
+fn gravity_cantilever(
+    et: &str,
+    length_m: f64,
+    cells_x: usize,
+    material: Material,
+    formulation: Formulation,
+    substeps: u32,
+    fps: f64,
+) -> Simulation {
     let mesh = beam(et, length_m, cells_x);
     let clamp = clamp_x0(&mesh);
     sim(mesh, material, formulation, substeps, fps, vec![clamp, Box::new(Gravity::new(GRAVITY_M_S2))])
@@ -290,10 +350,22 @@ fn load_and_release(s: Simulation, load_secs: f64, damping_per_sec: f64, release
 }
 
 /// [`load_and_release`] with the allowance `H ≤ allowance × |V_g|max` while loaded.
-fn load_and_release_within(mut s: Simulation, load_secs: f64, damping_per_sec: f64, release_secs: f64, allowance: f64) -> Result<String, String> {
+fn load_and_release_within(
+    mut s: Simulation,
+    load_secs: f64,
+    damping_per_sec: f64,
+    release_secs: f64,
+    allowance: f64,
+) -> Result<String, String> {
     let fps = s.settings().frames_per_second;
     // a first pass without a bound finds the work scale; the same run is then checked frame by frame
-    let mut probe_run = Simulation::new(s.mesh().clone(), *s.material(), *s.settings(), vec![clamp_x0(s.mesh()), Box::new(Gravity::new(GRAVITY_M_S2))]).map_err(|e| e.to_string())?;
+    let mut probe_run = Simulation::new(
+        s.mesh().clone(),
+        *s.material(),
+        *s.settings(),
+        vec![clamp_x0(s.mesh()), Box::new(Gravity::new(GRAVITY_M_S2))],
+    )
+    .map_err(|e| e.to_string())?;
     let scale = run_checked(&mut probe_run, frames(load_secs, fps), GRAVITY_M_S2, f64::INFINITY)?.max_gravity_work_j;
     let loaded = run_checked(&mut s, frames(load_secs, fps), GRAVITY_M_S2, allowance * scale)?;
     let at_release = health(&s, Vec3::zeros());
@@ -338,7 +410,13 @@ fn near_incompressible(model: MaterialModel) {
     let mut problems = Vec::new();
     for nu in [0.45, 0.49, 0.499] {
         problems.extend(configurations(&format!("2 ν = {nu}, {model}"), &ELEMENT_TYPES, &BOTH, &[], |et, f| {
-            load_and_release_within(gravity_cantilever(et, 1.0, 4, material(model, 1.0e6, nu), f, 50, 60.0), 1.0, 10.0, 3.0, 0.1)
+            load_and_release_within(
+                gravity_cantilever(et, 1.0, 4, material(model, 1.0e6, nu), f, 50, 60.0),
+                1.0,
+                10.0,
+                3.0,
+                0.1,
+            )
         }));
     }
     if model != SNH {
@@ -356,7 +434,9 @@ fn near_incompressible(model: MaterialModel) {
 /// `H / |V_g|max` (1 % is the bound of the passing cases; NaN when the solver's guard stopped it).
 fn energy_gain(et: &str, f: Formulation, youngs_modulus_pa: f64, substeps: u32, fps: f64) -> f64 {
     let mut s = unguarded(gravity_cantilever(et, 1.0, 4, material(SNH, youngs_modulus_pa, 0.3), f, substeps, fps));
-    run_checked(&mut s, frames(3.0, fps), GRAVITY_M_S2, f64::INFINITY).map(|t| t.max_total_j / t.max_gravity_work_j).unwrap_or(f64::NAN)
+    run_checked(&mut s, frames(3.0, fps), GRAVITY_M_S2, f64::INFINITY)
+        .map(|t| t.max_total_j / t.max_gravity_work_j)
+        .unwrap_or(f64::NAN)
 }
 
 /// The same simulation with the stability guard off.
@@ -372,13 +452,27 @@ fn unguarded(mut s: Simulation) -> Simulation {
 /// (damping `damping_per_sec` for `release_secs`), with the bound of every gravity case
 /// (`H ≤ 1 %` of the work of gravity). The guard takes the substeps the stiffest element needs
 /// (`h ω_max ≤ 1`).
-fn guarded_cantilever(et: &str, model: MaterialModel, f: Formulation, youngs_modulus_pa: f64, substeps: u32, fps: f64, damping_per_sec: f64, release_secs: f64) -> Result<String, String> {
+fn guarded_cantilever(
+    et: &str,
+    model: MaterialModel,
+    f: Formulation,
+    youngs_modulus_pa: f64,
+    substeps: u32,
+    fps: f64,
+    damping_per_sec: f64,
+    release_secs: f64,
+) -> Result<String, String> {
     let mut s = gravity_cantilever(et, 1.0, 4, material(model, youngs_modulus_pa, 0.3), f, substeps, fps);
     let guard = s.stability();
     if !guard.raised() {
         return Err(format!("the guard did not raise the substeps: {}", guard.summary()));
     }
-    Ok(format!("{} substeps instead of {substeps} (h·ω_max {:.1} asked); {}", guard.substeps, guard.requested_h_omega, load_and_release(s, 1.0, damping_per_sec, release_secs)?))
+    Ok(format!(
+        "{} substeps instead of {substeps} (h·ω_max {:.1} asked); {}",
+        guard.substeps,
+        guard.requested_h_omega,
+        load_and_release(s, 1.0, damping_per_sec, release_secs)?
+    ))
 }
 
 /// Case 3: E = 10⁹ Pa asked for with one substep per frame at 60 fps (`h ω_max ≈ 10²–10³`):
@@ -387,7 +481,9 @@ fn guarded_cantilever(et: &str, model: MaterialModel, f: Formulation, youngs_mod
 #[test]
 #[ignore = "release: CI runs it with --release --ignored (hundreds of substeps per frame)"]
 fn a_stiff_cantilever_with_one_substep_per_frame_is_stable_under_the_stability_guard() {
-    each_configuration("3 E = 1e9 Pa, 1 substep asked, guard, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| guarded_cantilever(et, SNH, f, 1.0e9, 1, 60.0, 10.0, 2.0));
+    each_configuration("3 E = 1e9 Pa, 1 substep asked, guard, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        guarded_cantilever(et, SNH, f, 1.0e9, 1, 60.0, 10.0, 2.0)
+    });
 }
 
 /// **Known failure (case 3) without the stability guard, kept visible.** E = 10⁹ Pa with a
@@ -402,7 +498,10 @@ fn known_failure_without_the_guard_a_stiff_cantilever_with_one_substep_per_frame
         for f in BOTH {
             let gain = energy_gain(et, f, 1.0e9, 1, 60.0);
             eprintln!("KNOWN 3 E = 1e9 Pa, 1 substep, guard off, snh | {et} | {f} | H/|V_g| up to {gain:.2e}");
-            assert!(!(gain <= 1.0), "{et} {f}: E = 1e9 Pa at 1 substep no longer gains energy ({gain:.2e}): update docs/STABILITY.md");
+            assert!(
+                !(gain <= 1.0),
+                "{et} {f}: E = 1e9 Pa at 1 substep no longer gains energy ({gain:.2e}): update docs/STABILITY.md"
+            );
         }
     }
 }
@@ -448,15 +547,33 @@ fn known_failure_a_very_soft_p1_cantilever_with_the_papers_stable_neo_hookean_st
 /// (the prescribed nodes get their mass back, damping 5/s) for 5 s. Bound on `H = T + U`:
 /// `10 μ V s²`, `s` the load's characteristic strain (the elastic energy of a uniform strain `s`
 /// is of order `μ V s²`; a blow-up exceeds it by orders of magnitude).
-fn drive_and_release(et: &str, model: MaterialModel, f: Formulation, drive: impl Fn(Vec<u32>) -> Prescribed, ramp_secs: f64, strain: f64) -> Result<String, String> {
+fn drive_and_release(
+    et: &str,
+    model: MaterialModel,
+    f: Formulation,
+    drive: impl Fn(Vec<u32>) -> Prescribed,
+    ramp_secs: f64,
+    strain: f64,
+) -> Result<String, String> {
     let (mut s, bound_j) = driven_cantilever(et, model, f, drive, strain);
     let (driven, after) = drive_then_release(&mut s, ramp_secs, bound_j)?;
-    Ok(format!("max U {:.3e} J (bound {bound_j:.2e}), min det F driven {:.3}; {}", driven.max_elastic_j, driven.min_det_f, recovered(&s, &after, false)?))
+    Ok(format!(
+        "max U {:.3e} J (bound {bound_j:.2e}), min det F driven {:.3}; {}",
+        driven.max_elastic_j,
+        driven.min_det_f,
+        recovered(&s, &after, false)?
+    ))
 }
 
 /// The cantilever of [`drive_and_release`] with its drive and light damping, and the bound on
 /// `H = T + U`.
-fn driven_cantilever(et: &str, model: MaterialModel, f: Formulation, drive: impl Fn(Vec<u32>) -> Prescribed, strain: f64) -> (Simulation, f64) {
+fn driven_cantilever(
+    et: &str,
+    model: MaterialModel,
+    f: Formulation,
+    drive: impl Fn(Vec<u32>) -> Prescribed,
+    strain: f64,
+) -> (Simulation, f64) {
     let mesh = beam(et, 1.0, 4);
     let end = nodes_on_plane(&mesh, 0, 1.0);
     let clamp = clamp_x0(&mesh);
@@ -478,7 +595,11 @@ fn twist(turns_deg: f64, ramp_secs: f64) -> impl Fn(Vec<u32>) -> Prescribed {
     move |nodes| Prescribed {
         nodes,
         translation_m: Vec3::zeros(),
-        rotation: Some(AxisRotation { axis: Vec3::x(), origin_m: Vec3::new(1.0, 0.125, 0.125), angle_rad: turns_deg.to_radians() }),
+        rotation: Some(AxisRotation {
+            axis: Vec3::x(),
+            origin_m: Vec3::new(1.0, 0.125, 0.125),
+            angle_rad: turns_deg.to_radians(),
+        }),
         ramp_secs,
     }
 }
@@ -490,7 +611,9 @@ fn stretch(by_m: f64, ramp_secs: f64) -> impl Fn(Vec<u32>) -> Prescribed {
 /// Torsion to 720°: shear strain `θ r / L` = 4π × 0.177 ≈ 2.2 at the corners.
 #[test]
 fn torsion_to_720_degrees_and_back() {
-    each_configuration("4 torsion 720°, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| drive_and_release(et, SNH, f, twist(720.0, 2.0), 2.0, 4.0 * std::f64::consts::PI * 0.177));
+    each_configuration("4 torsion 720°, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        drive_and_release(et, SNH, f, twist(720.0, 2.0), 2.0, 4.0 * std::f64::consts::PI * 0.177)
+    });
 }
 
 /// Stretch to three times the length (strain 2), released at once. Compressible Neo-Hookean
@@ -501,8 +624,16 @@ fn torsion_to_720_degrees_and_back() {
 /// [`trapped_states_are_minima_of_the_near_exactly_integrated_energy`]).
 #[test]
 fn stretch_to_three_times_the_length_and_back() {
-    each_configuration("4 stretch 3×, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| drive_and_release(et, NH, f, stretch(2.0, 1.0), 1.0, 2.0));
-    each_configuration("4 stretch 3×, snh", &ELEMENT_TYPES, &BOTH, &["p2 energy", "p2 split", "p3 energy", "p3 split"], |et, f| drive_and_release(et, SNH, f, stretch(2.0, 1.0), 1.0, 2.0));
+    each_configuration("4 stretch 3×, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        drive_and_release(et, NH, f, stretch(2.0, 1.0), 1.0, 2.0)
+    });
+    each_configuration(
+        "4 stretch 3×, snh",
+        &ELEMENT_TYPES,
+        &BOTH,
+        &["p2 energy", "p2 split", "p3 energy", "p3 split"],
+        |et, f| drive_and_release(et, SNH, f, stretch(2.0, 1.0), 1.0, 2.0),
+    );
 }
 
 /// StVK under the same extreme drives: bounded (finite, energy within the bound); recovery
@@ -531,22 +662,28 @@ fn stvk_under_extreme_drives_stays_bounded() {
 /// released (plates removed, damping 10/s) for 3 s; compared with its rest shape after rigid
 /// alignment. Bound: `10 μ V s²` with `s` = 0.9.
 fn squash(et: &str, model: MaterialModel, f: Formulation) -> Result<String, String> {
-        let mesh = box_mesh(et, [0.25; 3], [2, 2, 2]);
-        let mat = material(model, 1.0e5, 0.3);
-        let bound_j = 10.0 * mat.lame().mu_pa * 0.25f64.powi(3) * 0.81;
-        let effects: Vec<Box<dyn Effect>> = vec![
-            Box::new(ContactPlane::new(Vec3::zeros(), Vec3::z(), Vec3::zeros(), f64::INFINITY, 0.5)),
-            Box::new(ContactPlane::new(Vec3::new(0.0, 0.0, 0.25), -Vec3::z(), Vec3::new(0.0, 0.0, -0.225), 1.0, 0.5)),
-            Box::new(Damping { rate_per_sec: 2.0 }),
-        ];
-        let mut s = sim(mesh, mat, f, 50, 60.0, effects);
-        let squashed = run_checked(&mut s, frames(1.5, 60.0), Vec3::zeros(), bound_j)?;
-        let height = s.positions.iter().map(|x| x.z).fold(f64::NEG_INFINITY, f64::max) - s.positions.iter().map(|x| x.z).fold(f64::INFINITY, f64::min);
-        if !(height < 0.1 * 0.25 * 1.05) {
-            return Err(format!("squashed height {height:.4} m, not 10 % of 0.25 m"));
-        }
-        let after = release(&mut s, &["contact", "damping"], 10.0, frames(3.0, 60.0), bound_j)?;
-        Ok(format!("height {height:.4} m, max U {:.3e} J, min det F squashed {:.3}; {}", squashed.max_elastic_j, squashed.min_det_f, recovered(&s, &after, true)?))
+    let mesh = box_mesh(et, [0.25; 3], [2, 2, 2]);
+    let mat = material(model, 1.0e5, 0.3);
+    let bound_j = 10.0 * mat.lame().mu_pa * 0.25f64.powi(3) * 0.81;
+    let effects: Vec<Box<dyn Effect>> = vec![
+        Box::new(ContactPlane::new(Vec3::zeros(), Vec3::z(), Vec3::zeros(), f64::INFINITY, 0.5)),
+        Box::new(ContactPlane::new(Vec3::new(0.0, 0.0, 0.25), -Vec3::z(), Vec3::new(0.0, 0.0, -0.225), 1.0, 0.5)),
+        Box::new(Damping { rate_per_sec: 2.0 }),
+    ];
+    let mut s = sim(mesh, mat, f, 50, 60.0, effects);
+    let squashed = run_checked(&mut s, frames(1.5, 60.0), Vec3::zeros(), bound_j)?;
+    let height = s.positions.iter().map(|x| x.z).fold(f64::NEG_INFINITY, f64::max)
+        - s.positions.iter().map(|x| x.z).fold(f64::INFINITY, f64::min);
+    if !(height < 0.1 * 0.25 * 1.05) {
+        return Err(format!("squashed height {height:.4} m, not 10 % of 0.25 m"));
+    }
+    let after = release(&mut s, &["contact", "damping"], 10.0, frames(3.0, 60.0), bound_j)?;
+    Ok(format!(
+        "height {height:.4} m, max U {:.3e} J, min det F squashed {:.3}; {}",
+        squashed.max_elastic_j,
+        squashed.min_det_f,
+        recovered(&s, &after, true)?
+    ))
 }
 
 /// Compressible Neo-Hookean's `ln J` term resists collapse (continued below its `J` floor of
@@ -588,7 +725,11 @@ fn bent_and_twisted(rest: &[Vec3], length_m: f64) -> Vec<Vec3> {
             let angle = 0.3 * p.x / length_m;
             let (c, s) = (angle.cos(), angle.sin());
             let (y, z) = (p.y - 0.125 * length_m, p.z - 0.125 * length_m);
-            Vec3::new(p.x, 0.125 * length_m + c * y - s * z, 0.125 * length_m + s * y + c * z + 0.2 * p.x * p.x / length_m)
+            Vec3::new(
+                p.x,
+                0.125 * length_m + c * y - s * z,
+                0.125 * length_m + s * y + c * z + 0.2 * p.x * p.x / length_m,
+            )
         })
         .collect()
 }
@@ -600,7 +741,8 @@ fn bent_and_twisted(rest: &[Vec3], length_m: f64) -> Vec<Vec3> {
 fn a_node_ten_thousand_times_heavier_than_its_neighbours() {
     each_configuration("5 heavy node ×1e4, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
         let mesh = beam(et, 0.5, 2);
-        let corner = mesh.rest_positions.iter().position(|p| (p - Vec3::new(0.5, 0.0, 0.0)).norm() < 1e-12).expect("corner");
+        let corner =
+            mesh.rest_positions.iter().position(|p| (p - Vec3::new(0.5, 0.0, 0.0)).norm() < 1e-12).expect("corner");
         let start = bent_and_twisted(&mesh.rest_positions, 0.5);
         let mut s = sim(mesh, material(SNH, 1.0e5, 0.3), f, 50, 60.0, vec![Box::new(Damping { rate_per_sec: 10.0 })]);
         let heavy_kg = 1e4 * s.masses_kg()[corner];
@@ -649,8 +791,16 @@ fn gravity_cantilever_from(mesh: Mesh, material: Material, formulation: Formulat
 /// with a thin inverted layer (as in cases 1 and 4), listed.
 #[test]
 fn ten_frames_per_second_with_one_substep_is_stable_under_the_stability_guard() {
-    each_configuration("6 10 fps × 1 substep asked, E = 1e5 Pa, guard, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| guarded_cantilever(et, NH, f, 1.0e5, 1, 10.0, 5.0, 6.0));
-    each_configuration("6 10 fps × 1 substep asked, E = 1e5 Pa, guard, snh", &ELEMENT_TYPES, &BOTH, &["p3 energy", "p3 split"], |et, f| guarded_cantilever(et, SNH, f, 1.0e5, 1, 10.0, 5.0, 6.0));
+    each_configuration("6 10 fps × 1 substep asked, E = 1e5 Pa, guard, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        guarded_cantilever(et, NH, f, 1.0e5, 1, 10.0, 5.0, 6.0)
+    });
+    each_configuration(
+        "6 10 fps × 1 substep asked, E = 1e5 Pa, guard, snh",
+        &ELEMENT_TYPES,
+        &BOTH,
+        &["p3 energy", "p3 split"],
+        |et, f| guarded_cantilever(et, SNH, f, 1.0e5, 1, 10.0, 5.0, 6.0),
+    );
 }
 
 /// **Known failure (case 6) without the stability guard, kept visible**: the energy grows by
@@ -661,7 +811,10 @@ fn known_failure_without_the_guard_ten_frames_per_second_with_one_substep_gains_
         for f in BOTH {
             let gain = energy_gain(et, f, 1.0e5, 1, 10.0);
             eprintln!("KNOWN 6 10 fps × 1 substep, E = 1e5 Pa, guard off, snh | {et} | {f} | H/|V_g| up to {gain:.2e}");
-            assert!(!(gain <= 1.0), "{et} {f}: 10 fps × 1 substep no longer gains energy ({gain:.2e}): update docs/STABILITY.md");
+            assert!(
+                !(gain <= 1.0),
+                "{et} {f}: 10 fps × 1 substep no longer gains energy ({gain:.2e}): update docs/STABILITY.md"
+            );
         }
     }
 }
@@ -755,7 +908,10 @@ mod perturbed {
 #[ignore = "release: CI runs it with --release --ignored (about a minute)"]
 fn ten_thousand_frames_of_the_undamped_bending_scene_do_not_gain_energy() {
     for formulation in ["energy", "split"] {
-        let scene = hox_scenes::by_name("bending").unwrap().with_overrides(&hox_scenes::SceneOverrides { formulation: Some(formulation.into()), ..Default::default() }).unwrap();
+        let scene = hox_scenes::by_name("bending")
+            .unwrap()
+            .with_overrides(&hox_scenes::SceneOverrides { formulation: Some(formulation.into()), ..Default::default() })
+            .unwrap();
         let mut instance = hox_scenes::Instance::new(scene).unwrap();
         let clock = std::time::Instant::now();
         let (mut early_max, mut late_max) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
@@ -771,10 +927,17 @@ fn ten_thousand_frames_of_the_undamped_bending_scene_do_not_gain_energy() {
             } else {
                 late_max = late_max.max(last.total_j());
             }
-            assert!(last.total_j() <= 0.05 * work_j, "{formulation}: H = {:.4e} J > 5 % of |V_g| = {work_j:.4e} J at frame {frame}", last.total_j());
+            assert!(
+                last.total_j() <= 0.05 * work_j,
+                "{formulation}: H = {:.4e} J > 5 % of |V_g| = {work_j:.4e} J at frame {frame}",
+                last.total_j()
+            );
         }
         let max_ratio = early_max.max(late_max) / work_j;
-        assert!(late_max <= early_max, "{formulation}: the energy grows: max H {late_max:.4e} J over frames 1001–10000 > {early_max:.4e} J over the first 1000");
+        assert!(
+            late_max <= early_max,
+            "{formulation}: the energy grows: max H {late_max:.4e} J over frames 1001–10000 > {early_max:.4e} J over the first 1000"
+        );
         eprintln!(
             "PASS 8 10,000 frames, bending, no damping | p2 | {formulation} | max H/|V_g|max {max_ratio:.2e} (frames 1–1000: {early_max:.3e} J, 1001–10000: {late_max:.3e} J), H at the end {:.3e} J (|V_g|max {work_j:.3e} J), {:.1} s",
             last.total_j(),
@@ -844,7 +1007,10 @@ fn non_finite_and_invalid_scene_values_are_clear_errors() {
 fn degenerate_inverted_and_empty_meshes_and_zero_substeps_are_clear_errors() {
     use hox_sim::mesh::ElementBlock;
     let mat = material(SNH, 1e6, 0.3);
-    let tet = |points: [[f64; 3]; 4]| Mesh { rest_positions: points.map(Vec3::from).to_vec(), blocks: vec![ElementBlock::new(element_type("p1"), vec![0, 1, 2, 3])] };
+    let tet = |points: [[f64; 3]; 4]| Mesh {
+        rest_positions: points.map(Vec3::from).to_vec(),
+        blocks: vec![ElementBlock::new(element_type("p1"), vec![0, 1, 2, 3])],
+    };
     let new = |mesh: Mesh, st| Simulation::new(mesh, mat, st, Vec::new()).map(|_| ()).expect_err("invalid").to_string();
     let ok = settings(Formulation::Energy, 50, 60.0);
     let flat = new(tet([[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]), ok);
@@ -859,7 +1025,10 @@ fn degenerate_inverted_and_empty_meshes_and_zero_substeps_are_clear_errors() {
     assert!(curved.contains("inverted") || curved.contains("flat"), "{curved}");
     let empty = new(Mesh { rest_positions: Vec::new(), blocks: Vec::new() }, ok);
     assert!(empty.contains("no elements"), "{empty}");
-    let empty_block = new(Mesh { rest_positions: vec![Vec3::zeros()], blocks: vec![ElementBlock::new(element_type("p1"), Vec::new())] }, ok);
+    let empty_block = new(
+        Mesh { rest_positions: vec![Vec3::zeros()], blocks: vec![ElementBlock::new(element_type("p1"), Vec::new())] },
+        ok,
+    );
     assert!(empty_block.contains("no elements"), "{empty_block}");
     let nan_node = new(tet([[0.0; 3], [1.0, 0.0, 0.0], [0.0, f64::NAN, 0.0], [0.0, 0.0, 1.0]]), ok);
     assert!(nan_node.contains("non-finite") && nan_node.contains("node 2"), "{nan_node}");
@@ -870,7 +1039,8 @@ fn degenerate_inverted_and_empty_meshes_and_zero_substeps_are_clear_errors() {
     assert!(fps.contains("frames per second"), "{fps}");
     let probe = hox_sim::probe::Probe::locate(&unit, "far", Vec3::new(5.0, 0.0, 0.0)).expect_err("outside").to_string();
     assert!(probe.contains("outside the body"), "{probe}");
-    let probe = hox_sim::probe::Probe::locate(&unit, "nan", Vec3::new(f64::NAN, 0.0, 0.0)).expect_err("non-finite").to_string();
+    let probe =
+        hox_sim::probe::Probe::locate(&unit, "nan", Vec3::new(f64::NAN, 0.0, 0.0)).expect_err("non-finite").to_string();
     assert!(probe.contains("non-finite"), "{probe}");
     let mut s = Simulation::new(unit, mat, ok, Vec::new()).unwrap();
     let mass = s.set_mass_kg(0, -1.0).expect_err("negative mass").to_string();
@@ -927,7 +1097,8 @@ fn a_nan_stops_the_scene_with_the_element_and_the_step_and_a_reset_recovers() {
         assert_eq!((*block, *node, *frame, *substep_in_frame, *substeps_per_frame), (0, 40, 3, 7, 50), "{err}");
         assert!(s.mesh().blocks[0].element(*element).contains(&40), "{err}");
         let message = err.to_string();
-        for needle in ["frame 3", "substep 7 of 50", &format!("element {element} of block 0 (p2)"), "node 40", "reset"] {
+        for needle in ["frame 3", "substep 7 of 50", &format!("element {element} of block 0 (p2)"), "node 40", "reset"]
+        {
             assert!(message.contains(needle), "'{needle}' missing from: {message}");
         }
         eprintln!("PASS 10 NaN guard | p2 | energy{} | {message}", if parallel { " (parallel)" } else { "" });
@@ -951,6 +1122,8 @@ fn a_non_finite_position_from_outside_is_named() {
     s.step_frame().unwrap();
     s.positions[40].z = f64::INFINITY;
     let message = s.step_frame().expect_err("stopped").to_string();
-    assert!(message.contains("node 40") && message.contains("frame 2") && message.contains("substep 1 of 50"), "{message}");
+    assert!(
+        message.contains("node 40") && message.contains("frame 2") && message.contains("substep 1 of 50"),
+        "{message}"
+    );
 }
-

@@ -23,7 +23,13 @@ fn p2_160_at_70_substeps_settles_within_one_percent_of_the_static_solution() {
     let u_static = probe.displacement(&statics.positions, &mesh.rest_positions);
     for formulation in ["energy", "split"] {
         let at = |substeps: u32| {
-            let s = scene.with_overrides(&SceneOverrides { substeps: Some(substeps), formulation: Some(formulation.into()), ..Default::default() }).unwrap();
+            let s = scene
+                .with_overrides(&SceneOverrides {
+                    substeps: Some(substeps),
+                    formulation: Some(formulation.into()),
+                    ..Default::default()
+                })
+                .unwrap();
             let mut inst = Instance::new(s).unwrap();
             let report = hox_scenes::run(&mut inst, RunMode::SETTLE, &mut |_, _| {}).unwrap();
             assert!(report.settled, "{formulation} at {substeps} substeps did not settle");

@@ -96,7 +96,10 @@ pub fn scene(args: &MeshFileArgs) -> Result<Option<Scene>> {
             m => bail!("--{name} is given {m} times for {n} --drive groups: give it once for all, or once per drive"),
         }
     }
-    let given = !args.drive_translation_m.is_empty() || !args.drive_rotation_deg.is_empty() || !args.drive_axis.is_empty() || !args.drive_origin_m.is_empty();
+    let given = !args.drive_translation_m.is_empty()
+        || !args.drive_rotation_deg.is_empty()
+        || !args.drive_axis.is_empty()
+        || !args.drive_origin_m.is_empty();
     if n == 0 && given {
         bail!("the --drive-* options need a --drive GROUP to move");
     }
@@ -113,7 +116,9 @@ pub fn scene(args: &MeshFileArgs) -> Result<Option<Scene>> {
         let axis = per_drive("drive-axis", &args.drive_axis, n, k)?;
         let origin = per_drive("drive-origin-m", &args.drive_origin_m, n, k)?;
         if rotation_deg == 0.0 && translation_m == [0.0; 3] {
-            bail!("--drive {group}: give a --drive-translation-m or a --drive-rotation-deg (to hold the group still, use --clamp)");
+            bail!(
+                "--drive {group}: give a --drive-translation-m or a --drive-rotation-deg (to hold the group still, use --clamp)"
+            );
         }
         drives.push(Drive {
             group: group.clone(),
@@ -158,7 +163,10 @@ impl VtkWriter {
     /// Called after every frame.
     pub fn frame(&mut self, instance: &Instance) -> Result<(), hox_scenes::SceneError> {
         if instance.sim.frames().is_multiple_of(self.every) {
-            self.write(instance).map_err(|e| hox_scenes::SceneError::Simulation { source_name: instance.scene.source.clone(), message: format!("{e:#}") })?;
+            self.write(instance).map_err(|e| hox_scenes::SceneError::Simulation {
+                source_name: instance.scene.source.clone(),
+                message: format!("{e:#}"),
+            })?;
         }
         Ok(())
     }
@@ -180,7 +188,8 @@ impl VtkWriter {
 
 /// A file-name-safe version of a scene name.
 fn sanitize(name: &str) -> String {
-    let s: String = name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    let s: String =
+        name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
     if s.is_empty() { "hox".into() } else { s }
 }
 

@@ -65,13 +65,17 @@ pub struct InspectArgs {
 pub fn parse_compare(spec: &str, base: &SceneOverrides) -> Result<SceneOverrides> {
     let mut o = base.clone();
     for pair in spec.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-        let (key, value) = pair.split_once('=').with_context(|| format!("--compare '{spec}': '{pair}' is not option=value"))?;
+        let (key, value) =
+            pair.split_once('=').with_context(|| format!("--compare '{spec}': '{pair}' is not option=value"))?;
         let (key, value) = (key.trim(), value.trim());
         let number = |what: &str| -> Result<f64> {
-            let v: f64 = value.parse().with_context(|| format!("--compare '{spec}': {key} needs {what}, got '{value}'"))?;
+            let v: f64 =
+                value.parse().with_context(|| format!("--compare '{spec}': {key} needs {what}, got '{value}'"))?;
             Ok(v)
         };
-        let whole = || -> Result<usize> { value.parse().with_context(|| format!("--compare '{spec}': {key} needs a whole number, got '{value}'")) };
+        let whole = || -> Result<usize> {
+            value.parse().with_context(|| format!("--compare '{spec}': {key} needs a whole number, got '{value}'"))
+        };
         match key {
             "element" => o.element = Some(value.into()),
             "grid" => o.grid = Some(super::parse_grid(value).map_err(anyhow::Error::msg)?),
@@ -108,7 +112,11 @@ pub fn check_writable(path: &Path) -> Result<()> {
     if path.is_dir() {
         bail!("cannot write {}: it is a folder", path.display());
     }
-    std::fs::OpenOptions::new().append(true).create(true).open(path).with_context(|| format!("cannot write {}", path.display()))?;
+    std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
     if !existed {
         let _ = std::fs::remove_file(path);
     }
@@ -133,7 +141,9 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     }
     let mut instances = Vec::new();
     for (k, o) in configurations.iter().enumerate() {
-        let s = scene.with_overrides(o).with_context(|| if args.compare.is_empty() { String::new() } else { format!("--compare '{}'", args.compare[k]) })?;
+        let s = scene.with_overrides(o).with_context(|| {
+            if args.compare.is_empty() { String::new() } else { format!("--compare '{}'", args.compare[k]) }
+        })?;
         let mut instance = Instance::new(s)?;
         super::note_stability(&mut instance);
         instances.push(instance);
@@ -152,7 +162,11 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         .recording_name(format!("hox record {}", instances[0].scene.name()))
         .save(&args.out)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
-    let settings = LogSettings { segments: args.tessellation, colour_max_m: args.colour_max_m, quadrature_points: args.quadrature_points };
+    let settings = LogSettings {
+        segments: args.tessellation,
+        colour_max_m: args.colour_max_m,
+        quadrature_points: args.quadrature_points,
+    };
     // configurations side by side along y, one body width plus a gap apart
     let (lo, hi) = instances[0].sim.mesh().bounding_box();
     let extent = hi - lo;
@@ -173,7 +187,10 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     let mut vtk_writers = Vec::new();
     for (inst, logger) in instances.iter().zip(&loggers) {
         let dir = args.vtk.vtk.as_ref().map(|d| if instances.len() > 1 { d.join(logger.name()) } else { d.clone() });
-        vtk_writers.push(super::gmsh::VtkWriter::create(&super::gmsh::VtkArgs { vtk: dir, vtk_every: args.vtk.vtk_every }, inst)?);
+        vtk_writers.push(super::gmsh::VtkWriter::create(
+            &super::gmsh::VtkArgs { vtk: dir, vtk_every: args.vtk.vtk_every },
+            inst,
+        )?);
     }
 
     let interrupted = Arc::new(AtomicBool::new(false));
@@ -269,7 +286,13 @@ pub fn record(args: &RecordArgs) -> Result<()> {
             summary["log_ms_per_frame"].as_f64().unwrap_or_default()
         );
         for c in summary["configurations"].as_array().into_iter().flatten() {
-            println!("  {}: {} elements, {} nodes, {:.2} ms per frame", c["entity"].as_str().unwrap_or_default(), c["elements"], c["nodes"], c["ms_per_frame"].as_f64().unwrap_or_default());
+            println!(
+                "  {}: {} elements, {} nodes, {:.2} ms per frame",
+                c["entity"].as_str().unwrap_or_default(),
+                c["elements"],
+                c["nodes"],
+                c["ms_per_frame"].as_f64().unwrap_or_default()
+            );
         }
         for index in &vtk_indexes {
             println!("  VTK series for ParaView: {index}");
@@ -298,7 +321,8 @@ pub fn read_rrd(path: &Path) -> Result<BTreeMap<String, EntitySummary>> {
         let msg = msg.with_context(|| format!("{} is not a readable Rerun recording", path.display()))?;
         messages += 1;
         let rerun::external::re_log_types::LogMsg::ArrowMsg(_, arrow) = msg else { continue };
-        let chunk = rerun::log::Chunk::from_arrow_msg(&arrow).with_context(|| format!("{}: a chunk does not decode", path.display()))?;
+        let chunk = rerun::log::Chunk::from_arrow_msg(&arrow)
+            .with_context(|| format!("{}: a chunk does not decode", path.display()))?;
         let entity = chunk.entity_path().to_string().trim_start_matches('/').to_string();
         let summary = entities.entry(entity).or_default();
         let components: Vec<String> = chunk.component_descriptors().map(|d| d.component.to_string()).collect();
@@ -306,7 +330,12 @@ pub fn read_rrd(path: &Path) -> Result<BTreeMap<String, EntitySummary>> {
             summary.static_components.extend(components);
             continue;
         }
-        let frames: Vec<i64> = chunk.timelines().iter().find(|(name, _)| name.as_str() == "frame").map(|(_, t)| t.times_raw().to_vec()).unwrap_or_default();
+        let frames: Vec<i64> = chunk
+            .timelines()
+            .iter()
+            .find(|(name, _)| name.as_str() == "frame")
+            .map(|(_, t)| t.times_raw().to_vec())
+            .unwrap_or_default();
         for c in components {
             summary.frames_per_component.entry(c).or_default().extend(frames.iter().copied());
         }
@@ -319,8 +348,11 @@ pub fn read_rrd(path: &Path) -> Result<BTreeMap<String, EntitySummary>> {
 
 /// Checks that every configuration (`world/<name>/surface`) was recorded at `frames` frames.
 pub fn check_frames(entities: &BTreeMap<String, EntitySummary>, frames: usize) -> Result<Vec<String>> {
-    let configs: Vec<String> =
-        entities.keys().filter_map(|e| e.strip_prefix("world/").and_then(|r| r.strip_suffix("/surface"))).map(str::to_string).collect();
+    let configs: Vec<String> = entities
+        .keys()
+        .filter_map(|e| e.strip_prefix("world/").and_then(|r| r.strip_suffix("/surface")))
+        .map(str::to_string)
+        .collect();
     if configs.is_empty() {
         bail!("no world/<configuration>/surface entity: not a hox recording");
     }
@@ -335,7 +367,9 @@ pub fn check_frames(entities: &BTreeMap<String, EntitySummary>, frames: usize) -
                 bail!("world/{c}/surface has {component} at {n} frames, expected {frames}");
             }
         }
-        for (entity, component) in [(format!("world/{c}/edges"), "LineStrips3D:strips"), (format!("world/{c}/probes"), "Points3D:positions")] {
+        for (entity, component) in
+            [(format!("world/{c}/edges"), "LineStrips3D:strips"), (format!("world/{c}/probes"), "Points3D:positions")]
+        {
             let n = entities.get(&entity).and_then(|s| s.frames_per_component.get(component)).map_or(0, BTreeSet::len);
             if n != frames {
                 bail!("{entity} has {component} at {n} frames, expected {frames}");
@@ -343,7 +377,10 @@ pub fn check_frames(entities: &BTreeMap<String, EntitySummary>, frames: usize) -
         }
         for quantity in ["kinetic_energy_j", "elastic_energy_j", "min_det_f"] {
             let entity = format!("plots/{quantity}/{c}");
-            let n = entities.get(&entity).and_then(|s| s.frames_per_component.get("Scalars:scalars")).map_or(0, BTreeSet::len);
+            let n = entities
+                .get(&entity)
+                .and_then(|s| s.frames_per_component.get("Scalars:scalars"))
+                .map_or(0, BTreeSet::len);
             if n != frames {
                 bail!("{entity} has {n} frames, expected {frames}");
             }
@@ -369,7 +406,12 @@ pub fn inspect(args: &InspectArgs) -> Result<()> {
         println!("{entity:<48} {frames:>6} frames  {}", components.join(", "));
     }
     if let Some(configs) = configs {
-        println!("ok: {} configuration(s) ({}) recorded at {} frames each", configs.len(), configs.join(", "), args.expect_frames.unwrap_or_default());
+        println!(
+            "ok: {} configuration(s) ({}) recorded at {} frames each",
+            configs.len(),
+            configs.join(", "),
+            args.expect_frames.unwrap_or_default()
+        );
     }
     Ok(())
 }

@@ -21,18 +21,36 @@ pub struct OpenDialog {
 pub fn menu_bar_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| {
-            if ui.button("Open scene file…").on_hover_text("Load a scene from a TOML file (see assets/scenes/).").clicked() {
+            if ui
+                .button("Open scene file…")
+                .on_hover_text("Load a scene from a TOML file (see assets/scenes/).")
+                .clicked()
+            {
                 app.open_dialog = Some(OpenDialog { mesh: false, path: "assets/scenes/".into(), ..Default::default() });
                 ui.close();
             }
-            if ui.button("Open mesh file…").on_hover_text("Simulate a Gmsh .msh mesh: clamp one of its physical groups, gravity on.").clicked() {
-                app.open_dialog = Some(OpenDialog { mesh: true, path: "assets/meshes/".into(), clamp_group: "clamp".into(), ..Default::default() });
+            if ui
+                .button("Open mesh file…")
+                .on_hover_text("Simulate a Gmsh .msh mesh: clamp one of its physical groups, gravity on.")
+                .clicked()
+            {
+                app.open_dialog = Some(OpenDialog {
+                    mesh: true,
+                    path: "assets/meshes/".into(),
+                    clamp_group: "clamp".into(),
+                    ..Default::default()
+                });
                 ui.close();
             }
         });
         ui.menu_button("View", |ui| {
-            ui.checkbox(&mut app.show_reference_element, "Reference element").on_hover_text("Shape functions of a reference element as colour fields, with its quadrature points.");
-            if ui.button("Reset camera").on_hover_text("Frame the bodies again (double-click in the view does the same).").clicked() {
+            ui.checkbox(&mut app.show_reference_element, "Reference element")
+                .on_hover_text("Shape functions of a reference element as colour fields, with its quadrature points.");
+            if ui
+                .button("Reset camera")
+                .on_hover_text("Frame the bodies again (double-click in the view does the same).")
+                .clicked()
+            {
                 let offsets = app.offsets();
                 app.viewport.reset_camera(&app.sessions, &offsets);
                 ui.close();
@@ -79,19 +97,32 @@ fn link_ui(app: &mut HoxApp, ui: &mut egui::Ui, field: &str) {
     }
     let linked = app.links.linked(field);
     let text = if linked { "linked" } else { "free" };
-    if ui.selectable_label(linked, text).on_hover_text("Linked: the other configuration follows this control. Click to unlink.").clicked() {
+    if ui
+        .selectable_label(linked, text)
+        .on_hover_text("Linked: the other configuration follows this control. Click to unlink.")
+        .clicked()
+    {
         app.links.0.insert(field.to_string(), !linked);
     }
 }
 
 /// A numeric text field that applies on Enter or focus loss; unparsable or refused values
 /// keep the previous value and show the reason.
-fn number_ui(app: &mut HoxApp, ui: &mut egui::Ui, field: &str, text: &str, tip: &str, value: f64, set: impl Fn(&mut Config, f64)) {
+fn number_ui(
+    app: &mut HoxApp,
+    ui: &mut egui::Ui,
+    field: &str,
+    text: &str,
+    tip: &str,
+    value: f64,
+    set: impl Fn(&mut Config, f64),
+) {
     ui.horizontal(|ui| {
         let l = label(ui, text, tip);
         let key = format!("{}:{field}", app.active);
         let buffer = app.edits.entry(key.clone()).or_insert_with(|| format!("{value}"));
-        let response = ui.add(egui::TextEdit::singleline(buffer).desired_width(90.0)).labelled_by(l.id).on_hover_text(tip);
+        let response =
+            ui.add(egui::TextEdit::singleline(buffer).desired_width(90.0)).labelled_by(l.id).on_hover_text(tip);
         let commit = response.lost_focus() || (response.has_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)));
         if commit {
             let typed = buffer.trim().to_string();
@@ -125,16 +156,18 @@ pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     let current = app.scene.label();
     let mut chosen = None;
     let l = ui.label("Scene file or built-in scene");
-    egui::ComboBox::from_id_salt("scene").selected_text(&current).show_ui(ui, |ui| {
-        for name in hox_scenes::BUILTIN.iter().map(|(n, _)| *n) {
-            if ui.selectable_label(current == name, name).clicked() {
-                chosen = Some(SceneSource::Builtin(name.to_string()));
+    egui::ComboBox::from_id_salt("scene")
+        .selected_text(&current)
+        .show_ui(ui, |ui| {
+            for name in hox_scenes::BUILTIN.iter().map(|(n, _)| *n) {
+                if ui.selectable_label(current == name, name).clicked() {
+                    chosen = Some(SceneSource::Builtin(name.to_string()));
+                }
             }
-        }
-    })
-    .response
-    .labelled_by(l.id)
-    .on_hover_text("The scene: its mesh, material, effects (gravity, clamps, motion…) and probes.");
+        })
+        .response
+        .labelled_by(l.id)
+        .on_hover_text("The scene: its mesh, material, effects (gravity, clamps, motion…) and probes.");
     if let Some(source) = chosen
         && let Err(e) = app.load_scene(source, None)
     {
@@ -142,7 +175,13 @@ pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     }
     ui.label(egui::RichText::new(&app.sessions[0].base.file.description).small());
     let mut compare = app.compare;
-    if ui.checkbox(&mut compare, "Compare two configurations").on_hover_text("Run a second configuration of the scene side by side; 🔗 links choose which controls it shares.").changed() {
+    if ui
+        .checkbox(&mut compare, "Compare two configurations")
+        .on_hover_text(
+            "Run a second configuration of the scene side by side; 🔗 links choose which controls it shares.",
+        )
+        .changed()
+    {
         app.set_compare(compare);
     }
     if app.compare {
@@ -150,7 +189,11 @@ pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
             ui.label("Editing:");
             for k in 0..2 {
                 let text = format!("{} {}", ["A", "B"][k], app.sessions[k].config.label());
-                if ui.selectable_label(app.active == k, text).on_hover_text("The configuration the controls below change.").clicked() {
+                if ui
+                    .selectable_label(app.active == k, text)
+                    .on_hover_text("The configuration the controls below change.")
+                    .clicked()
+                {
                     app.active = k;
                 }
             }
@@ -199,7 +242,13 @@ fn row_ui<T: Clone + PartialEq>(
 }
 
 /// A combo box over `options` (value, text).
-fn combo<T: Clone + PartialEq>(ui: &mut egui::Ui, id: (&str, usize), value: &mut T, shown: String, options: Vec<(T, String)>) -> egui::Response {
+fn combo<T: Clone + PartialEq>(
+    ui: &mut egui::Ui,
+    id: (&str, usize),
+    value: &mut T,
+    shown: String,
+    options: Vec<(T, String)>,
+) -> egui::Response {
     egui::ComboBox::from_id_salt(id)
         .selected_text(shown)
         .show_ui(ui, |ui| {
@@ -218,72 +267,197 @@ fn mesh_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         return;
     }
     let k = app.active;
-    row_ui(app, ui, "element", "Element", "The element type: P1/P2/P3 tetrahedra (order 1–3), Q1/Q2 hexahedra, prisms, pyramids.", |c| c.element.clone(), |c, v| c.element = v, |ui, v| {
-        let shown = v.to_uppercase();
-        combo(ui, ("element", k), v, shown, ElementType::all().map(|e| (e.name().to_string(), format!("{} — {}", e.name().to_uppercase(), e.description()))).collect())
-    });
+    row_ui(
+        app,
+        ui,
+        "element",
+        "Element",
+        "The element type: P1/P2/P3 tetrahedra (order 1–3), Q1/Q2 hexahedra, prisms, pyramids.",
+        |c| c.element.clone(),
+        |c, v| c.element = v,
+        |ui, v| {
+            let shown = v.to_uppercase();
+            combo(
+                ui,
+                ("element", k),
+                v,
+                shown,
+                ElementType::all()
+                    .map(|e| (e.name().to_string(), format!("{} — {}", e.name().to_uppercase(), e.description())))
+                    .collect(),
+            )
+        },
+    );
     let tets = ["p1", "p2", "p3"].contains(&c.element.as_str());
-    row_ui(app, ui, "split", "Tet split", "How each hexahedral cell is cut into tetrahedra: five (unbiased, alternating) or six (biased along one diagonal).", |c| c.split.clone(), |c, v| c.split = v, |ui, v| {
-        ui.add_enabled_ui(tets, |ui| {
-            ui.radio_value(v, "five".to_string(), "five (unbiased)");
-            ui.radio_value(v, "six".to_string(), "six (biased)")
-        })
-        .inner
-    });
-    row_ui(app, ui, "grid", "Grid", "Hexahedral cells along x, y and z before any splitting (each 1–64).", |c| c.grid, |c, v| c.grid = v, |ui, g| {
-        let mut response: Option<egui::Response> = None;
-        for (cells, axis) in g.iter_mut().zip(["x", "y", "z"]) {
-            let l = ui.label(axis);
-            let r = ui.add(egui::DragValue::new(cells).range(1..=64)).labelled_by(l.id);
-            response = Some(match response {
-                Some(prev) => prev | r,
-                None => r,
-            });
-        }
-        response.expect("three cells")
-    });
-    row_ui(app, ui, "refine", "Refine", "1-to-8 refinements of the tetrahedra (each multiplies the element count by 8; tetrahedra only).", |c| c.refine, |c, v| c.refine = v, |ui, v| {
-        ui.add_enabled(tets, egui::Slider::new(v, 0..=3))
-    });
+    row_ui(
+        app,
+        ui,
+        "split",
+        "Tet split",
+        "How each hexahedral cell is cut into tetrahedra: five (unbiased, alternating) or six (biased along one diagonal).",
+        |c| c.split.clone(),
+        |c, v| c.split = v,
+        |ui, v| {
+            ui.add_enabled_ui(tets, |ui| {
+                ui.radio_value(v, "five".to_string(), "five (unbiased)");
+                ui.radio_value(v, "six".to_string(), "six (biased)")
+            })
+            .inner
+        },
+    );
+    row_ui(
+        app,
+        ui,
+        "grid",
+        "Grid",
+        "Hexahedral cells along x, y and z before any splitting (each 1–64).",
+        |c| c.grid,
+        |c, v| c.grid = v,
+        |ui, g| {
+            let mut response: Option<egui::Response> = None;
+            for (cells, axis) in g.iter_mut().zip(["x", "y", "z"]) {
+                let l = ui.label(axis);
+                let r = ui.add(egui::DragValue::new(cells).range(1..=64)).labelled_by(l.id);
+                response = Some(match response {
+                    Some(prev) => prev | r,
+                    None => r,
+                });
+            }
+            response.expect("three cells")
+        },
+    );
+    row_ui(
+        app,
+        ui,
+        "refine",
+        "Refine",
+        "1-to-8 refinements of the tetrahedra (each multiplies the element count by 8; tetrahedra only).",
+        |c| c.refine,
+        |c, v| c.refine = v,
+        |ui, v| ui.add_enabled(tets, egui::Slider::new(v, 0..=3)),
+    );
 }
 
 fn material_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Material");
     let c = app.sessions[app.active].config.clone();
     let k = app.active;
-    row_ui(app, ui, "material", "Model", "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean (without or with Smith et al.'s log term) or Neo-Hookean.", |c| c.material.clone(), |c, v| c.material = v, |ui, v| {
-        let shown = MaterialModel::from_name(v).map_or(v.clone(), |m| m.long_name().to_string());
-        combo(ui, ("model", k), v, shown, MaterialModel::ALL.iter().map(|m| (m.name().to_string(), m.long_name().to_string())).collect())
-    });
-    number_ui(app, ui, "youngs", "Young's modulus E (Pa)", "Stiffness in pascals, > 0 (rubber ~1e6, the paper's beam 3e6).", c.youngs_modulus_pa, |c, v| c.youngs_modulus_pa = v);
-    number_ui(app, ui, "poisson", "Poisson ratio ν", "Lateral contraction, between −1 and 0.5 (exclusive); near 0.5 is nearly incompressible.", c.poisson_ratio, |c, v| c.poisson_ratio = v);
-    number_ui(app, ui, "density", "Density ρ (kg/m³)", "Mass per volume in kg/m³, > 0 (water 1000).", c.density_kg_m3, |c, v| c.density_kg_m3 = v);
+    row_ui(
+        app,
+        ui,
+        "material",
+        "Model",
+        "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean (without or with Smith et al.'s log term) or Neo-Hookean.",
+        |c| c.material.clone(),
+        |c, v| c.material = v,
+        |ui, v| {
+            let shown = MaterialModel::from_name(v).map_or(v.clone(), |m| m.long_name().to_string());
+            combo(
+                ui,
+                ("model", k),
+                v,
+                shown,
+                MaterialModel::ALL.iter().map(|m| (m.name().to_string(), m.long_name().to_string())).collect(),
+            )
+        },
+    );
+    number_ui(
+        app,
+        ui,
+        "youngs",
+        "Young's modulus E (Pa)",
+        "Stiffness in pascals, > 0 (rubber ~1e6, the paper's beam 3e6).",
+        c.youngs_modulus_pa,
+        |c, v| c.youngs_modulus_pa = v,
+    );
+    number_ui(
+        app,
+        ui,
+        "poisson",
+        "Poisson ratio ν",
+        "Lateral contraction, between −1 and 0.5 (exclusive); near 0.5 is nearly incompressible.",
+        c.poisson_ratio,
+        |c, v| c.poisson_ratio = v,
+    );
+    number_ui(
+        app,
+        ui,
+        "density",
+        "Density ρ (kg/m³)",
+        "Mass per volume in kg/m³, > 0 (water 1000).",
+        c.density_kg_m3,
+        |c, v| c.density_kg_m3 = v,
+    );
 }
 
 fn solver_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Solver");
     let k = app.active;
-    row_ui(app, ui, "formulation", "Formulation", "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.", |c| c.formulation.clone(), |c, v| c.formulation = v, |ui, v| {
-        ui.radio_value(v, "energy".to_string(), "energy") | ui.radio_value(v, "split".to_string(), "split")
-    });
-    row_ui(app, ui, "quadrature", "Quadrature", "Degree of polynomials the element quadrature integrates exactly (default: the element's own).", |c| c.quadrature_degree, |c, v| c.quadrature_degree = v, |ui, v| {
-        let shown = v.map_or("element default".to_string(), |d| format!("degree {d}"));
-        let mut options = vec![(None, "element default".to_string())];
-        options.extend((1..=8).map(|d| (Some(d), format!("degree {d}"))));
-        combo(ui, ("quadrature", k), v, shown, options)
-    });
-    row_ui(app, ui, "substeps", "Substeps", "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.", |c| c.substeps, |c, v| c.substeps = v, |ui, v| {
-        ui.add(egui::Slider::new(v, 1..=500).logarithmic(true))
-    });
-    row_ui(app, ui, "iterations", "Iterations", "Constraint sweeps per substep (the paper: 1).", |c| c.iterations, |c, v| c.iterations = v, |ui, v| {
-        ui.add(egui::Slider::new(v, 1..=20).logarithmic(true))
-    });
-    row_ui(app, ui, "guard", "Stability guard", "More substeps when the stiffest element needs them (when h·ω_max would exceed 3, enough for h·ω_max ≤ 1; just below 3 your substeps are kept); off: exactly the substeps asked for, which may blow up.", |c| c.stability_guard, |c, v| c.stability_guard = v, |ui, v| {
-        ui.checkbox(v, "raise substeps when needed")
-    });
-    row_ui(app, ui, "fps", "Frames per second", "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.", |c| c.frames_per_second, |c, v| c.frames_per_second = v, |ui, v| {
-        ui.add(egui::Slider::new(v, 10.0..=240.0).logarithmic(true).suffix(" fps"))
-    });
+    row_ui(
+        app,
+        ui,
+        "formulation",
+        "Formulation",
+        "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.",
+        |c| c.formulation.clone(),
+        |c, v| c.formulation = v,
+        |ui, v| ui.radio_value(v, "energy".to_string(), "energy") | ui.radio_value(v, "split".to_string(), "split"),
+    );
+    row_ui(
+        app,
+        ui,
+        "quadrature",
+        "Quadrature",
+        "Degree of polynomials the element quadrature integrates exactly (default: the element's own).",
+        |c| c.quadrature_degree,
+        |c, v| c.quadrature_degree = v,
+        |ui, v| {
+            let shown = v.map_or("element default".to_string(), |d| format!("degree {d}"));
+            let mut options = vec![(None, "element default".to_string())];
+            options.extend((1..=8).map(|d| (Some(d), format!("degree {d}"))));
+            combo(ui, ("quadrature", k), v, shown, options)
+        },
+    );
+    row_ui(
+        app,
+        ui,
+        "substeps",
+        "Substeps",
+        "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.",
+        |c| c.substeps,
+        |c, v| c.substeps = v,
+        |ui, v| ui.add(egui::Slider::new(v, 1..=500).logarithmic(true)),
+    );
+    row_ui(
+        app,
+        ui,
+        "iterations",
+        "Iterations",
+        "Constraint sweeps per substep (the paper: 1).",
+        |c| c.iterations,
+        |c, v| c.iterations = v,
+        |ui, v| ui.add(egui::Slider::new(v, 1..=20).logarithmic(true)),
+    );
+    row_ui(
+        app,
+        ui,
+        "guard",
+        "Stability guard",
+        "More substeps when the stiffest element needs them (when h·ω_max would exceed 3, enough for h·ω_max ≤ 1; just below 3 your substeps are kept); off: exactly the substeps asked for, which may blow up.",
+        |c| c.stability_guard,
+        |c, v| c.stability_guard = v,
+        |ui, v| ui.checkbox(v, "raise substeps when needed"),
+    );
+    row_ui(
+        app,
+        ui,
+        "fps",
+        "Frames per second",
+        "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.",
+        |c| c.frames_per_second,
+        |c, v| c.frames_per_second = v,
+        |ui, v| ui.add(egui::Slider::new(v, 10.0..=240.0).logarithmic(true).suffix(" fps")),
+    );
 }
 
 fn playback_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
@@ -310,16 +484,24 @@ fn view_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("View");
     let v = &mut app.view;
     ui.horizontal_wrapped(|ui| {
-        ui.checkbox(&mut v.edges, "edges").on_hover_text("Element edges on the surface (curved for high-order elements).");
-        ui.checkbox(&mut v.nodes, "nodes").on_hover_text("Corner nodes white, high-order (edge, face, interior) nodes cyan.");
-        ui.checkbox(&mut v.quadrature_points, "quadrature points").on_hover_text("Where the elastic energy is sampled (orange).");
-        ui.checkbox(&mut v.boundary_conditions, "clamped / driven").on_hover_text("Clamped nodes blue, nodes with prescribed motion magenta.");
+        ui.checkbox(&mut v.edges, "edges")
+            .on_hover_text("Element edges on the surface (curved for high-order elements).");
+        ui.checkbox(&mut v.nodes, "nodes")
+            .on_hover_text("Corner nodes white, high-order (edge, face, interior) nodes cyan.");
+        ui.checkbox(&mut v.quadrature_points, "quadrature points")
+            .on_hover_text("Where the elastic energy is sampled (orange).");
+        ui.checkbox(&mut v.boundary_conditions, "clamped / driven")
+            .on_hover_text("Clamped nodes blue, nodes with prescribed motion magenta.");
         ui.checkbox(&mut v.ghost, "rest shape").on_hover_text("The undeformed shape's edges as a faint ghost.");
         ui.checkbox(&mut v.probes, "probes").on_hover_text("The probe points the study measures (red).");
     });
     let mut segments = v.segments;
     ui.horizontal(|ui| {
-        let l = label(ui, "Curved-face pieces", "Pieces per edge when drawing curved (high-order) and quadrilateral faces.");
+        let l = label(
+            ui,
+            "Curved-face pieces",
+            "Pieces per edge when drawing curved (high-order) and quadrilateral faces.",
+        );
         ui.add(egui::Slider::new(&mut segments, 1..=12)).labelled_by(l.id);
     });
     if segments != app.view.segments {
@@ -330,9 +512,16 @@ fn view_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     }
     let mut auto = app.view.colour_max_m.is_none();
     ui.horizontal(|ui| {
-        let l = label(ui, "Colour range", "Top of the displacement colour map, metres (auto: a fifth of the body's largest extent).");
+        let l = label(
+            ui,
+            "Colour range",
+            "Top of the displacement colour map, metres (auto: a fifth of the body's largest extent).",
+        );
         ui.checkbox(&mut auto, "auto");
-        let mut max = app.view.colour_max_m.unwrap_or_else(|| super::viewport::Viewport::colour_range(&app.sessions, &app.view).max_m);
+        let mut max = app
+            .view
+            .colour_max_m
+            .unwrap_or_else(|| super::viewport::Viewport::colour_range(&app.sessions, &app.view).max_m);
         if !auto {
             ui.add(egui::DragValue::new(&mut max).range(1e-6..=1e3).speed(0.01).suffix(" m")).labelled_by(l.id);
         }
@@ -357,7 +546,11 @@ fn rerun_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 app.set_rerun(false, false);
             }
         } else {
-            if ui.button("Stream to viewer").on_hover_text("Log every simulated frame to the viewer at the URL above.").clicked() {
+            if ui
+                .button("Stream to viewer")
+                .on_hover_text("Log every simulated frame to the viewer at the URL above.")
+                .clicked()
+            {
                 app.set_rerun(true, false);
             }
             if ui.button("Save to file").on_hover_text("Log every simulated frame to the .rrd file above.").clicked() {
@@ -391,7 +584,11 @@ pub fn open_dialog_ui(app: &mut HoxApp, ctx: &egui::Context) {
         let folder = if dialog.mesh { "assets/meshes" } else { "assets/scenes" };
         let ext = if dialog.mesh { "msh" } else { "toml" };
         if let Ok(entries) = std::fs::read_dir(folder) {
-            let mut files: Vec<_> = entries.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.extension().is_some_and(|e| e == ext)).collect();
+            let mut files: Vec<_> = entries
+                .filter_map(|e| e.ok())
+                .map(|e| e.path())
+                .filter(|p| p.extension().is_some_and(|e| e == ext))
+                .collect();
             files.sort();
             egui::ScrollArea::vertical().max_height(160.0).show(ui, |ui| {
                 for f in files {
@@ -406,7 +603,12 @@ pub fn open_dialog_ui(app: &mut HoxApp, ctx: &egui::Context) {
         }
         if ui.button("Open").clicked() {
             let path = std::path::PathBuf::from(dialog.path.trim());
-            let result = if dialog.mesh { mesh_scene_file(&path, dialog.clamp_group.trim()).and_then(|p| app.load_scene(SceneSource::File(p), None)) } else { app.load_scene(SceneSource::File(path), None) };
+            let result = if dialog.mesh {
+                mesh_scene_file(&path, dialog.clamp_group.trim())
+                    .and_then(|p| app.load_scene(SceneSource::File(p), None))
+            } else {
+                app.load_scene(SceneSource::File(path), None)
+            };
             match result {
                 Ok(()) => done = true,
                 Err(e) => dialog.error = Some(e),

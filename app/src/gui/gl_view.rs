@@ -46,7 +46,11 @@ impl GlScene {
     /// Adds shaded triangles: `positions` and `colours` per vertex, `triangles` indexing them.
     pub fn add_triangles(&mut self, positions: &[[f32; 3]], colours: &[[u8; 3]], triangles: &[[u32; 3]]) {
         let base = self.vertices.len() as u32;
-        self.vertices.extend(positions.iter().zip(colours).map(|(&position, c)| GlVertex { position, colour: [c[0], c[1], c[2], 255], ..Default::default() }));
+        self.vertices.extend(positions.iter().zip(colours).map(|(&position, c)| GlVertex {
+            position,
+            colour: [c[0], c[1], c[2], 255],
+            ..Default::default()
+        }));
         self.triangles.extend(triangles.iter().flat_map(|t| t.map(|i| base + i)));
     }
 
@@ -182,7 +186,11 @@ impl Program {
                 gl.detach_shader(program, s);
                 gl.delete_shader(s);
             }
-            Ok(Program { u_view_projection: gl.get_uniform_location(program, "u_view_projection"), u_viewport_px: gl.get_uniform_location(program, "u_viewport_px"), program })
+            Ok(Program {
+                u_view_projection: gl.get_uniform_location(program, "u_view_projection"),
+                u_viewport_px: gl.get_uniform_location(program, "u_viewport_px"),
+                program,
+            })
         }
     }
 
@@ -198,7 +206,12 @@ impl Program {
 }
 
 /// Vertex attributes: name, components, type, normalised, byte offset in [`GlVertex`].
-const ATTRIBUTES: [(&str, i32, u32, bool, i32); 4] = [("a_position", 3, glow::FLOAT, false, 0), ("a_colour", 4, glow::UNSIGNED_BYTE, true, 12), ("a_corner", 2, glow::FLOAT, false, 16), ("a_size_px", 1, glow::FLOAT, false, 24)];
+const ATTRIBUTES: [(&str, i32, u32, bool, i32); 4] = [
+    ("a_position", 3, glow::FLOAT, false, 0),
+    ("a_colour", 4, glow::UNSIGNED_BYTE, true, 12),
+    ("a_corner", 2, glow::FLOAT, false, 16),
+    ("a_size_px", 1, glow::FLOAT, false, 24),
+];
 
 impl GlView {
     /// Compiles the shaders and makes the buffers.
@@ -223,14 +236,7 @@ impl GlView {
             }
             gl.bind_vertex_array(None);
             gl.bind_buffer(glow::ARRAY_BUFFER, None);
-            Ok(GlView {
-                plain,
-                discs,
-                vertex_array,
-                vertex_buffer,
-                index_buffer,
-                indices: Vec::new(),
-            })
+            Ok(GlView { plain, discs, vertex_array, vertex_buffer, index_buffer, indices: Vec::new() })
         }
     }
 

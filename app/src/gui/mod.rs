@@ -34,8 +34,22 @@ use viewport::{ViewOptions, Viewport};
 pub struct Links(pub std::collections::BTreeMap<String, bool>);
 
 /// The fields a link can tie, in control order.
-pub const LINKABLE: [&str; 14] =
-    ["element", "split", "grid", "refine", "material", "youngs", "poisson", "density", "formulation", "quadrature", "substeps", "iterations", "fps", "guard"];
+pub const LINKABLE: [&str; 14] = [
+    "element",
+    "split",
+    "grid",
+    "refine",
+    "material",
+    "youngs",
+    "poisson",
+    "density",
+    "formulation",
+    "quadrature",
+    "substeps",
+    "iterations",
+    "fps",
+    "guard",
+];
 
 impl Default for Links {
     fn default() -> Self {
@@ -250,7 +264,9 @@ impl HoxApp {
             show_reference_element: saved.as_ref().is_some_and(|s| s.show_reference_element),
             reference_element: teach::ReferenceElementView::default(),
             bottom_tab: plots::Tab::default(),
-            rerun_url: saved.as_ref().map_or_else(|| "rerun+http://127.0.0.1:9876/proxy".into(), |s| s.rerun_url.clone()),
+            rerun_url: saved
+                .as_ref()
+                .map_or_else(|| "rerun+http://127.0.0.1:9876/proxy".into(), |s| s.rerun_url.clone()),
             rerun_file: saved.as_ref().map_or_else(|| "hox.rrd".into(), |s| s.rerun_file.clone()),
             rerun: None,
             generation: 0,
@@ -262,7 +278,14 @@ impl HoxApp {
             last_ui_frame: None,
             screenshot: args.screenshot.clone().map(|p| (p, args.after_secs)),
             screenshot_requested: false,
-            measure: args.measure_secs.map(|s| Measure { until_secs: s, started: None, frames: 0, sim_frames: 0, frame_ms: Vec::new(), last: None }),
+            measure: args.measure_secs.map(|s| Measure {
+                until_secs: s,
+                started: None,
+                frames: 0,
+                sim_frames: 0,
+                frame_ms: Vec::new(),
+                last: None,
+            }),
             gl_available: false,
             renderer: None,
             deferred_frames: 0,
@@ -288,7 +311,8 @@ impl HoxApp {
         let mut sessions = Vec::new();
         for c in wanted.into_iter().take(2) {
             // a saved configuration the scene no longer accepts falls back to the scene's own
-            let s = Session::new(base.clone(), c, segments(&self.view)).or_else(|_| Session::new(base.clone(), defaults.clone(), segments(&self.view)))?;
+            let s = Session::new(base.clone(), c, segments(&self.view))
+                .or_else(|_| Session::new(base.clone(), defaults.clone(), segments(&self.view)))?;
             sessions.push(s);
         }
         self.scene = source;
@@ -318,7 +342,8 @@ impl HoxApp {
                 c.element = "p2".into();
                 c.refine = 0;
             }
-            let second = Session::new(first.base.clone(), c.clone(), segments(&self.view)).or_else(|_| Session::new(first.base.clone(), first.config.clone(), segments(&self.view)));
+            let second = Session::new(first.base.clone(), c.clone(), segments(&self.view))
+                .or_else(|_| Session::new(first.base.clone(), first.config.clone(), segments(&self.view)));
             match second {
                 Ok(s) => {
                     // P1 first, so the pair reads "P1 vs P2" left to right
@@ -376,7 +401,9 @@ impl HoxApp {
             match self.sessions[other].apply(follow) {
                 Ok(config::Invalidates::Mesh) => self.rebuilt(),
                 Ok(_) => {}
-                Err(reason) => self.refusal = Some((control.to_string(), format!("the other configuration refused it: {reason}"))),
+                Err(reason) => {
+                    self.refusal = Some((control.to_string(), format!("the other configuration refused it: {reason}")))
+                }
             }
         }
     }
@@ -456,7 +483,8 @@ impl HoxApp {
             }
             return;
         }
-        let builder = rerun::RecordingStreamBuilder::new("hox").recording_name(format!("hox app {}", self.scene.label()));
+        let builder =
+            rerun::RecordingStreamBuilder::new("hox").recording_name(format!("hox app {}", self.scene.label()));
         let (rec, target) = if to_file {
             let path = PathBuf::from(&self.rerun_file);
             if let Err(e) = crate::cli::check_writable(&path) {
@@ -485,7 +513,11 @@ impl HoxApp {
         let offsets = self.offsets();
         let Some(link) = &mut self.rerun else { return };
         if link.generation != self.generation {
-            let settings = LogSettings { segments: segments(&self.view), colour_max_m: self.view.colour_max_m, quadrature_points: self.view.quadrature_points };
+            let settings = LogSettings {
+                segments: segments(&self.view),
+                colour_max_m: self.view.colour_max_m,
+                quadrature_points: self.view.quadrature_points,
+            };
             link.loggers.clear();
             for (k, (s, o)) in self.sessions.iter().zip(&offsets).enumerate() {
                 let name = format!("{}_{}", ["a", "b"][k.min(1)], s.config.label());
@@ -529,7 +561,8 @@ impl HoxApp {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
-        let (space, s, r) = ctx.input(|i| (i.key_pressed(egui::Key::Space), i.key_pressed(egui::Key::S), i.key_pressed(egui::Key::R)));
+        let (space, s, r) =
+            ctx.input(|i| (i.key_pressed(egui::Key::Space), i.key_pressed(egui::Key::S), i.key_pressed(egui::Key::R)));
         if space {
             self.playing = !self.playing;
         }
@@ -623,13 +656,20 @@ impl HoxApp {
         let frame = egui::Frame::side_top_panel(ui.style()).fill(egui::Color32::TRANSPARENT);
         egui::Panel::top("menu").frame(frame).show(ui, |ui| controls::menu_bar_ui(self, ui));
         egui::Panel::bottom("status").frame(frame).show(ui, |ui| self.status_line_ui(ui));
-        egui::Panel::bottom("plots").frame(frame).resizable(true).default_size(230.0).show(ui, |ui| plots::plots_ui(self, ui));
+        egui::Panel::bottom("plots")
+            .frame(frame)
+            .resizable(true)
+            .default_size(230.0)
+            .show(ui, |ui| plots::plots_ui(self, ui));
         egui::Panel::left("controls").frame(frame).resizable(true).default_size(330.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| controls::controls_ui(self, ui));
         });
         if self.show_reference_element {
             let mut open = true;
-            egui::Window::new("Reference element").open(&mut open).default_size([420.0, 460.0]).show(&ctx, |ui| self.reference_element.ui(ui));
+            egui::Window::new("Reference element")
+                .open(&mut open)
+                .default_size([420.0, 460.0])
+                .show(&ctx, |ui| self.reference_element.ui(ui));
             self.show_reference_element = open;
         }
         controls::open_dialog_ui(self, &ctx);
@@ -775,7 +815,9 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
         Scene::load(path)?;
     }
     let options = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default().with_inner_size([w, h]).with_title("hox — high-order elements in XPBD"),
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size([w, h])
+            .with_title("hox — high-order elements in XPBD"),
         glow_options: eframe::egui_glow::GlowConfiguration { vsync: !args.no_vsync, ..Default::default() },
         // an explicit --size (or --fresh) wins over the window geometry eframe saved last time
         persist_window: args.size.is_none() && !args.fresh,

@@ -57,39 +57,69 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     match app.bottom_tab {
         Tab::Probe => {
             let probe = app.sessions[0].instance.probes.first().map_or("probe".to_string(), |p| p.name.clone());
-            Plot::new("probe").show_background(false).legend(Legend::default()).x_axis_label("t (s)").y_axis_label(format!("{probe} u (m)")).show(ui, |plot| {
-                for (k, s) in app.sessions.iter().enumerate() {
-                    let h = &s.history;
-                    for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate() {
-                        let points = PlotPoints::Owned(decimate(&h.time_secs, |i| h.probe_m[i][axis], MAX_PLOT_POINTS));
-                        let name = if app.compare { format!("{} {} {label}", names[k], s.config.label()) } else { label.to_string() };
-                        plot.line(Line::new(name, points));
+            Plot::new("probe")
+                .show_background(false)
+                .legend(Legend::default())
+                .x_axis_label("t (s)")
+                .y_axis_label(format!("{probe} u (m)"))
+                .show(ui, |plot| {
+                    for (k, s) in app.sessions.iter().enumerate() {
+                        let h = &s.history;
+                        for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate() {
+                            let points =
+                                PlotPoints::Owned(decimate(&h.time_secs, |i| h.probe_m[i][axis], MAX_PLOT_POINTS));
+                            let name = if app.compare {
+                                format!("{} {} {label}", names[k], s.config.label())
+                            } else {
+                                label.to_string()
+                            };
+                            plot.line(Line::new(name, points));
+                        }
+                        // the reference displacement, as a dashed level
+                        if let Some((_, r)) = s.reference.iter().find(|(n, _)| *n == probe)
+                            && k == 0
+                        {
+                            let t1 = h.time_secs.last().copied().unwrap_or(1.0).max(1e-3);
+                            plot.line(
+                                Line::new("reference u_z", PlotPoints::from(vec![[0.0, r.z], [t1, r.z]]))
+                                    .style(egui_plot::LineStyle::dashed_loose()),
+                            );
+                        }
                     }
-                    // the reference displacement, as a dashed level
-                    if let Some((_, r)) = s.reference.iter().find(|(n, _)| *n == probe)
-                        && k == 0
-                    {
-                        let t1 = h.time_secs.last().copied().unwrap_or(1.0).max(1e-3);
-                        plot.line(Line::new("reference u_z", PlotPoints::from(vec![[0.0, r.z], [t1, r.z]])).style(egui_plot::LineStyle::dashed_loose()));
-                    }
-                }
-            });
+                });
         }
         Tab::Energy => {
-            Plot::new("energy").show_background(false).legend(Legend::default()).x_axis_label("t (s)").y_axis_label("energy (J)").show(ui, |plot| {
-                for (k, s) in app.sessions.iter().enumerate() {
-                    let h = &s.history;
-                    let prefix = if app.compare { format!("{} ", names[k]) } else { String::new() };
-                    plot.line(Line::new(format!("{prefix}kinetic"), PlotPoints::Owned(decimate(&h.time_secs, |i| h.kinetic_j[i], MAX_PLOT_POINTS))));
-                    plot.line(Line::new(format!("{prefix}elastic"), PlotPoints::Owned(decimate(&h.time_secs, |i| h.elastic_j[i], MAX_PLOT_POINTS))));
-                }
-            });
+            Plot::new("energy")
+                .show_background(false)
+                .legend(Legend::default())
+                .x_axis_label("t (s)")
+                .y_axis_label("energy (J)")
+                .show(ui, |plot| {
+                    for (k, s) in app.sessions.iter().enumerate() {
+                        let h = &s.history;
+                        let prefix = if app.compare { format!("{} ", names[k]) } else { String::new() };
+                        plot.line(Line::new(
+                            format!("{prefix}kinetic"),
+                            PlotPoints::Owned(decimate(&h.time_secs, |i| h.kinetic_j[i], MAX_PLOT_POINTS)),
+                        ));
+                        plot.line(Line::new(
+                            format!("{prefix}elastic"),
+                            PlotPoints::Owned(decimate(&h.time_secs, |i| h.elastic_j[i], MAX_PLOT_POINTS)),
+                        ));
+                    }
+                });
         }
         Tab::Study => {
             let current: Vec<StudyPoint> = app
                 .sessions
                 .iter()
-                .filter_map(|s| s.probe_error_m().map(|e| StudyPoint { label: format!("now: {}", s.config.label()), ms_per_frame: s.ms_per_frame, error_m: e }))
+                .filter_map(|s| {
+                    s.probe_error_m().map(|e| StudyPoint {
+                        label: format!("now: {}", s.config.label()),
+                        ms_per_frame: s.ms_per_frame,
+                        error_m: e,
+                    })
+                })
                 .collect();
             study_chart_ui(ui, app.sessions[0].base.name(), &current);
         }

@@ -33,7 +33,13 @@ impl Camera {
         let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
         let radius = 0.5 * (hi - lo).length().max(1e-6);
         let fov_y = 35f32.to_radians();
-        Camera { target: (0.5 * (lo + hi)).into(), distance: 1.15 * radius / (0.5 * fov_y).sin(), yaw: -0.9, pitch: 0.45, fov_y }
+        Camera {
+            target: (0.5 * (lo + hi)).into(),
+            distance: 1.15 * radius / (0.5 * fov_y).sin(),
+            yaw: -0.9,
+            pitch: 0.45,
+            fov_y,
+        }
     }
 
     pub fn eye(&self) -> Vec3 {
@@ -109,7 +115,13 @@ pub const BACKGROUND: [u8; 4] = [24, 26, 32, 255];
 
 impl Image {
     pub fn new(width: usize, height: usize) -> Image {
-        Image { width, height, rgba: vec![BACKGROUND; width * height], depth: vec![f32::INFINITY; width * height], view_projection: Mat4::IDENTITY }
+        Image {
+            width,
+            height,
+            rgba: vec![BACKGROUND; width * height],
+            depth: vec![f32::INFINITY; width * height],
+            view_projection: Mat4::IDENTITY,
+        }
     }
 
     /// Projects a world point to pixel coordinates and NDC depth (None behind the camera).
@@ -152,7 +164,13 @@ impl Image {
         let mut tris = Vec::new();
         for layer in layers {
             let screen: Vec<Option<[f32; 3]>> = layer.positions.iter().map(|&p| project(&vp, w, h, p)).collect();
-            let shade: Vec<[f32; 3]> = layer.positions.iter().zip(&layer.normals).zip(&layer.colours).map(|((&p, &n), &c)| shade(p, n, c, eye)).collect();
+            let shade: Vec<[f32; 3]> = layer
+                .positions
+                .iter()
+                .zip(&layer.normals)
+                .zip(&layer.colours)
+                .map(|((&p, &n), &c)| shade(p, n, c, eye))
+                .collect();
             for t in &layer.triangles {
                 let [a, b, c] = t.map(|i| i as usize);
                 let (Some(pa), Some(pb), Some(pc)) = (screen[a], screen[b], screen[c]) else { continue };
@@ -165,15 +183,17 @@ impl Image {
             }
         }
         let band_rows = h.div_ceil(4 * rayon::current_num_threads().max(1)).max(8);
-        self.rgba.par_chunks_mut(band_rows * w).zip(self.depth.par_chunks_mut(band_rows * w)).enumerate().for_each(|(band, (rgba, depth))| {
-            rgba.fill(BACKGROUND);
-            depth.fill(f32::INFINITY);
-            let y0 = (band * band_rows) as i32;
-            let y1 = y0 + (rgba.len() / w) as i32 - 1;
-            for t in tris.iter().filter(|t| t.max_y >= y0 && t.min_y <= y1) {
-                raster_triangle(t, w, y0, y1, rgba, depth);
-            }
-        });
+        self.rgba.par_chunks_mut(band_rows * w).zip(self.depth.par_chunks_mut(band_rows * w)).enumerate().for_each(
+            |(band, (rgba, depth))| {
+                rgba.fill(BACKGROUND);
+                depth.fill(f32::INFINITY);
+                let y0 = (band * band_rows) as i32;
+                let y1 = y0 + (rgba.len() / w) as i32 - 1;
+                for t in tris.iter().filter(|t| t.max_y >= y0 && t.min_y <= y1) {
+                    raster_triangle(t, w, y0, y1, rgba, depth);
+                }
+            },
+        );
         for &(a, b, colour) in &overlay.lines {
             if let (Some(pa), Some(pb)) = (project(&vp, w, h, a), project(&vp, w, h, b)) {
                 self.line(pa, pb, colour);
@@ -272,7 +292,8 @@ fn raster_triangle(t: &ScreenTriangle, w: usize, y0: i32, y1: i32, rgba: &mut [[
             let i = row + x as usize;
             if z < depth[i] {
                 depth[i] = z;
-                let colour: [u8; 3] = std::array::from_fn(|k| (w0 * t.c[0][k] + w1 * t.c[1][k] + w2 * t.c[2][k]).clamp(0.0, 255.0) as u8);
+                let colour: [u8; 3] =
+                    std::array::from_fn(|k| (w0 * t.c[0][k] + w1 * t.c[1][k] + w2 * t.c[2][k]).clamp(0.0, 255.0) as u8);
                 rgba[i] = [colour[0], colour[1], colour[2], 255];
             }
         }
@@ -310,7 +331,13 @@ mod tests {
     #[test]
     fn background_outside_and_lines_hidden_behind_surfaces() {
         let near = square(1.0, [200, 200, 200]);
-        let overlay = Overlay { lines: vec![([-3.0, 0.0, -2.0], [3.0, 0.0, -2.0], [255, 0, 0, 255]), ([-3.0, 0.5, 2.0], [3.0, 0.5, 2.0], [0, 255, 0, 255])], points: vec![] };
+        let overlay = Overlay {
+            lines: vec![
+                ([-3.0, 0.0, -2.0], [3.0, 0.0, -2.0], [255, 0, 0, 255]),
+                ([-3.0, 0.5, 2.0], [3.0, 0.5, 2.0], [0, 255, 0, 255]),
+            ],
+            points: vec![],
+        };
         let mut img = Image::new(80, 60);
         img.render(&top_view(), &[&near], &overlay);
         assert_eq!(img.rgba[0], BACKGROUND);
@@ -319,7 +346,9 @@ mod tests {
         assert!(greens > 20, "the line in front is drawn ({greens} px)");
         // the line below the square shows only outside the square's silhouette
         let s = img.project([1.0, 0.0, 1.0]).unwrap();
-        let inside_red = (0..80).filter(|&x| (x as f32) < s[0] - 1.0 && img.rgba[30 * 80 + x][0] == 255 && img.rgba[30 * 80 + x][1] == 0).count();
+        let inside_red = (0..80)
+            .filter(|&x| (x as f32) < s[0] - 1.0 && img.rgba[30 * 80 + x][0] == 255 && img.rgba[30 * 80 + x][1] == 0)
+            .count();
         assert!(reds > 0 && inside_red < reds, "{reds} {inside_red}");
     }
 

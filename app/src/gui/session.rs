@@ -151,7 +151,11 @@ impl Session {
         self.clamped.clear();
         self.driven.clear();
         for (k, e) in scene.file.effects.iter().enumerate() {
-            let (hox_scenes::scene::EffectSpec::Clamp { nodes } | hox_scenes::scene::EffectSpec::Prescribed { nodes, .. }) = e else { continue };
+            let (hox_scenes::scene::EffectSpec::Clamp { nodes }
+            | hox_scenes::scene::EffectSpec::Prescribed { nodes, .. }) = e
+            else {
+                continue;
+            };
             let set = scene.selected_nodes(mesh, k, nodes).unwrap_or_default();
             if matches!(e, hox_scenes::scene::EffectSpec::Clamp { .. }) {
                 self.clamped.extend(set);
@@ -167,7 +171,8 @@ impl Session {
 
     /// Every quadrature point as a material point (computed on first use).
     pub fn quadrature_points(&self) -> &PointMap {
-        self.quadrature.get_or_init(|| hox_sim::surface::quadrature_points(self.instance.sim.mesh(), self.instance.sim.geometry()))
+        self.quadrature
+            .get_or_init(|| hox_sim::surface::quadrature_points(self.instance.sim.mesh(), self.instance.sim.geometry()))
     }
 
     /// Changes the display tessellation.
@@ -220,7 +225,8 @@ impl Session {
             self.instance.sim.remove_effects_named("attachment");
         }
         if let Some(d) = self.drag {
-            let _ = self.instance.sim.add_effect(Box::new(Attachment::new(d.node, d.target_m, DRAG_COMPLIANCE_M_PER_N)));
+            let _ =
+                self.instance.sim.add_effect(Box::new(Attachment::new(d.node, d.target_m, DRAG_COMPLIANCE_M_PER_N)));
         }
         self.attached = self.drag;
     }
@@ -317,7 +323,9 @@ mod tests {
     #[test]
     fn dragging_pulls_the_node_and_leaves_no_effect_behind() {
         let mut s = bending();
-        let tip = s.instance.sim.mesh().rest_positions.iter().enumerate().max_by(|a, b| a.1.x.total_cmp(&b.1.x)).unwrap().0 as u32;
+        let tip =
+            s.instance.sim.mesh().rest_positions.iter().enumerate().max_by(|a, b| a.1.x.total_cmp(&b.1.x)).unwrap().0
+                as u32;
         let target = s.instance.sim.mesh().rest_positions[tip as usize] + Vec3::new(0.0, 0.0, 0.3);
         s.drag = Some(Drag { node: tip, target_m: target });
         s.step(60);

@@ -50,7 +50,8 @@ struct StudyRecord {
 fn parse_study_csv(text: &str) -> Result<Vec<StudyRecord>, String> {
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     let header: Vec<&str> = lines.next().ok_or("study.csv is empty")?.split(',').map(str::trim).collect();
-    let column = |name: &str| header.iter().position(|h| *h == name).ok_or_else(|| format!("study.csv has no column '{name}'"));
+    let column =
+        |name: &str| header.iter().position(|h| *h == name).ok_or_else(|| format!("study.csv has no column '{name}'"));
     let [scene, configuration, element, ms, error, substeps, ms_1pct, error_1pct] = [
         "scene",
         "configuration",
@@ -68,10 +69,12 @@ fn parse_study_csv(text: &str) -> Result<Vec<StudyRecord>, String> {
         .enumerate()
         .map(|(row, line)| {
             let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-            let field = |i: usize| fields.get(i).copied().ok_or_else(|| format!("study.csv row {}: too few columns", row + 1));
+            let field =
+                |i: usize| fields.get(i).copied().ok_or_else(|| format!("study.csv row {}: too few columns", row + 1));
             let number = |i: usize| -> Result<f64, String> {
                 let text = field(i)?;
-                text.parse::<f64>().map_err(|_| format!("study.csv row {}, column '{}': '{text}' is not a number", row + 1, header[i]))
+                text.parse::<f64>()
+                    .map_err(|_| format!("study.csv row {}, column '{}': '{text}' is not a number", row + 1, header[i]))
             };
             Ok(StudyRecord {
                 scene: field(scene)?.to_string(),
@@ -79,7 +82,9 @@ fn parse_study_csv(text: &str) -> Result<Vec<StudyRecord>, String> {
                 element: field(element)?.to_string(),
                 ms_per_frame: number(ms)?,
                 error_m: number(error)?,
-                substeps_for_1pct: field(substeps)?.parse().map_err(|_| format!("study.csv row {}: bad substeps_for_1pct", row + 1))?,
+                substeps_for_1pct: field(substeps)?
+                    .parse()
+                    .map_err(|_| format!("study.csv row {}: bad substeps_for_1pct", row + 1))?,
                 ms_per_frame_1pct: number(ms_1pct)?,
                 error_1pct_m: number(error_1pct)?,
             })
@@ -116,7 +121,9 @@ fn power_of_ten(exponent: i32) -> String {
     if exponent < 0 {
         s.push('⁻');
     }
-    s.extend(exponent.unsigned_abs().to_string().chars().filter_map(|d| d.to_digit(10).map(|d| SUPERSCRIPTS[d as usize])));
+    s.extend(
+        exponent.unsigned_abs().to_string().chars().filter_map(|d| d.to_digit(10).map(|d| SUPERSCRIPTS[d as usize])),
+    );
     s
 }
 
@@ -213,7 +220,10 @@ pub fn study_chart_ui(ui: &mut egui::Ui, scene: &str, current: &[StudyPoint]) {
                 labelled.push(Labelled {
                     series: name.clone(),
                     at: p,
-                    text: format!("{}, 50 substeps\n{:.2} ms per frame, error {:.2e} m", r.configuration, r.ms_per_frame, r.error_m),
+                    text: format!(
+                        "{}, 50 substeps\n{:.2} ms per frame, error {:.2e} m",
+                        r.configuration, r.ms_per_frame, r.error_m
+                    ),
                 });
             }
             if r.substeps_for_1pct != 50
@@ -231,9 +241,22 @@ pub fn study_chart_ui(ui: &mut egui::Ui, scene: &str, current: &[StudyPoint]) {
             }
         }
         // same name: one legend entry for both
-        series.push(Points::new(name.clone(), PlotPoints::from(filled)).id(format!("{element} 50")).color(colour).radius(4.5).shape(MarkerShape::Circle));
+        series.push(
+            Points::new(name.clone(), PlotPoints::from(filled))
+                .id(format!("{element} 50"))
+                .color(colour)
+                .radius(4.5)
+                .shape(MarkerShape::Circle),
+        );
         if !hollow.is_empty() {
-            series.push(Points::new(name, PlotPoints::from(hollow)).id(format!("{element} 1pct")).color(colour).radius(4.5).filled(false).shape(MarkerShape::Circle));
+            series.push(
+                Points::new(name, PlotPoints::from(hollow))
+                    .id(format!("{element} 1pct"))
+                    .color(colour)
+                    .radius(4.5)
+                    .filled(false)
+                    .shape(MarkerShape::Circle),
+            );
         }
     }
     if scene == "bending" {
@@ -249,10 +272,16 @@ pub fn study_chart_ui(ui: &mut egui::Ui, scene: &str, current: &[StudyPoint]) {
                 });
             }
         }
-        series.push(Points::new(paper_name, PlotPoints::from(crosses)).color(egui::Color32::GRAY).radius(5.0).shape(MarkerShape::Cross));
+        series.push(
+            Points::new(paper_name, PlotPoints::from(crosses))
+                .color(egui::Color32::GRAY)
+                .radius(5.0)
+                .shape(MarkerShape::Cross),
+        );
     }
     let highlight = ui.visuals().strong_text_color();
-    let now: Vec<(&StudyPoint, [f64; 2])> = current.iter().filter_map(|c| log_point(c.ms_per_frame, c.error_m).map(|p| (c, p))).collect();
+    let now: Vec<(&StudyPoint, [f64; 2])> =
+        current.iter().filter_map(|c| log_point(c.ms_per_frame, c.error_m).map(|p| (c, p))).collect();
     for (c, p) in &now {
         labelled.push(Labelled {
             series: "now".into(),
@@ -290,12 +319,30 @@ pub fn study_chart_ui(ui: &mut egui::Ui, scene: &str, current: &[StudyPoint]) {
             }
             if !now.is_empty() {
                 let at: Vec<[f64; 2]> = now.iter().map(|(_, p)| *p).collect();
-                plot.points(Points::new("now", PlotPoints::from(at.clone())).id("now ring").color(highlight).radius(11.0).filled(false).shape(MarkerShape::Diamond));
-                plot.points(Points::new("now", PlotPoints::from(at)).id("now fill").color(egui::Color32::GOLD).radius(7.0).shape(MarkerShape::Diamond));
+                plot.points(
+                    Points::new("now", PlotPoints::from(at.clone()))
+                        .id("now ring")
+                        .color(highlight)
+                        .radius(11.0)
+                        .filled(false)
+                        .shape(MarkerShape::Diamond),
+                );
+                plot.points(
+                    Points::new("now", PlotPoints::from(at))
+                        .id("now fill")
+                        .color(egui::Color32::GOLD)
+                        .radius(7.0)
+                        .shape(MarkerShape::Diamond),
+                );
                 for (i, (c, p)) in now.iter().enumerate() {
                     // a little right of the marker: 0.04 decades
                     let text = egui::RichText::new(&c.label).color(highlight).strong();
-                    plot.text(Text::new("", PlotPoint::new(p[0] + 0.04, p[1]), text).id(("now label", i)).anchor(egui::Align2::LEFT_BOTTOM).allow_hover(false));
+                    plot.text(
+                        Text::new("", PlotPoint::new(p[0] + 0.04, p[1]), text)
+                            .id(("now label", i))
+                            .anchor(egui::Align2::LEFT_BOTTOM)
+                            .allow_hover(false),
+                    );
                 }
             }
         });

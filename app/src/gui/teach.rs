@@ -78,7 +78,8 @@ pub struct ReferenceElementView {
 
 impl Default for ReferenceElementView {
     fn default() -> Self {
-        let element = ElementType::from_name("p2").or_else(|| ElementType::all().next()).expect("hox registers element types");
+        let element =
+            ElementType::from_name("p2").or_else(|| ElementType::all().next()).expect("hox registers element types");
         ReferenceElementView {
             element,
             node: 0,
@@ -138,7 +139,8 @@ impl ElementGeometry {
         let mut positions = Vec::new();
         surface.vertices.eval_into(&mesh.rest_positions, &mut positions);
         let vertex_reference: Vec<[f64; 3]> = positions.iter().map(|p| [p.x, p.y, p.z]).collect();
-        let node_vertex = reference.nodes().iter().map(|r| vertex_reference.iter().position(|v| same_point(v, r))).collect();
+        let node_vertex =
+            reference.nodes().iter().map(|r| vertex_reference.iter().position(|v| same_point(v, r))).collect();
         ElementGeometry { element, surface, vertex_reference, node_vertex }
     }
 }
@@ -181,7 +183,9 @@ pub fn field_colour(value: f64) -> [u8; 3] {
         let ((a, colour_a), (b, colour_b)) = (w[0], w[1]);
         if value <= b {
             let t = (value - a) / (b - a);
-            return std::array::from_fn(|k| (colour_a[k] as f64 + t * (colour_b[k] as f64 - colour_a[k] as f64)).round() as u8);
+            return std::array::from_fn(|k| {
+                (colour_a[k] as f64 + t * (colour_b[k] as f64 - colour_a[k] as f64)).round() as u8
+            });
         }
     }
     last.1
@@ -281,7 +285,8 @@ impl FieldMesh {
     /// the shading separates the faces without darkening the colour map much.
     fn layer(&self, camera: &Camera) -> TriangleLayer {
         let eye = camera.eye();
-        let view = (Vec3::new(eye.x as f64, eye.y as f64, eye.z as f64) - Vec3::from(camera.target.map(|c| c as f64))).normalize();
+        let view = (Vec3::new(eye.x as f64, eye.y as f64, eye.z as f64) - Vec3::from(camera.target.map(|c| c as f64)))
+            .normalize();
         TriangleLayer {
             positions: self.points.iter().map(|r| r.map(|c| c as f32)).collect(),
             normals: self
@@ -348,10 +353,12 @@ fn polygon_centroid(points: &[[f64; 3]]) -> [f64; 3] {
 /// Area of a planar polygon lying in a plane normal to `axis` (shoelace formula).
 fn polygon_area(points: &[[f64; 3]], axis: usize) -> f64 {
     let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-    let twice: f64 = (0..points.len()).map(|k| {
-        let (p, q) = (points[k], points[(k + 1) % points.len()]);
-        p[u] * q[v] - q[u] * p[v]
-    }).sum();
+    let twice: f64 = (0..points.len())
+        .map(|k| {
+            let (p, q) = (points[k], points[(k + 1) % points.len()]);
+            p[u] * q[v] - q[u] * p[v]
+        })
+        .sum();
     0.5 * twice.abs()
 }
 
@@ -447,14 +454,18 @@ fn explanation(element: &dyn ReferenceElement, node: usize, field_min: f64, on_s
     let kind = function_kind(element);
     let mut s = format!("N_{node} of {name} ({}): 1 at node {node}, 0 at every other node; ", node_kind(element, node));
     if field_min < -1e-9 {
-        s += &format!("negative values (blue, down to {field_min:.3} here) show where a {kind} shape function dips below zero");
+        s += &format!(
+            "negative values (blue, down to {field_min:.3} here) show where a {kind} shape function dips below zero"
+        );
     } else if element.order() == 1 {
         s += &format!("a {kind} shape function, never negative");
     } else {
         s += &format!("a {kind} shape function, not negative anywhere shown");
     }
     if !on_surface {
-        s += &format!(". Node {node} is inside the element, so N_{node} vanishes on every face: shown on the sections through it");
+        s += &format!(
+            ". Node {node} is inside the element, so N_{node} vanishes on every face: shown on the sections through it"
+        );
     }
     s
 }
@@ -495,8 +506,9 @@ impl ReferenceElementView {
             }
             let last_node = self.element.num_nodes().saturating_sub(1);
             self.node = self.node.min(last_node);
-            ui.add(egui::Slider::new(&mut self.node, 0..=last_node).text("node"))
-                .on_hover_text("The node whose shape function N_i colours the element (or click a node in the picture).");
+            ui.add(egui::Slider::new(&mut self.node, 0..=last_node).text("node")).on_hover_text(
+                "The node whose shape function N_i colours the element (or click a node in the picture).",
+            );
             ui.checkbox(&mut self.sections, "sections through the node")
                 .on_hover_text("Show the field on the three planes through the node instead of on the surface.");
             ui.checkbox(&mut self.show_quadrature, "quadrature points")
@@ -517,7 +529,9 @@ impl ReferenceElementView {
                         }
                     })
                     .response
-                    .on_hover_text("The polynomial degree the quadrature rule integrates exactly (default: the element's own).");
+                    .on_hover_text(
+                        "The polynomial degree the quadrature rule integrates exactly (default: the element's own).",
+                    );
             });
             if ui.button("reset view").on_hover_text("Frame the element again from the default direction.").clicked() {
                 self.camera = framing_camera(shape);
@@ -534,9 +548,17 @@ impl ReferenceElementView {
         let height = (0.7 * width).min(available.y - 110.0).max(160.0);
         let (rect, response) = ui.allocate_exact_size(egui::vec2(width, height), egui::Sense::click_and_drag());
         let ppp = ui.ctx().pixels_per_point();
-        let size_px = [((rect.width() * ppp).round() as usize).max(16), ((rect.height() * ppp).round() as usize).max(16)];
-        let to_point = |px: [f32; 2]| rect.min + egui::vec2(px[0] / size_px[0] as f32 * rect.width(), px[1] / size_px[1] as f32 * rect.height());
-        let to_px = |p: egui::Pos2| [(p.x - rect.min.x) / rect.width() * size_px[0] as f32, (p.y - rect.min.y) / rect.height() * size_px[1] as f32];
+        let size_px =
+            [((rect.width() * ppp).round() as usize).max(16), ((rect.height() * ppp).round() as usize).max(16)];
+        let to_point = |px: [f32; 2]| {
+            rect.min + egui::vec2(px[0] / size_px[0] as f32 * rect.width(), px[1] / size_px[1] as f32 * rect.height())
+        };
+        let to_px = |p: egui::Pos2| {
+            [
+                (p.x - rect.min.x) / rect.width() * size_px[0] as f32,
+                (p.y - rect.min.y) / rect.height() * size_px[1] as f32,
+            ]
+        };
 
         // --- input (picking uses the picture on screen)
         if response.hovered() {
@@ -575,7 +597,8 @@ impl ReferenceElementView {
         }
 
         // --- render when something changed
-        let key = RenderKey { field: field_key, camera: self.camera, quadrature_degree: self.quadrature_degree, size_px };
+        let key =
+            RenderKey { field: field_key, camera: self.camera, quadrature_degree: self.quadrature_degree, size_px };
         if self.picture.as_ref().is_none_or(|p| p.key != key) {
             let Some((_, field)) = &self.field else { return };
             let image = self.image.get_or_insert_with(|| Image::new(size_px[0], size_px[1]));
@@ -596,16 +619,27 @@ impl ReferenceElementView {
             let degree = self.quadrature_degree.unwrap_or_else(|| element.default_quadrature_degree());
             let (quadrature_px, quadrature) = match quadrature::rule(element.shape(), degree) {
                 Ok(rule) => (
-                    rule.points.iter().filter_map(|r| image.project(r.map(|c| c as f32))).map(|s| [s[0], s[1]]).collect(),
+                    rule.points
+                        .iter()
+                        .filter_map(|r| image.project(r.map(|c| c as f32)))
+                        .map(|s| [s[0], s[1]])
+                        .collect(),
                     Ok((rule.len(), rule.degree)),
                 ),
                 Err(e) => (Vec::new(), Err(e.to_string())),
             };
             let pixels = image.rgba.iter().map(|c| egui::Color32::from_rgb(c[0], c[1], c[2])).collect();
-            let colour_image = egui::ColorImage { size: size_px, source_size: egui::vec2(size_px[0] as f32, size_px[1] as f32), pixels };
+            let colour_image = egui::ColorImage {
+                size: size_px,
+                source_size: egui::vec2(size_px[0] as f32, size_px[1] as f32),
+                pixels,
+            };
             match &mut self.texture {
                 Some(t) => t.set(colour_image, egui::TextureOptions::LINEAR),
-                None => self.texture = Some(ui.ctx().load_texture("hox-reference-element", colour_image, egui::TextureOptions::LINEAR)),
+                None => {
+                    self.texture =
+                        Some(ui.ctx().load_texture("hox-reference-element", colour_image, egui::TextureOptions::LINEAR))
+                }
             }
             let mut hidden_edges_px = Vec::new();
             if !key.field.sections {
@@ -640,7 +674,12 @@ impl ReferenceElementView {
         // --- paint: picture, quadrature points, nodes, labels
         let painter = ui.painter_at(rect);
         if let Some(t) = &self.texture {
-            painter.image(t.id(), rect, egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)), egui::Color32::WHITE);
+            painter.image(
+                t.id(),
+                rect,
+                egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+                egui::Color32::WHITE,
+            );
         }
         if let Some(picture) = &self.picture {
             let hidden = egui::Stroke::new(1.0, egui::Color32::from_rgba_unmultiplied(150, 150, 165, 110));
@@ -650,7 +689,12 @@ impl ReferenceElementView {
             }
             if self.show_quadrature {
                 for &q in &picture.quadrature_px {
-                    painter.circle(to_point(q), 3.5, QUADRATURE_COLOUR, egui::Stroke::new(1.0, egui::Color32::from_rgb(60, 30, 0)));
+                    painter.circle(
+                        to_point(q),
+                        3.5,
+                        QUADRATURE_COLOUR,
+                        egui::Stroke::new(1.0, egui::Color32::from_rgb(60, 30, 0)),
+                    );
                 }
             }
             let font = egui::FontId::proportional(12.0);
@@ -666,11 +710,27 @@ impl ReferenceElementView {
                     HIGH_ORDER_NODE_COLOUR
                 };
                 let fill = egui::Color32::from_rgba_unmultiplied(fill.r(), fill.g(), fill.b(), alpha);
-                let (radius, stroke) = if i == self.node { (7.0, egui::Stroke::new(2.0, egui::Color32::BLACK)) } else { (4.0, egui::Stroke::new(1.0, egui::Color32::from_white_alpha(alpha))) };
+                let (radius, stroke) = if i == self.node {
+                    (7.0, egui::Stroke::new(2.0, egui::Color32::BLACK))
+                } else {
+                    (4.0, egui::Stroke::new(1.0, egui::Color32::from_white_alpha(alpha)))
+                };
                 painter.circle(p, radius, fill, stroke);
                 let text_pos = p + egui::vec2(radius + 2.0, -radius - 1.0);
-                painter.text(text_pos + egui::vec2(1.0, 1.0), egui::Align2::LEFT_BOTTOM, i, font.clone(), egui::Color32::from_black_alpha(alpha));
-                painter.text(text_pos, egui::Align2::LEFT_BOTTOM, i, font.clone(), egui::Color32::from_white_alpha(alpha));
+                painter.text(
+                    text_pos + egui::vec2(1.0, 1.0),
+                    egui::Align2::LEFT_BOTTOM,
+                    i,
+                    font.clone(),
+                    egui::Color32::from_black_alpha(alpha),
+                );
+                painter.text(
+                    text_pos,
+                    egui::Align2::LEFT_BOTTOM,
+                    i,
+                    font.clone(),
+                    egui::Color32::from_white_alpha(alpha),
+                );
             }
         }
         response.on_hover_text("Drag to orbit, right-drag to pan, scroll to zoom, click a node to select it, double-click to reset the view.");
@@ -680,7 +740,8 @@ impl ReferenceElementView {
         let Some((key, field)) = &self.field else { return };
         let element = self.element.reference();
         // the colour bar, FIELD_MIN_SHOWN … 1
-        let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width().clamp(120.0, 360.0), 30.0), egui::Sense::hover());
+        let (rect, _) =
+            ui.allocate_exact_size(egui::vec2(ui.available_width().clamp(120.0, 360.0), 30.0), egui::Sense::hover());
         let painter = ui.painter_at(rect);
         let bar = egui::Rect::from_min_size(rect.min, egui::vec2(rect.width(), 12.0));
         let slices = 96;
@@ -688,15 +749,33 @@ impl ReferenceElementView {
         for s in 0..slices {
             let (t0, t1) = (s as f32 / slices as f32, (s + 1) as f32 / slices as f32);
             let c = field_colour(value_at(0.5 * (t0 + t1)));
-            let slice = egui::Rect::from_x_y_ranges(bar.left() + t0 * bar.width()..=bar.left() + t1 * bar.width(), bar.y_range());
+            let slice = egui::Rect::from_x_y_ranges(
+                bar.left() + t0 * bar.width()..=bar.left() + t1 * bar.width(),
+                bar.y_range(),
+            );
             painter.rect_filled(slice, 0.0, egui::Color32::from_rgb(c[0], c[1], c[2]));
         }
         let text_colour = ui.visuals().text_color();
         for tick in [FIELD_MIN_SHOWN, 0.0, 0.5, 1.0] {
             let x = bar.left() + ((tick - FIELD_MIN_SHOWN) / (1.0 - FIELD_MIN_SHOWN)) as f32 * bar.width();
-            painter.line_segment([egui::pos2(x, bar.bottom()), egui::pos2(x, bar.bottom() + 3.0)], egui::Stroke::new(1.0, text_colour));
-            let anchor = if tick == FIELD_MIN_SHOWN { egui::Align2::LEFT_TOP } else if tick == 1.0 { egui::Align2::RIGHT_TOP } else { egui::Align2::CENTER_TOP };
-            painter.text(egui::pos2(x, bar.bottom() + 3.0), anchor, format!("{tick}"), egui::FontId::proportional(11.0), text_colour);
+            painter.line_segment(
+                [egui::pos2(x, bar.bottom()), egui::pos2(x, bar.bottom() + 3.0)],
+                egui::Stroke::new(1.0, text_colour),
+            );
+            let anchor = if tick == FIELD_MIN_SHOWN {
+                egui::Align2::LEFT_TOP
+            } else if tick == 1.0 {
+                egui::Align2::RIGHT_TOP
+            } else {
+                egui::Align2::CENTER_TOP
+            };
+            painter.text(
+                egui::pos2(x, bar.bottom() + 3.0),
+                anchor,
+                format!("{tick}"),
+                egui::FontId::proportional(11.0),
+                text_colour,
+            );
         }
         ui.label(format!(
             "N_{} from {:.3} to {:.3} on what is shown (colours saturate below {FIELD_MIN_SHOWN} and above 1)",
@@ -704,9 +783,13 @@ impl ReferenceElementView {
         ));
         let on_surface = self.geometry.as_ref().and_then(|g| g.node_vertex.get(key.node).copied().flatten()).is_some();
         ui.label(explanation(element, key.node, field.min, on_surface));
-        let far_side = self.picture.as_ref().and_then(|p| p.nodes.get(key.node).copied().flatten()).is_some_and(|m| !m.visible);
+        let far_side =
+            self.picture.as_ref().and_then(|p| p.nodes.get(key.node).copied().flatten()).is_some_and(|m| !m.visible);
         if far_side {
-            ui.weak(format!("Node {} is on the far side: drag the picture to turn the element, or show the sections.", key.node));
+            ui.weak(format!(
+                "Node {} is on the far side: drag the picture to turn the element, or show the sections.",
+                key.node
+            ));
         }
         if self.show_quadrature
             && let Some(picture) = &self.picture

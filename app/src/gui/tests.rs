@@ -7,7 +7,11 @@ use egui_kittest::kittest::{NodeT, Queryable};
 
 fn harness(args: AppArgs) -> Harness<'static, HoxApp> {
     let app = HoxApp::new(&AppArgs { fresh: true, ..args }, None).expect("the app starts on bending");
-    Harness::builder().with_size(egui::vec2(1400.0, 900.0)).allow_missing_glyphs().with_step_dt(1.0 / 60.0).build_ui_state(|ui, app: &mut HoxApp| app.ui_all(ui), app)
+    Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .allow_missing_glyphs()
+        .with_step_dt(1.0 / 60.0)
+        .build_ui_state(|ui, app: &mut HoxApp| app.ui_all(ui), app)
 }
 
 /// The text of the one node whose text contains `needle`.
@@ -156,7 +160,13 @@ fn drag_the_tip(gl: bool) {
     let (node, at) = {
         let app = h.state();
         let sim = &app.sessions[0].instance.sim;
-        let tip = sim.positions.iter().enumerate().filter(|(i, _)| sim.inv_mass()[*i] > 0.0).max_by(|a, b| (a.1.x + a.1.z).total_cmp(&(b.1.x + b.1.z))).expect("free nodes");
+        let tip = sim
+            .positions
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| sim.inv_mass()[*i] > 0.0)
+            .max_by(|a, b| (a.1.x + a.1.z).total_cmp(&(b.1.x + b.1.z)))
+            .expect("free nodes");
         (tip.0 as u32, app.viewport.screen_position(*tip.1).expect("the tip is in view"))
     };
     h.hover_at(at);

@@ -33,7 +33,16 @@ pub struct ViewOptions {
 
 impl Default for ViewOptions {
     fn default() -> Self {
-        Self { edges: true, nodes: false, quadrature_points: false, boundary_conditions: true, ghost: true, probes: true, segments: 4, colour_max_m: None }
+        Self {
+            edges: true,
+            nodes: false,
+            quadrature_points: false,
+            boundary_conditions: true,
+            ghost: true,
+            probes: true,
+            segments: 4,
+            colour_max_m: None,
+        }
     }
 }
 
@@ -64,7 +73,17 @@ pub struct Viewport {
 
 impl Viewport {
     pub fn new(camera: Option<Camera>) -> Viewport {
-        Viewport { fitted: camera.is_some(), camera: camera.unwrap_or(Camera::framing([0.0; 3], [1.0; 3])), image: Image::new(1, 1), texture: None, layers: Vec::new(), render_ms: 0.0, dragging: None, gl_state: GlState::default(), last_rect: egui::Rect::NOTHING }
+        Viewport {
+            fitted: camera.is_some(),
+            camera: camera.unwrap_or(Camera::framing([0.0; 3], [1.0; 3])),
+            image: Image::new(1, 1),
+            texture: None,
+            layers: Vec::new(),
+            render_ms: 0.0,
+            dragging: None,
+            gl_state: GlState::default(),
+            last_rect: egui::Rect::NOTHING,
+        }
     }
 
     /// Frames the sessions' bodies again.
@@ -97,15 +116,19 @@ impl Viewport {
         if !self.fitted {
             self.reset_camera(sessions, offsets);
         }
-        let (rect, response) = ui.allocate_exact_size(ui.available_size().max(egui::vec2(64.0, 64.0)), egui::Sense::click_and_drag());
+        let (rect, response) =
+            ui.allocate_exact_size(ui.available_size().max(egui::vec2(64.0, 64.0)), egui::Sense::click_and_drag());
         self.last_rect = rect;
         let ppp = ui.ctx().pixels_per_point();
         let scale = (1600.0 / (rect.width() * ppp)).min(1000.0 / (rect.height() * ppp)).min(1.0);
-        let (w, h) = (((rect.width() * ppp * scale) as usize).max(16), ((rect.height() * ppp * scale) as usize).max(16));
+        let (w, h) =
+            (((rect.width() * ppp * scale) as usize).max(16), ((rect.height() * ppp * scale) as usize).max(16));
         if self.image.width != w || self.image.height != h {
             self.image = Image::new(w, h);
         }
-        let to_px = |p: egui::Pos2| -> [f32; 2] { [(p.x - rect.min.x) / rect.width() * w as f32, (p.y - rect.min.y) / rect.height() * h as f32] };
+        let to_px = |p: egui::Pos2| -> [f32; 2] {
+            [(p.x - rect.min.x) / rect.width() * w as f32, (p.y - rect.min.y) / rect.height() * h as f32]
+        };
 
         // --- input
         if response.hovered() {
@@ -174,7 +197,11 @@ impl Viewport {
             if opts.edges {
                 for e in &s.surface.edges {
                     for pair in e.windows(2) {
-                        overlay.lines.push((layer.positions[pair[0] as usize], layer.positions[pair[1] as usize], EDGE));
+                        overlay.lines.push((
+                            layer.positions[pair[0] as usize],
+                            layer.positions[pair[1] as usize],
+                            EDGE,
+                        ));
                     }
                 }
             }
@@ -182,7 +209,11 @@ impl Viewport {
                 let rest = &s.rest_vertices;
                 for e in &s.surface.edges {
                     for pair in e.windows(2) {
-                        overlay.lines.push((f32s(&(rest[pair[0] as usize] + o)), f32s(&(rest[pair[1] as usize] + o)), GHOST));
+                        overlay.lines.push((
+                            f32s(&(rest[pair[0] as usize] + o)),
+                            f32s(&(rest[pair[1] as usize] + o)),
+                            GHOST,
+                        ));
                     }
                 }
             }
@@ -211,7 +242,11 @@ impl Viewport {
                 }
             }
             if let Some(d) = s.drag {
-                overlay.lines.push((f32s(&(sim.positions[d.node as usize] + o)), f32s(&(d.target_m + o)), [255, 255, 0, 255]));
+                overlay.lines.push((
+                    f32s(&(sim.positions[d.node as usize] + o)),
+                    f32s(&(d.target_m + o)),
+                    [255, 255, 0, 255],
+                ));
                 overlay.points.push((f32s(&(d.target_m + o)), 4.0, [255, 255, 0, 255]));
             }
         }
@@ -219,9 +254,16 @@ impl Viewport {
         if use_gl {
             self.image.set_camera(&self.camera);
             let eye = self.camera.eye();
-            let mut scene = GlScene { view_projection: self.image.view_projection(), background: BACKGROUND, ..Default::default() };
+            let mut scene =
+                GlScene { view_projection: self.image.view_projection(), background: BACKGROUND, ..Default::default() };
             for layer in &self.layers {
-                let shaded: Vec<[u8; 3]> = layer.positions.iter().zip(&layer.normals).zip(&layer.colours).map(|((&p, &n), &c)| shade(p, n, c, eye).map(|v| v.clamp(0.0, 255.0) as u8)).collect();
+                let shaded: Vec<[u8; 3]> = layer
+                    .positions
+                    .iter()
+                    .zip(&layer.normals)
+                    .zip(&layer.colours)
+                    .map(|((&p, &n), &c)| shade(p, n, c, eye).map(|v| v.clamp(0.0, 255.0) as u8))
+                    .collect();
                 scene.add_triangles(&layer.positions, &shaded, &layer.triangles);
             }
             for &(a, b, colour) in &overlay.lines {
@@ -246,7 +288,13 @@ impl Viewport {
                     if let Some(e) = s.probe_error_m() {
                         text += &format!("\nprobe error {} m", crate::recording::format_metres(e));
                     }
-                    painter.text(p - egui::vec2(0.0, 14.0), egui::Align2::CENTER_BOTTOM, text, egui::FontId::proportional(14.0), egui::Color32::WHITE);
+                    painter.text(
+                        p - egui::vec2(0.0, 14.0),
+                        egui::Align2::CENTER_BOTTOM,
+                        text,
+                        egui::FontId::proportional(14.0),
+                        egui::Color32::WHITE,
+                    );
                 }
             }
         }
@@ -254,10 +302,19 @@ impl Viewport {
     }
 
     /// Draws the view with the CPU rasteriser and shows it as a texture.
-    fn cpu_view(&mut self, painter: &egui::Painter, rect: egui::Rect, w: usize, h: usize, scale: f32, overlay: &Overlay) {
+    fn cpu_view(
+        &mut self,
+        painter: &egui::Painter,
+        rect: egui::Rect,
+        w: usize,
+        h: usize,
+        scale: f32,
+        overlay: &Overlay,
+    ) {
         let layer_refs: Vec<&TriangleLayer> = self.layers.iter().collect();
         self.image.render(&self.camera, &layer_refs, overlay);
-        let pixels: Vec<egui::Color32> = self.image.rgba.iter().map(|c| egui::Color32::from_rgb(c[0], c[1], c[2])).collect();
+        let pixels: Vec<egui::Color32> =
+            self.image.rgba.iter().map(|c| egui::Color32::from_rgb(c[0], c[1], c[2])).collect();
         // one texel per screen pixel unless the view is capped: nearest sampling is exact there and
         // cheaper than bilinear in a software renderer
         let sampling = if scale < 1.0 { egui::TextureOptions::LINEAR } else { egui::TextureOptions::NEAREST };
@@ -267,7 +324,12 @@ impl Viewport {
             None => self.texture = Some(painter.ctx().load_texture("hox-viewport", image, sampling)),
         }
         if let Some(t) = &self.texture {
-            painter.image(t.id(), rect, egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)), egui::Color32::WHITE);
+            painter.image(
+                t.id(),
+                rect,
+                egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+                egui::Color32::WHITE,
+            );
         }
     }
 
@@ -276,7 +338,10 @@ impl Viewport {
     pub fn screen_position(&self, p: Vec3) -> Option<egui::Pos2> {
         let s = self.image.project(f32s(&p))?;
         let r = self.last_rect;
-        Some(egui::pos2(r.min.x + s[0] / self.image.width as f32 * r.width(), r.min.y + s[1] / self.image.height as f32 * r.height()))
+        Some(egui::pos2(
+            r.min.x + s[0] / self.image.width as f32 * r.width(),
+            r.min.y + s[1] / self.image.height as f32 * r.height(),
+        ))
     }
 
     /// Why the OpenGL view could not be made (the CPU rasteriser is used instead), if it failed.
@@ -323,14 +388,29 @@ fn legend_ui(painter: &egui::Painter, rect: egui::Rect, colours: &ColourRange) {
         let f0 = i as f32 / steps as f32;
         let f1 = (i + 1) as f32 / steps as f32;
         let c = colours.colour(colours.max_m * (f0 as f64 + 0.5 / steps as f64));
-        let r = egui::Rect::from_min_max(egui::pos2(bar.min.x, bar.max.y - f1 * bar.height()), egui::pos2(bar.max.x, bar.max.y - f0 * bar.height()));
+        let r = egui::Rect::from_min_max(
+            egui::pos2(bar.min.x, bar.max.y - f1 * bar.height()),
+            egui::pos2(bar.max.x, bar.max.y - f0 * bar.height()),
+        );
         painter.rect_filled(r, 0.0, egui::Color32::from_rgb(c[0], c[1], c[2]));
     }
     for t in colours.ticks_m() {
         let y = bar.max.y - (t / colours.max_m) as f32 * bar.height();
-        painter.text(egui::pos2(bar.max.x + 4.0, y), egui::Align2::LEFT_CENTER, crate::recording::format_metres(t), egui::FontId::monospace(11.0), egui::Color32::WHITE);
+        painter.text(
+            egui::pos2(bar.max.x + 4.0, y),
+            egui::Align2::LEFT_CENTER,
+            crate::recording::format_metres(t),
+            egui::FontId::monospace(11.0),
+            egui::Color32::WHITE,
+        );
     }
-    painter.text(bar.center_top() - egui::vec2(0.0, 6.0), egui::Align2::CENTER_BOTTOM, "|u| (m)", egui::FontId::proportional(12.0), egui::Color32::WHITE);
+    painter.text(
+        bar.center_top() - egui::vec2(0.0, 6.0),
+        egui::Align2::CENTER_BOTTOM,
+        "|u| (m)",
+        egui::FontId::proportional(12.0),
+        egui::Color32::WHITE,
+    );
 }
 
 pub fn f32s(v: &Vec3) -> [f32; 3] {

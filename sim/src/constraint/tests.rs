@@ -1,6 +1,6 @@
 use super::*;
-use crate::energy::element_grads;
 use crate::constraint::MAX_NODES;
+use crate::energy::element_grads;
 use crate::energy::tests::{elements, materials};
 use proptest::prelude::*;
 
@@ -32,10 +32,28 @@ fn a_rest_element_is_left_exactly_at_rest_by_both_formulations() {
             let w = vec![1.0; et.num_nodes()];
             let mut x = mesh.rest_positions.clone();
             let mut lambda = 0.0;
-            project_energy_constraint(&mut x, &mesh.rest_positions, &w, element_grads(g, 0), g.volumes(0), &material, 1e4, &mut lambda);
+            project_energy_constraint(
+                &mut x,
+                &mesh.rest_positions,
+                &w,
+                element_grads(g, 0),
+                g.volumes(0),
+                &material,
+                1e4,
+                &mut lambda,
+            );
             assert_eq!(x, mesh.rest_positions, "{et} {:?} energy", material.model);
             let mut lambdas = vec![0.0; 2 * g.points_per_element];
-            project_split_constraints(&mut x, &mesh.rest_positions, &w, element_grads(g, 0), g.volumes(0), &material, 1e4, &mut lambdas);
+            project_split_constraints(
+                &mut x,
+                &mesh.rest_positions,
+                &w,
+                element_grads(g, 0),
+                g.volumes(0),
+                &material,
+                1e4,
+                &mut lambdas,
+            );
             let dmax = x.iter().zip(&mesh.rest_positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
             // exactly at rest for StVK and Neo-Hookean; stable Neo-Hookean's two terms cancel at
             // rest only up to round-off in the 2×2 solve
@@ -48,7 +66,10 @@ fn deformed(mesh: &crate::mesh::Mesh, seed: &[f64], amplitude: f64) -> Vec<Vec3>
     mesh.rest_positions
         .iter()
         .enumerate()
-        .map(|(i, p)| p + amplitude * Vec3::new(seed[(3 * i) % seed.len()], seed[(3 * i + 1) % seed.len()], seed[(3 * i + 2) % seed.len()]))
+        .map(|(i, p)| {
+            p + amplitude
+                * Vec3::new(seed[(3 * i) % seed.len()], seed[(3 * i + 1) % seed.len()], seed[(3 * i + 2) % seed.len()])
+        })
         .collect()
 }
 

@@ -29,15 +29,8 @@ pub mod q2;
 use std::fmt;
 
 /// Every element type hox knows. Adding an element type: its file plus one line here.
-pub static REGISTRY: [&'static dyn ReferenceElement; 7] = [
-    &p1::P1,
-    &p2::P2,
-    &p3::P3,
-    &q1::Q1,
-    &q2::Q2,
-    &prism::PRISM,
-    &pyramid::PYRAMID,
-];
+pub static REGISTRY: [&'static dyn ReferenceElement; 7] =
+    [&p1::P1, &p2::P2, &p3::P3, &q1::Q1, &q2::Q2, &prism::PRISM, &pyramid::PYRAMID];
 
 /// The geometric shape of a reference element.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -63,14 +56,7 @@ impl ReferenceShape {
                 [1., 1., 1.],
                 [-1., 1., 1.],
             ],
-            Self::Prism => &[
-                [0., 0., -1.],
-                [1., 0., -1.],
-                [0., 1., -1.],
-                [0., 0., 1.],
-                [1., 0., 1.],
-                [0., 1., 1.],
-            ],
+            Self::Prism => &[[0., 0., -1.], [1., 0., -1.], [0., 1., -1.], [0., 0., 1.], [1., 0., 1.], [0., 1., 1.]],
             Self::Pyramid => &[[-1., -1., 0.], [1., -1., 0.], [1., 1., 0.], [-1., 1., 0.], [0., 0., 1.]],
         }
     }
@@ -80,14 +66,9 @@ impl ReferenceShape {
     pub fn faces(self) -> &'static [&'static [usize]] {
         match self {
             Self::Tetrahedron => &[&[0, 2, 1], &[0, 1, 3], &[0, 3, 2], &[3, 1, 2]],
-            Self::Hexahedron => &[
-                &[0, 3, 2, 1],
-                &[0, 1, 5, 4],
-                &[0, 4, 7, 3],
-                &[1, 2, 6, 5],
-                &[2, 3, 7, 6],
-                &[4, 5, 6, 7],
-            ],
+            Self::Hexahedron => {
+                &[&[0, 3, 2, 1], &[0, 1, 5, 4], &[0, 4, 7, 3], &[1, 2, 6, 5], &[2, 3, 7, 6], &[4, 5, 6, 7]]
+            }
             Self::Prism => &[&[0, 2, 1], &[3, 4, 5], &[0, 1, 4, 3], &[0, 3, 5, 2], &[1, 2, 5, 4]],
             Self::Pyramid => &[&[0, 3, 2, 1], &[0, 1, 4], &[1, 2, 4], &[2, 3, 4], &[3, 0, 4]],
         }
@@ -97,20 +78,9 @@ impl ReferenceShape {
     pub fn edges(self) -> &'static [[usize; 2]] {
         match self {
             Self::Tetrahedron => &[[0, 1], [1, 2], [2, 0], [3, 0], [3, 2], [3, 1]],
-            Self::Hexahedron => &[
-                [0, 1],
-                [0, 3],
-                [0, 4],
-                [1, 2],
-                [1, 5],
-                [2, 3],
-                [2, 6],
-                [3, 7],
-                [4, 5],
-                [4, 7],
-                [5, 6],
-                [6, 7],
-            ],
+            Self::Hexahedron => {
+                &[[0, 1], [0, 3], [0, 4], [1, 2], [1, 5], [2, 3], [2, 6], [3, 7], [4, 5], [4, 7], [5, 6], [6, 7]]
+            }
             Self::Prism => &[[0, 1], [0, 2], [0, 3], [1, 2], [1, 4], [2, 5], [3, 4], [3, 5], [4, 5]],
             Self::Pyramid => &[[0, 1], [0, 3], [0, 4], [1, 2], [1, 4], [2, 3], [2, 4], [3, 4]],
         }
@@ -143,9 +113,7 @@ impl ReferenceShape {
             Self::Tetrahedron => x >= -tol && y >= -tol && z >= -tol && x + y + z <= 1.0 + tol,
             Self::Hexahedron => r.iter().all(|c| c.abs() <= 1.0 + tol),
             Self::Prism => x >= -tol && y >= -tol && x + y <= 1.0 + tol && z.abs() <= 1.0 + tol,
-            Self::Pyramid => {
-                z >= -tol && z <= 1.0 + tol && x.abs() <= 1.0 - z + tol && y.abs() <= 1.0 - z + tol
-            }
+            Self::Pyramid => z >= -tol && z <= 1.0 + tol && x.abs() <= 1.0 - z + tol && y.abs() <= 1.0 - z + tol,
         }
     }
 }
@@ -277,8 +245,7 @@ impl fmt::Display for ElementType {
 impl std::str::FromStr for ElementType {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::from_name(s)
-            .ok_or_else(|| format!("unknown element type '{s}' (expected one of: {})", Self::names()))
+        Self::from_name(s).ok_or_else(|| format!("unknown element type '{s}' (expected one of: {})", Self::names()))
     }
 }
 

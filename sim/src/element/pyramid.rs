@@ -56,11 +56,8 @@ impl ReferenceElement for Pyramid {
         let [x, y, z] = *r;
         let s = base_scale(z);
         for (o, [sx, sy]) in out.iter_mut().zip(SIGNS) {
-            *o = [
-                sx * (s + sy * y) / (4.0 * s),
-                sy * (s + sx * x) / (4.0 * s),
-                -0.25 + sx * sy * x * y / (4.0 * s * s),
-            ];
+            *o =
+                [sx * (s + sy * y) / (4.0 * s), sy * (s + sx * x) / (4.0 * s), -0.25 + sx * sy * x * y / (4.0 * s * s)];
         }
         out[4] = [0.0, 0.0, 1.0];
     }

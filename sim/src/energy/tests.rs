@@ -2,7 +2,7 @@ use super::*;
 use crate::element::ElementType;
 use crate::geometry::precompute;
 use crate::geometry::tests::curved_element;
-use crate::material::{MaterialModel, Mat3};
+use crate::material::{Mat3, MaterialModel};
 use nalgebra::Rotation3;
 use proptest::prelude::*;
 
@@ -25,7 +25,10 @@ fn perturbed(mesh: &Mesh, seed: &[f64]) -> Vec<Vec3> {
     mesh.rest_positions
         .iter()
         .enumerate()
-        .map(|(i, p)| p + 0.08 * Vec3::new(seed[(3 * i) % seed.len()], seed[(3 * i + 1) % seed.len()], seed[(3 * i + 2) % seed.len()]))
+        .map(|(i, p)| {
+            p + 0.08
+                * Vec3::new(seed[(3 * i) % seed.len()], seed[(3 * i + 1) % seed.len()], seed[(3 * i + 2) % seed.len()])
+        })
         .collect()
 }
 
@@ -33,7 +36,9 @@ fn perturbed(mesh: &Mesh, seed: &[f64]) -> Vec<Vec3> {
 fn rigid_motions_give_zero_energy_and_zero_gradient() {
     for (et, mesh, geo) in elements() {
         for material in materials() {
-            for (axis, t) in [(Vec3::new(0.3, -1.2, 0.7), Vec3::new(1.0, 2.0, -3.0)), (Vec3::new(2.5, 0.1, 0.0), Vec3::zeros())] {
+            for (axis, t) in
+                [(Vec3::new(0.3, -1.2, 0.7), Vec3::new(1.0, 2.0, -3.0)), (Vec3::new(2.5, 0.1, 0.0), Vec3::zeros())]
+            {
                 let r = Rotation3::from_scaled_axis(axis);
                 let x: Vec<Vec3> = mesh.rest_positions.iter().map(|p| r * p + t).collect();
                 let mut grad = vec![Vec3::zeros(); x.len()];
@@ -109,13 +114,31 @@ fn element_hessians_match_finite_differences_of_the_gradient() {
                     let (mut xp, mut xm) = (x.clone(), x.clone());
                     xp[j][b] += h;
                     xm[j][b] -= h;
-                    element_energy_and_gradient(&xp, &mesh.rest_positions, element_grads(g, 0), g.volumes(0), &material, &mut gp);
-                    element_energy_and_gradient(&xm, &mesh.rest_positions, element_grads(g, 0), g.volumes(0), &material, &mut gm);
+                    element_energy_and_gradient(
+                        &xp,
+                        &mesh.rest_positions,
+                        element_grads(g, 0),
+                        g.volumes(0),
+                        &material,
+                        &mut gp,
+                    );
+                    element_energy_and_gradient(
+                        &xm,
+                        &mesh.rest_positions,
+                        element_grads(g, 0),
+                        g.volumes(0),
+                        &material,
+                        &mut gm,
+                    );
                     for i in 0..n {
                         for a in 0..3 {
                             let fd = (gp[i][a] - gm[i][a]) / (2.0 * h);
                             let an = hess[(3 * i + a, 3 * j + b)];
-                            assert!((fd - an).abs() < 1e-5 * hmax, "{et} {:?}: H[{i}{a},{j}{b}] {an} vs {fd}", material.model);
+                            assert!(
+                                (fd - an).abs() < 1e-5 * hmax,
+                                "{et} {:?}: H[{i}{a},{j}{b}] {an} vs {fd}",
+                                material.model
+                            );
                         }
                     }
                 }

@@ -159,7 +159,12 @@ unsafe fn store_rows(v: V3, out: [*mut Vec3; 4], lanes: u32) {
         let xy_13 = _mm256_unpackhi_pd(v[0].0, v[1].0); // x1 y1 x3 y3
         let z_01 = _mm256_castpd256_pd128(v[2].0);
         let z_23 = _mm256_extractf128_pd::<1>(v[2].0);
-        let xy = [_mm256_castpd256_pd128(xy_02), _mm256_castpd256_pd128(xy_13), _mm256_extractf128_pd::<1>(xy_02), _mm256_extractf128_pd::<1>(xy_13)];
+        let xy = [
+            _mm256_castpd256_pd128(xy_02),
+            _mm256_castpd256_pd128(xy_13),
+            _mm256_extractf128_pd::<1>(xy_02),
+            _mm256_extractf128_pd::<1>(xy_13),
+        ];
         for (l, p) in out.into_iter().enumerate() {
             if lanes & (1 << l) == 0 {
                 continue;
@@ -204,7 +209,11 @@ pub struct BatchIo<'a> {
 /// share no node, and no other thread touches these nodes and multipliers meanwhile.
 #[target_feature(enable = "avx2,fma")]
 pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> Result<u64, NonFiniteElement> {
-    assert!(io.nodes.len() >= batches * 16 && io.values.len() >= batches * BATCH_VALUES && io.element_ids.len() >= batches * 4);
+    assert!(
+        io.nodes.len() >= batches * 16
+            && io.values.len() >= batches * BATCH_VALUES
+            && io.element_ids.len() >= batches * 4
+    );
     let (nx, rx, wx) = (io.positions.len, io.rest.len(), io.inv_mass.len());
     let two_mu = F64x4::splat(2.0 * material.mu_pa);
     let (mu, lambda_pa) = (F64x4::splat(material.mu_pa), F64x4::splat(material.lambda_pa));
@@ -221,7 +230,12 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
         // node i of lane l is nodes[4 l + i]
         let node = |l: usize, i: usize| nodes[4 * l + i] as usize;
         let w: [F64x4; 4] = std::array::from_fn(|i| {
-            F64x4::new(io.inv_mass[node(0, i)], io.inv_mass[node(1, i)], io.inv_mass[node(2, i)], io.inv_mass[node(3, i)])
+            F64x4::new(
+                io.inv_mass[node(0, i)],
+                io.inv_mass[node(1, i)],
+                io.inv_mass[node(2, i)],
+                io.inv_mass[node(3, i)],
+            )
         });
         // the scalar sweep skips an element whose nodes are all pinned
         let free = w[0].ne(zero).or(w[1].ne(zero)).or(w[2].ne(zero)).or(w[3].ne(zero));
@@ -243,7 +257,9 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
         };
         let vals = &io.values[b * BATCH_VALUES..(b + 1) * BATCH_VALUES];
         // SAFETY: vals holds 40 doubles.
-        let g: [[F64x4; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| unsafe { F64x4::load(vals.as_ptr().add((3 * r + c) * 4)) }));
+        let g: [[F64x4; 3]; 3] = std::array::from_fn(|r| {
+            std::array::from_fn(|c| unsafe { F64x4::load(vals.as_ptr().add((3 * r + c) * 4)) })
+        });
         let v = unsafe { F64x4::load(vals.as_ptr().add(36)) };
         // du[a][r] = (u_{r+1} − u_0)_a
         let du: [[F64x4; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|r| u[r + 1][a].sub(u[0][a])));
@@ -255,7 +271,8 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
             })
         });
         // StVK: H = F − I, E = ½(H + Hᵀ + HᵀH), S = 2μE + λ tr(E) I, ψ = μ E:E + λ/2 tr(E)², P = F S
-        let h: [[F64x4; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|c| if a == c { f[a][c].sub(one) } else { f[a][c] }));
+        let h: [[F64x4; 3]; 3] =
+            std::array::from_fn(|a| std::array::from_fn(|c| if a == c { f[a][c].sub(one) } else { f[a][c] }));
         let e: [[F64x4; 3]; 3] = std::array::from_fn(|r| {
             std::array::from_fn(|c| {
                 let hth = h[2][r].fma(h[2][c], h[1][r].fma(h[1][c], h[0][r].mul(h[0][c])));
@@ -264,7 +281,9 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
         });
         let tr = e[0][0].add(e[1][1]).add(e[2][2]);
         let lt = lambda_pa.mul(tr);
-        let s: [[F64x4; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| if r == c { e[r][c].mul(two_mu).add(lt) } else { e[r][c].mul(two_mu) }));
+        let s: [[F64x4; 3]; 3] = std::array::from_fn(|r| {
+            std::array::from_fn(|c| if r == c { e[r][c].mul(two_mu).add(lt) } else { e[r][c].mul(two_mu) })
+        });
         let mut e2 = zero;
         for c in 0..3 {
             for r in 0..3 {
@@ -272,7 +291,9 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
             }
         }
         let psi = mu.mul(e2).add(half.mul(lambda_pa).mul(tr).mul(tr));
-        let p: [[F64x4; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| f[r][2].fma(s[2][c], f[r][1].fma(s[1][c], f[r][0].mul(s[0][c])))));
+        let p: [[F64x4; 3]; 3] = std::array::from_fn(|r| {
+            std::array::from_fn(|c| f[r][2].fma(s[2][c], f[r][1].fma(s[1][c], f[r][0].mul(s[0][c]))))
+        });
         // ∇_{j+1} U = V P g_j (H = (V P) Gᵀ), ∇_0 U = −Σ
         let vp: [[F64x4; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| p[r][c].mul(v)));
         let mut grad = [[zero; 3]; 4];
@@ -317,7 +338,9 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
         }
         // lanes whose new positions are not all finite (pinned elements are not checked)
         let bad = check.ne(zero).and(free).mask_bits();
-        let (done, lambda_lanes) = if bad == 0 { (free_bits, 0b1111) } else {
+        let (done, lambda_lanes) = if bad == 0 {
+            (free_bits, 0b1111)
+        } else {
             let first = bad.trailing_zeros();
             ((1 << first) - 1, (1 << (first + 1)) - 1)
         };

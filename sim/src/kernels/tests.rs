@@ -23,22 +23,46 @@ fn specialised_sweep_matches_the_generic_kernel() {
         for material in materials() {
             let mut expected = deformed.clone();
             let mut lambda_expected = 0.0;
-            project_energy_constraint(&mut expected, &mesh.rest_positions, &w, element_grads(g, 0), g.volumes(0), &material, 1e4, &mut lambda_expected);
+            project_energy_constraint(
+                &mut expected,
+                &mesh.rest_positions,
+                &w,
+                element_grads(g, 0),
+                g.volumes(0),
+                &material,
+                1e4,
+                &mut lambda_expected,
+            );
 
-            let (serial, colour) = (PackedBlock::in_element_order(block, g), PackedBlock::in_colour_order(block, g, &[vec![0]]));
+            let (serial, colour) =
+                (PackedBlock::in_element_order(block, g), PackedBlock::in_colour_order(block, g, &[vec![0]]));
             for data in [serial.data(), colour.data()] {
                 let mut x = deformed.clone();
                 let mut lambdas = vec![0.0];
                 // SAFETY: one thread, sizes from the mesh.
                 let done = unsafe {
-                    energy_sweep(n, &material, Positions::new(&mut x), &mesh.rest_positions, &w, &data, 0..1, Multipliers::new(&mut lambdas), 1e4)
+                    energy_sweep(
+                        n,
+                        &material,
+                        Positions::new(&mut x),
+                        &mesh.rest_positions,
+                        &w,
+                        &data,
+                        0..1,
+                        Multipliers::new(&mut lambdas),
+                        1e4,
+                    )
                 };
                 assert_eq!(done, Some(Ok(1)), "{et}");
                 let scale = expected.iter().zip(&deformed).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
                 assert!(scale > 0.0, "{et} {:?}: nothing moved", material.model);
                 let gap = x.iter().zip(&expected).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
                 assert!(gap <= 1e-12 * scale.max(1.0), "{et} {:?}: {gap:e}", material.model);
-                assert!((lambdas[0] - lambda_expected).abs() <= 1e-12 * lambda_expected.abs(), "{et} {:?}", material.model);
+                assert!(
+                    (lambdas[0] - lambda_expected).abs() <= 1e-12 * lambda_expected.abs(),
+                    "{et} {:?}",
+                    material.model
+                );
                 assert_eq!(x[0], deformed[0], "a pinned node stays");
             }
         }
@@ -56,7 +80,17 @@ fn a_non_finite_correction_is_reported_and_not_scattered() {
     let material = materials()[0];
     // SAFETY: one thread, sizes from the mesh.
     let done = unsafe {
-        energy_sweep(et.num_nodes(), &material, Positions::new(&mut x), &mesh.rest_positions, &w, &PackedBlock::in_element_order(&mesh.blocks[0], &geo[0]).data(), 0..1, Multipliers::new(&mut lambdas), 1e4)
+        energy_sweep(
+            et.num_nodes(),
+            &material,
+            Positions::new(&mut x),
+            &mesh.rest_positions,
+            &w,
+            &PackedBlock::in_element_order(&mesh.blocks[0], &geo[0]).data(),
+            0..1,
+            Multipliers::new(&mut lambdas),
+            1e4,
+        )
     };
     assert!(matches!(done, Some(Err(NonFiniteElement { element: 0, .. }))), "{done:?}");
     assert_eq!(x.iter().map(|p| p.x).collect::<Vec<_>>(), before.iter().map(|p| p.x).collect::<Vec<_>>());
@@ -87,7 +121,12 @@ fn p1_colour_sweep_matches_the_generic_kernel() {
     let (mesh, geo, colours, packed) = p1_beam(0);
     let block = &mesh.blocks[0];
     let material = materials()[0];
-    let deformed: Vec<Vec3> = mesh.rest_positions.iter().enumerate().map(|(i, p)| p + 0.02 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin())).collect();
+    let deformed: Vec<Vec3> = mesh
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p + 0.02 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin()))
+        .collect();
     let w: Vec<f64> = mesh.rest_positions.iter().map(|p| if p.x < 1e-12 { 0.0 } else { 1.0 }).collect();
     let inv_dt2 = 9e6;
 
@@ -102,7 +141,16 @@ fn p1_colour_sweep_matches_the_generic_kernel() {
         let mut x: Vec<Vec3> = nodes.iter().map(|&n| expected[n as usize]).collect();
         let rest: Vec<Vec3> = nodes.iter().map(|&n| mesh.rest_positions[n as usize]).collect();
         let we: Vec<f64> = nodes.iter().map(|&n| w[n as usize]).collect();
-        project_energy_constraint(&mut x, &rest, &we, element_grads(&geo[0], e), geo[0].volumes(e), &material, inv_dt2, &mut lambdas_expected[e]);
+        project_energy_constraint(
+            &mut x,
+            &rest,
+            &we,
+            element_grads(&geo[0], e),
+            geo[0].volumes(e),
+            &material,
+            inv_dt2,
+            &mut lambdas_expected[e],
+        );
         for (xi, &n) in x.iter().zip(nodes) {
             expected[n as usize] = *xi;
         }
@@ -113,7 +161,19 @@ fn p1_colour_sweep_matches_the_generic_kernel() {
     let mut done = 0;
     for c in 0..packed.num_colours() {
         // SAFETY: one thread, sizes from the mesh.
-        let r = unsafe { energy_sweep(4, &material, Positions::new(&mut x), &mesh.rest_positions, &w, &packed.data(), packed.colour(c), Multipliers::new(&mut lambdas), inv_dt2) };
+        let r = unsafe {
+            energy_sweep(
+                4,
+                &material,
+                Positions::new(&mut x),
+                &mesh.rest_positions,
+                &w,
+                &packed.data(),
+                packed.colour(c),
+                Multipliers::new(&mut lambdas),
+                inv_dt2,
+            )
+        };
         done += r.unwrap().unwrap();
     }
     assert!(done > 0);
@@ -129,18 +189,50 @@ fn p1_colour_sweep_matches_the_generic_kernel() {
 /// x < 0.3 pinned (so whole elements are pinned too).
 fn p1_colour_case() -> (crate::mesh::Mesh, PackedBlock, Vec<Vec3>, Vec<f64>) {
     let (mesh, _, _, packed) = p1_beam(1);
-    let deformed: Vec<Vec3> = mesh.rest_positions.iter().enumerate().map(|(i, p)| p + 0.02 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin())).collect();
-    let w: Vec<f64> = mesh.rest_positions.iter().enumerate().map(|(i, p)| if p.x < 0.3 { 0.0 } else { 1.0 + 0.01 * (i % 7) as f64 }).collect();
+    let deformed: Vec<Vec3> = mesh
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p + 0.02 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin()))
+        .collect();
+    let w: Vec<f64> = mesh
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| if p.x < 0.3 { 0.0 } else { 1.0 + 0.01 * (i % 7) as f64 })
+        .collect();
     (mesh, packed, deformed, w)
 }
 
 /// Every colour of `packed` through [`colour_sweep`], batched or not; the first error stops.
-fn sweep_colours(packed: &PackedBlock, rest: &[Vec3], w: &[f64], x: &mut [Vec3], lambdas: &mut [f64], batched: bool) -> Result<u64, NonFiniteElement> {
+fn sweep_colours(
+    packed: &PackedBlock,
+    rest: &[Vec3],
+    w: &[f64],
+    x: &mut [Vec3],
+    lambdas: &mut [f64],
+    batched: bool,
+) -> Result<u64, NonFiniteElement> {
     let material = materials()[0];
     let mut done = 0;
     for c in 0..packed.num_colours() {
         // SAFETY: one thread, sizes from the mesh.
-        done += unsafe { colour_sweep(4, &material, Positions::new(x), rest, w, packed, c, packed.colour(c), Multipliers::new(lambdas), 9e6, batched) }.unwrap()?;
+        done += unsafe {
+            colour_sweep(
+                4,
+                &material,
+                Positions::new(x),
+                rest,
+                w,
+                packed,
+                c,
+                packed.colour(c),
+                Multipliers::new(lambdas),
+                9e6,
+                batched,
+            )
+        }
+        .unwrap()?;
     }
     Ok(done)
 }
@@ -190,13 +282,20 @@ fn p1_batches_of_four_match_the_scalar_colour_sweep() {
     }
     let c = (1..packed.num_colours()).find(|&c| packed.colour(c).len() >= 8).unwrap();
     let k = (packed.colour(c).start..packed.colour(c).end - 4)
-        .find(|&k| (k - packed.colour(c).start) % 4 == 2 && first_seen[packed.nodes[4 * k + 1] as usize] == k && w[packed.nodes[4 * k + 1] as usize] > 0.0)
+        .find(|&k| {
+            (k - packed.colour(c).start) % 4 == 2
+                && first_seen[packed.nodes[4 * k + 1] as usize] == k
+                && w[packed.nodes[4 * k + 1] as usize] > 0.0
+        })
         .expect("a node first met in a third lane");
     let bad_node = packed.nodes[4 * k + 1];
     let (mut x1, mut l1, mut x4, mut l4) = (deformed.clone(), vec![0.0; n], deformed.clone(), vec![0.0; n]);
     x1[bad_node as usize].y = f64::NAN;
     x4[bad_node as usize].y = f64::NAN;
-    let (r1, r4) = (sweep_colours(&packed, &mesh.rest_positions, &w, &mut x1, &mut l1, false), sweep_colours(&packed, &mesh.rest_positions, &w, &mut x4, &mut l4, true));
+    let (r1, r4) = (
+        sweep_colours(&packed, &mesh.rest_positions, &w, &mut x1, &mut l1, false),
+        sweep_colours(&packed, &mesh.rest_positions, &w, &mut x4, &mut l4, true),
+    );
     let bad = r1.unwrap_err();
     assert_eq!(bad, r4.unwrap_err());
     assert_eq!(bad.node, bad_node);

@@ -95,9 +95,7 @@ impl MaterialModel {
     /// surrounding whitespace. The long names are accepted as well.
     pub fn from_name(s: &str) -> Option<Self> {
         let s = s.trim();
-        Self::ALL
-            .into_iter()
-            .find(|m| s.eq_ignore_ascii_case(m.name()) || s.eq_ignore_ascii_case(m.long_name()))
+        Self::ALL.into_iter().find(|m| s.eq_ignore_ascii_case(m.name()) || s.eq_ignore_ascii_case(m.long_name()))
     }
 }
 
@@ -123,10 +121,7 @@ impl Lame {
     pub fn from_youngs_poisson(youngs_modulus_pa: f64, poisson_ratio: f64) -> Lame {
         let e = youngs_modulus_pa;
         let nu = poisson_ratio;
-        Lame {
-            mu_pa: e / (2.0 * (1.0 + nu)),
-            lambda_pa: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
-        }
+        Lame { mu_pa: e / (2.0 * (1.0 + nu)), lambda_pa: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)) }
     }
 }
 
@@ -138,10 +133,7 @@ pub enum MaterialError {
     YoungsModulus { youngs_modulus_pa: f64 },
     /// ν is not a finite number in the open interval (−1, 0.5).
     #[error("Poisson ratio must lie in (-1, 0.5) for {model} (λ → ∞ at 0.5), got {poisson_ratio}")]
-    PoissonRatio {
-        model: MaterialModel,
-        poisson_ratio: f64,
-    },
+    PoissonRatio { model: MaterialModel, poisson_ratio: f64 },
     /// ρ is not a finite number > 0.
     #[error("density must be a finite positive number of kg/m³, got {density_kg_m3}")]
     Density { density_kg_m3: f64 },
@@ -150,12 +142,7 @@ pub enum MaterialError {
         "Young's modulus {youngs_modulus_pa} Pa with Poisson ratio {poisson_ratio} gives \
          non-finite Lamé parameters (μ = {mu_pa} Pa, λ = {lambda_pa} Pa)"
     )]
-    NonFiniteLame {
-        youngs_modulus_pa: f64,
-        poisson_ratio: f64,
-        mu_pa: f64,
-        lambda_pa: f64,
-    },
+    NonFiniteLame { youngs_modulus_pa: f64, poisson_ratio: f64, mu_pa: f64, lambda_pa: f64 },
 }
 
 /// A validated hyperelastic material.
@@ -205,10 +192,7 @@ impl Material {
         }
         // Every model needs a finite λ, hence the open upper bound 0.5.
         if !(poisson_ratio.is_finite() && poisson_ratio > -1.0 && poisson_ratio < 0.5) {
-            return Err(MaterialError::PoissonRatio {
-                model,
-                poisson_ratio,
-            });
+            return Err(MaterialError::PoissonRatio { model, poisson_ratio });
         }
         if !(density_kg_m3.is_finite() && density_kg_m3 > 0.0) {
             return Err(MaterialError::Density { density_kg_m3 });
@@ -216,10 +200,7 @@ impl Material {
         let lame = Lame::from_youngs_poisson(youngs_modulus_pa, poisson_ratio);
         // λ + μ = E / (2(1+ν)(1−2ν)) is what stable Neo-Hookean divides by
         // (with the log term, λ + 5μ/6, > 0 for ν > −1 and finite when λ + μ is).
-        if !(lame.mu_pa.is_finite()
-            && lame.lambda_pa.is_finite()
-            && (lame.mu_pa + lame.lambda_pa).is_finite())
-        {
+        if !(lame.mu_pa.is_finite() && lame.lambda_pa.is_finite() && (lame.mu_pa + lame.lambda_pa).is_finite()) {
             return Err(MaterialError::NonFiniteLame {
                 youngs_modulus_pa,
                 poisson_ratio,
@@ -227,13 +208,7 @@ impl Material {
                 lambda_pa: lame.lambda_pa,
             });
         }
-        Ok(Material {
-            model,
-            youngs_modulus_pa,
-            poisson_ratio,
-            density_kg_m3,
-            _validated: (),
-        })
+        Ok(Material { model, youngs_modulus_pa, poisson_ratio, density_kg_m3, _validated: () })
     }
 
     /// Lamé parameters μ, λ of this material.
@@ -263,9 +238,7 @@ impl Material {
         match self.model {
             MaterialModel::StVenantKirchhoff => stvk::energy_density_and_pk1(l, f),
             MaterialModel::StableNeoHookean => stable_neo_hookean::energy_density_and_pk1(l, f),
-            MaterialModel::StableNeoHookeanLog => {
-                stable_neo_hookean_log::energy_density_and_pk1(l, f)
-            }
+            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::energy_density_and_pk1(l, f),
             MaterialModel::NeoHookean => neo_hookean::energy_density_and_pk1(l, f),
         }
     }
@@ -355,11 +328,7 @@ fn cofactor_directional(f: &Mat3, df: &Mat3) -> Mat3 {
     let da: Vector3<f64> = df.column(0).into_owned();
     let db: Vector3<f64> = df.column(1).into_owned();
     let dc: Vector3<f64> = df.column(2).into_owned();
-    Mat3::from_columns(&[
-        db.cross(&c) + b.cross(&dc),
-        dc.cross(&a) + c.cross(&da),
-        da.cross(&b) + a.cross(&db),
-    ])
+    Mat3::from_columns(&[db.cross(&c) + b.cross(&dc), dc.cross(&a) + c.cross(&da), da.cross(&b) + a.cross(&db)])
 }
 
 /// J − 1 = det(F) − 1 without the cancellation of `det(F) - 1.0` near rest:
@@ -428,36 +397,18 @@ mod tests {
             assert_eq!(MaterialModel::from_name(m.long_name()), Some(m));
             assert_eq!(m.to_string(), m.name());
         }
-        assert_eq!(
-            MaterialModel::ALL.map(MaterialModel::name),
-            ["stvk", "snh", "snh-log", "nh"]
-        );
-        assert_eq!(
-            MaterialModel::from_name(" SNH-Log "),
-            Some(MaterialModel::StableNeoHookeanLog)
-        );
+        assert_eq!(MaterialModel::ALL.map(MaterialModel::name), ["stvk", "snh", "snh-log", "nh"]);
+        assert_eq!(MaterialModel::from_name(" SNH-Log "), Some(MaterialModel::StableNeoHookeanLog));
         assert_eq!(
             MaterialModel::from_name("stable Neo-Hookean with log term"),
             Some(MaterialModel::StableNeoHookeanLog)
         );
-        assert_eq!(
-            MaterialModel::from_name(" StVK "),
-            Some(MaterialModel::StVenantKirchhoff)
-        );
-        assert_eq!(
-            MaterialModel::from_name("NH"),
-            Some(MaterialModel::NeoHookean)
-        );
-        assert_eq!(
-            MaterialModel::from_name("Snh"),
-            Some(MaterialModel::StableNeoHookean)
-        );
+        assert_eq!(MaterialModel::from_name(" StVK "), Some(MaterialModel::StVenantKirchhoff));
+        assert_eq!(MaterialModel::from_name("NH"), Some(MaterialModel::NeoHookean));
+        assert_eq!(MaterialModel::from_name("Snh"), Some(MaterialModel::StableNeoHookean));
         assert_eq!(MaterialModel::from_name("neo"), None);
         assert_eq!(MaterialModel::from_name(""), None);
-        assert_eq!(
-            MaterialModel::StVenantKirchhoff.long_name(),
-            "Saint-Venant–Kirchhoff"
-        );
+        assert_eq!(MaterialModel::StVenantKirchhoff.long_name(), "Saint-Venant–Kirchhoff");
     }
 
     #[test]
@@ -495,15 +446,7 @@ mod tests {
     #[test]
     fn new_rejects_invalid_parameters_with_named_messages() {
         for model in MaterialModel::ALL {
-            for nu in [
-                0.5,
-                0.7,
-                -1.0,
-                -1.5,
-                f64::NAN,
-                f64::INFINITY,
-                f64::NEG_INFINITY,
-            ] {
+            for nu in [0.5, 0.7, -1.0, -1.5, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
                 let msg = err(model, 1.0e6, nu, 1000.0);
                 assert!(msg.contains("Poisson ratio"), "{msg}");
                 assert!(msg.contains(model.name()), "{msg}");
@@ -532,10 +475,7 @@ mod tests {
         assert!(err(MaterialModel::NeoHookean, f64::NAN, 0.3, 1.0).ends_with("got NaN"));
         assert_eq!(
             Material::new(MaterialModel::NeoHookean, 1.0e6, 0.7, 1.0),
-            Err(MaterialError::PoissonRatio {
-                model: MaterialModel::NeoHookean,
-                poisson_ratio: 0.7
-            })
+            Err(MaterialError::PoissonRatio { model: MaterialModel::NeoHookean, poisson_ratio: 0.7 })
         );
         // Valid-looking E and ν whose Lamé parameters overflow.
         let msg = err(MaterialModel::StableNeoHookean, 1.0e308, 0.5 - 1.0e-12, 1.0);
@@ -550,26 +490,20 @@ mod tests {
             let expected = inv_t * f.determinant();
             let cof = cofactor(&f);
             prop_assert!((cof - expected).norm() <= 1e-9 * (1.0 + expected.norm()));
-            prop_assert!(
-                (det_minus_one(&f) - (f.determinant() - 1.0)).abs()
-                    <= 1e-12 * (1.0 + f.norm().powi(3))
-            );
+            prop_assert!((det_minus_one(&f) - (f.determinant() - 1.0)).abs() <= 1e-12 * (1.0 + f.norm().powi(3)));
             Ok(())
         });
     }
 
     #[test]
     fn cofactor_directional_matches_finite_differences() {
-        testing::run(
-            (testing::general_matrix(1.5), testing::general_matrix(1.0)),
-            |(f, df)| {
-                let h = 1e-6;
-                let fd = (cofactor(&(f + df * h)) - cofactor(&(f - df * h))) / (2.0 * h);
-                let an = cofactor_directional(&f, &df);
-                prop_assert!((fd - an).norm() <= 1e-7 * (1.0 + an.norm()));
-                Ok(())
-            },
-        );
+        testing::run((testing::general_matrix(1.5), testing::general_matrix(1.0)), |(f, df)| {
+            let h = 1e-6;
+            let fd = (cofactor(&(f + df * h)) - cofactor(&(f - df * h))) / (2.0 * h);
+            let an = cofactor_directional(&f, &df);
+            prop_assert!((fd - an).norm() <= 1e-7 * (1.0 + an.norm()));
+            Ok(())
+        });
     }
 
     #[test]
@@ -586,10 +520,7 @@ mod tests {
             expected[(i, i)] = (i as f64 - 4.0).max(0.0);
         }
         let expected = r * expected * r.transpose();
-        assert!(
-            (p - expected).norm() < 1e-12 * expected.norm().max(1.0),
-            "{p}"
-        );
+        assert!((p - expected).norm() < 1e-12 * expected.norm().max(1.0), "{p}");
         // Already positive definite: returned unchanged (bit for bit).
         let mut pd = Mat9::zeros();
         for i in 0..9 {

@@ -40,8 +40,8 @@
 //! (with ln J and F⁻ᵀ replaced by L and L' cof F below the floor).
 
 use super::{
-    Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
-    dpdf_from_directional, first_invariant_minus_three,
+    Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one, dpdf_from_directional,
+    first_invariant_minus_three,
 };
 
 /// J below which ln J is continued linearly (see the module doc).
@@ -59,18 +59,10 @@ fn log_j(f: &Mat3) -> LogJ {
     let j = 1.0 + j_minus_1;
     if j >= NEO_HOOKEAN_J_FLOOR {
         let d1 = 1.0 / j;
-        LogJ {
-            value: j_minus_1.ln_1p(),
-            d1,
-            d2: -d1 * d1,
-        }
+        LogJ { value: j_minus_1.ln_1p(), d1, d2: -d1 * d1 }
     } else {
         let d1 = 1.0 / NEO_HOOKEAN_J_FLOOR;
-        LogJ {
-            value: NEO_HOOKEAN_J_FLOOR.ln() + (j - NEO_HOOKEAN_J_FLOOR) * d1,
-            d1,
-            d2: 0.0,
-        }
+        LogJ { value: NEO_HOOKEAN_J_FLOOR.ln() + (j - NEO_HOOKEAN_J_FLOOR) * d1, d1, d2: 0.0 }
     }
 }
 
@@ -100,9 +92,7 @@ pub(super) fn dpdf(l: Lame, f: &Mat3) -> Mat9 {
     let a = l.lambda_pa * log.value - l.mu_pa;
     let g = a * log.d1;
     let dg = l.lambda_pa * log.d1 * log.d1 + a * log.d2;
-    dpdf_from_directional(|df| {
-        df * l.mu_pa + cof * (dg * cof.dot(df)) + cofactor_directional(f, df) * g
-    })
+    dpdf_from_directional(|df| df * l.mu_pa + cof * (dg * cof.dot(df)) + cofactor_directional(f, df) * g)
 }
 
 pub(super) fn split_terms(f: &Mat3) -> [SplitTerm; 2] {
@@ -110,16 +100,8 @@ pub(super) fn split_terms(f: &Mat3) -> [SplitTerm; 2] {
     let inv_t = cofactor(f) * log.d1;
     let c_dev = deviatoric_square(f, &log).sqrt();
     [
-        SplitTerm {
-            value: c_dev,
-            scale: c_dev,
-            grad_f_scaled: f - inv_t,
-        },
-        SplitTerm {
-            value: log.value,
-            scale: 1.0,
-            grad_f_scaled: inv_t,
-        },
+        SplitTerm { value: c_dev, scale: c_dev, grad_f_scaled: f - inv_t },
+        SplitTerm { value: log.value, scale: 1.0, grad_f_scaled: inv_t },
     ]
 }
 
@@ -150,18 +132,14 @@ mod tests {
 
     #[test]
     fn matches_textbook_formulas() {
-        testing::run(
-            (testing::material(MODEL), testing::deformation(MODEL)),
-            |(m, f)| {
-                let l = m.lame();
-                let j = f.determinant();
-                let inv_t = f.try_inverse().expect("J > 0.25").transpose();
-                let psi = 0.5 * l.mu_pa * (f.norm_squared() - 3.0) - l.mu_pa * j.ln()
-                    + 0.5 * l.lambda_pa * j.ln().powi(2);
-                let p = (f - inv_t) * l.mu_pa + inv_t * (l.lambda_pa * j.ln());
-                testing::check_against_formulas(&m, &f, psi, p)
-            },
-        );
+        testing::run((testing::material(MODEL), testing::deformation(MODEL)), |(m, f)| {
+            let l = m.lame();
+            let j = f.determinant();
+            let inv_t = f.try_inverse().expect("J > 0.25").transpose();
+            let psi = 0.5 * l.mu_pa * (f.norm_squared() - 3.0) - l.mu_pa * j.ln() + 0.5 * l.lambda_pa * j.ln().powi(2);
+            let p = (f - inv_t) * l.mu_pa + inv_t * (l.lambda_pa * j.ln());
+            testing::check_against_formulas(&m, &f, psi, p)
+        });
     }
 
     #[test]
@@ -183,13 +161,10 @@ mod tests {
                 assert!(e_inv > e_flat && e_flat > 0.0);
             }
         }
-        testing::run(
-            (testing::material(MODEL), testing::general_matrix(2.0)),
-            |(m, f)| {
-                prop_assert!(testing::all_finite(&m, &f));
-                Ok(())
-            },
-        );
+        testing::run((testing::material(MODEL), testing::general_matrix(2.0)), |(m, f)| {
+            prop_assert!(testing::all_finite(&m, &f));
+            Ok(())
+        });
     }
 
     /// Below the floor the continuation is smooth, so the derivative
@@ -223,14 +198,8 @@ mod tests {
         let eps = 1e-9 * NEO_HOOKEAN_J_FLOOR;
         let (psi_lo, p_lo) = m.energy_density_and_pk1(&at(NEO_HOOKEAN_J_FLOOR - eps));
         let (psi_hi, p_hi) = m.energy_density_and_pk1(&at(NEO_HOOKEAN_J_FLOOR + eps));
-        assert!(
-            (psi_lo - psi_hi).abs() <= 1e-6 * psi_hi.abs(),
-            "{psi_lo} vs {psi_hi}"
-        );
-        assert!(
-            (p_lo - p_hi).norm() <= 1e-6 * p_hi.norm(),
-            "{p_lo} vs {p_hi}"
-        );
+        assert!((psi_lo - psi_hi).abs() <= 1e-6 * psi_hi.abs(), "{psi_lo} vs {psi_hi}");
+        assert!((p_lo - p_hi).norm() <= 1e-6 * p_hi.norm(), "{p_lo} vs {p_hi}");
         let [_, hyd] = m.split_terms(&at(NEO_HOOKEAN_J_FLOOR));
         assert!((hyd.value - NEO_HOOKEAN_J_FLOOR.ln()).abs() < 1e-9);
     }

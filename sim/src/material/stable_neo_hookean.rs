@@ -27,8 +27,8 @@
 //! * hydrostatic C = J − α, k = λ̂, ∂C/∂F = cof F
 
 use super::{
-    Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
-    dpdf_from_directional, first_invariant_minus_three,
+    Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one, dpdf_from_directional,
+    first_invariant_minus_three,
 };
 
 /// λ̂ = λ + μ and r = μ/λ̂ = α − 1.
@@ -58,25 +58,15 @@ pub(super) fn dpdf(l: Lame, f: &Mat3) -> Mat9 {
     let (lambda_hat, _) = lambda_hat_and_ratio(l);
     let cof = cofactor(f);
     let g = lambda_hat * det_minus_one(f) - l.mu_pa;
-    dpdf_from_directional(|df| {
-        df * l.mu_pa + cof * (lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g
-    })
+    dpdf_from_directional(|df| df * l.mu_pa + cof * (lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g)
 }
 
 pub(super) fn split_terms(l: Lame, f: &Mat3) -> [SplitTerm; 2] {
     let (_, r) = lambda_hat_and_ratio(l);
     let c_dev = f.norm();
     [
-        SplitTerm {
-            value: c_dev,
-            scale: c_dev,
-            grad_f_scaled: *f,
-        },
-        SplitTerm {
-            value: det_minus_one(f) - r,
-            scale: 1.0,
-            grad_f_scaled: cofactor(f),
-        },
+        SplitTerm { value: c_dev, scale: c_dev, grad_f_scaled: *f },
+        SplitTerm { value: det_minus_one(f) - r, scale: 1.0, grad_f_scaled: cofactor(f) },
     ]
 }
 
@@ -102,32 +92,25 @@ mod tests {
 
     #[test]
     fn matches_paper_formulas() {
-        testing::run(
-            (testing::material(MODEL), testing::deformation(MODEL)),
-            |(m, f)| {
-                let l = m.lame();
-                let lambda_hat = l.lambda_pa + l.mu_pa;
-                let alpha = 1.0 + l.mu_pa / lambda_hat;
-                let j = f.determinant();
-                let psi = 0.5 * l.mu_pa * (f.norm_squared() - 3.0)
-                    + 0.5 * lambda_hat * (j - alpha).powi(2)
-                    - l.mu_pa * l.mu_pa / (2.0 * lambda_hat);
-                let inv_t = f.try_inverse().expect("invertible").transpose();
-                let p = f * l.mu_pa + inv_t * (lambda_hat * (j - alpha) * j);
-                testing::check_against_formulas(&m, &f, psi, p)
-            },
-        );
+        testing::run((testing::material(MODEL), testing::deformation(MODEL)), |(m, f)| {
+            let l = m.lame();
+            let lambda_hat = l.lambda_pa + l.mu_pa;
+            let alpha = 1.0 + l.mu_pa / lambda_hat;
+            let j = f.determinant();
+            let psi = 0.5 * l.mu_pa * (f.norm_squared() - 3.0) + 0.5 * lambda_hat * (j - alpha).powi(2)
+                - l.mu_pa * l.mu_pa / (2.0 * lambda_hat);
+            let inv_t = f.try_inverse().expect("invertible").transpose();
+            let p = f * l.mu_pa + inv_t * (lambda_hat * (j - alpha) * j);
+            testing::check_against_formulas(&m, &f, psi, p)
+        });
     }
 
     /// Degenerate and inverted elements: F with arbitrary entries, J of any sign.
     #[test]
     fn derivatives_hold_for_inverted_and_degenerate_elements() {
-        testing::run(
-            (testing::material(MODEL), testing::general_matrix(1.5)),
-            |(m, f)| {
-                testing::check_derivatives_and_split_at(&m, &f)
-            },
-        );
+        testing::run((testing::material(MODEL), testing::general_matrix(1.5)), |(m, f)| {
+            testing::check_derivatives_and_split_at(&m, &f)
+        });
         let m = Material::new(MODEL, 1.0e6, 0.45, 1000.0).expect("valid");
         for f in [
             Mat3::from_diagonal(&nalgebra::Vector3::new(-1.0, 1.0, 1.0)),
@@ -140,9 +123,7 @@ mod tests {
             assert!(m.dpdf_projected(&f).iter().all(|x| x.is_finite()));
         }
         // Inverting pushes back: P at diag(-1,1,1) has a restoring component.
-        let p = m.pk1(&Mat3::from_diagonal(&nalgebra::Vector3::new(
-            -0.5, 1.0, 1.0,
-        )));
+        let p = m.pk1(&Mat3::from_diagonal(&nalgebra::Vector3::new(-0.5, 1.0, 1.0)));
         assert!(p[(0, 0)] < 0.0);
     }
 

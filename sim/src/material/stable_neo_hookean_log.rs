@@ -48,8 +48,8 @@
 //! * hydrostatic C = J − α, k = λ̂, ∂C/∂F = cof F
 
 use super::{
-    Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
-    dpdf_from_directional, first_invariant_minus_three,
+    Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one, dpdf_from_directional,
+    first_invariant_minus_three,
 };
 
 /// The re-parametrised constants of the model.
@@ -65,11 +65,7 @@ struct Params {
 
 fn params(l: Lame) -> Params {
     let lambda_hat = l.lambda_pa + (5.0 / 6.0) * l.mu_pa;
-    Params {
-        mu_hat: (4.0 / 3.0) * l.mu_pa,
-        lambda_hat,
-        r: l.mu_pa / lambda_hat,
-    }
+    Params { mu_hat: (4.0 / 3.0) * l.mu_pa, lambda_hat, r: l.mu_pa / lambda_hat }
 }
 
 /// x − log(1 + x) for x ≥ 0, accurate for small x (where it is ≈ x²/2 and the
@@ -120,10 +116,7 @@ pub(super) fn dpdf(l: Lame, f: &Mat3) -> Mat9 {
     let da = 2.0 * p.mu_hat / ((ic + 1.0) * (ic + 1.0));
     let g = cofactor_coefficient(p, det_minus_one(f));
     dpdf_from_directional(|df| {
-        df * a
-            + f * (da * f.dot(df))
-            + cof * (p.lambda_hat * cof.dot(df))
-            + cofactor_directional(f, df) * g
+        df * a + f * (da * f.dot(df)) + cof * (p.lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g
     })
 }
 
@@ -132,16 +125,8 @@ pub(super) fn split_terms(l: Lame, f: &Mat3) -> [SplitTerm; 2] {
     let ic = f.norm_squared();
     let c_dev = x_minus_log1p(ic).sqrt();
     [
-        SplitTerm {
-            value: c_dev,
-            scale: c_dev,
-            grad_f_scaled: f * (ic / (ic + 1.0)),
-        },
-        SplitTerm {
-            value: det_minus_one(f) - p.r,
-            scale: 1.0,
-            grad_f_scaled: cofactor(f),
-        },
+        SplitTerm { value: c_dev, scale: c_dev, grad_f_scaled: f * (ic / (ic + 1.0)) },
+        SplitTerm { value: det_minus_one(f) - p.r, scale: 1.0, grad_f_scaled: cofactor(f) },
     ]
 }
 
@@ -186,21 +171,16 @@ mod tests {
 
     #[test]
     fn matches_paper_formulas() {
-        testing::run(
-            (testing::material(MODEL), testing::deformation(MODEL)),
-            |(m, f)| {
-                let (mu_hat, lambda_hat, alpha, c) = paper_constants(&m);
-                let ic = f.norm_squared();
-                let j = f.determinant();
-                let psi = 0.5 * mu_hat * (ic - 3.0) + 0.5 * lambda_hat * (j - alpha).powi(2)
-                    - 0.5 * mu_hat * (ic + 1.0).ln()
-                    + c;
-                let inv_t = f.try_inverse().expect("invertible").transpose();
-                let p = f * (mu_hat * (1.0 - 1.0 / (ic + 1.0)))
-                    + inv_t * (lambda_hat * (j - alpha) * j);
-                testing::check_against_formulas(&m, &f, psi, p)
-            },
-        );
+        testing::run((testing::material(MODEL), testing::deformation(MODEL)), |(m, f)| {
+            let (mu_hat, lambda_hat, alpha, c) = paper_constants(&m);
+            let ic = f.norm_squared();
+            let j = f.determinant();
+            let psi =
+                0.5 * mu_hat * (ic - 3.0) + 0.5 * lambda_hat * (j - alpha).powi(2) - 0.5 * mu_hat * (ic + 1.0).ln() + c;
+            let inv_t = f.try_inverse().expect("invertible").transpose();
+            let p = f * (mu_hat * (1.0 - 1.0 / (ic + 1.0))) + inv_t * (lambda_hat * (j - alpha) * j);
+            testing::check_against_formulas(&m, &f, psi, p)
+        });
     }
 
     #[test]
@@ -213,8 +193,7 @@ mod tests {
         let expected = c - 1.5 * mu_hat;
         assert!((m.split_energy_offset() - expected).abs() <= 1e-12 * expected.abs());
         // c = μ̂ log 2 − 9μ̂²/(32λ̂).
-        let c_closed =
-            mu_hat * std::f64::consts::LN_2 - 9.0 * mu_hat * mu_hat / (32.0 * lambda_hat);
+        let c_closed = mu_hat * std::f64::consts::LN_2 - 9.0 * mu_hat * mu_hat / (32.0 * lambda_hat);
         assert!((c - c_closed).abs() <= 1e-12 * c.abs());
         // At rest: C_dev = sqrt(3 − log 4), C_hyd = 1 − α.
         let [dev, hyd] = m.split_terms(&Mat3::identity());
@@ -225,22 +204,15 @@ mod tests {
 
     #[test]
     fn x_minus_log1p_is_accurate() {
-        for x in [
-            0.0, 1e-300, 1e-12, 1e-6, 1e-3, 0.05, 0.0999, 0.1, 0.5, 1.0, 3.0, 1e6,
-        ] {
+        for x in [0.0, 1e-300, 1e-12, 1e-6, 1e-3, 0.05, 0.0999, 0.1, 0.5, 1.0, 3.0, 1e6] {
             let got = x_minus_log1p(x);
             // Reference: the series to many terms where small, else the direct formula.
             let expected = if x < 0.5 {
-                (2..60)
-                    .map(|n| (-x).powi(n - 2) * x * x / n as f64)
-                    .sum::<f64>()
+                (2..60).map(|n| (-x).powi(n - 2) * x * x / n as f64).sum::<f64>()
             } else {
                 x - (1.0 + x).ln()
             };
-            assert!(
-                (got - expected).abs() <= 2e-15 * expected,
-                "x = {x}: {got} vs {expected}"
-            );
+            assert!((got - expected).abs() <= 2e-15 * expected, "x = {x}: {got} vs {expected}");
         }
         // Continuous across the switch at 0.1.
         let below = x_minus_log1p(0.1 - 1e-15);
@@ -261,8 +233,8 @@ mod tests {
                 let s = 1e-4 + (0.999 - 1e-4) * i as f64 / SAMPLES as f64;
                 // F = sI: dψ/ds = P : I.
                 let dpsi = m.pk1(&(Mat3::identity() * s)).trace();
-                let closed = 9.0 * mu_hat * s.powi(3) / (3.0 * s * s + 1.0)
-                    + 3.0 * lambda_hat * s * s * (s.powi(3) - alpha);
+                let closed =
+                    9.0 * mu_hat * s.powi(3) / (3.0 * s * s + 1.0) + 3.0 * lambda_hat * s * s * (s.powi(3) - alpha);
                 assert!(
                     (dpsi - closed).abs() <= 1e-9 * (closed.abs() + mu_hat * s * s),
                     "ν = {nu}, s = {s}: {dpsi} vs {closed}"
@@ -272,15 +244,10 @@ mod tests {
                 let dpsi = m.pk1(&Mat3::from_diagonal(&Vector3::new(s, 1.0, 1.0)))[(0, 0)];
                 let closed = mu_hat * s * (s * s + 2.0) / (s * s + 3.0) + lambda_hat * (s - alpha);
                 assert!((dpsi - closed).abs() <= 1e-9 * (closed.abs() + mu_hat));
-                assert!(
-                    dpsi < 0.0,
-                    "ν = {nu}: dψ/ds = {dpsi} ≥ 0 at F = diag({s}, 1, 1)"
-                );
+                assert!(dpsi < 0.0, "ν = {nu}: dψ/ds = {dpsi} ≥ 0 at F = diag({s}, 1, 1)");
             }
             // And ψ decreases monotonically towards rest along sI.
-            let psi: Vec<f64> = (0..=100)
-                .map(|i| m.energy_density(&(Mat3::identity() * (i as f64 / 100.0))))
-                .collect();
+            let psi: Vec<f64> = (0..=100).map(|i| m.energy_density(&(Mat3::identity() * (i as f64 / 100.0)))).collect();
             assert!(psi.windows(2).all(|w| w[1] < w[0]), "ν = {nu}: {psi:?}");
             assert_eq!(psi[100], 0.0);
         }
@@ -293,24 +260,17 @@ mod tests {
     fn snh_without_log_term_has_the_collapse_minimum_this_model_removes() {
         let s = 0.05;
         for nu in [0.0, 0.3, 0.45] {
-            let old =
-                Material::new(MaterialModel::StableNeoHookean, 1.0e6, nu, 1000.0).expect("valid");
+            let old = Material::new(MaterialModel::StableNeoHookean, 1.0e6, nu, 1000.0).expect("valid");
             let l = old.lame();
             let lambda_hat = l.lambda_pa + l.mu_pa;
             let alpha = 1.0 + l.mu_pa / lambda_hat;
             let dpsi_old = old.pk1(&(Mat3::identity() * s)).trace();
             let closed = 3.0 * l.mu_pa * s + 3.0 * lambda_hat * s * s * (s.powi(3) - alpha);
             assert!((dpsi_old - closed).abs() <= 1e-9 * l.mu_pa);
-            assert!(
-                dpsi_old > 0.0,
-                "ν = {nu}: snh dψ/ds = {dpsi_old} at s = {s}"
-            );
+            assert!(dpsi_old > 0.0, "ν = {nu}: snh dψ/ds = {dpsi_old} at s = {s}");
             let new = Material::new(MODEL, 1.0e6, nu, 1000.0).expect("valid");
             let dpsi_new = new.pk1(&(Mat3::identity() * s)).trace();
-            assert!(
-                dpsi_new < 0.0,
-                "ν = {nu}: snh-log dψ/ds = {dpsi_new} at s = {s}"
-            );
+            assert!(dpsi_new < 0.0, "ν = {nu}: snh-log dψ/ds = {dpsi_new} at s = {s}");
         }
     }
 
@@ -329,13 +289,10 @@ mod tests {
     /// Degenerate and inverted elements: F with arbitrary entries, J of any sign.
     #[test]
     fn derivatives_hold_for_inverted_and_degenerate_elements() {
-        testing::run(
-            (testing::material(MODEL), testing::general_matrix(1.5)),
-            |(m, f)| {
-                prop_assert!(testing::all_finite(&m, &f));
-                testing::check_derivatives_and_split_at(&m, &f)
-            },
-        );
+        testing::run((testing::material(MODEL), testing::general_matrix(1.5)), |(m, f)| {
+            prop_assert!(testing::all_finite(&m, &f));
+            testing::check_derivatives_and_split_at(&m, &f)
+        });
         for nu in [-0.45, 0.0, 0.3, 0.45, 0.499] {
             let m = Material::new(MODEL, 1.0e6, nu, 1000.0).expect("valid");
             for f in [
@@ -355,10 +312,7 @@ mod tests {
             assert_eq!(p0, Mat3::zeros());
             let k = m.split_stiffness_pa();
             let expected = 0.5 * k[1] + k[0] * (std::f64::consts::LN_2 - 0.75);
-            assert!(
-                (psi0 - expected).abs() <= 1e-12 * expected,
-                "{psi0} vs {expected}"
-            );
+            assert!((psi0 - expected).abs() <= 1e-12 * expected, "{psi0} vs {expected}");
             let [dev, hyd] = m.split_terms(&Mat3::zeros());
             assert_eq!((dev.value, dev.scale), (0.0, 0.0));
             assert_eq!(dev.grad_f_scaled, Mat3::zeros());
@@ -378,11 +332,7 @@ mod tests {
         let [dev, _] = m.split_terms(&(Mat3::identity() * s));
         let ic = 3.0 * s * s;
         let expected = (ic * ic / 2.0 - ic.powi(3) / 3.0).sqrt();
-        assert!(
-            (dev.value - expected).abs() <= 1e-14 * expected,
-            "{} vs {expected}",
-            dev.value
-        );
+        assert!((dev.value - expected).abs() <= 1e-14 * expected, "{} vs {expected}", dev.value);
     }
 
     /// Nearly incompressible: ν = 0.499 (λ ≈ 250 E) is accepted, exactly at rest at F = I,
@@ -398,28 +348,20 @@ mod tests {
         assert!((h - c).norm() <= 1e-12 * c.norm());
         let k = m.split_stiffness_pa();
         assert!(k[0] > 0.0 && k[1] > 300.0 * k[0]);
-        testing::run(
-            (
-                testing::material_with_nu(MODEL, 0.49, 0.4999),
-                testing::deformation(MODEL),
-            ),
-            |(m, f)| {
-                let mu = m.lame().mu_pa;
-                let (psi, p) = m.energy_density_and_pk1(&f);
-                prop_assert!(psi >= 0.0);
-                let fd = testing::fd_gradient(&f, |g| m.energy_density(g));
-                prop_assert!((p - fd).norm() <= 1e-6 * (p.norm() + mu), "{p} vs {fd}");
-                let h = m.dpdf(&f);
-                let fd = testing::fd_jacobian(&f, |g| m.pk1(g));
-                prop_assert!((h - fd).norm() <= 1e-6 * (h.norm() + mu));
-                let k = m.split_stiffness_pa();
-                let t = m.split_terms(&f);
-                let split = 0.5 * k[0] * t[0].value.powi(2)
-                    + 0.5 * k[1] * t[1].value.powi(2)
-                    + m.split_energy_offset();
-                prop_assert!((split - psi).abs() <= 1e-9 * (psi.abs() + mu));
-                Ok(())
-            },
-        );
+        testing::run((testing::material_with_nu(MODEL, 0.49, 0.4999), testing::deformation(MODEL)), |(m, f)| {
+            let mu = m.lame().mu_pa;
+            let (psi, p) = m.energy_density_and_pk1(&f);
+            prop_assert!(psi >= 0.0);
+            let fd = testing::fd_gradient(&f, |g| m.energy_density(g));
+            prop_assert!((p - fd).norm() <= 1e-6 * (p.norm() + mu), "{p} vs {fd}");
+            let h = m.dpdf(&f);
+            let fd = testing::fd_jacobian(&f, |g| m.pk1(g));
+            prop_assert!((h - fd).norm() <= 1e-6 * (h.norm() + mu));
+            let k = m.split_stiffness_pa();
+            let t = m.split_terms(&f);
+            let split = 0.5 * k[0] * t[0].value.powi(2) + 0.5 * k[1] * t[1].value.powi(2) + m.split_energy_offset();
+            prop_assert!((split - psi).abs() <= 1e-9 * (psi.abs() + mu));
+            Ok(())
+        });
     }
 }

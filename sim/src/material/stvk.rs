@@ -58,16 +58,8 @@ pub(super) fn split_terms(f: &Mat3) -> [SplitTerm; 2] {
     let e = green_strain(f);
     let c_dev = e.norm();
     [
-        SplitTerm {
-            value: c_dev,
-            scale: c_dev,
-            grad_f_scaled: f * e,
-        },
-        SplitTerm {
-            value: e.trace(),
-            scale: 1.0,
-            grad_f_scaled: *f,
-        },
+        SplitTerm { value: c_dev, scale: c_dev, grad_f_scaled: f * e },
+        SplitTerm { value: e.trace(), scale: 1.0, grad_f_scaled: *f },
     ]
 }
 
@@ -96,21 +88,17 @@ mod tests {
 
     #[test]
     fn matches_textbook_formulas() {
-        testing::run(
-            (testing::material(MODEL), testing::deformation(MODEL)),
-            |(m, f)| {
-                let l = m.lame();
-                let e = (f.transpose() * f - Mat3::identity()) * 0.5;
-                let psi =
-                    l.mu_pa * (e.transpose() * e).trace() + 0.5 * l.lambda_pa * e.trace().powi(2);
-                let s = e * (2.0 * l.mu_pa) + Mat3::identity() * (l.lambda_pa * e.trace());
-                let p = f * s;
-                let (psi_got, p_got) = m.energy_density_and_pk1(&f);
-                prop_assert!((psi - psi_got).abs() <= 1e-10 * (psi.abs() + l.mu_pa));
-                prop_assert!((p - p_got).norm() <= 1e-10 * (p.norm() + l.mu_pa));
-                Ok(())
-            },
-        );
+        testing::run((testing::material(MODEL), testing::deformation(MODEL)), |(m, f)| {
+            let l = m.lame();
+            let e = (f.transpose() * f - Mat3::identity()) * 0.5;
+            let psi = l.mu_pa * (e.transpose() * e).trace() + 0.5 * l.lambda_pa * e.trace().powi(2);
+            let s = e * (2.0 * l.mu_pa) + Mat3::identity() * (l.lambda_pa * e.trace());
+            let p = f * s;
+            let (psi_got, p_got) = m.energy_density_and_pk1(&f);
+            prop_assert!((psi - psi_got).abs() <= 1e-10 * (psi.abs() + l.mu_pa));
+            prop_assert!((p - p_got).norm() <= 1e-10 * (p.norm() + l.mu_pa));
+            Ok(())
+        });
     }
 
     #[test]

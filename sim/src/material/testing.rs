@@ -72,25 +72,16 @@ pub fn run<S: Strategy>(strategy: S, test: impl Fn(S::Value) -> Result<(), TestC
 where
     S::Value: std::fmt::Debug,
 {
-    let mut runner = TestRunner::new(Config {
-        cases: CASES,
-        failure_persistence: None,
-        ..Config::default()
-    });
+    let mut runner = TestRunner::new(Config { cases: CASES, failure_persistence: None, ..Config::default() });
     if let Err(e) = runner.run(&strategy, test) {
         panic!("{e}");
     }
 }
 
 /// Valid material with E ∈ [1e3, 1e9] Pa (log-uniform) and ν ∈ [nu_min, nu_max).
-pub fn material_with_nu(
-    model: MaterialModel,
-    nu_min: f64,
-    nu_max: f64,
-) -> impl Strategy<Value = Material> {
+pub fn material_with_nu(model: MaterialModel, nu_min: f64, nu_max: f64) -> impl Strategy<Value = Material> {
     (3.0f64..9.0, nu_min..nu_max).prop_map(move |(log_e, nu)| {
-        Material::new(model, 10f64.powf(log_e), nu, 1000.0)
-            .expect("strategy yields valid parameters")
+        Material::new(model, 10f64.powf(log_e), nu, 1000.0).expect("strategy yields valid parameters")
     })
 }
 
@@ -105,10 +96,7 @@ pub fn general_matrix(amplitude: f64) -> impl Strategy<Value = Mat3> {
 }
 
 /// F = I + amplitude·R, R entries in [−1, 1]; J > 0.2 for Neo-Hookean.
-pub fn deformation_with_amplitude(
-    model: MaterialModel,
-    amplitude: f64,
-) -> impl Strategy<Value = Mat3> {
+pub fn deformation_with_amplitude(model: MaterialModel, amplitude: f64) -> impl Strategy<Value = Mat3> {
     general_matrix(amplitude)
         .prop_map(|r| Mat3::identity() + r)
         .prop_filter("Neo-Hookean's textbook form needs J above its floor (0.2, with a margin)", move |f| {
@@ -157,20 +145,14 @@ pub fn fd_jacobian(f: &Mat3, p: impl Fn(&Mat3) -> Mat3) -> Mat9 {
 }
 
 pub fn min_eigenvalue(m: &Mat9) -> f64 {
-    SymmetricEigen::new((m + m.transpose()) * 0.5)
-        .eigenvalues
-        .min()
+    SymmetricEigen::new((m + m.transpose()) * 0.5).eigenvalues.min()
 }
 
 /// Deterministic pseudo-random orthogonal 9×9 matrix.
 pub fn random_orthogonal9(seed: u64) -> Mat9 {
-    let mut state = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
+    let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
     let m = Mat9::from_fn(|_, _| {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
     });
     m.qr().q()
@@ -185,8 +167,8 @@ pub fn linear_elasticity_tensor(l: Lame) -> Mat9 {
         for j in 0..3 {
             for k in 0..3 {
                 for m in 0..3 {
-                    c[(i + 3 * j, k + 3 * m)] = l.mu_pa * (d(i, k) * d(j, m) + d(i, m) * d(j, k))
-                        + l.lambda_pa * d(i, j) * d(k, m);
+                    c[(i + 3 * j, k + 3 * m)] =
+                        l.mu_pa * (d(i, k) * d(j, m) + d(i, m) * d(j, k)) + l.lambda_pa * d(i, j) * d(k, m);
                 }
             }
         }
@@ -212,10 +194,7 @@ pub fn check_pk1_matches_energy_fd(model: MaterialModel) {
         let p = m.pk1(&f);
         let fd = fd_gradient(&f, |g| m.energy_density(g));
         let scale = p.norm() + m.lame().mu_pa;
-        prop_assert!(
-            (p - fd).norm() <= FD_RTOL * scale,
-            "P = {p}, finite differences = {fd}"
-        );
+        prop_assert!((p - fd).norm() <= FD_RTOL * scale, "P = {p}, finite differences = {fd}");
         Ok(())
     });
 }
@@ -225,10 +204,7 @@ pub fn check_dpdf_matches_pk1_fd(model: MaterialModel) {
         let h = m.dpdf(&f);
         let fd = fd_jacobian(&f, |g| m.pk1(g));
         let scale = h.norm() + m.lame().mu_pa;
-        prop_assert!(
-            (h - fd).norm() <= FD_RTOL * scale,
-            "dP/dF = {h}, finite differences = {fd}"
-        );
+        prop_assert!((h - fd).norm() <= FD_RTOL * scale, "dP/dF = {h}, finite differences = {fd}");
         Ok(())
     });
 }
@@ -246,30 +222,22 @@ pub fn check_dpdf_symmetric(model: MaterialModel) {
 }
 
 pub fn check_projected_psd(model: MaterialModel) {
-    run(
-        (material(model), deformation_with_amplitude(model, 0.6)),
-        |(m, f)| {
-            let h = m.dpdf(&f);
-            let p = m.dpdf_projected(&f);
-            let scale = h.norm();
-            prop_assert!((p - p.transpose()).norm() <= 1e-12 * scale);
-            prop_assert!(min_eigenvalue(&p) >= -1e-9 * scale);
-            // Nearest PSD matrix in the Frobenius norm: the distance is the
-            // norm of the clamped (negative) eigenvalues.
-            let eig = SymmetricEigen::new(h).eigenvalues;
-            let negative_part = eig
-                .iter()
-                .filter(|l| **l < 0.0)
-                .map(|l| l * l)
-                .sum::<f64>()
-                .sqrt();
-            prop_assert!(((p - h).norm() - negative_part).abs() <= 1e-9 * scale);
-            if negative_part <= 1e-12 * scale {
-                prop_assert!((p - h).norm() <= 1e-9 * scale);
-            }
-            Ok(())
-        },
-    );
+    run((material(model), deformation_with_amplitude(model, 0.6)), |(m, f)| {
+        let h = m.dpdf(&f);
+        let p = m.dpdf_projected(&f);
+        let scale = h.norm();
+        prop_assert!((p - p.transpose()).norm() <= 1e-12 * scale);
+        prop_assert!(min_eigenvalue(&p) >= -1e-9 * scale);
+        // Nearest PSD matrix in the Frobenius norm: the distance is the
+        // norm of the clamped (negative) eigenvalues.
+        let eig = SymmetricEigen::new(h).eigenvalues;
+        let negative_part = eig.iter().filter(|l| **l < 0.0).map(|l| l * l).sum::<f64>().sqrt();
+        prop_assert!(((p - h).norm() - negative_part).abs() <= 1e-9 * scale);
+        if negative_part <= 1e-12 * scale {
+            prop_assert!((p - h).norm() <= 1e-9 * scale);
+        }
+        Ok(())
+    });
 }
 
 pub fn check_projected_at_rest(model: MaterialModel) {
@@ -284,44 +252,30 @@ pub fn check_projected_at_rest(model: MaterialModel) {
 }
 
 pub fn check_rotation_invariance(model: MaterialModel) {
-    run(
-        (material(model), deformation(model), rotation()),
-        |(m, f, r)| {
-            let (psi, p) = m.energy_density_and_pk1(&f);
-            let (psi_r, p_r) = m.energy_density_and_pk1(&(r * f));
-            let mu = m.lame().mu_pa;
-            prop_assert!(
-                (psi - psi_r).abs() <= 1e-9 * (psi.abs() + mu),
-                "{psi} vs {psi_r}"
-            );
-            prop_assert!((p_r - r * p).norm() <= 1e-9 * (p.norm() + mu));
-            Ok(())
-        },
-    );
+    run((material(model), deformation(model), rotation()), |(m, f, r)| {
+        let (psi, p) = m.energy_density_and_pk1(&f);
+        let (psi_r, p_r) = m.energy_density_and_pk1(&(r * f));
+        let mu = m.lame().mu_pa;
+        prop_assert!((psi - psi_r).abs() <= 1e-9 * (psi.abs() + mu), "{psi} vs {psi_r}");
+        prop_assert!((p_r - r * p).norm() <= 1e-9 * (p.norm() + mu));
+        Ok(())
+    });
 }
 
 fn split_energy(m: &Material, f: &Mat3) -> f64 {
     let k = m.split_stiffness_pa();
     let terms = m.split_terms(f);
-    0.5 * k[0] * terms[0].value.powi(2)
-        + 0.5 * k[1] * terms[1].value.powi(2)
-        + m.split_energy_offset()
+    0.5 * k[0] * terms[0].value.powi(2) + 0.5 * k[1] * terms[1].value.powi(2) + m.split_energy_offset()
 }
 
 pub fn check_split_identity(model: MaterialModel) {
-    run(
-        (material(model), deformation_with_amplitude(model, 0.6)),
-        |(m, f)| {
-            let psi = m.energy_density(&f);
-            let split = split_energy(&m, &f);
-            let mu = m.lame().mu_pa;
-            prop_assert!(
-                (psi - split).abs() <= 1e-9 * (psi.abs() + mu),
-                "ψ = {psi}, split = {split}"
-            );
-            Ok(())
-        },
-    );
+    run((material(model), deformation_with_amplitude(model, 0.6)), |(m, f)| {
+        let psi = m.energy_density(&f);
+        let split = split_energy(&m, &f);
+        let mu = m.lame().mu_pa;
+        prop_assert!((psi - split).abs() <= 1e-9 * (psi.abs() + mu), "ψ = {psi}, split = {split}");
+        Ok(())
+    });
     // Also at rest.
     run(material(model), |m| {
         let split = split_energy(&m, &Mat3::identity());
@@ -358,10 +312,7 @@ pub fn check_linearisation_at_rest(model: MaterialModel) {
     run(material(model), |m| {
         let h = m.dpdf(&Mat3::identity());
         let c = linear_elasticity_tensor(m.lame());
-        prop_assert!(
-            (h - c).norm() <= 1e-12 * c.norm(),
-            "dP/dF(I) = {h}, C = {c}"
-        );
+        prop_assert!((h - c).norm() <= 1e-12 * c.norm(), "dP/dF(I) = {h}, C = {c}");
         Ok(())
     });
 }
@@ -377,22 +328,16 @@ pub fn check_energy_and_pk1_consistent(model: MaterialModel) {
 
 /// ψ ≥ 0 on random F; exactly when λ ≥ 0, up to rounding otherwise.
 pub fn check_energy_nonnegative(model: MaterialModel, nu_min: f64) {
-    run(
-        (
-            material_with_nu(model, nu_min, 0.48),
-            deformation_with_amplitude(model, 0.6),
-        ),
-        |(m, f)| {
-            let psi = m.energy_density(&f);
-            let l = m.lame();
-            if l.lambda_pa >= 0.0 {
-                prop_assert!(psi >= 0.0, "ψ = {psi}");
-            } else {
-                prop_assert!(psi >= -1e-12 * l.mu_pa, "ψ = {psi}");
-            }
-            Ok(())
-        },
-    );
+    run((material_with_nu(model, nu_min, 0.48), deformation_with_amplitude(model, 0.6)), |(m, f)| {
+        let psi = m.energy_density(&f);
+        let l = m.lame();
+        if l.lambda_pa >= 0.0 {
+            prop_assert!(psi >= 0.0, "ψ = {psi}");
+        } else {
+            prop_assert!(psi >= -1e-12 * l.mu_pa, "ψ = {psi}");
+        }
+        Ok(())
+    });
 }
 
 /// At any `f` (inverted and degenerate ones included): P against finite differences of ψ,
@@ -432,5 +377,7 @@ pub fn all_finite(m: &Material, f: &Mat3) -> bool {
         && p.iter().all(|x| x.is_finite())
         && finite9(m.dpdf(f))
         && finite9(m.dpdf_projected(f))
-        && m.split_terms(f).iter().all(|t| t.value.is_finite() && t.scale.is_finite() && t.grad_f_scaled.iter().all(|x| x.is_finite()))
+        && m.split_terms(f)
+            .iter()
+            .all(|t| t.value.is_finite() && t.scale.is_finite() && t.grad_f_scaled.iter().all(|x| x.is_finite()))
 }

@@ -68,7 +68,9 @@ pub enum GmshError {
     Io { file: String, message: String },
     #[error("{file}: not a Gmsh mesh file: {message}")]
     NotMsh { file: String, message: String },
-    #[error("{file}: MSH format version {version} is not supported (hox reads 4.1 and 2.2; in Gmsh: File → Export, or -format msh41)")]
+    #[error(
+        "{file}: MSH format version {version} is not supported (hox reads 4.1 and 2.2; in Gmsh: File → Export, or -format msh41)"
+    )]
     Version { file: String, version: String },
     #[error("{file}{at}: {message}")]
     Parse { file: String, at: String, message: String },
@@ -208,12 +210,13 @@ fn build(raw: RawMsh, file: &str) -> Result<ImportedMesh, GmshError> {
     let mut max_dim = 0;
     let mut num_volume = 0;
     for el in &raw.elements {
-        let (dim, expected, description) = gmsh_type_info(el.gmsh_type).ok_or_else(|| GmshError::UnknownElementType {
-            file: file_s.clone(),
-            at: at(el.line),
-            element_tag: el.tag,
-            gmsh_type: el.gmsh_type,
-        })?;
+        let (dim, expected, description) =
+            gmsh_type_info(el.gmsh_type).ok_or_else(|| GmshError::UnknownElementType {
+                file: file_s.clone(),
+                at: at(el.line),
+                element_tag: el.tag,
+                gmsh_type: el.gmsh_type,
+            })?;
         if dim == 3 && ElementType::from_gmsh_type(el.gmsh_type).is_none() {
             return Err(GmshError::UnsupportedElement {
                 file: file_s.clone(),
@@ -234,7 +237,12 @@ fn build(raw: RawMsh, file: &str) -> Result<ImportedMesh, GmshError> {
             });
         }
         if let Some(&node_tag) = el.nodes.iter().find(|t| !index_of_tag.contains_key(t)) {
-            return Err(GmshError::MissingNode { file: file_s.clone(), at: at(el.line), element_tag: el.tag, node_tag });
+            return Err(GmshError::MissingNode {
+                file: file_s.clone(),
+                at: at(el.line),
+                element_tag: el.tag,
+                node_tag,
+            });
         }
         max_dim = max_dim.max(dim);
         num_volume += usize::from(dim == 3);
@@ -282,8 +290,10 @@ fn build(raw: RawMsh, file: &str) -> Result<ImportedMesh, GmshError> {
         element_tags[b].push(el.tag);
     }
     let mesh = Mesh { rest_positions, blocks };
-    mesh.validate()
-        .map_err(|e| GmshError::Mesh { file: file_s.clone(), message: describe_mesh_error(&e, &mesh.blocks, &element_tags, &node_tags) })?;
+    mesh.validate().map_err(|e| GmshError::Mesh {
+        file: file_s.clone(),
+        message: describe_mesh_error(&e, &mesh.blocks, &element_tags, &node_tags),
+    })?;
     // physical groups
     let name_of = |dim: i32, tag: i32| raw.physical_names.get(&(dim, tag)).cloned().unwrap_or_else(|| tag.to_string());
     let mut node_sets: BTreeMap<String, Vec<u32>> = BTreeMap::new();
@@ -307,16 +317,18 @@ fn build(raw: RawMsh, file: &str) -> Result<ImportedMesh, GmshError> {
     for (b, block) in mesh.blocks.iter().enumerate() {
         if let Err(e) = precompute_block(&mesh.rest_positions, block, None) {
             return Err(match e {
-                GeometryError::BadElement { element_type, element, point, reference, det_j, what, nodes } => GmshError::BadElement {
-                    file: file_s,
-                    element_tag: element_tags[b][element],
-                    element_type,
-                    what,
-                    detail: format!(
-                        "det J = {det_j:.3e} at quadrature point {point} (reference coordinates {reference:?}); its nodes (file tags) are {:?}",
-                        nodes.iter().map(|&n| node_tags[n as usize]).collect::<Vec<_>>()
-                    ),
-                },
+                GeometryError::BadElement { element_type, element, point, reference, det_j, what, nodes } => {
+                    GmshError::BadElement {
+                        file: file_s,
+                        element_tag: element_tags[b][element],
+                        element_type,
+                        what,
+                        detail: format!(
+                            "det J = {det_j:.3e} at quadrature point {point} (reference coordinates {reference:?}); its nodes (file tags) are {:?}",
+                            nodes.iter().map(|&n| node_tags[n as usize]).collect::<Vec<_>>()
+                        ),
+                    }
+                }
                 other => GmshError::Mesh { file: file_s, message: other.to_string() },
             });
         }
@@ -340,7 +352,9 @@ fn describe_mesh_error(e: &MeshError, blocks: &[ElementBlock], element_tags: &[V
                 .unwrap_or(*element as u64);
             format!("element {tag} ({element_type}) uses node {} twice", node_tag(*node as usize))
         }
-        MeshError::NonFiniteNode { node, position } => format!("node {} has a non-finite coordinate {position:?}", node_tag(*node)),
+        MeshError::NonFiniteNode { node, position } => {
+            format!("node {} has a non-finite coordinate {position:?}", node_tag(*node))
+        }
         other => other.to_string(),
     }
 }
@@ -394,11 +408,12 @@ fn physical_names(bytes: &[u8], file: &str) -> Result<HashMap<(i32, i32), String
         return Ok(names);
     };
     let body_start = start + b"$PhysicalNames".len();
-    let end = find(&bytes[body_start..], b"$EndPhysicalNames").map(|e| body_start + e).ok_or_else(|| GmshError::Parse {
-        file: file.into(),
-        at: format!(":{}", line_of(bytes, start)),
-        message: "$PhysicalNames is not closed by $EndPhysicalNames".into(),
-    })?;
+    let end =
+        find(&bytes[body_start..], b"$EndPhysicalNames").map(|e| body_start + e).ok_or_else(|| GmshError::Parse {
+            file: file.into(),
+            at: format!(":{}", line_of(bytes, start)),
+            message: "$PhysicalNames is not closed by $EndPhysicalNames".into(),
+        })?;
     let first_line = line_of(bytes, body_start);
     let text = String::from_utf8_lossy(&bytes[body_start..end]);
     for (k, line) in text.lines().enumerate() {
@@ -499,7 +514,11 @@ mod msh41 {
     fn parse_error(file: &str, message: &str) -> GmshError {
         // mshio's messages can quote a long stretch of the input: keep the first lines
         let short: Vec<&str> = message.lines().take(6).collect();
-        GmshError::Parse { file: file.into(), at: String::new(), message: format!("malformed MSH 4.1 file: {}", short.join(" / ")) }
+        GmshError::Parse {
+            file: file.into(),
+            at: String::new(),
+            message: format!("malformed MSH 4.1 file: {}", short.join(" / ")),
+        }
     }
 }
 
@@ -544,7 +563,8 @@ mod msh22 {
 
     pub(super) fn parse_ascii(bytes: &[u8], file: &str) -> Result<RawMsh, GmshError> {
         let mut raw = RawMsh::default();
-        let err = |line: usize, message: String| GmshError::Parse { file: file.into(), at: format!(":{line}"), message };
+        let err =
+            |line: usize, message: String| GmshError::Parse { file: file.into(), at: format!(":{line}"), message };
         if let Some((body, first)) = section(bytes, "Nodes", file)? {
             let text = String::from_utf8_lossy(body);
             let mut lines = text.lines().enumerate().map(|(k, l)| (first + k, l.trim())).filter(|(_, l)| !l.is_empty());
@@ -570,11 +590,14 @@ mod msh22 {
         if let Some((body, first)) = section(bytes, "Elements", file)? {
             let text = String::from_utf8_lossy(body);
             let mut lines = text.lines().enumerate().map(|(k, l)| (first + k, l.trim())).filter(|(_, l)| !l.is_empty());
-            let (count_line, count) = lines.next().ok_or_else(|| err(first, "$Elements has no element count".into()))?;
+            let (count_line, count) =
+                lines.next().ok_or_else(|| err(first, "$Elements has no element count".into()))?;
             let count: usize = count.parse().map_err(|_| err(count_line, format!("bad element count \"{count}\"")))?;
             for (line, l) in lines {
-                let bad = || err(line, format!("bad element line \"{l}\" (expected: tag type number-of-tags tags… nodes…)"));
-                let v: Vec<u64> = l.split_whitespace().map(|s| s.parse::<u64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
+                let bad =
+                    || err(line, format!("bad element line \"{l}\" (expected: tag type number-of-tags tags… nodes…)"));
+                let v: Vec<u64> =
+                    l.split_whitespace().map(|s| s.parse::<u64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
                 if v.len() < 3 || v.len() < 3 + v[2] as usize {
                     return Err(bad());
                 }
@@ -589,7 +612,10 @@ mod msh22 {
                 });
             }
             if raw.elements.len() != count {
-                return Err(err(count_line, format!("$Elements announces {count} elements but lists {}", raw.elements.len())));
+                return Err(err(
+                    count_line,
+                    format!("$Elements announces {count} elements but lists {}", raw.elements.len()),
+                ));
             }
         }
         Ok(raw)
@@ -627,11 +653,18 @@ mod msh22 {
     }
 
     pub(super) fn parse_binary(bytes: &[u8], file: &str) -> Result<RawMsh, GmshError> {
-        let err = |message: &str| GmshError::Parse { file: file.into(), at: String::new(), message: format!("MSH 2.2 binary: {message}") };
+        let err = |message: &str| GmshError::Parse {
+            file: file.into(),
+            at: String::new(),
+            message: format!("MSH 2.2 binary: {message}"),
+        };
         // the header line is followed by the integer 1 written in the file's byte order
         let (format_body, _) = section(bytes, "MeshFormat", file)?.ok_or_else(|| err("no $MeshFormat"))?;
         let nl = format_body.iter().position(|&c| c == b'\n').ok_or_else(|| err("truncated $MeshFormat"))?;
-        let one: [u8; 4] = format_body.get(nl + 1..nl + 5).and_then(|s| s.try_into().ok()).ok_or_else(|| err("truncated $MeshFormat"))?;
+        let one: [u8; 4] = format_body
+            .get(nl + 1..nl + 5)
+            .and_then(|s| s.try_into().ok())
+            .ok_or_else(|| err("truncated $MeshFormat"))?;
         let swap = match i32::from_ne_bytes(one) {
             1 => false,
             x if x.swap_bytes() == 1 => true,
@@ -656,19 +689,23 @@ mod msh22 {
                 let gmsh_type = c.i32().ok_or_else(truncated)?;
                 let following = c.i32().ok_or_else(truncated)?;
                 let ntags = c.i32().ok_or_else(truncated)?;
-                let nodes_per = gmsh_type_info(gmsh_type as u32).map(|i| i.1).ok_or_else(|| GmshError::UnknownElementType {
-                    file: file.into(),
-                    at: String::new(),
-                    element_tag: 0,
-                    gmsh_type: gmsh_type as u32,
-                })?;
+                let nodes_per =
+                    gmsh_type_info(gmsh_type as u32).map(|i| i.1).ok_or_else(|| GmshError::UnknownElementType {
+                        file: file.into(),
+                        at: String::new(),
+                        element_tag: 0,
+                        gmsh_type: gmsh_type as u32,
+                    })?;
                 if following <= 0 || ntags < 0 {
                     return Err(err("bad element block header"));
                 }
                 for _ in 0..following {
                     let tag = c.i32().ok_or_else(truncated)?;
                     let tags: Vec<i32> = (0..ntags).map(|_| c.i32()).collect::<Option<_>>().ok_or_else(truncated)?;
-                    let nodes: Vec<u64> = (0..nodes_per).map(|_| c.i32().map(|t| t as u64)).collect::<Option<_>>().ok_or_else(truncated)?;
+                    let nodes: Vec<u64> = (0..nodes_per)
+                        .map(|_| c.i32().map(|t| t as u64))
+                        .collect::<Option<_>>()
+                        .ok_or_else(truncated)?;
                     raw.elements.push(RawElement {
                         tag: tag as u64,
                         gmsh_type: gmsh_type as u32,

@@ -57,7 +57,9 @@ pub enum MeshError {
     Empty,
     #[error("element {element} of the {element_type} block refers to node {node}, but the mesh has {num_nodes} nodes")]
     NodeOutOfRange { element_type: String, element: usize, node: u32, num_nodes: usize },
-    #[error("the {element_type} block's connectivity has {len} entries, not a multiple of {per_element} nodes per element")]
+    #[error(
+        "the {element_type} block's connectivity has {len} entries, not a multiple of {per_element} nodes per element"
+    )]
     RaggedConnectivity { element_type: String, len: usize, per_element: usize },
     #[error("node {node} has a non-finite coordinate {position:?}")]
     NonFiniteNode { node: usize, position: [f64; 3] },
@@ -109,7 +111,11 @@ impl Mesh {
                         });
                     }
                     if nodes[..k].contains(&node) {
-                        return Err(MeshError::RepeatedNode { element_type: b.element_type.to_string(), element, node });
+                        return Err(MeshError::RepeatedNode {
+                            element_type: b.element_type.to_string(),
+                            element,
+                            node,
+                        });
                     }
                 }
             }

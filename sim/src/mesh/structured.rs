@@ -64,8 +64,7 @@ pub struct BoxMeshSpec {
 }
 
 // Corners of a unit cell in Gmsh hexahedron order.
-const CELL: [[usize; 3]; 8] =
-    [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]];
+const CELL: [[usize; 3]; 8] = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]];
 
 // Five tetrahedra: corner tetrahedra at cell corners 0, 2, 5, 7 and the central one, and the
 // mirror decomposition with corners at 1, 3, 4, 6.
@@ -236,10 +235,7 @@ pub fn refine_tetrahedra(mesh: &Mesh) -> Mesh {
             // inner octahedron: pick the shortest of its three diagonals
             let diagonals = [(m01, m23), (m02, m13), (m03, m12)];
             let len = |(a, b): (u32, u32)| (positions[a as usize] - positions[b as usize]).norm();
-            let (a, b) = diagonals
-                .into_iter()
-                .min_by(|x, y| len(*x).total_cmp(&len(*y)))
-                .expect("three diagonals");
+            let (a, b) = diagonals.into_iter().min_by(|x, y| len(*x).total_cmp(&len(*y))).expect("three diagonals");
             // the four other octahedron vertices, in cyclic order around the diagonal
             let ring: [u32; 4] = if (a, b) == (m01, m23) {
                 [m02, m03, m13, m12]

@@ -46,7 +46,9 @@ pub fn vtk_cell(element_type: ElementType) -> (u8, &'static [usize]) {
         "p2" => (24, &[0, 1, 2, 3, 4, 5, 6, 7, 9, 8]),
         "p3" => (71, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 10, 15, 14, 13, 12, 17, 19, 18, 16]),
         "q1" => (12, &[0, 1, 2, 3, 4, 5, 6, 7]),
-        "q2" => (29, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 13, 9, 16, 18, 19, 17, 10, 12, 14, 15, 22, 23, 21, 24, 20, 25, 26]),
+        "q2" => {
+            (29, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 13, 9, 16, 18, 19, 17, 10, 12, 14, 15, 22, 23, 21, 24, 20, 25, 26])
+        }
         "prism" => (13, &[0, 1, 2, 3, 4, 5]),
         "pyramid" => (14, &[0, 1, 2, 3, 4]),
         other => unreachable!("element type {other} has no VTK cell type: add it to vtk_cell"),
@@ -77,25 +79,42 @@ impl DataArray {
 
 /// Writes `mesh` at `positions` (the current positions; the rest positions for the undeformed
 /// mesh) as VTU text, with `displacement_m` = positions − rest and the extra arrays.
-pub fn vtu_string(mesh: &Mesh, positions: &[Vec3], point_data: &[DataArray], cell_data: &[DataArray]) -> Result<String, VtkError> {
+pub fn vtu_string(
+    mesh: &Mesh,
+    positions: &[Vec3],
+    point_data: &[DataArray],
+    cell_data: &[DataArray],
+) -> Result<String, VtkError> {
     let n = mesh.num_nodes();
     if positions.len() != n {
         return Err(VtkError::Invalid(format!("{} positions for a mesh of {n} nodes", positions.len())));
     }
     for a in point_data {
         if a.values.len() != a.components * n {
-            return Err(VtkError::Invalid(format!("point array {} has {} values, expected {}", a.name, a.values.len(), a.components * n)));
+            return Err(VtkError::Invalid(format!(
+                "point array {} has {} values, expected {}",
+                a.name,
+                a.values.len(),
+                a.components * n
+            )));
         }
     }
     let num_cells = mesh.num_elements();
     for a in cell_data {
         if a.values.len() != a.components * num_cells {
-            return Err(VtkError::Invalid(format!("cell array {} has {} values, expected {}", a.name, a.values.len(), a.components * num_cells)));
+            return Err(VtkError::Invalid(format!(
+                "cell array {} has {} values, expected {}",
+                a.name,
+                a.values.len(),
+                a.components * num_cells
+            )));
         }
     }
     let mut s = String::with_capacity(64 * n + 64 * num_cells);
     s.push_str("<?xml version=\"1.0\"?>\n");
-    s.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
+    s.push_str(
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n",
+    );
     s.push_str("  <UnstructuredGrid>\n");
     let _ = writeln!(s, "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{num_cells}\">");
     s.push_str("      <Points>\n");
@@ -119,10 +138,16 @@ pub fn vtu_string(mesh: &Mesh, positions: &[Vec3], point_data: &[DataArray], cel
     write_array(&mut s, "UInt8", "types", 1, types.iter());
     s.push_str("      </Cells>\n");
     s.push_str("      <PointData Vectors=\"displacement_m\">\n");
-    write_array(&mut s, "Float64", "displacement_m", 3, positions.iter().zip(&mesh.rest_positions).flat_map(|(x, x0)| {
-        let u = x - x0;
-        [u.x, u.y, u.z]
-    }));
+    write_array(
+        &mut s,
+        "Float64",
+        "displacement_m",
+        3,
+        positions.iter().zip(&mesh.rest_positions).flat_map(|(x, x0)| {
+            let u = x - x0;
+            [u.x, u.y, u.z]
+        }),
+    );
     for a in point_data {
         write_array(&mut s, "Float64", &a.name, a.components, a.values.iter());
     }
@@ -138,8 +163,18 @@ pub fn vtu_string(mesh: &Mesh, positions: &[Vec3], point_data: &[DataArray], cel
     Ok(s)
 }
 
-fn write_array<T: std::fmt::Display>(s: &mut String, ty: &str, name: &str, components: usize, values: impl Iterator<Item = T>) {
-    let _ = writeln!(s, "        <DataArray type=\"{ty}\" Name=\"{}\" NumberOfComponents=\"{components}\" format=\"ascii\">", xml_escape(name));
+fn write_array<T: std::fmt::Display>(
+    s: &mut String,
+    ty: &str,
+    name: &str,
+    components: usize,
+    values: impl Iterator<Item = T>,
+) {
+    let _ = writeln!(
+        s,
+        "        <DataArray type=\"{ty}\" Name=\"{}\" NumberOfComponents=\"{components}\" format=\"ascii\">",
+        xml_escape(name)
+    );
     let per_line = if components > 1 { components } else { 12 };
     for (k, v) in values.enumerate() {
         s.push_str(if k % per_line == 0 { "          " } else { " " });
@@ -159,14 +194,25 @@ fn xml_escape(s: &str) -> String {
 }
 
 /// Writes one VTU file.
-pub fn write_vtu(path: &Path, mesh: &Mesh, positions: &[Vec3], point_data: &[DataArray], cell_data: &[DataArray]) -> Result<(), VtkError> {
+pub fn write_vtu(
+    path: &Path,
+    mesh: &Mesh,
+    positions: &[Vec3],
+    point_data: &[DataArray],
+    cell_data: &[DataArray],
+) -> Result<(), VtkError> {
     let text = vtu_string(mesh, positions, point_data, cell_data)?;
     std::fs::write(path, text).map_err(|source| VtkError::Io { path: path.display().to_string(), source })
 }
 
 /// Volume-averaged von Mises stress of every element (cell order of the VTU file: block by
 /// block), from the Cauchy stress `σ = P Fᵀ / det F` at the quadrature points; Pa.
-pub fn von_mises_stress_pa(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, positions: &[Vec3]) -> Vec<f64> {
+pub fn von_mises_stress_pa(
+    mesh: &Mesh,
+    geometry: &[BlockGeometry],
+    material: &Material,
+    positions: &[Vec3],
+) -> Vec<f64> {
     let mut out = Vec::with_capacity(mesh.num_elements());
     for (b, g) in mesh.blocks.iter().zip(geometry) {
         for (e, nodes) in b.elements().enumerate() {
@@ -244,7 +290,9 @@ impl PvdSeries {
     }
 
     fn write_index(&self) -> Result<(), VtkError> {
-        let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <Collection>\n");
+        let mut s = String::from(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+        );
         for (t, file) in &self.frames {
             let _ = writeln!(s, "    <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{}\"/>", xml_escape(file));
         }
@@ -274,7 +322,9 @@ impl VtuData {
     pub fn to_mesh(&self) -> Result<Mesh, VtkError> {
         let mut blocks: Vec<crate::mesh::ElementBlock> = Vec::new();
         for (k, (cell_type, conn)) in self.cells.iter().enumerate() {
-            let et = element_type_of_vtk(*cell_type).ok_or_else(|| VtkError::Invalid(format!("cell {k}: VTK cell type {cell_type} is not one hox writes")))?;
+            let et = element_type_of_vtk(*cell_type).ok_or_else(|| {
+                VtkError::Invalid(format!("cell {k}: VTK cell type {cell_type} is not one hox writes"))
+            })?;
             let (_, perm) = vtk_cell(et);
             if conn.len() != perm.len() {
                 return Err(VtkError::Invalid(format!("cell {k}: {} nodes for a {et}", conn.len())));
@@ -294,7 +344,8 @@ impl VtuData {
 
 /// Reads a VTU file written by [`write_vtu`] (ASCII data arrays; not a general VTU reader).
 pub fn read_vtu(path: &Path) -> Result<VtuData, VtkError> {
-    let text = std::fs::read_to_string(path).map_err(|e| VtkError::Read { path: path.display().to_string(), message: e.to_string() })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| VtkError::Read { path: path.display().to_string(), message: e.to_string() })?;
     parse_vtu(&text).map_err(|message| VtkError::Read { path: path.display().to_string(), message })
 }
 
@@ -330,7 +381,12 @@ pub fn parse_vtu(text: &str) -> Result<VtuData, String> {
         out_cells.push((ty as u8, conn.values[start..end].iter().map(|&v| v as u32).collect()));
         start = end;
     }
-    Ok(VtuData { points, cells: out_cells, point_data: arrays(section("PointData"))?, cell_data: arrays(section("CellData"))? })
+    Ok(VtuData {
+        points,
+        cells: out_cells,
+        point_data: arrays(section("PointData"))?,
+        cell_data: arrays(section("CellData"))?,
+    })
 }
 
 /// The `<DataArray>`s in `xml`, by name.
@@ -376,22 +432,72 @@ mod tests {
         }
         // VTK's own coordinates of the quadratic tet (vtkQuadraticTetra) and the P3 tet
         let h = 0.5;
-        let vtk_tet10 = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.], [h, 0., 0.], [h, h, 0.], [0., h, 0.], [0., 0., h], [h, 0., h], [0., h, h]];
+        let vtk_tet10 = [
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [0., 1., 0.],
+            [0., 0., 1.],
+            [h, 0., 0.],
+            [h, h, 0.],
+            [0., h, 0.],
+            [0., 0., h],
+            [h, 0., h],
+            [0., h, h],
+        ];
         check(ElementType::from_name("p2").unwrap(), &vtk_tet10, |r| r);
         let (a, b) = (1.0 / 3.0, 2.0 / 3.0);
         let vtk_tet20 = [
-            [0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.],
-            [a, 0., 0.], [b, 0., 0.], [b, a, 0.], [a, b, 0.], [0., b, 0.], [0., a, 0.],
-            [0., 0., a], [0., 0., b], [b, 0., a], [a, 0., b], [0., b, a], [0., a, b],
-            [a, 0., a], [a, a, a], [0., a, a], [a, a, 0.],
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [0., 1., 0.],
+            [0., 0., 1.],
+            [a, 0., 0.],
+            [b, 0., 0.],
+            [b, a, 0.],
+            [a, b, 0.],
+            [0., b, 0.],
+            [0., a, 0.],
+            [0., 0., a],
+            [0., 0., b],
+            [b, 0., a],
+            [a, 0., b],
+            [0., b, a],
+            [0., a, b],
+            [a, 0., a],
+            [a, a, a],
+            [0., a, a],
+            [a, a, 0.],
         ];
         check(ElementType::from_name("p3").unwrap(), &vtk_tet20, |r| r);
         // vtkTriQuadraticHexahedron on [0,1]³: Gmsh's [-1,1]³ maps by (r + 1) / 2
         let vtk_hex27 = [
-            [0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.], [0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.],
-            [h, 0., 0.], [1., h, 0.], [h, 1., 0.], [0., h, 0.], [h, 0., 1.], [1., h, 1.], [h, 1., 1.], [0., h, 1.],
-            [0., 0., h], [1., 0., h], [1., 1., h], [0., 1., h],
-            [0., h, h], [1., h, h], [h, 0., h], [h, 1., h], [h, h, 0.], [h, h, 1.], [h, h, h],
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [1., 1., 0.],
+            [0., 1., 0.],
+            [0., 0., 1.],
+            [1., 0., 1.],
+            [1., 1., 1.],
+            [0., 1., 1.],
+            [h, 0., 0.],
+            [1., h, 0.],
+            [h, 1., 0.],
+            [0., h, 0.],
+            [h, 0., 1.],
+            [1., h, 1.],
+            [h, 1., 1.],
+            [0., h, 1.],
+            [0., 0., h],
+            [1., 0., h],
+            [1., 1., h],
+            [0., 1., h],
+            [0., h, h],
+            [1., h, h],
+            [h, 0., h],
+            [h, 1., h],
+            [h, h, 0.],
+            [h, h, 1.],
+            [h, h, h],
         ];
         check(ElementType::from_name("q2").unwrap(), &vtk_hex27, |r| r.map(|c| (c + 1.0) / 2.0));
         let vtk_hex8 = &vtk_hex27[..8];
@@ -403,7 +509,11 @@ mod tests {
         let (_, perm) = vtk_cell(et);
         for (i, &p) in perm.iter().enumerate() {
             let r = to_vtk(et.nodes()[p]);
-            assert!((0..3).all(|d| (r[d] - vtk_nodes[i][d]).abs() < 1e-12), "{et}: VTK node {i} is Gmsh node {p} at {r:?}, VTK has {:?}", vtk_nodes[i]);
+            assert!(
+                (0..3).all(|d| (r[d] - vtk_nodes[i][d]).abs() < 1e-12),
+                "{et}: VTK node {i} is Gmsh node {p} at {r:?}, VTK has {:?}",
+                vtk_nodes[i]
+            );
         }
     }
 
@@ -436,7 +546,8 @@ mod tests {
             }
             .build()
             .unwrap();
-            let positions: Vec<Vec3> = mesh.rest_positions.iter().map(|p| p + Vec3::new(0.1 * p.x * p.x, 1.0 / 3.0, -0.2)).collect();
+            let positions: Vec<Vec3> =
+                mesh.rest_positions.iter().map(|p| p + Vec3::new(0.1 * p.x * p.x, 1.0 / 3.0, -0.2)).collect();
             let temp = DataArray::scalars("temperature_k", (0..mesh.num_nodes()).map(|i| i as f64 * 0.1).collect());
             let cell = DataArray::scalars("cell_id", (0..mesh.num_elements()).map(|i| i as f64).collect());
             let text = vtu_string(&mesh, &positions, std::slice::from_ref(&temp), std::slice::from_ref(&cell)).unwrap();
@@ -458,7 +569,11 @@ mod tests {
     fn a_series_rewrites_its_index_after_every_frame() {
         let dir = std::env::temp_dir().join(format!("hox-pvd-test-{}", std::process::id()));
         let mesh = crate::mesh::structured::BoxMeshSpec {
-            grid: crate::mesh::structured::BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 1.0, 1.0), cells: [1, 1, 1] },
+            grid: crate::mesh::structured::BoxGrid {
+                min_m: Vec3::zeros(),
+                max_m: Vec3::new(1.0, 1.0, 1.0),
+                cells: [1, 1, 1],
+            },
             element_type: ElementType::from_name("q1").unwrap(),
             split: crate::mesh::structured::TetSplit::Five,
             refine: 0,

@@ -13,7 +13,14 @@ fn cantilever(et: ElementType) -> Mesh {
 
 /// The beam `[0, 1] × [0, 0.25]²` with `cells`, five tetrahedra per cell for P1–P3.
 fn beam(et: ElementType, cells: [usize; 3]) -> Mesh {
-    BoxMeshSpec { grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 0.25, 0.25), cells }, element_type: et, split: TetSplit::Five, refine: 0 }.build().unwrap()
+    BoxMeshSpec {
+        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 0.25, 0.25), cells },
+        element_type: et,
+        split: TetSplit::Five,
+        refine: 0,
+    }
+    .build()
+    .unwrap()
 }
 
 fn clamped_at_x0(mesh: &Mesh) -> Vec<u32> {
@@ -54,8 +61,25 @@ fn frequency_range(mesh: &Mesh, material: &Material, clamped: &[u32], x: &[Vec3]
 
 /// Runs XPBD (one iteration per substep, as the paper) with velocity damping until it has
 /// settled, and returns the largest node distance to `reference`.
-fn settled_xpbd_error(mesh: &Mesh, material: &Material, formulation: Formulation, clamped: &[u32], dt_secs: f64, damping_per_sec: f64, settle_secs: f64, reference: &[Vec3]) -> f64 {
-    let settings = SolverSettings { substeps: 1, iterations: 1, frames_per_second: 1.0 / dt_secs, formulation, quadrature_degree: None, parallel: false, stability_guard: false };
+fn settled_xpbd_error(
+    mesh: &Mesh,
+    material: &Material,
+    formulation: Formulation,
+    clamped: &[u32],
+    dt_secs: f64,
+    damping_per_sec: f64,
+    settle_secs: f64,
+    reference: &[Vec3],
+) -> f64 {
+    let settings = SolverSettings {
+        substeps: 1,
+        iterations: 1,
+        frames_per_second: 1.0 / dt_secs,
+        formulation,
+        quadrature_degree: None,
+        parallel: false,
+        stability_guard: false,
+    };
     let effects: Vec<Box<dyn Effect>> = vec![
         Box::new(Gravity::new(G)),
         Box::new(Clamp { nodes: clamped.to_vec() }),
@@ -76,9 +100,8 @@ fn settled_xpbd_error(mesh: &Mesh, material: &Material, formulation: Formulation
 /// the settled error is small, and halving the step divides it by about four.
 #[test]
 fn settled_xpbd_converges_to_the_static_equilibrium_for_every_element_type_and_formulation() {
-    let cases = ElementType::all().flat_map(|et| {
-        MaterialModel::ALL.map(|model| (et, Material::new(model, 1.0e5, 0.3, 1000.0).unwrap()))
-    });
+    let cases = ElementType::all()
+        .flat_map(|et| MaterialModel::ALL.map(|model| (et, Material::new(model, 1.0e5, 0.3, 1000.0).unwrap())));
     for (et, material) in cases {
         let mesh = one_cell_cantilever(et);
         let clamped = clamped_at_x0(&mesh);
@@ -90,11 +113,27 @@ fn settled_xpbd_converges_to_the_static_equilibrium_for_every_element_type_and_f
         let settle_secs = 40.0 / omega_min;
         for formulation in Formulation::ALL {
             let h = 0.1 / omega_max;
-            let coarse = settled_xpbd_error(&mesh, &material, formulation, &clamped, h, damping, settle_secs, &reference) / u_max;
-            let fine = settled_xpbd_error(&mesh, &material, formulation, &clamped, h / 2.0, damping, settle_secs, &reference) / u_max;
-            eprintln!("{et} {:?} {formulation}: ω {omega_min:.1}..{omega_max:.1} rad/s, error {coarse:.2e} at h = {h:.2e} s, {fine:.2e} at h/2", material.model);
-            assert!(fine < 0.01, "{et} {:?} {formulation}: settled XPBD is {:.2}% off the static equilibrium", material.model, 100.0 * fine);
-            assert!(fine < coarse / 2.5, "{et} {:?} {formulation}: the gap does not shrink with the step: {coarse:.2e} → {fine:.2e}", material.model);
+            let coarse =
+                settled_xpbd_error(&mesh, &material, formulation, &clamped, h, damping, settle_secs, &reference)
+                    / u_max;
+            let fine =
+                settled_xpbd_error(&mesh, &material, formulation, &clamped, h / 2.0, damping, settle_secs, &reference)
+                    / u_max;
+            eprintln!(
+                "{et} {:?} {formulation}: ω {omega_min:.1}..{omega_max:.1} rad/s, error {coarse:.2e} at h = {h:.2e} s, {fine:.2e} at h/2",
+                material.model
+            );
+            assert!(
+                fine < 0.01,
+                "{et} {:?} {formulation}: settled XPBD is {:.2}% off the static equilibrium",
+                material.model,
+                100.0 * fine
+            );
+            assert!(
+                fine < coarse / 2.5,
+                "{et} {:?} {formulation}: the gap does not shrink with the step: {coarse:.2e} → {fine:.2e}",
+                material.model
+            );
         }
     }
 }
@@ -130,7 +169,8 @@ fn a_free_body_without_effects_stays_exactly_at_rest_and_runs_no_effect_work() {
 fn free_fall_follows_symplectic_euler_exactly() {
     let mesh = cantilever(ElementType::from_name("p2").unwrap());
     let material = Material::new(MaterialModel::StableNeoHookean, 1.0e6, 0.35, 1000.0).unwrap();
-    let mut sim = Simulation::new(mesh.clone(), material, SolverSettings::default(), vec![Box::new(Gravity::new(G))]).unwrap();
+    let mut sim =
+        Simulation::new(mesh.clone(), material, SolverSettings::default(), vec![Box::new(Gravity::new(G))]).unwrap();
     for _ in 0..60 {
         sim.step_frame().unwrap();
     }
@@ -153,10 +193,15 @@ fn bad_settings_and_blow_ups_are_clear_errors() {
     assert!(err.contains("substeps must be at least 1"), "{err}");
     let bad = SolverSettings { frames_per_second: f64::NAN, ..SolverSettings::default() };
     assert!(Simulation::new(mesh.clone(), material, bad, Vec::new()).is_err());
-    let err = Simulation::new(mesh.clone(), material, SolverSettings::default(), vec![Box::new(Clamp { nodes: vec![99_999] })])
-        .err()
-        .unwrap()
-        .to_string();
+    let err = Simulation::new(
+        mesh.clone(),
+        material,
+        SolverSettings::default(),
+        vec![Box::new(Clamp { nodes: vec![99_999] })],
+    )
+    .err()
+    .unwrap()
+    .to_string();
     assert!(err.contains("node 99999"), "{err}");
 
     let mut sim = Simulation::new(mesh, material, SolverSettings::default(), Vec::new()).unwrap();
@@ -164,7 +209,6 @@ fn bad_settings_and_blow_ups_are_clear_errors() {
     let err = sim.step_frame().unwrap_err().to_string();
     assert!(err.contains("node 7") && err.contains("element") && err.contains("substep 1"), "{err}");
 }
-
 
 fn beam_sim(parallel: bool, formulation: Formulation) -> Simulation {
     let mesh = cantilever(ElementType::from_name("p2").unwrap());
@@ -207,7 +251,8 @@ fn sweeps_agree_and_settle(mesh: Mesh, parallel_runs: &[(usize, usize)]) {
     for formulation in Formulation::ALL {
         let sim = |parallel: bool| {
             let settings = SolverSettings { formulation, parallel, ..SolverSettings::default() };
-            let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.clone() })];
+            let effects: Vec<Box<dyn Effect>> =
+                vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.clone() })];
             Simulation::new(mesh.clone(), material, settings, effects).unwrap()
         };
         let mut runs = vec![(rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap(), sim(false))];
@@ -221,7 +266,9 @@ fn sweeps_agree_and_settle(mesh: Mesh, parallel_runs: &[(usize, usize)]) {
         for (pool, sim) in &mut runs {
             pool.install(|| (0..30).for_each(|_| sim.step_frame().unwrap()));
         }
-        let gap = |a: &Simulation, b: &Simulation| a.positions.iter().zip(&b.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        let gap = |a: &Simulation, b: &Simulation| {
+            a.positions.iter().zip(&b.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max)
+        };
         for (_, parallel) in &runs[1..] {
             let gap = gap(&runs[0].1, parallel);
             assert!(gap > 0.0 && gap < 0.02 * u_max, "{formulation}: serial and parallel differ by {gap:.3e} m");
@@ -235,7 +282,10 @@ fn sweeps_agree_and_settle(mesh: Mesh, parallel_runs: &[(usize, usize)]) {
             let settled_gap = gap(&runs[0].1, parallel);
             let to_static = parallel.positions.iter().zip(&reference).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
             assert!(settled_gap < 1e-3 * u_max, "{formulation}: settled states differ by {settled_gap:.3e} m");
-            assert!(to_static < 0.02 * u_max, "{formulation}: parallel settles {to_static:.3e} m from the static answer");
+            assert!(
+                to_static < 0.02 * u_max,
+                "{formulation}: parallel settles {to_static:.3e} m from the static answer"
+            );
         }
     }
 }
@@ -243,7 +293,10 @@ fn sweeps_agree_and_settle(mesh: Mesh, parallel_runs: &[(usize, usize)]) {
 #[test]
 fn serial_and_parallel_sweeps_agree_and_settle_on_the_same_static_answer() {
     // P2: colour by colour on one and two threads, and cut into two slabs
-    sweeps_agree_and_settle(cantilever(ElementType::from_name("p2").unwrap()), &[(1, usize::MAX), (2, usize::MAX), (2, 0)]);
+    sweeps_agree_and_settle(
+        cantilever(ElementType::from_name("p2").unwrap()),
+        &[(1, usize::MAX), (2, usize::MAX), (2, 0)],
+    );
 }
 
 /// A P1 beam large enough for slabs with an interior: the colour sweep (four tetrahedra per

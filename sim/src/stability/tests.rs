@@ -19,12 +19,19 @@ fn omega2_bounds_the_largest_eigenvalue_from_above_within_its_safety_factor() {
             let a = DMatrix::from_fn(n, n, |r, c| w[r / 3].sqrt() * k[(r, c)] * w[c / 3].sqrt());
             let exact = SymmetricEigen::new(a).eigenvalues.max();
             let estimate = element_omega2(rest, &w, element_grads(g, 0), g.volumes(0), &material);
-            assert!(estimate >= exact * 0.99 && estimate <= exact * OMEGA2_SAFETY * 1.0001, "{et} {:?}: {estimate} vs {exact}", material.model);
+            assert!(
+                estimate >= exact * 0.99 && estimate <= exact * OMEGA2_SAFETY * 1.0001,
+                "{et} {:?}: {estimate} vs {exact}",
+                material.model
+            );
         }
     }
     // every node pinned: nothing can move
     let (_, mesh, geo) = &elements()[0];
-    assert_eq!(element_omega2(&mesh.rest_positions, &[0.0; 4], element_grads(&geo[0], 0), geo[0].volumes(0), &materials()[0]), 0.0);
+    assert_eq!(
+        element_omega2(&mesh.rest_positions, &[0.0; 4], element_grads(&geo[0], 0), geo[0].volumes(0), &materials()[0]),
+        0.0
+    );
 }
 
 #[test]
@@ -63,7 +70,11 @@ fn the_energy_formulation_of_a_nearly_incompressible_material_is_guarded_from_h_
         assert_eq!(guard_trigger_h_omega(Formulation::Energy, &at(model_nu)), GUARD_TRIGGER_H_OMEGA, "ν = {model_nu}");
     }
     for nu in [0.45, 0.49, 0.499] {
-        assert_eq!(guard_trigger_h_omega(Formulation::Energy, &at(nu)), GUARD_TRIGGER_NEAR_INCOMPRESSIBLE_ENERGY_H_OMEGA, "ν = {nu}");
+        assert_eq!(
+            guard_trigger_h_omega(Formulation::Energy, &at(nu)),
+            GUARD_TRIGGER_NEAR_INCOMPRESSIBLE_ENERGY_H_OMEGA,
+            "ν = {nu}"
+        );
         assert_eq!(guard_trigger_h_omega(Formulation::Split, &at(nu)), GUARD_TRIGGER_H_OMEGA, "ν = {nu}");
     }
     // λ/μ = 2ν/(1 − 2ν) = 9 at the threshold

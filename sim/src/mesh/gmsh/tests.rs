@@ -48,12 +48,16 @@ fn msh41_ascii_reads_nodes_elements_and_groups() {
 fn an_unknown_group_is_an_error_listing_the_groups() {
     let m = read_msh_str(&msh41("1 2 3 4"), "t.msh").unwrap();
     let e = m.node_set("clamp").unwrap_err().to_string();
-    assert!(e.contains("t.msh") && e.contains("\"clamp\" does not exist") && e.contains("\"bottom\", \"solid\""), "{e}");
+    assert!(
+        e.contains("t.msh") && e.contains("\"clamp\" does not exist") && e.contains("\"bottom\", \"solid\""),
+        "{e}"
+    );
 }
 
 #[test]
 fn an_unnamed_group_is_called_by_its_number() {
-    let text = msh22("4 2 7 1 1 2 3 4").replace("$PhysicalNames\n2\n2 1 \"bottom\"\n3 2 \"solid\"\n$EndPhysicalNames\n", "");
+    let text =
+        msh22("4 2 7 1 1 2 3 4").replace("$PhysicalNames\n2\n2 1 \"bottom\"\n3 2 \"solid\"\n$EndPhysicalNames\n", "");
     let m = read_msh_str(&text, "t.msh").unwrap();
     assert_eq!(m.node_set("7").unwrap(), &[0, 1, 2, 3]);
     assert_eq!(m.node_set("1").unwrap(), &[0, 1, 2]);
@@ -104,7 +108,8 @@ fn a_wrong_node_count_is_an_error() {
 fn empty_and_surface_only_meshes_are_errors() {
     let empty = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n0\n$EndNodes\n$Elements\n0\n$EndElements\n";
     assert!(error(empty).contains("the mesh is empty: no nodes"), "{}", error(empty));
-    let no_elements = msh22("4 2 2 1 1 2 3 4").replace("$Elements\n2\n1 2 2 1 1 1 3 2\n2 4 2 2 1 1 2 3 4\n", "$Elements\n0\n");
+    let no_elements =
+        msh22("4 2 2 1 1 2 3 4").replace("$Elements\n2\n1 2 2 1 1 1 3 2\n2 4 2 2 1 1 2 3 4\n", "$Elements\n0\n");
     assert!(error(&no_elements).contains("no elements"), "{}", error(&no_elements));
     let surface = msh22("2 2 1 1 1 2 4");
     let e = error(&surface);

@@ -60,7 +60,8 @@ fn high_order_meshes_are_conforming_every_interior_face_is_shared_by_two_element
             for (b, el, f) in m.boundary_faces() {
                 let block = &m.blocks[b];
                 let face = &block.element_type.faces()[f];
-                let pts: Vec<Vec3> = face.nodes.iter().map(|&l| m.rest_positions[block.element(el)[l] as usize]).collect();
+                let pts: Vec<Vec3> =
+                    face.nodes.iter().map(|&l| m.rest_positions[block.element(el)[l] as usize]).collect();
                 let on_box = (0..3).any(|d| {
                     pts.iter().all(|p| (p[d] - lo[d]).abs() < 1e-12) || pts.iter().all(|p| (p[d] - hi[d]).abs() < 1e-12)
                 });
