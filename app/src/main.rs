@@ -10,6 +10,7 @@
 mod cli;
 mod colour;
 mod gui;
+mod output;
 mod recording;
 
 use clap::Parser;

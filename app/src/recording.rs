@@ -60,6 +60,18 @@ pub fn entity_name(label: &str) -> String {
 }
 
 /// A short label for an instance, e.g. `p2 160` (element type and count).
+/// What the recording states about a configuration: every parameter of the table
+/// ([`hox_scenes::params`]) by its scene-file key, with its unit.
+pub fn configuration_markdown(instance: &Instance) -> String {
+    let scene = &instance.scene;
+    let mut text = format!("Configuration of scene `{}`:\n", scene.name());
+    for p in hox_scenes::params::PARAMS.iter().filter(|p| scene.is_box() || !p.box_only) {
+        let unit = if p.unit.is_empty() { String::new() } else { format!(" {}", p.unit) };
+        text += &format!("- `{}` = {}{unit}\n", p.file_path(), (p.get)(scene.params()));
+    }
+    text
+}
+
 pub fn config_label(instance: &Instance) -> String {
     let mesh = instance.sim.mesh();
     let types: Vec<&str> = mesh.blocks.iter().map(|b| b.element_type.name()).collect();
@@ -187,8 +199,9 @@ impl SimLogger {
         rec.log_static(
             format!("legend/{name}"),
             &rerun::TextDocument::from_markdown(format!(
-                "**{name}**: surface colour = displacement magnitude |u| in metres, viridis, fixed range 0 m (dark purple) to {} m (yellow); larger values are clamped.",
-                format_metres(colours.max_m)
+                "**{name}**: surface colour = displacement magnitude |u| in metres, viridis, fixed range 0 m (dark purple) to {} m (yellow); larger values are clamped.\n\n{}",
+                format_metres(colours.max_m),
+                configuration_markdown(instance)
             )),
         )
     }

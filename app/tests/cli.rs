@@ -306,3 +306,33 @@ fn an_unwritable_vtk_folder_is_an_error_before_simulating() {
     assert!(started.elapsed().as_secs() < 30, "refused before simulating 1000 s");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Inputs at their edges (issue #10): the parameter table's ranges on the command line, each
+/// error naming the option.
+#[test]
+fn grid_and_refine_at_their_edges_name_the_option() {
+    // a negative value reaches the option's parser instead of clap's "unexpected argument"
+    fails_with(&["mesh", "--scene", "bending", "--grid", "-4x2x2"], "--grid");
+    fails_with(&["mesh", "--scene", "bending", "--refine", "-1"], "--refine");
+    // the app's ranges: at most 64 cells per direction, 3 refinements
+    fails_with(&["mesh", "--scene", "bending", "--grid", "65x2x2"], "--grid");
+    // 5 million elements: refused with the count and the memory, before building anything
+    fails_with(&["mesh", "--scene", "bending", "--refine", "5"], "5,242,880 elements");
+    fails_with(&["mesh", "--scene", "bending", "--refine", "5"], "GB");
+    fails_with(
+        &["mesh", "--scene", "bending", "--element", "p1", "--grid", "64x64x64", "--split", "six", "--refine", "1"],
+        "12,582,912 elements",
+    );
+    // the largest the app offers builds
+    let m = json(&["mesh", "--scene", "bending", "--element", "p1", "--refine", "3", "--json"]);
+    assert_eq!(m["elements"], 81_920);
+}
+
+#[test]
+fn a_mistyped_compare_key_is_named_even_alone() {
+    let rrd = scratch("compare-key").join("never.rrd");
+    let rrd = rrd.to_str().expect("utf-8 path");
+    fails_with(&["record", "--scene", "bending", "--out", rrd, "--compare", "youngz=1e6"], "'youngz'");
+    fails_with(&["record", "--scene", "bending", "--out", rrd, "--compare", "youngz=1e6"], "did you mean 'youngs'");
+    fails_with(&["record", "--scene", "bending", "--out", rrd, "--compare", "element=p1"], "two or more");
+}

@@ -4,12 +4,14 @@
 //! runs from anywhere); [`scene`] documents the format. [`Instance`] builds a scene into a
 //! running simulation with its probes, and [`run`] advances it for a time or until it settles.
 
+pub mod params;
 pub mod run;
 pub mod scene;
 pub mod study;
 
+pub use params::{Params, SceneOverrides};
 pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, median, run, run_observed};
-pub use scene::{Drive, NodeSelector, Scene, SceneFile, SceneMesh, SceneOverrides};
+pub use scene::{Drive, NodeSelector, Scene, SceneFile, SceneMesh};
 
 use hox_sim::probe::Probe;
 use hox_sim::solver::Simulation;
@@ -86,7 +88,7 @@ impl Instance {
             .map(|p| Probe::locate(&mesh, &p.name, hox_sim::Vec3::from(p.point_m)))
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| SceneError::Probe { source_name: scene.source.clone(), message: e.to_string() })?;
-        let sim = Simulation::new(mesh, scene.material, scene.settings, effects)
+        let sim = Simulation::new(mesh, scene.material(), scene.settings(), effects)
             .map_err(|e| SceneError::Simulation { source_name: scene.source.clone(), message: e.to_string() })?;
         Ok(Instance { scene, sim, probes })
     }
@@ -142,8 +144,8 @@ pub fn solve_static(
     let (acceleration_m_s2, dirichlet) = static_problem(scene, mesh)?;
     let problem = hox_sim::statics::StaticProblem {
         mesh,
-        material: scene.material,
-        quadrature_degree: scene.settings.quadrature_degree,
+        material: scene.material(),
+        quadrature_degree: scene.settings().quadrature_degree,
         acceleration_m_s2,
         dirichlet,
         tolerance,

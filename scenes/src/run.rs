@@ -66,13 +66,13 @@ pub fn run_observed(
     progress: &mut dyn FnMut(f64, Option<f64>),
     on_frame: &mut dyn FnMut(&Instance) -> Result<(), SceneError>,
 ) -> Result<RunReport, SceneError> {
-    let frame_secs = 1.0 / instance.scene.settings.frames_per_second;
+    let frame_secs = 1.0 / instance.scene.params().frames_per_second;
     let source = instance.scene.source.clone();
     let fail =
         |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: source.clone(), message: e.to_string() };
     let mut settled = false;
     let mut frame_ms: Vec<f64> = Vec::new();
-    let window = (instance.scene.settings.frames_per_second.round() as usize).max(1);
+    let window = (instance.scene.params().frames_per_second.round() as usize).max(1);
     let mut history: std::collections::VecDeque<Vec<(String, [f64; 3])>> =
         std::collections::VecDeque::with_capacity(window + 1);
     let mut remember = |instance: &Instance| {
@@ -99,7 +99,7 @@ pub fn run_observed(
             }
         }
         RunMode::Settle { cap_secs } => {
-            let damping = instance.scene.file.solver.settle_damping_per_sec;
+            let damping = instance.scene.params().settle_damping_per_sec;
             if damping > 0.0 {
                 instance.sim.add_effect(Box::new(Damping { rate_per_sec: damping })).map_err(fail)?;
             }

@@ -223,7 +223,7 @@ pub fn study_one(
     // the settled state, timed
     progress(&format!("{scene_name} {label}: XPBD at 50 substeps, all threads"));
     let mut parallel_scene = scene.clone();
-    parallel_scene.settings.parallel = true;
+    parallel_scene.file.params.parallel = true;
     let mut parallel = Instance::new(parallel_scene)?;
     parallel.sim.warm_start(&instance.sim.positions, instance.sim.time_secs());
     let all_threads = run(&mut parallel, RunMode::Seconds(1.0), &mut |_, _| {})?.ms_per_frame;

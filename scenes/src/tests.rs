@@ -26,13 +26,16 @@ fn the_paper_scenes_have_the_papers_parameters() {
     let b = by_name("bending").unwrap();
     let bm = b.mesh.as_box().unwrap();
     assert_eq!((bm.element_type.name(), bm.grid.cells), ("p2", [8, 2, 2]));
-    assert_eq!((b.material.youngs_modulus_pa, b.material.poisson_ratio, b.material.density_kg_m3), (3e6, 0.35, 1000.0));
-    assert_eq!((b.settings.substeps, b.settings.iterations, b.settings.frames_per_second), (50, 1, 60.0));
+    assert_eq!(
+        (b.material().youngs_modulus_pa, b.material().poisson_ratio, b.material().density_kg_m3),
+        (3e6, 0.35, 1000.0)
+    );
+    assert_eq!((b.params().substeps, b.params().iterations, b.params().frames_per_second), (50, 1, 60.0));
     for name in ["tension", "torsion"] {
         let s = by_name(name).unwrap();
         let sm = s.mesh.as_box().unwrap();
         assert_eq!((sm.element_type.name(), sm.grid.cells, sm.split.name()), ("p2", [6, 3, 3], "six"));
-        assert_eq!(s.material.youngs_modulus_pa, 1e6);
+        assert_eq!(s.material().youngs_modulus_pa, 1e6);
         assert!(!s.file.effects.iter().any(|e| matches!(e, EffectSpec::Gravity { .. })), "{name} has no gravity");
     }
 }
@@ -139,7 +142,7 @@ fn overrides_change_the_scene_and_are_validated() {
     };
     let t = s.with_overrides(&o).unwrap();
     assert_eq!(t.build_mesh().unwrap().num_elements(), 1280);
-    assert_eq!(t.material.youngs_modulus_pa, 1e6);
+    assert_eq!(t.material().youngs_modulus_pa, 1e6);
     let bad = SceneOverrides { poisson_ratio: Some(0.7), ..Default::default() };
     assert!(s.with_overrides(&bad).unwrap_err().to_string().contains("Poisson"));
     let split_negative =

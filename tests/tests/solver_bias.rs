@@ -11,7 +11,7 @@ fn p2_160_at_70_substeps_settles_within_one_percent_of_the_static_solution() {
     let (acceleration, dirichlet) = hox_scenes::static_problem(&scene, &mesh).unwrap();
     let problem = hox_sim::statics::StaticProblem {
         mesh: &mesh,
-        material: scene.material,
+        material: scene.material(),
         quadrature_degree: None,
         acceleration_m_s2: acceleration,
         dirichlet,

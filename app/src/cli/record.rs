@@ -2,6 +2,7 @@
 //! headless) and `hox inspect` (read an .rrd back and check what it holds).
 
 use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, load_scene, overrides};
+use crate::output::check_writable;
 use crate::recording::{LogSettings, SimLogger, config_label, entity_name};
 use anyhow::{Context, Result, bail};
 use hox_scenes::{Instance, SceneOverrides};
@@ -27,9 +28,9 @@ pub struct RecordArgs {
     pub out: PathBuf,
     /// Record several configurations of the scene side by side (give it two or more times).
     /// Each value lists option=value pairs applied on top of the other options, e.g.
-    /// `--compare element=p1,refine=1 --compare element=p2`. Options: element, grid, split,
-    /// refine, material, youngs, poisson, density, formulation, quadrature, substeps,
-    /// iterations, fps, guard (on/off: the stability guard).
+    /// `--compare element=p1,refine=1 --compare element=p2`. Options: every scene parameter of
+    /// the command line by its key (element, grid, split, refine, material, youngs, poisson,
+    /// density, formulation, quadrature, substeps, iterations, guard (on/off), fps, parallel).
     #[arg(long, value_name = "OPTION=VALUE,...")]
     pub compare: Vec<String>,
     /// Pieces per edge when tessellating curved (high-order) and quadrilateral faces.
@@ -61,75 +62,28 @@ pub struct InspectArgs {
     pub json: bool,
 }
 
-/// Applies one `--compare` value (`option=value,...`) on top of `base`.
+/// Applies one `--compare` value (`key=value,...`, the keys of the parameter table) on top of
+/// `base`; an unknown key or a bad value is an error naming it.
 pub fn parse_compare(spec: &str, base: &SceneOverrides) -> Result<SceneOverrides> {
     let mut o = base.clone();
     for pair in spec.split(',').map(str::trim).filter(|p| !p.is_empty()) {
         let (key, value) =
             pair.split_once('=').with_context(|| format!("--compare '{spec}': '{pair}' is not option=value"))?;
-        let (key, value) = (key.trim(), value.trim());
-        let number = |what: &str| -> Result<f64> {
-            let v: f64 =
-                value.parse().with_context(|| format!("--compare '{spec}': {key} needs {what}, got '{value}'"))?;
-            Ok(v)
-        };
-        let whole = || -> Result<usize> {
-            value.parse().with_context(|| format!("--compare '{spec}': {key} needs a whole number, got '{value}'"))
-        };
-        match key {
-            "element" => o.element = Some(value.into()),
-            "grid" => o.grid = Some(super::parse_grid(value).map_err(anyhow::Error::msg)?),
-            "split" => o.split = Some(value.into()),
-            "refine" => o.refine = Some(whole()?),
-            "material" => o.material = Some(value.into()),
-            "youngs" => o.youngs_modulus_pa = Some(number("a Young's modulus in Pa")?),
-            "poisson" => o.poisson_ratio = Some(number("a Poisson ratio")?),
-            "density" => o.density_kg_m3 = Some(number("a density in kg/m³")?),
-            "formulation" => o.formulation = Some(value.into()),
-            "quadrature" => o.quadrature_degree = Some(whole()?),
-            "substeps" => o.substeps = Some(whole()? as u32),
-            "iterations" => o.iterations = Some(whole()? as u32),
-            "fps" => o.frames_per_second = Some(number("frames per second")?),
-            "guard" => {
-                o.stability_guard = Some(match value {
-                    "on" | "true" => true,
-                    "off" | "false" => false,
-                    _ => bail!("--compare '{spec}': guard needs on or off, got '{value}'"),
-                })
-            }
-            _ => bail!(
-                "--compare '{spec}': unknown option '{key}' (use element, grid, split, refine, material, youngs, poisson, density, formulation, quadrature, substeps, iterations, fps, guard)"
-            ),
-        }
+        o.set_text(key.trim(), value).map_err(|e| anyhow::anyhow!("--compare '{spec}': {e}"))?;
     }
     Ok(o)
-}
-
-/// Fails unless `path` can be written, without truncating an existing file and without leaving
-/// a new one behind.
-pub fn check_writable(path: &Path) -> Result<()> {
-    let existed = path.exists();
-    if path.is_dir() {
-        bail!("cannot write {}: it is a folder", path.display());
-    }
-    std::fs::OpenOptions::new()
-        .append(true)
-        .create(true)
-        .open(path)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    if !existed {
-        let _ = std::fs::remove_file(path);
-    }
-    Ok(())
 }
 
 pub fn record(args: &RecordArgs) -> Result<()> {
     let scene = load_scene(&args.scene)?;
     let base = overrides(&args.mesh, Some(&args.physics));
-    let configurations: Vec<SceneOverrides> = match args.compare.len() {
+    // every value is checked first, so a mistyped key is named even when only one is given
+    let compared: Vec<SceneOverrides> =
+        args.compare.iter().map(|spec| parse_compare(spec, &base)).collect::<Result<_>>()?;
+    let configurations = match compared.len() {
         0 => vec![base],
         1 => bail!("--compare needs two or more configurations (give it once per configuration)"),
-        _ => args.compare.iter().map(|spec| parse_compare(spec, &base)).collect::<Result<_>>()?,
+        _ => compared,
     };
     if args.tessellation == 0 || args.tessellation > 32 {
         bail!("--tessellation must be between 1 and 32 pieces per edge, got {}", args.tessellation);
@@ -148,12 +102,12 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         super::note_stability(&mut instance);
         instances.push(instance);
     }
-    let seconds = args.seconds.unwrap_or(instances[0].scene.file.solver.duration_secs);
+    let seconds = args.seconds.unwrap_or(instances[0].scene.params().duration_secs);
     if !(seconds.is_finite() && seconds >= 0.0) {
         bail!("--seconds must be a finite, non-negative number of seconds, got {seconds}");
     }
-    let fps = instances[0].scene.settings.frames_per_second;
-    if instances.iter().any(|i| i.scene.settings.frames_per_second != fps) {
+    let fps = instances[0].scene.params().frames_per_second;
+    if instances.iter().any(|i| i.scene.params().frames_per_second != fps) {
         bail!("the compared configurations must share one frame rate (fps) so their frames line up");
     }
     check_writable(&args.out)?;
@@ -297,7 +251,11 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         for index in &vtk_indexes {
             println!("  VTK series for ParaView: {index}");
         }
-        println!("play it back with the Rerun viewer {}: rerun {}", rerun::build_info().version, args.out.display());
+        println!(
+            "play it back with the Rerun viewer {}: scripts/rerun.sh {} (installs the matching viewer on first use)",
+            rerun::build_info().version,
+            args.out.display()
+        );
     }
     Ok(())
 }

@@ -6,8 +6,7 @@
 use super::config::Config;
 use super::{HoxApp, SceneSource};
 use eframe::egui;
-use hox_sim::element::ElementType;
-use hox_sim::material::MaterialModel;
+use hox_scenes::params::{self, Group, Kind, Param, Value};
 
 /// The File → Open dialog: a path typed or picked from the project's assets.
 #[derive(Clone, Debug, Default)]
@@ -106,45 +105,35 @@ fn link_ui(app: &mut HoxApp, ui: &mut egui::Ui, field: &str) {
     }
 }
 
-/// A numeric text field that applies on Enter or focus loss; unparsable or refused values
-/// keep the previous value and show the reason.
-fn number_ui(
-    app: &mut HoxApp,
-    ui: &mut egui::Ui,
-    field: &str,
-    text: &str,
-    tip: &str,
-    value: f64,
-    set: impl Fn(&mut Config, f64),
-) {
+/// A numeric text field for parameter `p` that applies on Enter or focus loss; unparsable or
+/// refused values keep the previous value and show the reason.
+fn number_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
+    let field = p.key;
+    let text = p.label_with_unit();
+    let value = (p.get)(&app.sessions[app.active].config).to_string();
     ui.horizontal(|ui| {
-        let l = label(ui, text, tip);
+        let l = label(ui, &text, p.help);
         let key = format!("{}:{field}", app.active);
-        let buffer = app.edits.entry(key.clone()).or_insert_with(|| format!("{value}"));
+        let buffer = app.edits.entry(key.clone()).or_insert_with(|| value.clone());
         let response =
-            ui.add(egui::TextEdit::singleline(buffer).desired_width(90.0)).labelled_by(l.id).on_hover_text(tip);
+            ui.add(egui::TextEdit::singleline(buffer).desired_width(90.0)).labelled_by(l.id).on_hover_text(p.help);
         let commit = response.lost_focus() || (response.has_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)));
         if commit {
             let typed = buffer.trim().to_string();
-            match typed.parse::<f64>() {
-                Ok(v) if v != value => {
+            match p.kind.parse(&typed) {
+                Ok(v) if v.to_string() != value => {
                     let mut c = app.sessions[app.active].config.clone();
-                    set(&mut c, v);
+                    (p.set)(&mut c, v);
                     app.apply(field, c);
                 }
                 Ok(_) => {}
-                Err(_) => app.refusal = Some((field.to_string(), format!("'{typed}' is not a number"))),
+                Err(e) => app.refusal = Some((field.to_string(), e)),
             }
             // show what is in force now
-            let now = app.sessions[app.active].config.clone();
-            let shown = match field {
-                "youngs" => now.youngs_modulus_pa,
-                "poisson" => now.poisson_ratio,
-                _ => now.density_kg_m3,
-            };
-            app.edits.insert(key, format!("{shown}"));
+            let now = (p.get)(&app.sessions[app.active].config).to_string();
+            app.edits.insert(key, now);
         } else if !response.has_focus() {
-            *buffer = format!("{value}");
+            *buffer = value;
         }
         link_ui(app, ui, field);
     });
@@ -188,7 +177,7 @@ pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             ui.label("Editing:");
             for k in 0..2 {
-                let text = format!("{} {}", ["A", "B"][k], app.sessions[k].config.label());
+                let text = format!("{} {}", ["A", "B"][k], app.sessions[k].label());
                 if ui
                     .selectable_label(app.active == k, text)
                     .on_hover_text("The configuration the controls below change.")
@@ -200,12 +189,10 @@ pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         });
     }
     ui.separator();
-    mesh_ui(app, ui);
-    ui.separator();
-    material_ui(app, ui);
-    ui.separator();
-    solver_ui(app, ui);
-    ui.separator();
+    for group in Group::ALL {
+        params_ui(app, ui, group);
+        ui.separator();
+    }
     playback_ui(app, ui);
     ui.separator();
     view_ui(app, ui);
@@ -259,205 +246,80 @@ fn combo<T: Clone + PartialEq>(
         .response
 }
 
-fn mesh_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
-    ui.heading("Mesh");
-    let c = app.sessions[app.active].config.clone();
-    if !c.is_box() {
+/// The controls of one group of the parameter table (mesh, material, solver): a row per
+/// parameter the app shows, its widget chosen by the parameter's kind.
+fn params_ui(app: &mut HoxApp, ui: &mut egui::Ui, group: Group) {
+    ui.heading(group.heading());
+    let is_box = app.sessions[app.active].base.is_box();
+    if group == Group::Mesh && !is_box {
         ui.label("from a mesh file (element type and grid are the file's)");
         return;
     }
+    for p in params::in_group(group).filter(|p| p.surfaces.app && (is_box || !p.box_only)) {
+        param_ui(app, ui, p);
+    }
+}
+
+/// One parameter's row.
+fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
     let k = app.active;
-    row_ui(
-        app,
-        ui,
-        "element",
-        "Element",
-        "The element type: P1/P2/P3 tetrahedra (order 1–3), Q1/Q2 hexahedra, prisms, pyramids.",
-        |c| c.element.clone(),
-        |c, v| c.element = v,
-        |ui, v| {
-            let shown = v.to_uppercase();
-            combo(
-                ui,
-                ("element", k),
-                v,
-                shown,
-                ElementType::all()
-                    .map(|e| (e.name().to_string(), format!("{} — {}", e.name().to_uppercase(), e.description())))
-                    .collect(),
-            )
-        },
-    );
-    let tets = ["p1", "p2", "p3"].contains(&c.element.as_str());
-    row_ui(
-        app,
-        ui,
-        "split",
-        "Tet split",
-        "How each hexahedral cell is cut into tetrahedra: five (unbiased, alternating) or six (biased along one diagonal).",
-        |c| c.split.clone(),
-        |c, v| c.split = v,
-        |ui, v| {
-            ui.add_enabled_ui(tets, |ui| {
-                ui.radio_value(v, "five".to_string(), "five (unbiased)");
-                ui.radio_value(v, "six".to_string(), "six (biased)")
+    let config = app.sessions[k].config.clone();
+    let enabled = p.applies.is_none_or(|f| f(&config));
+    let text = p.label_with_unit();
+    let get = |c: &Config| (p.get)(c);
+    let set = |c: &mut Config, v: Value| {
+        (p.set)(c, v);
+    };
+    match p.kind {
+        Kind::Number { soft: None, .. } => number_ui(app, ui, p),
+        Kind::Choice(options) => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
+            let Value::Text(name) = v else { return ui.label("?") };
+            let options = options();
+            let shown = options.iter().find(|(n, _)| *n == name.as_str()).map_or(name.to_uppercase(), |(n, d)| {
+                if d.starts_with(&n.to_uppercase()) { n.to_uppercase() } else { d.clone() }
+            });
+            ui.add_enabled_ui(enabled, |ui| {
+                combo(ui, (p.key, k), name, shown, options.into_iter().map(|(n, d)| (n.to_string(), d)).collect())
             })
             .inner
-        },
-    );
-    row_ui(
-        app,
-        ui,
-        "grid",
-        "Grid",
-        "Hexahedral cells along x, y and z before any splitting (each 1–64).",
-        |c| c.grid,
-        |c, v| c.grid = v,
-        |ui, g| {
+        }),
+        Kind::Whole { min, soft_max, .. } => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
+            let Value::Whole(n) = v else { return ui.label("?") };
+            let log = soft_max >= 20 * min.max(1);
+            ui.add_enabled(enabled, egui::Slider::new(n, min..=soft_max).logarithmic(log))
+        }),
+        Kind::Number { soft: Some((lo, hi)), .. } => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
+            let Value::Number(x) = v else { return ui.label("?") };
+            let suffix = if p.key == "fps" { " fps".to_string() } else { String::new() };
+            ui.add_enabled(enabled, egui::Slider::new(x, lo..=hi).logarithmic(true).suffix(suffix))
+        }),
+        Kind::Flag => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
+            let Value::Flag(b) = v else { return ui.label("?") };
+            ui.add_enabled(enabled, egui::Checkbox::new(b, "on"))
+        }),
+        Kind::Grid { min, max } => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
+            let Value::Grid(g) = v else { return ui.label("?") };
             let mut response: Option<egui::Response> = None;
             for (cells, axis) in g.iter_mut().zip(["x", "y", "z"]) {
                 let l = ui.label(axis);
-                let r = ui.add(egui::DragValue::new(cells).range(1..=64)).labelled_by(l.id);
+                let r = ui.add_enabled(enabled, egui::DragValue::new(cells).range(min..=max)).labelled_by(l.id);
                 response = Some(match response {
                     Some(prev) => prev | r,
                     None => r,
                 });
             }
             response.expect("three cells")
-        },
-    );
-    row_ui(
-        app,
-        ui,
-        "refine",
-        "Refine",
-        "1-to-8 refinements of the tetrahedra (each multiplies the element count by 8; tetrahedra only).",
-        |c| c.refine,
-        |c, v| c.refine = v,
-        |ui, v| ui.add_enabled(tets, egui::Slider::new(v, 0..=3)),
-    );
-}
-
-fn material_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
-    ui.heading("Material");
-    let c = app.sessions[app.active].config.clone();
-    let k = app.active;
-    row_ui(
-        app,
-        ui,
-        "material",
-        "Model",
-        "The hyperelastic energy: Saint-Venant–Kirchhoff (the paper's), stable Neo-Hookean (without or with Smith et al.'s log term) or Neo-Hookean.",
-        |c| c.material.clone(),
-        |c, v| c.material = v,
-        |ui, v| {
-            let shown = MaterialModel::from_name(v).map_or(v.clone(), |m| m.long_name().to_string());
-            combo(
-                ui,
-                ("model", k),
-                v,
-                shown,
-                MaterialModel::ALL.iter().map(|m| (m.name().to_string(), m.long_name().to_string())).collect(),
-            )
-        },
-    );
-    number_ui(
-        app,
-        ui,
-        "youngs",
-        "Young's modulus E (Pa)",
-        "Stiffness in pascals, > 0 (rubber ~1e6, the paper's beam 3e6).",
-        c.youngs_modulus_pa,
-        |c, v| c.youngs_modulus_pa = v,
-    );
-    number_ui(
-        app,
-        ui,
-        "poisson",
-        "Poisson ratio ν",
-        "Lateral contraction, between −1 and 0.5 (exclusive); near 0.5 is nearly incompressible.",
-        c.poisson_ratio,
-        |c, v| c.poisson_ratio = v,
-    );
-    number_ui(
-        app,
-        ui,
-        "density",
-        "Density ρ (kg/m³)",
-        "Mass per volume in kg/m³, > 0 (water 1000).",
-        c.density_kg_m3,
-        |c, v| c.density_kg_m3 = v,
-    );
-}
-
-fn solver_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
-    ui.heading("Solver");
-    let k = app.active;
-    row_ui(
-        app,
-        ui,
-        "formulation",
-        "Formulation",
-        "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.",
-        |c| c.formulation.clone(),
-        |c, v| c.formulation = v,
-        |ui, v| ui.radio_value(v, "energy".to_string(), "energy") | ui.radio_value(v, "split".to_string(), "split"),
-    );
-    row_ui(
-        app,
-        ui,
-        "quadrature",
-        "Quadrature",
-        "Degree of polynomials the element quadrature integrates exactly (default: the element's own).",
-        |c| c.quadrature_degree,
-        |c, v| c.quadrature_degree = v,
-        |ui, v| {
-            let shown = v.map_or("element default".to_string(), |d| format!("degree {d}"));
-            let mut options = vec![(None, "element default".to_string())];
-            options.extend((1..=8).map(|d| (Some(d), format!("degree {d}"))));
-            combo(ui, ("quadrature", k), v, shown, options)
-        },
-    );
-    row_ui(
-        app,
-        ui,
-        "substeps",
-        "Substeps",
-        "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.",
-        |c| c.substeps,
-        |c, v| c.substeps = v,
-        |ui, v| ui.add(egui::Slider::new(v, 1..=500).logarithmic(true)),
-    );
-    row_ui(
-        app,
-        ui,
-        "iterations",
-        "Iterations",
-        "Constraint sweeps per substep (the paper: 1).",
-        |c| c.iterations,
-        |c, v| c.iterations = v,
-        |ui, v| ui.add(egui::Slider::new(v, 1..=20).logarithmic(true)),
-    );
-    row_ui(
-        app,
-        ui,
-        "guard",
-        "Stability guard",
-        "More substeps when the stiffest element needs them (when h·ω_max would exceed 3, enough for h·ω_max ≤ 1; just below 3 your substeps are kept); off: exactly the substeps asked for, which may blow up.",
-        |c| c.stability_guard,
-        |c, v| c.stability_guard = v,
-        |ui, v| ui.checkbox(v, "raise substeps when needed"),
-    );
-    row_ui(
-        app,
-        ui,
-        "fps",
-        "Frames per second",
-        "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.",
-        |c| c.frames_per_second,
-        |c, v| c.frames_per_second = v,
-        |ui, v| ui.add(egui::Slider::new(v, 10.0..=240.0).logarithmic(true).suffix(" fps")),
-    );
+        }),
+        Kind::Degree { max } => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
+            let Value::Degree(d) = v else { return ui.label("?") };
+            let name = |d: Option<usize>| d.map_or("element default".to_string(), |d| format!("degree {d}"));
+            let shown = name(*d);
+            let mut options = vec![(None, name(None))];
+            options.extend((1..=max).map(|d| (Some(d), name(Some(d)))));
+            ui.add_enabled_ui(enabled, |ui| combo(ui, (p.key, k), d, shown, options)).inner
+        }),
+        Kind::Point => {}
+    }
 }
 
 fn playback_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
@@ -625,11 +487,12 @@ pub fn open_dialog_ui(app: &mut HoxApp, ctx: &egui::Context) {
 pub(super) fn mesh_scene_file(mesh: &std::path::Path, clamp_group: &str) -> Result<std::path::PathBuf, String> {
     let mesh = std::fs::canonicalize(mesh).map_err(|e| format!("{}: {e}", mesh.display()))?;
     let name = mesh.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().to_string());
-    let text = format!(
-        "name = \"{name}\"\ndescription = \"{} with group '{clamp_group}' clamped, under gravity\"\n[mesh]\nfile = {:?}\n[material]\nmodel = \"stvk\"\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.35\ndensity_kg_m3 = 1000.0\n[[effects]]\ntype = \"gravity\"\nacceleration_m_s2 = [0.0, 0.0, -9.81]\n[[effects]]\ntype = \"clamp\"\nnodes = {{ group = {clamp_group:?} }}\n",
-        mesh.display(),
-        mesh.display().to_string()
-    );
+    // the scene `hox simulate --mesh FILE --clamp GROUP` runs: the paper's material (read from
+    // the bending scene), gravity, the group clamped
+    let mut file = hox_scenes::SceneFile::for_mesh_file(&mesh, true);
+    file.description = format!("{} with group '{clamp_group}' clamped, under gravity", mesh.display());
+    file.effects.push(hox_scenes::scene::EffectSpec::Clamp { nodes: hox_scenes::NodeSelector::group(clamp_group) });
+    let text = file.to_toml();
     let dir = std::env::temp_dir().join("hox-app-scenes");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let path = dir.join(format!("{name}.toml"));

@@ -33,28 +33,15 @@ use viewport::{ViewOptions, Viewport};
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Links(pub std::collections::BTreeMap<String, bool>);
 
-/// The fields a link can tie, in control order.
-pub const LINKABLE: [&str; 14] = [
-    "element",
-    "split",
-    "grid",
-    "refine",
-    "material",
-    "youngs",
-    "poisson",
-    "density",
-    "formulation",
-    "quadrature",
-    "substeps",
-    "iterations",
-    "fps",
-    "guard",
-];
+/// The parameters a link can tie: those the app shows, in control order (the parameter table).
+pub fn linkable() -> impl Iterator<Item = &'static str> {
+    hox_scenes::params::PARAMS.iter().filter(|p| p.surfaces.app).map(|p| p.key)
+}
 
 impl Default for Links {
     fn default() -> Self {
         // the classroom comparison: different element (and refinement), everything else shared
-        Links(LINKABLE.iter().map(|f| (f.to_string(), !matches!(*f, "element" | "refine"))).collect())
+        Links(linkable().map(|f| (f.to_string(), !matches!(f, "element" | "refine"))).collect())
     }
 }
 
@@ -62,40 +49,6 @@ impl Links {
     pub fn linked(&self, field: &str) -> bool {
         self.0.get(field).copied().unwrap_or(true)
     }
-}
-
-/// Copies `field` from `from` to `to`.
-pub fn copy_field(from: &Config, to: &mut Config, field: &str) {
-    match field {
-        "element" => to.element.clone_from(&from.element),
-        "split" => to.split.clone_from(&from.split),
-        "grid" => to.grid = from.grid,
-        "refine" => to.refine = from.refine,
-        "material" => to.material.clone_from(&from.material),
-        "youngs" => to.youngs_modulus_pa = from.youngs_modulus_pa,
-        "poisson" => to.poisson_ratio = from.poisson_ratio,
-        "density" => to.density_kg_m3 = from.density_kg_m3,
-        "formulation" => to.formulation.clone_from(&from.formulation),
-        "quadrature" => to.quadrature_degree = from.quadrature_degree,
-        "substeps" => to.substeps = from.substeps,
-        "iterations" => to.iterations = from.iterations,
-        "fps" => to.frames_per_second = from.frames_per_second,
-        "guard" => to.stability_guard = from.stability_guard,
-        _ => {}
-    }
-}
-
-/// The fields that differ between two configurations.
-pub fn changed_fields(a: &Config, b: &Config) -> Vec<&'static str> {
-    LINKABLE
-        .iter()
-        .copied()
-        .filter(|f| {
-            let mut probe = a.clone();
-            copy_field(b, &mut probe, f);
-            probe != *a
-        })
-        .collect()
 }
 
 /// Where the scene comes from.
@@ -218,6 +171,8 @@ pub struct HoxApp {
     /// CPU time of a whole frame (ours, egui's layout and painting; not waiting for vsync), ms.
     frame_cpu_ms: f64,
     last_ui_frame: Option<Instant>,
+    /// A frame has been shown (the first frame's clock step is not a real interval).
+    last_clock_frame: bool,
     screenshot: Option<(PathBuf, f64)>,
     screenshot_requested: bool,
     measure: Option<Measure>,
@@ -276,6 +231,7 @@ impl HoxApp {
             app_ms: 0.0,
             frame_cpu_ms: 0.0,
             last_ui_frame: None,
+            last_clock_frame: false,
             screenshot: args.screenshot.clone().map(|p| (p, args.after_secs)),
             screenshot_requested: false,
             measure: args.measure_secs.map(|s| Measure {
@@ -306,7 +262,7 @@ impl HoxApp {
     /// Switches to `source`, with saved configurations if given (falling back to the scene's).
     pub fn load_scene(&mut self, source: SceneSource, configs: Option<(Vec<Config>, bool)>) -> Result<(), String> {
         let base = source.load()?;
-        let defaults = Config::from_scene(&base);
+        let defaults = config::from_scene(&base);
         let wanted = configs.clone().map(|c| c.0).filter(|c| !c.is_empty()).unwrap_or_else(|| vec![defaults.clone()]);
         let mut sessions = Vec::new();
         for c in wanted.into_iter().take(2) {
@@ -335,10 +291,11 @@ impl HoxApp {
         if on {
             let first = &self.sessions[0];
             let mut c = first.config.clone();
-            if c.is_box() && c.element == "p2" {
+            let is_box = first.base.is_box();
+            if is_box && c.element == "p2" {
                 c.element = "p1".into();
                 c.refine = 1;
-            } else if c.is_box() && c.element == "p1" {
+            } else if is_box && c.element == "p1" {
                 c.element = "p2".into();
                 c.refine = 0;
             }
@@ -393,9 +350,9 @@ impl HoxApp {
         if self.compare {
             let other = 1 - k;
             let mut follow = self.sessions[other].config.clone();
-            for f in changed_fields(&old, &new) {
+            for f in old.changed_keys(&new) {
                 if self.links.linked(f) {
-                    copy_field(&new, &mut follow, f);
+                    follow.copy_from(&new, f);
                 }
             }
             match self.sessions[other].apply(follow) {
@@ -487,7 +444,7 @@ impl HoxApp {
             rerun::RecordingStreamBuilder::new("hox").recording_name(format!("hox app {}", self.scene.label()));
         let (rec, target) = if to_file {
             let path = PathBuf::from(&self.rerun_file);
-            if let Err(e) = crate::cli::check_writable(&path) {
+            if let Err(e) = crate::output::check_writable(&path) {
                 self.message = Some(format!("Rerun: {e:#}"));
                 return;
             }
@@ -520,7 +477,7 @@ impl HoxApp {
             };
             link.loggers.clear();
             for (k, (s, o)) in self.sessions.iter().zip(&offsets).enumerate() {
-                let name = format!("{}_{}", ["a", "b"][k.min(1)], s.config.label());
+                let name = format!("{}_{}", ["a", "b"][k.min(1)], s.label());
                 match SimLogger::new(&link.rec, &name, &s.instance, *o, &settings) {
                     Ok(l) => link.loggers.push(l),
                     Err(e) => {
@@ -601,7 +558,7 @@ impl HoxApp {
                 let mut text = format!(
                     "{}{}: {} nodes, {} elements, {} constraints, {:.2} ms/frame, residual {:.1e}, t = {:.2} s",
                     if self.compare { ["A ", "B "][k] } else { "" },
-                    s.config.label(),
+                    s.label(),
                     sim.mesh().num_nodes(),
                     sim.mesh().num_elements(),
                     sim.num_constraints(),
@@ -649,7 +606,12 @@ impl HoxApp {
         }
         self.join_background();
         self.shortcuts(&ctx);
-        self.advance(dt);
+        // Simulated time follows egui's clock (the window's: wall time between frames; the
+        // headless tests': exactly their step), never the wall clock read here, so a test plays
+        // the same frames in a slow debug build and a fast release one.
+        let clock_dt = f64::from(ctx.input(|i| i.unstable_dt));
+        self.advance(if self.last_clock_frame { clock_dt } else { 0.0 });
+        self.last_clock_frame = true;
 
         // The panels are not filled: the window is cleared to the panel colour (`clear_color`), and
         // a software renderer pays per blended pixel for each fill (docs/APP.md).
@@ -703,7 +665,7 @@ impl HoxApp {
                 println!(
                     "{}",
                     serde_json::json!({
-                        "configuration": s.config.label(),
+                        "configuration": s.label(),
                         "seconds": secs,
                         "display_frames": m.frames,
                         "display_fps": m.frames as f64 / secs,
@@ -805,7 +767,7 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
         .filter(|(w, h)| *w >= 320.0 && *h >= 240.0)
         .ok_or_else(|| anyhow::anyhow!("--size must be WIDTHxHEIGHT in points, at least 320x240, got '{size}'"))?;
     if let Some(p) = &args.screenshot {
-        crate::cli::check_writable(p)?;
+        crate::output::check_writable(p)?;
     }
     // fail before opening a window on a bad scene
     if let Some(name) = &args.scene {

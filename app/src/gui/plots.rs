@@ -69,7 +69,7 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                             let points =
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.probe_m[i][axis], MAX_PLOT_POINTS));
                             let name = if app.compare {
-                                format!("{} {} {label}", names[k], s.config.label())
+                                format!("{} {} {label}", names[k], s.label())
                             } else {
                                 label.to_string()
                             };
@@ -115,7 +115,7 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 .iter()
                 .filter_map(|s| {
                     s.probe_error_m().map(|e| StudyPoint {
-                        label: format!("now: {}", s.config.label()),
+                        label: format!("now: {}", s.label()),
                         ms_per_frame: s.ms_per_frame,
                         error_m: e,
                     })

@@ -4,7 +4,7 @@
 //! A configuration change rebuilds only what it invalidates ([`Invalidates`]): a material or
 //! solver change keeps the current positions and velocities; a mesh change rebuilds from rest.
 
-use super::config::{Config, Invalidates};
+use super::config::{self, Config, Invalidates};
 use hox_scenes::{Instance, Scene};
 use hox_sim::Vec3;
 use hox_sim::effect::Attachment;
@@ -79,8 +79,13 @@ pub struct Session {
 }
 
 impl Session {
+    /// A short label of the configuration, e.g. `P2 8×2×2 five` (or "mesh file").
+    pub fn label(&self) -> String {
+        config::label(&self.config, &self.base)
+    }
+
     pub fn new(base: Scene, config: Config, segments: usize) -> Result<Session, String> {
-        let scene = config.resolve(&base)?;
+        let scene = config::resolve(&config, &base)?;
         let instance = Instance::new(scene).map_err(|e| e.to_string())?;
         let surface = Surface::new(instance.sim.mesh(), segments);
         let reference = hox_scenes::study::reference(base.name()).unwrap_or_default();
@@ -115,7 +120,7 @@ impl Session {
         if what == Invalidates::Nothing {
             return Ok(what);
         }
-        let scene = new.resolve(&self.base)?;
+        let scene = config::resolve(&new, &self.base)?;
         match what {
             Invalidates::Mesh => {
                 let instance = Instance::new(scene).map_err(|e| e.to_string())?;
@@ -129,12 +134,12 @@ impl Session {
                 self.residual = self.force_residual();
             }
             Invalidates::Material => {
-                self.instance.sim.set_material(scene.material).map_err(|e| e.to_string())?;
-                self.instance.sim.set_settings(scene.settings).map_err(|e| e.to_string())?;
+                self.instance.sim.set_material(scene.material()).map_err(|e| e.to_string())?;
+                self.instance.sim.set_settings(scene.settings()).map_err(|e| e.to_string())?;
                 self.instance.scene = scene;
             }
             Invalidates::Settings => {
-                self.instance.sim.set_settings(scene.settings).map_err(|e| e.to_string())?;
+                self.instance.sim.set_settings(scene.settings()).map_err(|e| e.to_string())?;
                 self.instance.scene = scene;
                 self.quadrature = std::cell::OnceCell::new();
             }
@@ -289,7 +294,7 @@ mod tests {
 
     fn bending() -> Session {
         let scene = hox_scenes::by_name("bending").unwrap();
-        let config = Config::from_scene(&scene);
+        let config = config::from_scene(&scene);
         Session::new(scene, config, 2).unwrap()
     }
 

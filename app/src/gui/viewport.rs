@@ -284,7 +284,7 @@ impl Viewport {
                 let (lo, hi) = s.instance.sim.mesh().bounding_box();
                 let top = Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z) + o;
                 if let Some(p) = self.screen_position(top) {
-                    let mut text = s.config.label();
+                    let mut text = s.label();
                     if let Some(e) = s.probe_error_m() {
                         text += &format!("\nprobe error {} m", crate::recording::format_metres(e));
                     }

@@ -1,0 +1,23 @@
+//! `hox bench`: time the XPBD loop on the paper's Table 1 beams and the other element types.
+
+use anyhow::{Result, bail};
+
+pub fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool) -> Result<()> {
+    if frames == 0 || threads.contains(&0) {
+        bail!("--frames and every --threads count must be at least 1");
+    }
+    let rows = hox_sim::benchmark::run(only, threads, colour_on_one, frames, &mut |r| {
+        eprintln!(
+            "{} on {} thread(s), parallel {}: {:.2} ms/frame",
+            r.case.label(),
+            r.threads,
+            r.parallel,
+            r.ms_per_frame
+        )
+    })?;
+    if rows.is_empty() {
+        bail!("no configuration matches '{only}'");
+    }
+    print!("{}", hox_sim::benchmark::markdown(&rows));
+    Ok(())
+}

@@ -1,0 +1,57 @@
+//! `hox scenes` and `hox elements`: what the registries hold.
+
+use anyhow::Result;
+use hox_sim::element::ElementType;
+use hox_sim::quadrature;
+
+pub fn scenes(json: bool) -> Result<()> {
+    let all = hox_scenes::registry()?;
+    if json {
+        let rows: Vec<_> = all
+            .iter()
+            .map(|s| serde_json::json!({"name": s.name(), "description": s.file.description, "effects": s.file.effects.iter().map(|e| e.kind()).collect::<Vec<_>>()}))
+            .collect();
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        for s in &all {
+            let effects: Vec<&str> = s.file.effects.iter().map(|e| e.kind()).collect();
+            println!("{:<8} {} [{}]", s.name(), s.file.description, effects.join(", "));
+        }
+    }
+    Ok(())
+}
+
+pub fn elements(json: bool) -> Result<()> {
+    let rows: Vec<serde_json::Value> = ElementType::all()
+        .map(|e| -> Result<serde_json::Value> {
+            let degree = e.default_quadrature_degree();
+            let rule = quadrature::rule(e.shape(), degree)?;
+            Ok(serde_json::json!({
+                "element": e.name(),
+                "description": e.description(),
+                "gmsh_type": e.gmsh_type(),
+                "nodes": e.num_nodes(),
+                "faces": e.faces().len(),
+                "quadrature_degree": degree,
+                "quadrature_points": rule.len(),
+            }))
+        })
+        .collect::<Result<_>>()?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+        return Ok(());
+    }
+    println!("{:<8} {:<38} {:>5} {:>5} {:>6} {:>7}", "element", "description", "gmsh", "nodes", "degree", "points");
+    for r in &rows {
+        println!(
+            "{:<8} {:<38} {:>5} {:>5} {:>6} {:>7}",
+            r["element"].as_str().unwrap_or(""),
+            r["description"].as_str().unwrap_or(""),
+            r["gmsh_type"].to_string(),
+            r["nodes"].to_string(),
+            r["quadrature_degree"].to_string(),
+            r["quadrature_points"].to_string()
+        );
+    }
+    Ok(())
+}

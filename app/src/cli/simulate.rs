@@ -1,0 +1,89 @@
+//! `hox simulate`: run a scene for a time or until it settles and print the probe displacements.
+
+use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, gmsh, load_scene, note_stability, overrides};
+use anyhow::{Result, bail};
+use hox_scenes::{Instance, RunMode};
+
+pub fn simulate(
+    scene: &SceneArgs,
+    mesh: &MeshArgs,
+    physics: &PhysicsArgs,
+    seconds: Option<f64>,
+    settle: bool,
+    vtk: &gmsh::VtkArgs,
+    json: bool,
+) -> Result<()> {
+    let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
+    let mode = if settle {
+        RunMode::SETTLE
+    } else {
+        let t = seconds.unwrap_or(scene.params().duration_secs);
+        if !(t.is_finite() && t >= 0.0) {
+            bail!("--seconds must be a finite, non-negative number of seconds, got {t}");
+        }
+        RunMode::Seconds(t)
+    };
+    let mut instance = Instance::new(scene)?;
+    let stability = note_stability(&mut instance);
+    let mut vtk_writer = gmsh::VtkWriter::create(vtk, &instance)?;
+    let mut bar = DelayedBar::new();
+    let mut on_frame = |i: &Instance| vtk_writer.as_mut().map_or(Ok(()), |w| w.frame(i));
+    let report = hox_scenes::run_observed(
+        &mut instance,
+        mode,
+        &mut |t, fraction| {
+            let template = if fraction.is_some() {
+                "{spinner} {bar:40} {percent}% {msg} (eta {eta})"
+            } else {
+                "{spinner} settling… {msg}"
+            };
+            bar.reveal(template);
+            if let Some(f) = fraction {
+                bar.bar.set_position((1000.0 * f) as u64);
+            }
+            bar.bar.set_message(format!("t = {t:.2} s"));
+        },
+        &mut on_frame,
+    )?;
+    bar.bar.finish_and_clear();
+    let groups = instance.group_displacements();
+    let vtk_index = vtk_writer.map(|w| w.finish(&instance)).transpose()?;
+    if json {
+        let mut out = serde_json::to_value(&report)?;
+        if !groups.is_empty() {
+            out["groups"] = serde_json::to_value(&groups)?;
+        }
+        if let Some(index) = &vtk_index {
+            out["vtk"] = index.display().to_string().into();
+        }
+        out["substeps_per_frame"] = stability.substeps.into();
+        out["h_omega_max"] = stability.requested_h_omega.into();
+        println!("{out}");
+    } else {
+        println!(
+            "{}: {} frames, {:.3} s simulated, {:.2} ms per frame{}",
+            instance.scene.name(),
+            report.frames,
+            report.sim_seconds,
+            report.ms_per_frame,
+            if settle { if report.settled { ", settled" } else { ", NOT settled (cap reached)" } } else { "" }
+        );
+        for (name, u) in &report.probes {
+            println!("  probe {name}: u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
+        }
+        for (name, u) in &groups {
+            println!("  group {name}: mean u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
+        }
+        println!(
+            "  kinetic energy {:.6e} J, elastic energy {:.6e} J",
+            report.kinetic_energy_j, report.elastic_energy_j
+        );
+        if let Some(index) = &vtk_index {
+            println!("  ParaView series: {}", index.display());
+        }
+    }
+    if settle && !report.settled {
+        eprintln!("warning: the run did not settle within {} s", hox_scenes::SETTLE_CAP_SECS);
+    }
+    Ok(())
+}

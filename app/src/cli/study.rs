@@ -1,0 +1,39 @@
+//! `hox study`: the accuracy-versus-time study over the paper scenes, written to a folder.
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::time::{Duration, Instant};
+
+pub fn study(quick: bool, out: &std::path::Path) -> Result<()> {
+    // refuse an unwritable folder before spending minutes
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
+    let probe = out.join(".hox-write-test");
+    std::fs::write(&probe, b"").with_context(|| format!("cannot write to the output folder {}", out.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed}] {msg}").expect("valid template"));
+    bar.enable_steady_tick(Duration::from_millis(200));
+    let started = Instant::now();
+    let mut report = |message: &str| {
+        // a log line per step when stderr is not a terminal (CI), the spinner otherwise
+        if bar.is_hidden() {
+            eprintln!("[{:>6.1} s] {message}", started.elapsed().as_secs_f64());
+        }
+        bar.set_message(message.to_string());
+    };
+    let rows = hox_scenes::study::run_study(quick, &mut report)?;
+    let locking = hox_scenes::study::locking(quick, &mut report)?;
+    bar.finish_and_clear();
+    let files = [
+        ("study.md", hox_scenes::study::markdown(&rows, quick) + "\n" + &hox_scenes::study::locking_markdown(&locking)),
+        ("study.csv", hox_scenes::study::csv(&rows)),
+        ("locking.csv", hox_scenes::study::locking_csv(&locking)),
+        ("study.svg", hox_scenes::study::svg(&rows)),
+    ];
+    for (name, text) in files {
+        let path = out.join(name);
+        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
