@@ -689,6 +689,13 @@ params! {
         kind: Kind::Number { min: 0.0, min_inclusive: false, max: f64::INFINITY, max_inclusive: false, soft: Some((10.0, 240.0)) },
         ..BASE
     }
+    /// Velocity damping of every node, 1/s (0: none).
+    damping_per_sec: f64 = 0.0 => {
+        key: "damping", group: Group::Solver, file_key: "damping_per_sec", label: "Damping", unit: "1/s",
+        help: "Velocity damping rate of every node per second, on top of any damping effect the scene lists (0: none); a swinging beam comes to rest at a rate of about this many e-foldings per second. A change restarts the run.",
+        kind: Kind::Number { min: 0.0, min_inclusive: true, max: f64::INFINITY, max_inclusive: false, soft: None },
+        invalidates: Invalidates::Mesh, ..BASE
+    }
     /// Project elements in parallel, colour by colour.
     parallel: bool = false => {
         key: "parallel", group: Group::Solver, file_key: "parallel", label: "Parallel",

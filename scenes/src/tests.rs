@@ -160,3 +160,15 @@ fn the_stability_guard_leaves_the_built_in_scenes_as_they_are() {
         assert!(!r.raised() && r.requested_h_omega < 1.0, "{name}: {}", r.summary());
     }
 }
+
+#[test]
+fn the_damping_parameter_adds_a_damping_effect_only_when_set() {
+    let scene = crate::by_name("bending").unwrap();
+    let mesh = scene.build_mesh().unwrap();
+    let names = |s: &Scene| s.build_effects(&mesh).unwrap().iter().map(|e| e.name()).collect::<Vec<_>>();
+    assert!(!names(&scene).contains(&"damping"));
+    let damped = scene.with_overrides(&SceneOverrides { damping_per_sec: Some(2.0), ..Default::default() }).unwrap();
+    assert!(names(&damped).contains(&"damping"));
+    let err = scene.with_overrides(&SceneOverrides { damping_per_sec: Some(-1.0), ..Default::default() }).unwrap_err();
+    assert!(err.to_string().contains("--damping"), "{err}");
+}

@@ -84,6 +84,10 @@ impl Scene {
                 }
             });
         }
+        let damping = self.params().damping_per_sec;
+        if damping > 0.0 {
+            effects.push(Box::new(Damping { rate_per_sec: damping }));
+        }
         Ok(effects)
     }
 }
