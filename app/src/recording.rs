@@ -139,7 +139,7 @@ impl SimLogger {
                     .with_radii([rerun::Radius::new_ui_points(2.5)]),
             )?;
         }
-        Self::log_legend(rec, &name, &root, &colours, lo, hi)?;
+        Self::log_legend(rec, &name, &root, &colours, lo, hi, &configuration_markdown(instance))?;
         Ok(SimLogger { name, surface, quadrature, colours, x: Vec::new(), u: Vec::new(), normals: Vec::new() })
     }
 
@@ -152,6 +152,7 @@ impl SimLogger {
         colours: &ColourRange,
         lo: Vec3,
         hi: Vec3,
+        configuration: &str,
     ) -> Result<(), rerun::RecordingStreamError> {
         let extent = hi - lo;
         let height = extent.z.max(0.25 * extent.max());
@@ -201,7 +202,7 @@ impl SimLogger {
             &rerun::TextDocument::from_markdown(format!(
                 "**{name}**: surface colour = displacement magnitude |u| in metres, viridis, fixed range 0 m (dark purple) to {} m (yellow); larger values are clamped.\n\n{}",
                 format_metres(colours.max_m),
-                configuration_markdown(instance)
+                configuration
             )),
         )
     }

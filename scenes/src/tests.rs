@@ -172,3 +172,13 @@ fn the_damping_parameter_adds_a_damping_effect_only_when_set() {
     let err = scene.with_overrides(&SceneOverrides { damping_per_sec: Some(-1.0), ..Default::default() }).unwrap_err();
     assert!(err.to_string().contains("--damping"), "{err}");
 }
+
+#[test]
+fn a_scene_file_written_back_parses_to_the_same_scene() {
+    for scene in crate::registry().unwrap() {
+        let text = scene.file.to_toml();
+        let again = Scene::from_toml(&text, "written").unwrap_or_else(|e| panic!("{}: {e}\n{text}", scene.name()));
+        assert_eq!(again.file.params, scene.file.params, "{}", scene.name());
+        assert_eq!((&again.file.effects, &again.file.probes), (&scene.file.effects, &scene.file.probes));
+    }
+}

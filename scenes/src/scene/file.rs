@@ -174,14 +174,16 @@ impl SceneFile {
             }
             root.insert(group.section().into(), toml::Value::Table(t));
         }
-        let mut text = toml::to_string(&root).unwrap_or_default();
-        #[derive(Serialize)]
-        struct Lists<'a> {
-            effects: &'a [EffectSpec],
-            probes: &'a [ProbeSpec],
+        // the lists go into the same document, so the serializer places them after the tables
+        if let Ok(v) = toml::Value::try_from(&self.effects) {
+            root.insert("effects".into(), v);
         }
-        text += &toml::to_string(&Lists { effects: &self.effects, probes: &self.probes }).unwrap_or_default();
-        text
+        if !self.probes.is_empty()
+            && let Ok(v) = toml::Value::try_from(&self.probes)
+        {
+            root.insert("probes".into(), v);
+        }
+        toml::to_string(&root).unwrap_or_default()
     }
 
     /// A scene around a mesh file: the bending scene's material (the paper's beam: StVK,
