@@ -224,7 +224,7 @@ fn p3_mirrored_under_strong_damping_is_trapped_inverted_between_its_quadrature_p
 #[ignore = "release: CI runs it with --release --ignored"]
 fn trapped_states_are_minima_of_the_near_exactly_integrated_energy() {
     let near_exact = |mut s: Simulation| {
-        let mut settings = s.settings().clone();
+        let mut settings = *s.settings();
         settings.quadrature_degree = Some(17);
         s.set_settings(settings).unwrap_or_else(|e| panic!("{e}"));
         s
