@@ -25,6 +25,7 @@
 //! quadrature_degree = 2   # omit for each element type's default
 //! duration_secs = 3       # default run length
 //! settle_damping_per_sec = 10  # velocity damping used by --settle
+//! damping_per_sec = 0    # velocity damping of every node, always on (0: none)
 //! parallel = false        # project elements colour by colour on all threads
 //! stability_guard = true   # above h·ω_max = 3, substeps with h·ω_max ≤ 1 (hox_sim::stability)
 //! [[effects]]             # only the effects listed are simulated
@@ -310,17 +311,4 @@ impl EffectSpec {
 pub struct ProbeSpec {
     pub name: String,
     pub point_m: [f64; 3],
-}
-
-/// Prescribed motion of a mesh file's physical group (see [`Scene::from_mesh_file`]): a
-/// translation and/or a rotation, ramped in smoothly over `ramp_secs`, then held.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Drive {
-    pub group: String,
-    pub translation_m: [f64; 3],
-    pub rotation_axis: Option<[f64; 3]>,
-    /// Default: the centre of the group's nodes.
-    pub rotation_origin_m: Option<[f64; 3]>,
-    pub rotation_deg: f64,
-    pub ramp_secs: f64,
 }
