@@ -104,8 +104,12 @@ pub struct NonFiniteElement {
     pub node: u32,
 }
 
-/// A slice the sweep reads and writes through a raw pointer, shared across the threads of one
-/// colour, which touch disjoint entries.
+/// A mutable slice shared across threads through a raw pointer: the parallel sweeps hand one
+/// copy to every thread of a colour (or slab), and those threads touch disjoint entries (no two
+/// elements of a colour share a node, [`crate::colouring`]; each element owns its multipliers).
+/// That disjointness, which the type cannot check, is what every `unsafe` access promises.
+/// Indices are checked against the length (a panic, never an out-of-bounds access); the hot
+/// loops that have already checked an index read and write through [`SharedMut::ptr`].
 pub struct SharedMut<T> {
     ptr: *mut T,
     len: usize,
@@ -126,6 +130,61 @@ impl<T> SharedMut<T> {
     pub fn new(slice: &mut [T]) -> Self {
         Self { ptr: slice.as_mut_ptr(), len: slice.len() }
     }
+
+    /// Number of entries.
+    #[inline(always)]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The first entry's address (for accesses whose index the caller has checked against
+    /// [`SharedMut::len`]).
+    #[inline(always)]
+    pub fn ptr(&self) -> *mut T {
+        self.ptr
+    }
+
+    /// Entry `i` (panics when `i ≥ len`).
+    ///
+    /// # Safety
+    /// No other thread may write entry `i` meanwhile, and the slice must still be alive.
+    #[inline(always)]
+    pub unsafe fn read(&self, i: usize) -> T
+    where
+        T: Copy,
+    {
+        assert!(i < self.len);
+        // SAFETY: in bounds (checked); the caller excludes concurrent writes.
+        unsafe { self.ptr.add(i).read() }
+    }
+
+    /// Writes entry `i` (panics when `i ≥ len`).
+    ///
+    /// # Safety
+    /// No other thread may access entry `i` meanwhile, and the slice must still be alive.
+    #[inline(always)]
+    pub unsafe fn write(&self, i: usize, value: T) {
+        assert!(i < self.len);
+        // SAFETY: in bounds (checked); the caller excludes concurrent access.
+        unsafe { self.ptr.add(i).write(value) }
+    }
+
+    /// Entries `start..start + len` as a mutable slice (panics when out of bounds).
+    ///
+    /// # Safety
+    /// No other thread may access that range while the returned slice lives, and the slice
+    /// must still be alive.
+    #[allow(clippy::mut_from_ref)] // disjoint ranges handed to different threads: the point
+    #[inline(always)]
+    pub unsafe fn slice_mut(&self, start: usize, len: usize) -> &mut [T] {
+        assert!(start <= self.len && len <= self.len - start);
+        // SAFETY: in bounds (checked); the caller excludes concurrent access.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(start), len) }
+    }
 }
 
 /// Node positions as the sweep reads and writes them.
@@ -143,7 +202,7 @@ pub const SPECIALISED_NODE_COUNTS: [usize; 7] = [4, 5, 6, 8, 10, 20, 27];
 ///
 /// # Safety
 /// `positions` and `lambdas` must be valid for the whole sweep, every node index of `data` must
-/// be below `positions.len`, every element id below `lambdas.len`, and no other thread may
+/// be below `positions.len()`, every element id below `lambdas.len()`, and no other thread may
 /// touch the nodes and multipliers of the elements in `range` meanwhile.
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn energy_sweep(
@@ -282,16 +341,14 @@ unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMateria
             continue;
         }
         let e = data.element_ids.map_or(k, |ids| ids[k] as usize);
-        assert!(e < lambdas.len);
+        assert!(e < lambdas.len());
         // SAFETY: node indices are checked against the length; the caller guarantees no other
         // thread touches these nodes and this multiplier.
         let mut x: [Vec3; N] = std::array::from_fn(|i| {
-            let n = nodes[i] as usize;
-            assert!(n < positions.len);
-            unsafe { positions.ptr.add(n).read() }
+            unsafe { positions.read(nodes[i] as usize) }
         });
         let d: [Vec3; N] = std::array::from_fn(|i| x[i] - rest[nodes[i] as usize]);
-        let lambda = unsafe { &mut *lambdas.ptr.add(e) };
+        let lambda = unsafe { &mut *lambdas.ptr().add(e) };
         let grads = &data.grads[k * q * 3 * P..(k + 1) * q * 3 * P];
         let volumes = &data.volumes[k * q..(k + 1) * q];
         if N == 4 && q == 1 {
@@ -320,7 +377,7 @@ unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMateria
         }
         for i in 0..N {
             // SAFETY: as above.
-            unsafe { positions.ptr.add(nodes[i] as usize).write(x[i]) };
+            unsafe { positions.ptr().add(nodes[i] as usize).write(x[i]) };
         }
         projected += 1;
     }

@@ -600,7 +600,7 @@ impl Simulation {
     /// ([`crate::kernels::Partition`]), which depends on the thread count.
     fn project_elements_parallel(&mut self, inv_dt2: f64) -> Result<(), BadElement> {
         use rayon::prelude::*;
-        let positions = SharedSlice::new(&mut self.positions);
+        let positions = crate::kernels::SharedMut::new(&mut self.positions);
         for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
             let block = &self.mesh.blocks[bi];
             let n = block.nodes_per_element();
@@ -608,7 +608,7 @@ impl Simulation {
             if self.settings.formulation == Formulation::Energy {
                 // SAFETY of the aliasing: the specialised sweep writes positions through its own
                 // pointer, and nothing else touches them meanwhile.
-                let all = unsafe { positions.slice_mut(0, positions.len) };
+                let all = unsafe { positions.slice_mut(0, positions.len()) };
                 let threads = rayon::current_num_threads();
                 use crate::kernels::BlockSweep;
                 let sweep = if threads >= 2 && block.len() >= threads.saturating_mul(self.partition_min_per_thread) {
@@ -648,7 +648,7 @@ impl Simulation {
                     None => {}
                 }
             }
-            let lambdas = SharedSlice::new(lambdas);
+            let lambdas = crate::kernels::SharedMut::new(lambdas);
             for colour in &self.colours[bi] {
                 let projected: Result<usize, BadElement> = colour
                     .par_iter()
@@ -850,44 +850,6 @@ impl ProjectionContext<'_> {
             }
         }
         true
-    }
-}
-
-/// A slice shared across threads for disjoint writes.
-struct SharedSlice<T> {
-    ptr: *mut T,
-    len: usize,
-}
-
-// SAFETY: used only for writes to disjoint indices (guaranteed by the element colouring).
-unsafe impl<T: Send> Send for SharedSlice<T> {}
-unsafe impl<T: Send> Sync for SharedSlice<T> {}
-
-impl<T> SharedSlice<T> {
-    fn new(slice: &mut [T]) -> Self {
-        Self { ptr: slice.as_mut_ptr(), len: slice.len() }
-    }
-    /// # Safety
-    /// No other thread may write index `i` at the same time.
-    unsafe fn read(&self, i: usize) -> T
-    where
-        T: Copy,
-    {
-        assert!(i < self.len);
-        unsafe { self.ptr.add(i).read() }
-    }
-    /// # Safety
-    /// The range must not be accessed by any other thread at the same time.
-    #[allow(clippy::mut_from_ref)] // disjoint ranges handed to different threads: the point
-    unsafe fn slice_mut(&self, start: usize, len: usize) -> &mut [T] {
-        assert!(start + len <= self.len);
-        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(start), len) }
-    }
-    /// # Safety
-    /// No other thread may access index `i` at the same time.
-    unsafe fn write(&self, i: usize, value: T) {
-        assert!(i < self.len);
-        unsafe { self.ptr.add(i).write(value) }
     }
 }
 

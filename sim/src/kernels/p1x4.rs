@@ -204,8 +204,8 @@ pub struct BatchIo<'a> {
 ///
 /// # Safety
 /// The CPU must support AVX2 and FMA; `io.nodes`, `io.values`, `io.element_ids` must hold
-/// `batches` batches; node indices below `io.positions.len` and `io.rest.len()` and
-/// `io.inv_mass.len()`, element ids below `io.lambdas.len`; the four elements of a batch
+/// `batches` batches; node indices below `io.positions.len()` and `io.rest.len()` and
+/// `io.inv_mass.len()`, element ids below `io.lambdas.len()`; the four elements of a batch
 /// share no node, and no other thread touches these nodes and multipliers meanwhile.
 #[target_feature(enable = "avx2,fma")]
 pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> Result<u64, NonFiniteElement> {
@@ -214,7 +214,7 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
             && io.values.len() >= batches * BATCH_VALUES
             && io.element_ids.len() >= batches * 4
     );
-    let (nx, rx, wx) = (io.positions.len, io.rest.len(), io.inv_mass.len());
+    let (nx, rx, wx) = (io.positions.len(), io.rest.len(), io.inv_mass.len());
     let two_mu = F64x4::splat(2.0 * material.mu_pa);
     let (mu, lambda_pa) = (F64x4::splat(material.mu_pa), F64x4::splat(material.lambda_pa));
     let (half, one, two, zero) = (F64x4::splat(0.5), F64x4::splat(1.0), F64x4::splat(2.0), F64x4::zero());
@@ -248,7 +248,7 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
             let mut x = [[zero; 3]; 4];
             let mut u = [[zero; 3]; 4];
             for i in 0..4 {
-                let xr: [__m256d; 4] = std::array::from_fn(|l| load_row(io.positions.ptr.add(node(l, i))));
+                let xr: [__m256d; 4] = std::array::from_fn(|l| load_row(io.positions.ptr().add(node(l, i))));
                 let rr: [__m256d; 4] = std::array::from_fn(|l| load_row(io.rest.as_ptr().add(node(l, i))));
                 x[i] = transpose(xr);
                 u[i] = transpose(std::array::from_fn(|l| _mm256_sub_pd(xr[l], rr[l])));
@@ -316,10 +316,10 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
         // None (no update) unless a > MIN_POSITIVE and the step is finite
         let ids: &[u32; 4] = io.element_ids[b * 4..(b + 1) * 4].try_into().expect("4 ids");
         for &id in ids {
-            assert!((id as usize) < io.lambdas.len);
+            assert!((id as usize) < io.lambdas.len());
         }
         // SAFETY: ids checked above; no other thread touches these multipliers.
-        let lam_ptr = |l: usize| unsafe { io.lambdas.ptr.add(ids[l] as usize) };
+        let lam_ptr = |l: usize| unsafe { io.lambdas.ptr().add(ids[l] as usize) };
         let lambda = unsafe { F64x4::new(*lam_ptr(0), *lam_ptr(1), *lam_ptr(2), *lam_ptr(3)) };
         let a = sum_w_grad2.add(inv_dt2.mul(c).mul(c));
         let rhs = c.add(inv_dt2.mul(lambda)).neg().mul(c);
@@ -352,7 +352,7 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
         }
         for (i, oi) in out.iter().enumerate() {
             // SAFETY: indices checked above; the lanes' nodes are distinct.
-            unsafe { store_rows(*oi, std::array::from_fn(|l| io.positions.ptr.add(node(l, i))), done) };
+            unsafe { store_rows(*oi, std::array::from_fn(|l| io.positions.ptr().add(node(l, i))), done) };
         }
         if bad != 0 {
             let l = bad.trailing_zeros() as usize;
