@@ -563,9 +563,30 @@ pub unsafe fn colour_sweep(
     Some(rest_of.map(|k| k + projected))
 }
 
-/// Fewest elements a thread gets in the parallel sweep: below this, splitting a colour costs
-/// more than it saves.
-pub const PARALLEL_MIN_ELEMENTS: usize = 256;
+// Scheduling thresholds of the parallel sweeps, all in one place. They decide only how the work
+// is cut between threads, never the result: the elements of one colour share no node and own
+// their multipliers, so projecting them in any grouping and order gives the same positions
+// bitwise (the four-lane batches are fixed by the colour's start, not by the cut), and a
+// non-finite correction is reported for the first bad element of the colour whatever the cut.
+// (The slab partition is the exception that changes the order, hence the result: it depends on
+// the thread count, see [`Partition`].)
+
+/// Fewest elements per thread in the specialised sweep ([`parallel_energy_block`]): a colour is
+/// cut into at most one contiguous chunk per thread, each at least this long (a colour shorter
+/// than twice this runs on one thread). The specialised sweep is cheap per element (540
+/// instructions for P1, 2,080 for P2: `docs/PERFORMANCE.md`), so a chunk must be long to
+/// outweigh waking a thread.
+pub const SWEEP_MIN_ELEMENTS_PER_THREAD: usize = 256;
+
+/// Fewest elements per rayon task in the generic parallel sweep (the split formulation, or a
+/// node count without a specialised sweep; `Simulation`'s colour loop): that kernel costs
+/// several times more per element, so shorter tasks still pay for themselves.
+pub const GENERIC_MIN_ELEMENTS_PER_TASK: usize = 64;
+
+/// Fewest elements per thread for which the parallel sweep cuts a block into slabs
+/// ([`Partition`]) instead of synchronising the threads after every colour (the default of
+/// `Simulation::set_partition_threshold`).
+pub const PARTITION_MIN_ELEMENTS_PER_THREAD: usize = 2048;
 
 /// How [`parallel_energy_block`] sweeps a block.
 #[derive(Clone, Copy, Debug)]
@@ -579,7 +600,7 @@ pub enum BlockSweep<'a> {
 /// The parallel sweep of the energy formulation over one block, by slabs (see [`Partition`]) or
 /// else colour after colour, each
 /// colour's packed range cut into one contiguous chunk per thread of rayon's current pool (at
-/// least [`PARALLEL_MIN_ELEMENTS`] elements each, cut at multiples of 4 elements from the
+/// least [`SWEEP_MIN_ELEMENTS_PER_THREAD`] elements each, cut at multiples of 4 elements from the
 /// colour's start; see [`colour_sweep`] for `batched`). Same-colour elements share no node, so the
 /// result is the same for any thread count and scheduling; on a non-finite correction the
 /// colour is finished (other chunks may have been scattered) and the error of the first such
@@ -620,7 +641,7 @@ pub fn parallel_energy_block(
     let mut projected = 0;
     for c in 0..packed.num_colours() {
         let range = packed.colour(c);
-        let chunks = threads.min(range.len().div_ceil(PARALLEL_MIN_ELEMENTS)).max(1);
+        let chunks = threads.min(range.len().div_ceil(SWEEP_MIN_ELEMENTS_PER_THREAD)).max(1);
         let fours = range.len().div_ceil(4);
         let cut = |i: usize| range.start + (4 * (fours * i / chunks)).min(range.len());
         let chunk = |i: usize| cut(i)..cut(i + 1);
@@ -656,9 +677,6 @@ pub fn parallel_energy_block(
     Some(Ok(projected))
 }
 
-/// Fewest elements per thread for which the parallel sweep cuts a block into slabs
-/// ([`Partition`]) instead of synchronising the threads after every colour.
-pub const PARTITION_MIN_ELEMENTS_PER_THREAD: usize = 2048;
 
 /// A block cut for `threads` threads: its nodes split into one slab per thread along the longest
 /// axis of the rest shape (cuts at the quantiles of the element centroids, so each slab holds

@@ -652,7 +652,7 @@ impl Simulation {
             for colour in &self.colours[bi] {
                 let projected: Result<usize, BadElement> = colour
                     .par_iter()
-                    .with_min_len(PARALLEL_MIN_ELEMENTS)
+                    .with_min_len(crate::kernels::GENERIC_MIN_ELEMENTS_PER_TASK)
                     .map(|&e| {
                         let e = e as usize;
                         let nodes = block.element(e);
@@ -783,9 +783,6 @@ impl BadElement {
 fn non_finite_node(x: &[Vec3], nodes: &[u32]) -> Option<u32> {
     x.iter().zip(nodes).find(|(xi, _)| !xi.iter().all(|c| c.is_finite())).map(|(_, &n)| n)
 }
-
-/// Fewest elements a parallel task gets: below this, splitting costs more than it saves.
-const PARALLEL_MIN_ELEMENTS: usize = 64;
 
 /// What projecting one element needs to read.
 struct ProjectionContext<'a> {
