@@ -24,7 +24,8 @@
 //!   stresses cancel), and projecting them one after the other would push a rest element.
 
 use crate::Vec3;
-use crate::energy::{element_energy_and_gradient, local_deformation_gradient};
+use crate::energy::element_energy_and_gradient;
+use crate::geometry::deformation_gradient;
 use crate::material::{Material, SplitTerm};
 
 /// Largest number of nodes of an element (Q2): kernels keep their scratch on the stack.
@@ -229,7 +230,7 @@ pub fn split_terms_and_gradients(
     material: &Material,
     g_out: &mut [[Vec3; MAX_NODES]; 2],
 ) -> [SplitTerm; 2] {
-    let f = local_deformation_gradient(x, rest, grads_q);
+    let f = deformation_gradient(x, rest, grads_q);
     let terms = material.split_terms(&f);
     for (t, term) in terms.iter().enumerate() {
         for (gi, ni) in g_out[t].iter_mut().zip(grads_q) {

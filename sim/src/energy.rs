@@ -10,22 +10,10 @@
 //! For the linear tetrahedron this is Bender et al.'s `V_0 P(F) D_m⁻ᵀ` (the paper, §2).
 
 use crate::Vec3;
-use crate::geometry::BlockGeometry;
-use crate::material::{Mat3, Material};
+use crate::geometry::{BlockGeometry, deformation_gradient};
+use crate::material::Material;
 use crate::mesh::Mesh;
 use nalgebra::DMatrix;
-
-/// `F = Σ_i x_i ⊗ ∇_X N_i`, evaluated as `I + Σ_i (x_i − X_i) ⊗ ∇_X N_i` (equal, since
-/// `Σ_i X_i ⊗ ∇_X N_i = I`): computing from displacements avoids cancellation, so small strains
-/// keep their relative accuracy and an element at rest has exactly `F = I` and zero energy.
-#[inline]
-pub fn local_deformation_gradient(x: &[Vec3], rest: &[Vec3], grads: &[Vec3]) -> Mat3 {
-    let mut f = Mat3::identity();
-    for ((xi, ri), g) in x.iter().zip(rest).zip(grads) {
-        f += (xi - ri) * g.transpose();
-    }
-    f
-}
 
 /// `U_e` for gathered positions `x` (one per element node); `grads` holds the material
 /// gradients of all quadrature points (`points × nodes`), `volumes` one entry per point.
@@ -34,7 +22,7 @@ pub fn element_energy(x: &[Vec3], rest: &[Vec3], grads: &[Vec3], volumes: &[f64]
     volumes
         .iter()
         .enumerate()
-        .map(|(q, v)| v * material.energy_density(&local_deformation_gradient(x, rest, &grads[q * n..(q + 1) * n])))
+        .map(|(q, v)| v * material.energy_density(&deformation_gradient(x, rest, &grads[q * n..(q + 1) * n])))
         .sum()
 }
 
@@ -52,7 +40,7 @@ pub fn element_energy_and_gradient(
     let mut energy = 0.0;
     for (q, v) in volumes.iter().enumerate() {
         let g = &grads[q * n..(q + 1) * n];
-        let (psi, p) = material.energy_density_and_pk1(&local_deformation_gradient(x, rest, g));
+        let (psi, p) = material.energy_density_and_pk1(&deformation_gradient(x, rest, g));
         energy += v * psi;
         let vp = p * *v;
         for (out, gi) in grad_out.iter_mut().zip(g) {
@@ -77,7 +65,7 @@ pub fn element_hessian(
     let mut h = DMatrix::zeros(3 * n, 3 * n);
     for (q, v) in volumes.iter().enumerate() {
         let g = &grads[q * n..(q + 1) * n];
-        let f = local_deformation_gradient(x, rest, g);
+        let f = deformation_gradient(x, rest, g);
         let c = if projected { material.dpdf_projected(&f) } else { material.dpdf(&f) };
         for i in 0..n {
             for j in 0..n {
@@ -161,8 +149,11 @@ pub struct MinDetF {
 }
 
 /// The smallest `det F_q = det(Σ_i x_i ⊗ ∇_X N_i(r_q))` over all elements and quadrature points
-/// at `positions` (None for a mesh without elements). A non-finite `det F` counts as the
-/// smallest (−∞), so NaN positions are never reported as healthy.
+/// at `positions` (None for a mesh without elements), `F_q` from displacements
+/// ([`deformation_gradient`], exactly 1 at rest). **NaN rule:** a non-finite `det F` (NaN or
+/// ±∞ positions) counts as the smallest, −∞, and the first such point is the one reported, so
+/// NaN positions are never reported as healthy. Ties keep the first point (block, element,
+/// point order).
 pub fn min_det_f(mesh: &Mesh, geometry: &[BlockGeometry], positions: &[Vec3]) -> Option<MinDetF> {
     let (mut x, mut rest) = (Vec::new(), Vec::new());
     let mut best: Option<MinDetF> = None;
@@ -174,7 +165,7 @@ pub fn min_det_f(mesh: &Mesh, geometry: &[BlockGeometry], positions: &[Vec3]) ->
             gather(positions, nodes, &mut x);
             gather(&mesh.rest_positions, nodes, &mut rest);
             for q in 0..g.points_per_element {
-                let det = local_deformation_gradient(&x, &rest, g.gradients(e, q)).determinant();
+                let det = deformation_gradient(&x, &rest, g.gradients(e, q)).determinant();
                 let det = if det.is_finite() { det } else { f64::NEG_INFINITY };
                 if best.is_none_or(|m| det < m.det_f) {
                     best = Some(MinDetF { det_f: det, block: bi, element: e, point: q });

@@ -67,7 +67,10 @@ pub enum GeometryError {
     Quadrature(#[from] QuadratureError),
 }
 
-/// `J = Σ_i X_i ⊗ ∂N_i/∂r` for the element's nodes.
+/// The element Jacobian `J(x, r) = Σ_i x_i ⊗ ∂N_i/∂r(r)` of the nodes `nodes` of `positions`
+/// (`grad_ref[i] = ∂N_i/∂r` at the point `r`): at rest positions the map whose inverse gives the
+/// material gradients and whose determinant the volumes; the probes' Newton iterations use it
+/// too ([`crate::probe`]). The one place it is computed.
 #[inline]
 pub fn jacobian(positions: &[Vec3], nodes: &[u32], grad_ref: &[[f64; 3]]) -> Matrix3<f64> {
     let mut j = Matrix3::zeros();
@@ -143,12 +146,18 @@ fn element_scale(positions: &[Vec3], nodes: &[u32]) -> f64 {
     nodes.iter().map(|&n| (positions[n as usize] - p0).norm()).fold(0.0, f64::max)
 }
 
-/// The deformation gradient `F = Σ_i x_i ⊗ ∇_X N_i` of one element at one quadrature point.
+/// The deformation gradient of one element at one point, `F = Σ_i x_i ⊗ ∇_X N_i`, from its
+/// gathered positions `x`, rest positions `rest` and material gradients `grads` (one each per
+/// node), evaluated as `I + Σ_i (x_i − X_i) ⊗ ∇_X N_i` (equal, since `Σ_i X_i ⊗ ∇_X N_i = I`):
+/// computing from displacements avoids cancellation, so small strains keep their relative
+/// accuracy and an element at rest has exactly `F = I` and zero energy. The one place `F` is
+/// computed outside the specialised sweep ([`crate::kernels`], which forms the same sum in
+/// registers).
 #[inline]
-pub fn deformation_gradient(positions: &[Vec3], nodes: &[u32], grad_in_material: &[Vec3]) -> Matrix3<f64> {
-    let mut f = Matrix3::zeros();
-    for (&n, g) in nodes.iter().zip(grad_in_material) {
-        f += positions[n as usize] * g.transpose();
+pub fn deformation_gradient(x: &[Vec3], rest: &[Vec3], grads: &[Vec3]) -> Matrix3<f64> {
+    let mut f = Matrix3::identity();
+    for ((xi, ri), g) in x.iter().zip(rest).zip(grads) {
+        f += (xi - ri) * g.transpose();
     }
     f
 }

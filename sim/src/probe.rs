@@ -24,6 +24,7 @@
 
 use crate::Vec3;
 use crate::element::{ElementType, ReferenceShape};
+use crate::geometry::jacobian;
 use crate::mesh::Mesh;
 use nalgebra::Matrix3;
 
@@ -105,7 +106,7 @@ impl Probe {
         for (b, block) in mesh.blocks.iter().enumerate() {
             let et = block.element_type;
             let padding = if et.order() > 1 { CURVED_PADDING } else { LINEAR_PADDING };
-            let mut map = ElementMap::new(et);
+            let mut map = ElementMap::new(et, &mesh.rest_positions);
             for (e, nodes) in block.elements().enumerate() {
                 let (lo, hi) = node_box(&mesh.rest_positions, nodes);
                 let size_m = (hi - lo).norm();
@@ -115,7 +116,7 @@ impl Probe {
                 if outside_m > pad_m {
                     continue;
                 }
-                map.load(&mesh.rest_positions, nodes);
+                map.load(nodes);
                 if let Some(r) = map.inverse(&point_m, size_m) {
                     return Ok(probe(b, e, r));
                 }
@@ -127,13 +128,14 @@ impl Probe {
         let (lo, hi) = mesh.bounding_box();
         let body_size_m = if mesh.num_nodes() > 0 { (hi - lo).norm() } else { 0.0 };
         let mut nearest: Option<(usize, usize, [f64; 3], f64)> = None;
-        let mut maps: Vec<ElementMap> = mesh.blocks.iter().map(|b| ElementMap::new(b.element_type)).collect();
+        let mut maps: Vec<ElementMap> =
+            mesh.blocks.iter().map(|b| ElementMap::new(b.element_type, &mesh.rest_positions)).collect();
         for &(b, e, lower_bound_m) in &boxes {
             if nearest.is_some_and(|n| lower_bound_m > n.3) {
                 break;
             }
             let map = &mut maps[b];
-            map.load(&mesh.rest_positions, mesh.blocks[b].element(e));
+            map.load(mesh.blocks[b].element(e));
             let (r, distance_m) = map.nearest(&point_m);
             if nearest.is_none_or(|n| distance_m < n.3) {
                 nearest = Some((b, e, r, distance_m));
@@ -171,36 +173,36 @@ fn node_box(positions: &[Vec3], nodes: &[u32]) -> (Vec3, Vec3) {
     nodes.iter().fold((first, first), |(lo, hi), &n| (lo.inf(&positions[n as usize]), hi.sup(&positions[n as usize])))
 }
 
-/// The isoparametric map `X(r) = Σ N_i(r) X_i` of one element, with its work buffers.
-struct ElementMap {
+/// The isoparametric map `X(r) = Σ N_i(r) X_i` of one element of `positions`, with its work
+/// buffers.
+struct ElementMap<'a> {
     et: ElementType,
-    nodes_m: Vec<Vec3>,
+    positions: &'a [Vec3],
+    nodes: &'a [u32],
     values: Vec<f64>,
     gradients: Vec<[f64; 3]>,
 }
 
-impl ElementMap {
-    fn new(et: ElementType) -> Self {
+impl<'a> ElementMap<'a> {
+    fn new(et: ElementType, positions: &'a [Vec3]) -> Self {
         let nn = et.num_nodes();
-        Self { et, nodes_m: Vec::with_capacity(nn), values: vec![0.0; nn], gradients: vec![[0.0; 3]; nn] }
+        Self { et, positions, nodes: &[], values: vec![0.0; nn], gradients: vec![[0.0; 3]; nn] }
     }
 
-    /// `X(r)` and `J(X, r) = Σ X_i ⊗ ∂N_i/∂r`.
+    /// `X(r)` and `J(X, r) = Σ X_i ⊗ ∂N_i/∂r` ([`jacobian`]).
     fn eval(&mut self, r: &[f64; 3]) -> (Vec3, Matrix3<f64>) {
         self.et.shape_functions(r, &mut self.values);
         self.et.shape_gradients(r, &mut self.gradients);
         let mut x = Vec3::zeros();
-        let mut j = Matrix3::zeros();
-        for ((p, &n), g) in self.nodes_m.iter().zip(&self.values).zip(&self.gradients) {
-            x += n * p;
-            j += p * Vec3::from(*g).transpose();
+        for (&node, &n) in self.nodes.iter().zip(&self.values) {
+            x += n * self.positions[node as usize];
         }
-        (x, j)
+        (x, jacobian(self.positions, self.nodes, &self.gradients))
     }
 
-    fn load(&mut self, positions: &[Vec3], nodes: &[u32]) {
-        self.nodes_m.clear();
-        self.nodes_m.extend(nodes.iter().map(|&n| positions[n as usize]));
+    /// Makes this the map of the element with nodes `nodes`.
+    fn load(&mut self, nodes: &'a [u32]) {
+        self.nodes = nodes;
     }
 
     fn shape(&self) -> ReferenceShape {
@@ -457,8 +459,8 @@ mod tests {
                 let et = ElementType::from_name(name).unwrap();
                 let mesh = curved_element(et, bend);
                 let r0 = crate::element::tests::point_in(et.shape(), u);
-                let mut map = ElementMap::new(et);
-                map.load(&mesh.rest_positions, mesh.blocks[0].element(0));
+                let mut map = ElementMap::new(et, &mesh.rest_positions);
+                map.load(mesh.blocks[0].element(0));
                 let p = map.eval(&r0).0;
                 let probe = Probe::locate(&mesh, "curved", p).unwrap_or_else(|e| panic!("{et}: {e}"));
                 let dr = [0, 1, 2].map(|d| (probe.reference[d] - r0[d]).abs()).into_iter().fold(0.0, f64::max);
@@ -481,12 +483,13 @@ mod tests {
         for (name, r0) in cases {
             let et = ElementType::from_name(name).unwrap();
             let mesh = curved_element(et, 0.15);
-            let mut map = ElementMap::new(et);
-            map.load(&mesh.rest_positions, mesh.blocks[0].element(0));
+            let mut map = ElementMap::new(et, &mesh.rest_positions);
+            map.load(mesh.blocks[0].element(0));
             let (p, _) = map.eval(&r0);
             let (straight, _) = {
-                let mut flat = ElementMap::new(et);
-                flat.load(&curved_element(et, 0.0).rest_positions, mesh.blocks[0].element(0));
+                let flat_mesh = curved_element(et, 0.0);
+                let mut flat = ElementMap::new(et, &flat_mesh.rest_positions);
+                flat.load(mesh.blocks[0].element(0));
                 flat.eval(&r0)
             };
             assert!((p - straight).norm() > 1e-3, "{name}: the element is not curved at {r0:?}");

@@ -300,27 +300,5 @@ pub fn quadrature_points(mesh: &Mesh, geometry: &[crate::geometry::BlockGeometry
     PointMap::from_reference_points(mesh, points)
 }
 
-/// The smallest `det F` over all quadrature points of the mesh at `positions` (negative: some
-/// element is inverted there), with the `(block, element)` where it occurs.
-pub fn min_det_f(
-    mesh: &Mesh,
-    geometry: &[crate::geometry::BlockGeometry],
-    positions: &[Vec3],
-) -> (f64, (usize, usize)) {
-    let mut worst = (f64::INFINITY, (0, 0));
-    for (b, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
-        for (e, nodes) in block.elements().enumerate() {
-            for q in 0..g.points_per_element {
-                let f = crate::geometry::deformation_gradient(positions, nodes, g.gradients(e, q));
-                let det = f.determinant();
-                if det < worst.0 || det.is_nan() {
-                    worst = (det, (b, e));
-                }
-            }
-        }
-    }
-    worst
-}
-
 #[cfg(test)]
 mod tests;

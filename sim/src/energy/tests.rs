@@ -52,12 +52,9 @@ fn rigid_motions_give_zero_energy_and_zero_gradient() {
     }
 }
 
-/// Smallest det F over the quadrature points of a one-element mesh.
+/// Smallest det F over the quadrature points of a mesh ([`super::min_det_f`]).
 fn min_det_f(mesh: &Mesh, geo: &[BlockGeometry], x: &[Vec3]) -> f64 {
-    let g = &geo[0];
-    (0..g.points_per_element)
-        .map(|q| local_deformation_gradient(x, &mesh.rest_positions, g.gradients(0, q)).determinant())
-        .fold(f64::INFINITY, f64::min)
+    super::min_det_f(mesh, geo, x).expect("elements").det_f
 }
 
 fn total_volume(geo: &[BlockGeometry]) -> f64 {

@@ -22,6 +22,7 @@
 
 use crate::Vec3;
 use crate::element::ElementType;
+use crate::energy::gather;
 use crate::geometry::{BlockGeometry, deformation_gradient};
 use crate::material::Material;
 use crate::mesh::Mesh;
@@ -214,11 +215,16 @@ pub fn von_mises_stress_pa(
     positions: &[Vec3],
 ) -> Vec<f64> {
     let mut out = Vec::with_capacity(mesh.num_elements());
+    let (mut x, mut rest) = (Vec::new(), Vec::new());
     for (b, g) in mesh.blocks.iter().zip(geometry) {
+        x.resize(b.nodes_per_element(), Vec3::zeros());
+        rest.resize(b.nodes_per_element(), Vec3::zeros());
         for (e, nodes) in b.elements().enumerate() {
+            gather(positions, nodes, &mut x);
+            gather(&mesh.rest_positions, nodes, &mut rest);
             let (mut sum, mut volume) = (0.0, 0.0);
             for (q, &v) in g.volumes(e).iter().enumerate() {
-                let f = deformation_gradient(positions, nodes, g.gradients(e, q));
+                let f = deformation_gradient(&x, &rest, g.gradients(e, q));
                 let j = f.determinant();
                 let sigma = material.pk1(&f) * f.transpose() / j;
                 let dev = sigma - nalgebra::Matrix3::identity() * (sigma.trace() / 3.0);
