@@ -21,7 +21,8 @@
 use crate::Vec3;
 use crate::constraint::xpbd_step;
 use crate::geometry::BlockGeometry;
-use crate::material::{Mat3, Material, MaterialModel};
+use crate::material::lane::{self, Scalar, madd};
+use crate::material::{Mat3, Material, MaterialModel, stvk};
 use crate::mesh::ElementBlock;
 
 /// `(ψ(F), P(F))` at one quadrature point: the material law the kernel is generic over.
@@ -36,15 +37,8 @@ pub fn mul3<const FMA: bool>(a: &Mat3, b: &Mat3) -> Mat3 {
     Mat3::from_fn(|r, c| madd::<FMA>(a[(r, 2)], b[(2, c)], madd::<FMA>(a[(r, 1)], b[(1, c)], a[(r, 0)] * b[(0, c)])))
 }
 
-/// `aᵀ b` for 3×3 matrices, as [`mul3`].
-#[inline(always)]
-pub fn tr_mul3<const FMA: bool>(a: &Mat3, b: &Mat3) -> Mat3 {
-    Mat3::from_fn(|r, c| madd::<FMA>(a[(2, r)], b[(2, c)], madd::<FMA>(a[(1, r)], b[(1, c)], a[(0, r)] * b[(0, c)])))
-}
-
-/// Saint-Venant–Kirchhoff with its Lamé parameters precomputed: `E = ½(H + Hᵀ + HᵀH)`,
-/// `H = F − I`, `S = 2μE + λ tr(E) I`, `ψ = μ E:E + λ/2 tr(E)²`, `P = F S` (as
-/// [`crate::material::stvk`]).
+/// Saint-Venant–Kirchhoff with its Lamé parameters computed once per sweep: the one StVK point
+/// law, [`crate::material::stvk::energy_and_pk1`], on one `f64` (fused multiply–adds with `FMA`).
 #[derive(Clone, Copy, Debug)]
 pub struct Stvk {
     pub mu_pa: f64,
@@ -54,16 +48,9 @@ pub struct Stvk {
 impl PointMaterial for Stvk {
     #[inline(always)]
     fn energy_and_pk1<const FMA: bool>(&self, f: &Mat3) -> (f64, Mat3) {
-        let h = f - Mat3::identity();
-        let e = (h + h.transpose() + tr_mul3::<FMA>(&h, &h)) * 0.5;
-        let tr = e.trace();
-        let mut s = e * (2.0 * self.mu_pa);
-        let lt = self.lambda_pa * tr;
-        s[(0, 0)] += lt;
-        s[(1, 1)] += lt;
-        s[(2, 2)] += lt;
-        let psi = self.mu_pa * e.norm_squared() + 0.5 * self.lambda_pa * tr * tr;
-        (psi, mul3::<FMA>(f, &s))
+        let (psi, p) =
+            stvk::energy_and_pk1::<Scalar<FMA>>(Scalar(self.mu_pa), Scalar(self.lambda_pa), &lane::from_mat3(f));
+        (psi.0, lane::to_mat3(&p))
     }
 }
 
@@ -242,12 +229,6 @@ pub unsafe fn energy_sweep(
         };
     }
     dispatch!((4, 4), (5, 8), (6, 8), (8, 8), (10, 12), (20, 20), (27, 28))
-}
-
-/// `a b + c`, fused (one rounding) when `FMA` (only where the CPU has it: in software it is slow).
-#[inline(always)]
-fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
-    if FMA { a.mul_add(b, c) } else { a * b + c }
 }
 
 /// What a sweep reads and writes, besides the material and the range of packed elements.

@@ -2,7 +2,8 @@
 //! no node) projected together, one element per 64-bit lane of a 256-bit register (AVX2 + FMA).
 //!
 //! Per lane this is [`super::project_p1`] with [`super::Stvk`] followed by the scatter and the
-//! non-finite check of the scalar sweep: `F = I + [u₁−u₀, u₂−u₀, u₃−u₀] G`, `P = F S`,
+//! non-finite check of the scalar sweep: `F = I + [u₁−u₀, u₂−u₀, u₃−u₀] G`, `(ψ, P)` by the one
+//! StVK point law ([`crate::material::stvk::energy_and_pk1`] on the four-lane [`Lane`] type),
 //! `[∇₁U ∇₂U ∇₃U] = V P Gᵀ`, `∇₀U = −Σ`, `C = √(2 max(VΨ, 0))` and the update of
 //! [`crate::constraint::xpbd_step`] with its guards (no update where `Σ w|∇U|² + α̃C² ≤
 //! f64::MIN_POSITIVE` or NaN, or where the step is not finite). An element whose nodes are all
@@ -15,6 +16,8 @@
 
 use super::{BATCH_VALUES, Multipliers, NonFiniteElement, Positions, Stvk};
 use crate::Vec3;
+use crate::material::lane::{Lane, M3};
+use crate::material::stvk;
 use std::arch::x86_64::*;
 
 /// Four doubles, one per element.
@@ -120,6 +123,41 @@ impl F64x4 {
     }
 }
 
+impl Lane for F64x4 {
+    #[inline(always)]
+    fn splat(v: f64) -> Self {
+        Self::splat(v)
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Self::add(self, o)
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        Self::sub(self, o)
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        Self::mul(self, o)
+    }
+    /// Fused.
+    #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        self.fma(b, c)
+    }
+    /// One chain of fused multiply–adds, column by column: `m₂₂ m₂₂ + (… + (m₀₀ m₀₀ + 0))`.
+    #[inline(always)]
+    fn sum_of_squares(m: &M3<Self>) -> Self {
+        let mut sum = Self::zero();
+        for c in 0..3 {
+            for r in 0..3 {
+                sum = m[r][c].fma(m[r][c], sum);
+            }
+        }
+        sum
+    }
+}
+
 /// A 3-vector of lanes.
 type V3 = [F64x4; 3];
 
@@ -215,9 +253,8 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
             && io.element_ids.len() >= batches * 4
     );
     let (nx, rx, wx) = (io.positions.len(), io.rest.len(), io.inv_mass.len());
-    let two_mu = F64x4::splat(2.0 * material.mu_pa);
     let (mu, lambda_pa) = (F64x4::splat(material.mu_pa), F64x4::splat(material.lambda_pa));
-    let (half, one, two, zero) = (F64x4::splat(0.5), F64x4::splat(1.0), F64x4::splat(2.0), F64x4::zero());
+    let (one, two, zero) = (F64x4::splat(1.0), F64x4::splat(2.0), F64x4::zero());
     let inv_dt2 = F64x4::splat(io.inv_dt2);
     let tiny = F64x4::splat(f64::MIN_POSITIVE);
     let mut projected = 0u64;
@@ -270,30 +307,8 @@ pub unsafe fn batches_avx2(material: &Stvk, io: BatchIo<'_>, batches: usize) -> 
                 if a == c { one.add(m) } else { m }
             })
         });
-        // StVK: H = F − I, E = ½(H + Hᵀ + HᵀH), S = 2μE + λ tr(E) I, ψ = μ E:E + λ/2 tr(E)², P = F S
-        let h: [[F64x4; 3]; 3] =
-            std::array::from_fn(|a| std::array::from_fn(|c| if a == c { f[a][c].sub(one) } else { f[a][c] }));
-        let e: [[F64x4; 3]; 3] = std::array::from_fn(|r| {
-            std::array::from_fn(|c| {
-                let hth = h[2][r].fma(h[2][c], h[1][r].fma(h[1][c], h[0][r].mul(h[0][c])));
-                h[r][c].add(h[c][r]).add(hth).mul(half)
-            })
-        });
-        let tr = e[0][0].add(e[1][1]).add(e[2][2]);
-        let lt = lambda_pa.mul(tr);
-        let s: [[F64x4; 3]; 3] = std::array::from_fn(|r| {
-            std::array::from_fn(|c| if r == c { e[r][c].mul(two_mu).add(lt) } else { e[r][c].mul(two_mu) })
-        });
-        let mut e2 = zero;
-        for c in 0..3 {
-            for r in 0..3 {
-                e2 = e[r][c].fma(e[r][c], e2);
-            }
-        }
-        let psi = mu.mul(e2).add(half.mul(lambda_pa).mul(tr).mul(tr));
-        let p: [[F64x4; 3]; 3] = std::array::from_fn(|r| {
-            std::array::from_fn(|c| f[r][2].fma(s[2][c], f[r][1].fma(s[1][c], f[r][0].mul(s[0][c]))))
-        });
+        // the one StVK point law, four elements at a time
+        let (psi, p) = stvk::energy_and_pk1(mu, lambda_pa, &f);
         // ∇_{j+1} U = V P g_j (H = (V P) Gᵀ), ∇_0 U = −Σ
         let vp: [[F64x4; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| p[r][c].mul(v)));
         let mut grad = [[zero; 3]; 4];

@@ -35,6 +35,7 @@ use nalgebra::{Matrix3, SMatrix, SymmetricEigen, Vector3};
 #[macro_use]
 mod testing;
 
+pub mod lane;
 pub mod neo_hookean;
 pub mod stable_neo_hookean;
 pub mod stable_neo_hookean_log;
