@@ -325,9 +325,7 @@ unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMateria
         assert!(e < lambdas.len());
         // SAFETY: node indices are checked against the length; the caller guarantees no other
         // thread touches these nodes and this multiplier.
-        let mut x: [Vec3; N] = std::array::from_fn(|i| {
-            unsafe { positions.read(nodes[i] as usize) }
-        });
+        let mut x: [Vec3; N] = std::array::from_fn(|i| unsafe { positions.read(nodes[i] as usize) });
         let d: [Vec3; N] = std::array::from_fn(|i| x[i] - rest[nodes[i] as usize]);
         let lambda = unsafe { &mut *lambdas.ptr().add(e) };
         let grads = &data.grads[k * q * 3 * P..(k + 1) * q * 3 * P];
@@ -657,7 +655,6 @@ pub fn parallel_energy_block(
     }
     Some(Ok(projected))
 }
-
 
 /// A block cut for `threads` threads: its nodes split into one slab per thread along the longest
 /// axis of the rest shape (cuts at the quantiles of the element centroids, so each slab holds

@@ -562,9 +562,13 @@ impl Simulation {
                         continue;
                     }
                     Some(Err(bad)) => {
-                        return Err(BadElement::projected(bi, bad.element, bad.node, block.element(bad.element), |i| {
-                            self.positions[i]
-                        }));
+                        return Err(BadElement::projected(
+                            bi,
+                            bad.element,
+                            bad.node,
+                            block.element(bad.element),
+                            |i| self.positions[i],
+                        ));
                     }
                     None => {}
                 }
