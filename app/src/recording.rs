@@ -246,7 +246,7 @@ impl SimLogger {
             }
         }
         let min_det_f =
-            hox_sim::energy::min_det_f(mesh, sim.geometry(), &sim.positions).map_or(f64::INFINITY, |m| m.det_f);
+            hox_sim::fem::energy::min_det_f(mesh, sim.geometry(), &sim.positions).map_or(f64::INFINITY, |m| m.det_f);
         for (quantity, value) in [
             ("kinetic_energy_j", sim.kinetic_energy_j()),
             ("elastic_energy_j", sim.elastic_energy_j()),

@@ -440,7 +440,7 @@ impl Scene {
                 SceneMesh::File { imported, .. } => imported.mesh.blocks.iter().map(|b| b.element_type).collect(),
             };
             for element_type in types {
-                let max = hox_sim::quadrature::max_degree(element_type.shape());
+                let max = hox_sim::fem::quadrature::max_degree(element_type.shape());
                 if d == 0 || d > max {
                     return Err(invalid(
                         "solver.quadrature_degree",

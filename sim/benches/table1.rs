@@ -10,7 +10,7 @@ use criterion::{BatchSize, Criterion, SamplingMode, criterion_group, criterion_m
 use hox_sim::Vec3;
 use hox_sim::benchmark::{CASES, bending_beam};
 use hox_sim::constraint::project_energy_constraint;
-use hox_sim::energy::{element_grads, gather};
+use hox_sim::fem::energy::{element_grads, gather};
 use hox_sim::kernels::{Multipliers, PackedBlock, Positions, colour_sweep, energy_sweep};
 use std::time::Duration;
 

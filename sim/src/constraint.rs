@@ -24,8 +24,8 @@
 //!   stresses cancel), and projecting them one after the other would push a rest element.
 
 use crate::Vec3;
-use crate::energy::element_energy_and_gradient;
-use crate::geometry::deformation_gradient;
+use crate::fem::energy::element_energy_and_gradient;
+use crate::fem::geometry::deformation_gradient;
 use crate::material::{Material, SplitTerm};
 
 /// Largest number of nodes of an element (Q2): kernels keep their scratch on the stack.

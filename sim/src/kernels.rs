@@ -20,7 +20,7 @@
 
 use crate::Vec3;
 use crate::constraint::xpbd_step;
-use crate::geometry::BlockGeometry;
+use crate::fem::geometry::BlockGeometry;
 use crate::material::lane::{self, Scalar, madd};
 use crate::material::{Mat3, Material, MaterialModel, stvk};
 use crate::mesh::ElementBlock;

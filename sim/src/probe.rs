@@ -24,7 +24,7 @@
 
 use crate::Vec3;
 use crate::element::{ElementType, ReferenceShape};
-use crate::geometry::jacobian;
+use crate::fem::geometry::jacobian;
 use crate::mesh::Mesh;
 use nalgebra::Matrix3;
 
@@ -340,7 +340,7 @@ fn project_on(shape: ReferenceShape, r: [f64; 3]) -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::tests::curved_element;
+    use crate::fem::geometry::tests::curved_element;
     use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
     use proptest::prelude::*;
     use std::sync::OnceLock;

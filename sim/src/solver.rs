@@ -23,9 +23,9 @@
 use crate::Vec3;
 use crate::constraint::{Formulation, MAX_NODES, project_energy_constraint, project_split_constraints};
 use crate::effect::{Effect, EffectState};
-use crate::energy::{element_grads, gather, total_energy};
-use crate::geometry::{BlockGeometry, GeometryError, precompute};
-use crate::mass::lumped_masses_kg;
+use crate::fem::energy::{element_grads, gather, total_energy};
+use crate::fem::geometry::{BlockGeometry, GeometryError, precompute};
+use crate::fem::mass::lumped_masses_kg;
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshError};
 use crate::stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};

@@ -31,8 +31,8 @@
 
 use crate::Vec3;
 use crate::constraint::Formulation;
-use crate::energy::{element_grads, element_hessian, gather};
-use crate::geometry::BlockGeometry;
+use crate::fem::energy::{element_grads, element_hessian, gather};
+use crate::fem::geometry::BlockGeometry;
 use crate::material::Material;
 use crate::mesh::Mesh;
 use nalgebra::{DMatrix, DVector};

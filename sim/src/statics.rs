@@ -15,9 +15,9 @@
 
 use crate::Vec3;
 use crate::effect::Prescribed;
-use crate::energy::{element_grads, element_hessian, total_energy_and_gradient};
-use crate::geometry::{BlockGeometry, GeometryError, precompute};
-use crate::mass::lumped_masses_kg;
+use crate::fem::energy::{element_grads, element_hessian, total_energy_and_gradient};
+use crate::fem::geometry::{BlockGeometry, GeometryError, precompute};
+use crate::fem::mass::lumped_masses_kg;
 use crate::material::Material;
 use crate::mesh::Mesh;
 use faer::Side;

@@ -293,7 +293,7 @@ impl Surface {
 }
 
 /// The quadrature points of every element as material points, in block, element, point order.
-pub fn quadrature_points(mesh: &Mesh, geometry: &[crate::geometry::BlockGeometry]) -> PointMap {
+pub fn quadrature_points(mesh: &Mesh, geometry: &[crate::fem::geometry::BlockGeometry]) -> PointMap {
     let points = mesh.blocks.iter().zip(geometry).enumerate().flat_map(|(b, (block, g))| {
         (0..block.len()).flat_map(move |e| g.quadrature.points.iter().map(move |r| (b, e, *r)))
     });

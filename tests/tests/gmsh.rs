@@ -51,13 +51,13 @@ fn every_gmsh_mesh_imports_with_its_counts_groups_and_the_box_volume() {
         got.sort();
         want.sort();
         assert_eq!(got, want, "{name}");
-        let geometry = hox_sim::geometry::precompute(&m.mesh, None).unwrap();
+        let geometry = hox_sim::fem::geometry::precompute(&m.mesh, None).unwrap();
         for g in &geometry {
             for e in 0..g.num_elements() {
                 assert!(g.element_volume_m3(e) > 0.0, "{name}: element {e} of the {} block", g.element_type);
             }
         }
-        let volume = hox_sim::geometry::total_volume_m3(&geometry);
+        let volume = hox_sim::fem::geometry::total_volume_m3(&geometry);
         assert!((volume - BOX_VOLUME_M3).abs() < 1e-12, "{name}: volume {volume}");
         // the groups: clamp at x = 0, tip at x = L, body = everything
         let x_of = |group: &str| {

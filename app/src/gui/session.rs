@@ -243,7 +243,7 @@ impl Session {
         let sim = &self.instance.sim;
         let mesh = sim.mesh();
         let mut grad = vec![Vec3::zeros(); mesh.num_nodes()];
-        hox_sim::energy::total_energy_and_gradient(mesh, sim.geometry(), sim.material(), &sim.positions, &mut grad);
+        hox_sim::fem::energy::total_energy_and_gradient(mesh, sim.geometry(), sim.material(), &sim.positions, &mut grad);
         let g = gravity(&self.instance.scene);
         let (mut num, mut den) = (0.0, 0.0);
         for (i, w) in sim.inv_mass().iter().enumerate() {

@@ -32,7 +32,7 @@ use eframe::egui;
 use hox_sim::Vec3;
 use hox_sim::element::{ElementType, ReferenceElement, ReferenceShape};
 use hox_sim::mesh::{ElementBlock, Mesh};
-use hox_sim::quadrature;
+use hox_sim::fem::quadrature;
 use hox_sim::surface::Surface;
 
 /// Pieces per face edge of the display surface (a multiple of 2 and 3: see the module docs).

@@ -1,7 +1,7 @@
 use super::*;
 use crate::constraint::MAX_NODES;
-use crate::energy::element_grads;
-use crate::energy::tests::{elements, materials};
+use crate::fem::energy::element_grads;
+use crate::fem::energy::tests::{elements, materials};
 use proptest::prelude::*;
 
 #[test]
@@ -89,7 +89,7 @@ proptest! {
                     let gq = &element_grads(g, 0)[q * n..(q + 1) * n];
                     // Neo-Hookean's ln J is continued linearly below J = 1e-6: no finite
                     // differences across that seam
-                    let j = crate::geometry::deformation_gradient(&x, &mesh.rest_positions, gq).determinant();
+                    let j = crate::fem::geometry::deformation_gradient(&x, &mesh.rest_positions, gq).determinant();
                     if material.model == crate::material::MaterialModel::NeoHookean && j < 0.2 {
                         continue;
                     }
@@ -178,7 +178,7 @@ proptest! {
             for material in materials() {
                 let mut x = x0.clone();
                 let mut grad = vec![Vec3::zeros(); n];
-                crate::energy::element_energy_and_gradient(&x0, &mesh.rest_positions, element_grads(g, 0), g.volumes(0), &material, &mut grad);
+                crate::fem::energy::element_energy_and_gradient(&x0, &mesh.rest_positions, element_grads(g, 0), g.volumes(0), &material, &mut grad);
                 project_energy_constraint(&mut x, &mesh.rest_positions, &w, element_grads(g, 0), g.volumes(0), &material, 1e3, &mut 0.0);
                 let slope: f64 = (0..n).map(|i| grad[i].dot(&(x[i] - x0[i]))).sum();
                 prop_assert!(slope < 0.0, "{} {:?}: ∇U·Δx = {}", et, material.model, slope);

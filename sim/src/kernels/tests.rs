@@ -1,7 +1,7 @@
 use super::*;
 use crate::constraint::project_energy_constraint;
-use crate::energy::element_grads;
-use crate::energy::tests::{elements, materials};
+use crate::fem::energy::element_grads;
+use crate::fem::energy::tests::{elements, materials};
 
 /// The specialised sweep projects one element exactly as the generic kernel does, up to the
 /// order of floating-point operations, for every element type and material; the colour-packed
@@ -98,7 +98,7 @@ fn a_non_finite_correction_is_reported_and_not_scattered() {
 
 /// The 2 × 0.5 × 0.5 m P1 beam of 8 × 2 × 2 cells refined `refine` times, its geometry,
 /// colouring and colour-packed block.
-fn p1_beam(refine: usize) -> (crate::mesh::Mesh, Vec<crate::geometry::BlockGeometry>, Vec<Vec<u32>>, PackedBlock) {
+fn p1_beam(refine: usize) -> (crate::mesh::Mesh, Vec<crate::fem::geometry::BlockGeometry>, Vec<Vec<u32>>, PackedBlock) {
     use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
     let mesh = BoxMeshSpec {
         grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(2.0, 0.5, 0.5), cells: [8, 2, 2] },
@@ -108,7 +108,7 @@ fn p1_beam(refine: usize) -> (crate::mesh::Mesh, Vec<crate::geometry::BlockGeome
     }
     .build()
     .unwrap();
-    let geo = crate::geometry::precompute(&mesh, None).unwrap();
+    let geo = crate::fem::geometry::precompute(&mesh, None).unwrap();
     let colours = crate::colouring::colour_elements(&mesh.blocks[0], mesh.num_nodes());
     let packed = PackedBlock::in_colour_order(&mesh.blocks[0], &geo[0], &colours);
     (mesh, geo, colours, packed)

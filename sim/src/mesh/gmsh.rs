@@ -15,13 +15,13 @@
 //! - **Nodes** not used by any 3D element (geometry points, …) are dropped and the rest
 //!   renumbered compactly, in the order of the `$Nodes` section.
 //!
-//! Every rest element's `det J` is checked at its quadrature points ([`crate::geometry`]); an
+//! Every rest element's `det J` is checked at its quadrature points ([`crate::fem::geometry`]); an
 //! inverted or flat element is an error naming the file and the element's Gmsh tag. Every error
 //! names the file and, where it can, the line (MSH 2.2 ASCII) or the element's tag.
 
 use crate::Vec3;
 use crate::element::ElementType;
-use crate::geometry::{GeometryError, precompute_block};
+use crate::fem::geometry::{GeometryError, precompute_block};
 use crate::mesh::{ElementBlock, Mesh, MeshError};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;

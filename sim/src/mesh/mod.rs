@@ -80,7 +80,7 @@ impl Mesh {
 
     /// Checks the structure: non-empty, finite coordinates, indices in range, no repeated node
     /// within an element. (Element shape — inverted or flat — is checked by
-    /// [`crate::geometry`], which knows the quadrature points.)
+    /// [`crate::fem::geometry`], which knows the quadrature points.)
     pub fn validate(&self) -> Result<(), MeshError> {
         if self.num_elements() == 0 {
             return Err(MeshError::Empty);

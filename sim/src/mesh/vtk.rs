@@ -22,8 +22,8 @@
 
 use crate::Vec3;
 use crate::element::ElementType;
-use crate::energy::gather;
-use crate::geometry::{BlockGeometry, deformation_gradient};
+use crate::fem::energy::gather;
+use crate::fem::geometry::{BlockGeometry, deformation_gradient};
 use crate::material::Material;
 use crate::mesh::Mesh;
 use std::collections::BTreeMap;

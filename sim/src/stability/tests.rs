@@ -1,5 +1,5 @@
 use super::*;
-use crate::energy::tests::{elements, materials};
+use crate::fem::energy::tests::{elements, materials};
 use nalgebra::SymmetricEigen;
 
 /// Inverse masses of an element's nodes that differ from node to node (as in a mesh).

@@ -1,6 +1,6 @@
 use super::*;
 use crate::element::ElementType;
-use crate::energy::{MinDetF, min_det_f};
+use crate::fem::energy::{MinDetF, min_det_f};
 use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 
 fn box_mesh(element: &str, cells: [usize; 3]) -> Mesh {
@@ -90,7 +90,7 @@ fn edges_and_node_kinds_of_one_cube() {
 fn quadrature_points_and_min_det_f() {
     for e in ElementType::all() {
         let mesh = box_mesh(e.name(), [2, 1, 1]);
-        let geometry = crate::geometry::precompute(&mesh, None).unwrap();
+        let geometry = crate::fem::geometry::precompute(&mesh, None).unwrap();
         let q = quadrature_points(&mesh, &geometry);
         let expected: usize = geometry.iter().map(|g| g.num_elements() * g.points_per_element).sum();
         assert_eq!(q.len(), expected);

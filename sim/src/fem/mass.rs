@@ -11,7 +11,7 @@
 //! element's mass quadrature degree (exact for `N_i N_j` on affine elements).
 
 use crate::element::ElementType;
-use crate::geometry::{GeometryError, precompute_block};
+use crate::fem::geometry::{GeometryError, precompute_block};
 use crate::mesh::Mesh;
 
 /// Lumped mass of every node of `mesh` (kg) for density `density_kg_m3`.
@@ -57,7 +57,7 @@ mod tests {
     use super::*;
     use crate::Vec3;
     use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
-    use crate::quadrature;
+    use crate::fem::quadrature;
 
     #[test]
     fn masses_are_positive_and_total_rho_v_for_every_element_type() {

@@ -10,7 +10,7 @@
 //! For the linear tetrahedron this is Bender et al.'s `V_0 P(F) D_m⁻ᵀ` (the paper, §2).
 
 use crate::Vec3;
-use crate::geometry::{BlockGeometry, deformation_gradient};
+use crate::fem::geometry::{BlockGeometry, deformation_gradient};
 use crate::material::Material;
 use crate::mesh::Mesh;
 use nalgebra::DMatrix;

@@ -13,7 +13,7 @@
 use crate::Vec3;
 use crate::element::ElementType;
 use crate::mesh::{ElementBlock, Mesh};
-use crate::quadrature::{self, QuadratureError, QuadratureRule};
+use crate::fem::quadrature::{self, QuadratureError, QuadratureRule};
 use nalgebra::Matrix3;
 
 /// Precomputed data of one element block.

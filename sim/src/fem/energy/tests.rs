@@ -1,7 +1,7 @@
 use super::*;
 use crate::element::ElementType;
-use crate::geometry::precompute;
-use crate::geometry::tests::curved_element;
+use crate::fem::geometry::precompute;
+use crate::fem::geometry::tests::curved_element;
 use crate::material::{Mat3, MaterialModel};
 use nalgebra::Rotation3;
 use proptest::prelude::*;
@@ -58,7 +58,7 @@ fn min_det_f(mesh: &Mesh, geo: &[BlockGeometry], x: &[Vec3]) -> f64 {
 }
 
 fn total_volume(geo: &[BlockGeometry]) -> f64 {
-    crate::geometry::total_volume_m3(geo)
+    crate::fem::geometry::total_volume_m3(geo)
 }
 
 proptest! {
