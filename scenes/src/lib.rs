@@ -99,12 +99,12 @@ impl Instance {
 
     /// Writes the current state as the next frame of `series`: current positions,
     /// `displacement_m` per point and the volume-averaged von Mises stress per cell
-    /// (`von_mises_stress_pa`); see [`hox_sim::mesh::vtk`].
+    /// (`von_mises_stress_pa`); see [`hox_sim::io::vtk`].
     pub fn write_vtk_frame(
         &self,
-        series: &mut hox_sim::mesh::vtk::PvdSeries,
+        series: &mut hox_sim::io::vtk::PvdSeries,
     ) -> Result<std::path::PathBuf, SceneError> {
-        use hox_sim::mesh::vtk::{DataArray, von_mises_stress_pa};
+        use hox_sim::io::vtk::{DataArray, von_mises_stress_pa};
         let sim = &self.sim;
         let stress = von_mises_stress_pa(sim.mesh(), sim.geometry(), sim.material(), &sim.positions);
         series

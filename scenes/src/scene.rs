@@ -66,7 +66,7 @@ use hox_sim::effect::{AxisRotation, Clamp, ContactPlane, Damping, Effect, Gravit
 use hox_sim::element::ElementType;
 use hox_sim::material::{Material, MaterialModel};
 use hox_sim::mesh::Mesh;
-use hox_sim::mesh::gmsh::ImportedMesh;
+use hox_sim::io::gmsh::ImportedMesh;
 use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 use hox_sim::solver::SolverSettings;
 use serde::{Deserialize, Serialize};
@@ -771,7 +771,7 @@ fn mesh_of(
         {
             return Ok(SceneMesh::File { path, imported: imported.clone() });
         }
-        let imported = hox_sim::mesh::gmsh::read_msh(&path).map_err(|e| {
+        let imported = hox_sim::io::gmsh::read_msh(&path).map_err(|e| {
             // a scene built from the mesh file alone (`--mesh`) is named by the file already
             if source == path.display().to_string() {
                 SceneError::MeshFile(e.to_string())

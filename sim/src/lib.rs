@@ -29,6 +29,7 @@ pub mod constraint;
 pub mod effect;
 pub mod element;
 pub mod fem;
+pub mod io;
 pub mod kernels;
 pub mod material;
 pub mod mesh;

@@ -5,8 +5,8 @@
 
 use hox_scenes::Scene;
 use hox_sim::Vec3;
-use hox_sim::mesh::gmsh::{ImportedMesh, read_msh};
-use hox_sim::mesh::vtk;
+use hox_sim::io::gmsh::{ImportedMesh, read_msh};
+use hox_sim::io::vtk;
 use std::path::PathBuf;
 
 /// Every mesh is the paper's beam [0,2]×[0,0.5]×[0,0.5] m.
