@@ -11,7 +11,7 @@ pub mod study;
 pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, median, run, run_observed};
 pub use scene::{Drive, NodeSelector, Scene, SceneFile, SceneMesh, SceneOverrides};
 
-use hox_sim::probe::Probe;
+use hox_sim::measure::probe::Probe;
 use hox_sim::solver::Simulation;
 
 /// The built-in scenes: (name, TOML text). Adding a scene: its file plus one line here.
@@ -100,10 +100,7 @@ impl Instance {
     /// Writes the current state as the next frame of `series`: current positions,
     /// `displacement_m` per point and the volume-averaged von Mises stress per cell
     /// (`von_mises_stress_pa`); see [`hox_sim::io::vtk`].
-    pub fn write_vtk_frame(
-        &self,
-        series: &mut hox_sim::io::vtk::PvdSeries,
-    ) -> Result<std::path::PathBuf, SceneError> {
+    pub fn write_vtk_frame(&self, series: &mut hox_sim::io::vtk::PvdSeries) -> Result<std::path::PathBuf, SceneError> {
         use hox_sim::io::vtk::{DataArray, von_mises_stress_pa};
         let sim = &self.sim;
         let stress = von_mises_stress_pa(sim.mesh(), sim.geometry(), sim.material(), &sim.positions);

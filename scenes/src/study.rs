@@ -358,8 +358,8 @@ fn static_tip_z(
         .iter()
         .find(|p| p.name == "tip")
         .ok_or_else(|| fail("the scene has no probe named tip".into()))?;
-    let probe =
-        hox_sim::probe::Probe::locate(&mesh, &tip.name, Vec3::from(tip.point_m)).map_err(|e| fail(e.to_string()))?;
+    let probe = hox_sim::measure::probe::Probe::locate(&mesh, &tip.name, Vec3::from(tip.point_m))
+        .map_err(|e| fail(e.to_string()))?;
     Ok((probe.displacement(&solution.positions, &mesh.rest_positions).z, mesh.num_elements()))
 }
 

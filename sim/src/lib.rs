@@ -32,12 +32,11 @@ pub mod fem;
 pub mod io;
 pub mod kernels;
 pub mod material;
+pub mod measure;
 pub mod mesh;
-pub mod probe;
 pub mod solver;
 pub mod stability;
 pub mod statics;
-pub mod surface;
 
 pub use nalgebra;
 

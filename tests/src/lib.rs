@@ -7,7 +7,7 @@
 //!   elastic energy `U = Σ_e Σ_q V_q ψ(F_q)` and the potential of a uniform body acceleration `g`,
 //!   `V_g = −Σ m_i g·(x_i − X_i)` (zero at rest, so a body released at rest starts at `H = 0`);
 //! - the smallest **`det F`** over all quadrature points (`≤ 0`: an inverted element), from
-//!   [`hox_sim::fem::energy::min_det_f`], and over a dense set of points of every element
+//!   [`hox_sim::measure::min_det_f`], and over a dense set of points of every element
 //!   ([`min_det_f_sampled`]): a curved high-order element can be inverted between its quadrature
 //!   points, where the energy does not see it;
 //! - the **distance to the rest shape**, `max_i |x_i − X_i|`, or, for an unconstrained body, the
@@ -18,8 +18,8 @@ use hox_sim::Vec3;
 use hox_sim::constraint::Formulation;
 use hox_sim::effect::{Clamp, Damping, Effect};
 use hox_sim::element::ElementType;
-use hox_sim::fem::energy::MinDetF;
 use hox_sim::material::{Material, MaterialModel};
+use hox_sim::measure::MinDetF;
 use hox_sim::mesh::Mesh;
 use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 use hox_sim::nalgebra::Matrix3;
@@ -122,7 +122,7 @@ pub fn health(sim: &Simulation, gravity_m_s2: Vec3) -> Health {
         kinetic_j: sim.kinetic_energy_j(),
         elastic_j: sim.elastic_energy_j(),
         gravity_potential_j,
-        min_det_f: hox_sim::fem::energy::min_det_f(sim.mesh(), sim.geometry(), &sim.positions)
+        min_det_f: hox_sim::measure::min_det_f(sim.mesh(), sim.geometry(), &sim.positions)
             .expect("a mesh with elements"),
         max_displacement_m,
     }

@@ -98,7 +98,7 @@ fn the_msh22_and_msh41_copies_of_a_mesh_are_the_same() {
 fn static_tip_uz(scene: &Scene) -> f64 {
     let mesh = scene.build_mesh().unwrap();
     let solution = hox_scenes::solve_static(scene, &mesh, 1e-10, 1, &mut |_, _, _| {}).unwrap();
-    let probe = hox_sim::probe::Probe::locate(&mesh, "tip", Vec3::new(LENGTH_M, 0.25, 0.25)).unwrap();
+    let probe = hox_sim::measure::probe::Probe::locate(&mesh, "tip", Vec3::new(LENGTH_M, 0.25, 0.25)).unwrap();
     probe.displacement(&solution.positions, &mesh.rest_positions).z
 }
 

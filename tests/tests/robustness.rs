@@ -1037,10 +1037,13 @@ fn degenerate_inverted_and_empty_meshes_and_zero_substeps_are_clear_errors() {
     assert!(zero.contains("substeps"), "{zero}");
     let fps = new(unit.clone(), settings(Formulation::Energy, 50, f64::NAN));
     assert!(fps.contains("frames per second"), "{fps}");
-    let probe = hox_sim::probe::Probe::locate(&unit, "far", Vec3::new(5.0, 0.0, 0.0)).expect_err("outside").to_string();
+    let probe = hox_sim::measure::probe::Probe::locate(&unit, "far", Vec3::new(5.0, 0.0, 0.0))
+        .expect_err("outside")
+        .to_string();
     assert!(probe.contains("outside the body"), "{probe}");
-    let probe =
-        hox_sim::probe::Probe::locate(&unit, "nan", Vec3::new(f64::NAN, 0.0, 0.0)).expect_err("non-finite").to_string();
+    let probe = hox_sim::measure::probe::Probe::locate(&unit, "nan", Vec3::new(f64::NAN, 0.0, 0.0))
+        .expect_err("non-finite")
+        .to_string();
     assert!(probe.contains("non-finite"), "{probe}");
     let mut s = Simulation::new(unit, mat, ok, Vec::new()).unwrap();
     let mass = s.set_mass_kg(0, -1.0).expect_err("negative mass").to_string();

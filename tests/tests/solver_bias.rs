@@ -19,7 +19,7 @@ fn p2_160_at_70_substeps_settles_within_one_percent_of_the_static_solution() {
         load_steps: 1,
     };
     let statics = hox_sim::statics::solve(&problem, &mut |_, _, _| {}).unwrap();
-    let probe = hox_sim::probe::Probe::locate(&mesh, "tip", hox_sim::Vec3::new(2.0, 0.25, 0.25)).unwrap();
+    let probe = hox_sim::measure::probe::Probe::locate(&mesh, "tip", hox_sim::Vec3::new(2.0, 0.25, 0.25)).unwrap();
     let u_static = probe.displacement(&statics.positions, &mesh.rest_positions);
     for formulation in ["energy", "split"] {
         let at = |substeps: u32| {

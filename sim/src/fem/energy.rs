@@ -137,45 +137,6 @@ pub fn total_energy_and_gradient(
     total
 }
 
-/// Where `det F` is smallest over every quadrature point of a mesh: the robustness checks'
-/// "is any element inverted?" (`det F ≤ 0` somewhere) measure.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MinDetF {
-    /// The smallest `det F_q` found.
-    pub det_f: f64,
-    pub block: usize,
-    pub element: usize,
-    pub point: usize,
-}
-
-/// The smallest `det F_q = det(Σ_i x_i ⊗ ∇_X N_i(r_q))` over all elements and quadrature points
-/// at `positions` (None for a mesh without elements), `F_q` from displacements
-/// ([`deformation_gradient`], exactly 1 at rest). **NaN rule:** a non-finite `det F` (NaN or
-/// ±∞ positions) counts as the smallest, −∞, and the first such point is the one reported, so
-/// NaN positions are never reported as healthy. Ties keep the first point (block, element,
-/// point order).
-pub fn min_det_f(mesh: &Mesh, geometry: &[BlockGeometry], positions: &[Vec3]) -> Option<MinDetF> {
-    let (mut x, mut rest) = (Vec::new(), Vec::new());
-    let mut best: Option<MinDetF> = None;
-    for (bi, (b, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
-        let n = b.nodes_per_element();
-        x.resize(n, Vec3::zeros());
-        rest.resize(n, Vec3::zeros());
-        for (e, nodes) in b.elements().enumerate() {
-            gather(positions, nodes, &mut x);
-            gather(&mesh.rest_positions, nodes, &mut rest);
-            for q in 0..g.points_per_element {
-                let det = deformation_gradient(&x, &rest, g.gradients(e, q)).determinant();
-                let det = if det.is_finite() { det } else { f64::NEG_INFINITY };
-                if best.is_none_or(|m| det < m.det_f) {
-                    best = Some(MinDetF { det_f: det, block: bi, element: e, point: q });
-                }
-            }
-        }
-    }
-    best
-}
-
 /// All quadrature points' material gradients of element `e` (`points × nodes`).
 #[inline]
 pub fn element_grads(g: &BlockGeometry, e: usize) -> &[Vec3] {

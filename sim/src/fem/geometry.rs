@@ -12,8 +12,8 @@
 
 use crate::Vec3;
 use crate::element::ElementType;
-use crate::mesh::{ElementBlock, Mesh};
 use crate::fem::quadrature::{self, QuadratureError, QuadratureRule};
+use crate::mesh::{ElementBlock, Mesh};
 use nalgebra::Matrix3;
 
 /// Precomputed data of one element block.
@@ -70,7 +70,7 @@ pub enum GeometryError {
 /// The element Jacobian `J(x, r) = Σ_i x_i ⊗ ∂N_i/∂r(r)` of the nodes `nodes` of `positions`
 /// (`grad_ref[i] = ∂N_i/∂r` at the point `r`): at rest positions the map whose inverse gives the
 /// material gradients and whose determinant the volumes; the probes' Newton iterations use it
-/// too ([`crate::probe`]). The one place it is computed.
+/// too ([`crate::measure::probe`]). The one place it is computed.
 #[inline]
 pub fn jacobian(positions: &[Vec3], nodes: &[u32], grad_ref: &[[f64; 3]]) -> Matrix3<f64> {
     let mut j = Matrix3::zeros();

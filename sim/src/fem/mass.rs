@@ -56,8 +56,8 @@ fn shape_values_squared(et: ElementType, points: &[[f64; 3]]) -> Vec<Vec<f64>> {
 mod tests {
     use super::*;
     use crate::Vec3;
-    use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
     use crate::fem::quadrature;
+    use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 
     #[test]
     fn masses_are_positive_and_total_rho_v_for_every_element_type() {

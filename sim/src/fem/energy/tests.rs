@@ -52,9 +52,9 @@ fn rigid_motions_give_zero_energy_and_zero_gradient() {
     }
 }
 
-/// Smallest det F over the quadrature points of a mesh ([`super::min_det_f`]).
+/// Smallest det F over the quadrature points of a mesh ([`crate::measure::min_det_f`]).
 fn min_det_f(mesh: &Mesh, geo: &[BlockGeometry], x: &[Vec3]) -> f64 {
-    super::min_det_f(mesh, geo, x).expect("elements").det_f
+    crate::measure::min_det_f(mesh, geo, x).expect("elements").det_f
 }
 
 fn total_volume(geo: &[BlockGeometry]) -> f64 {

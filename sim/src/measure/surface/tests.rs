@@ -1,6 +1,5 @@
 use super::*;
 use crate::element::ElementType;
-use crate::fem::energy::{MinDetF, min_det_f};
 use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 
 fn box_mesh(element: &str, cells: [usize; 3]) -> Mesh {
@@ -87,7 +86,7 @@ fn edges_and_node_kinds_of_one_cube() {
 }
 
 #[test]
-fn quadrature_points_and_min_det_f() {
+fn quadrature_points_lie_in_the_body() {
     for e in ElementType::all() {
         let mesh = box_mesh(e.name(), [2, 1, 1]);
         let geometry = crate::fem::geometry::precompute(&mesh, None).unwrap();
@@ -98,14 +97,5 @@ fn quadrature_points_and_min_det_f() {
         q.eval_into(&mesh.rest_positions, &mut x);
         let inside = |p: &Vec3| p.x >= 0.0 && p.x <= 2.0 && p.y >= 0.0 && p.y <= 1.0 && p.z >= 0.0 && p.z <= 0.5;
         assert!(x.iter().all(inside), "{}", e.name());
-        let det = min_det_f(&mesh, &geometry, &mesh.rest_positions).unwrap().det_f;
-        assert!((det - 1.0).abs() < 1e-12, "{}: {det}", e.name());
-        // mirror one node through the body: some element inverts
-        let mut inverted = mesh.rest_positions.clone();
-        let n = mesh.blocks[0].element(0)[0] as usize;
-        inverted[n].z = 2.0;
-        let MinDetF { det_f: det, block: b, element: el, .. } = min_det_f(&mesh, &geometry, &inverted).unwrap();
-        assert!(det < 0.0, "{}: {det}", e.name());
-        assert!(mesh.blocks[b].element(el).contains(&(n as u32)));
     }
 }
