@@ -61,7 +61,6 @@
 //! the body and unknown physical groups are errors naming the file, the key and the value.
 
 use hox_sim::Vec3;
-use hox_sim::constraint::Formulation;
 use hox_sim::effect::{AxisRotation, Clamp, ContactPlane, Damping, Effect, Gravity, Prescribed};
 use hox_sim::element::ElementType;
 use hox_sim::io::gmsh::ImportedMesh;
@@ -69,6 +68,7 @@ use hox_sim::material::{Material, MaterialModel};
 use hox_sim::mesh::Mesh;
 use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 use hox_sim::solver::SolverSettings;
+use hox_sim::xpbd::constraint::Formulation;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

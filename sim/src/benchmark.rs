@@ -4,7 +4,7 @@
 //! formulation, gravity, clamped at x = 0), ms per frame as the median of timed frames.
 //!
 //! **Flop count.** Per element and substep, with `N` nodes and `Q` quadrature points, the energy
-//! kernel ([`crate::kernels`]) does, counting a fused multiply–add as 2 flops:
+//! kernel ([`crate::xpbd::kernels`]) does, counting a fused multiply–add as 2 flops:
 //! - per point: `F = I + Σ_i u_i ⊗ ∇N_i` (18N), StVK `E`, `S`, `ψ`, `P = F S` (165), and
 //!   `∇_i U += V P ∇N_i` (18N + 9);
 //! - per element: displacements `u_i = x_i − X_i` (3N), `Σ_i w_i |∇_i U|²` (6N), the update
@@ -207,7 +207,7 @@ pub fn markdown(rows: &[BenchRow]) -> String {
 /// case), on each of `threads`
 /// (1: the serial sweep; more: the parallel colour sweep; with `colour_on_one`, also the
 /// colour sweep on one thread, which projects linear tetrahedra four per 256-bit register:
-/// `crate::kernels::p1x4`), reporting each row to `progress` as it is measured (what
+/// `crate::xpbd::kernels::p1x4`), reporting each row to `progress` as it is measured (what
 /// `hox bench` runs).
 pub fn run(
     filter: &str,

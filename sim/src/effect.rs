@@ -229,7 +229,7 @@ impl Effect for ContactPlane {
 
 /// Pulls one node towards a target point through a compliant distance constraint
 /// `C = |x − target|` with compliance `α` (m/N), solved by the XPBD update
-/// ([`crate::constraint::xpbd_step`]). The app creates one while a node is dragged.
+/// ([`crate::xpbd::constraint::xpbd_step`]). The app creates one while a node is dragged.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Attachment {
     pub node: u32,
@@ -260,7 +260,7 @@ impl Effect for Attachment {
             return;
         }
         let alpha_tilde = self.compliance_m_per_n / (s.dt_secs * s.dt_secs);
-        if let Some((d_lambda, step)) = crate::constraint::xpbd_step(c, 1.0, w, alpha_tilde, self.lambda) {
+        if let Some((d_lambda, step)) = crate::xpbd::constraint::xpbd_step(c, 1.0, w, alpha_tilde, self.lambda) {
             self.lambda += d_lambda;
             s.positions[i] += d / c * (step * w);
         }

@@ -24,19 +24,17 @@
 //! - [`benchmark`]: timing the paper's Table 1 beams (`hox bench`, `sim/benches/`).
 
 pub mod benchmark;
-pub mod colouring;
-pub mod constraint;
 pub mod effect;
 pub mod element;
 pub mod fem;
 pub mod io;
-pub mod kernels;
 pub mod material;
 pub mod measure;
 pub mod mesh;
 pub mod solver;
 pub mod stability;
 pub mod statics;
+pub mod xpbd;
 
 pub use nalgebra;
 

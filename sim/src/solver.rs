@@ -4,7 +4,7 @@
 //! 1. applies the effects' accelerations, `v ← v + h a`;
 //! 2. predicts `x ← x + h v` (keeping `x_prev`), then lets effects place pinned/driven nodes;
 //! 3. resets every multiplier `λ ← 0` and runs `k` Gauss–Seidel iterations over the element
-//!    constraints ([`crate::constraint`]), each followed by the effects' own projections;
+//!    constraints ([`crate::xpbd::constraint`]), each followed by the effects' own projections;
 //! 4. updates velocities `v ← (x − x_prev)/h`, then lets effects damp them.
 //!
 //! Defaults are the paper's: 50 substeps × 1 iteration, 60 frames per second. The solver
@@ -21,7 +21,6 @@
 //! state instead of painting garbage, and offers a reset. See `docs/STABILITY.md`.
 
 use crate::Vec3;
-use crate::constraint::{Formulation, MAX_NODES, project_energy_constraint, project_split_constraints};
 use crate::effect::{Effect, EffectState};
 use crate::fem::energy::{element_grads, gather, total_energy};
 use crate::fem::geometry::{BlockGeometry, GeometryError, precompute};
@@ -29,6 +28,7 @@ use crate::fem::mass::lumped_masses_kg;
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshError};
 use crate::stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
+use crate::xpbd::constraint::{Formulation, MAX_NODES, project_energy_constraint, project_split_constraints};
 
 /// Time stepping and constraint settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -148,12 +148,12 @@ pub struct Simulation {
     /// Per block, the elements grouped by colour (no two elements of a colour share a node).
     colours: Vec<Vec<Vec<u32>>>,
     /// Per block, the element data packed for the sweeps (element order and colour order).
-    packed: crate::kernels::SolverData,
-    /// The colour sweep projects linear tetrahedra four at a time ([`crate::kernels::p1x4`]).
+    packed: crate::xpbd::kernels::SolverData,
+    /// The colour sweep projects linear tetrahedra four at a time ([`crate::xpbd::kernels::p1x4`]).
     simd_batches: bool,
     /// Per block, its cut into one slab per thread for the parallel sweep on two or more
     /// threads (built for the current thread count on first use).
-    partitions: Vec<crate::kernels::Partition>,
+    partitions: Vec<crate::xpbd::kernels::Partition>,
     /// Fewest elements per thread for which a block is partitioned.
     partition_min_per_thread: usize,
     time_secs: f64,
@@ -202,10 +202,10 @@ impl Simulation {
             lambdas,
             effects: Vec::with_capacity(effects.len()),
             colours: Vec::new(),
-            packed: crate::kernels::SolverData::default(),
+            packed: crate::xpbd::kernels::SolverData::default(),
             simd_batches: true,
             partitions: Vec::new(),
-            partition_min_per_thread: crate::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD,
+            partition_min_per_thread: crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD,
             time_secs: 0.0,
             frames: 0,
             substeps_in_frame: 0,
@@ -219,15 +219,15 @@ impl Simulation {
             sim.add_effect(e)?;
         }
         sim.colours =
-            sim.mesh.blocks.iter().map(|b| crate::colouring::colour_elements(b, sim.mesh.num_nodes())).collect();
+            sim.mesh.blocks.iter().map(|b| crate::xpbd::colouring::colour_elements(b, sim.mesh.num_nodes())).collect();
         sim.pack_colours();
         sim.update_guard();
         Ok(sim)
     }
 
     fn pack_colours(&mut self) {
-        self.packed = crate::kernels::SolverData::new(&self.mesh.blocks, &self.geometry, &self.colours);
-        self.partitions = vec![crate::kernels::Partition::default(); self.mesh.blocks.len()];
+        self.packed = crate::xpbd::kernels::SolverData::new(&self.mesh.blocks, &self.geometry, &self.colours);
+        self.partitions = vec![crate::xpbd::kernels::Partition::default(); self.mesh.blocks.len()];
     }
 
     fn multipliers(geometry: &[BlockGeometry], formulation: Formulation) -> Vec<Vec<f64>> {
@@ -276,9 +276,9 @@ impl Simulation {
     }
 
     /// On two or more threads the parallel sweep cuts a block of at least `per_thread` elements
-    /// per thread into one slab per thread ([`crate::kernels::Partition`]: two synchronisations
+    /// per thread into one slab per thread ([`crate::xpbd::kernels::Partition`]: two synchronisations
     /// per sweep instead of one per colour); smaller blocks are swept colour by colour. Default
-    /// [`crate::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD`]; `usize::MAX`: never.
+    /// [`crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD`]; `usize::MAX`: never.
     pub fn set_partition_threshold(&mut self, per_thread: usize) {
         self.partition_min_per_thread = per_thread;
     }
@@ -539,7 +539,7 @@ impl Simulation {
             let block = &self.mesh.blocks[bi];
             let n = block.nodes_per_element();
             if self.settings.formulation == Formulation::Energy {
-                use crate::kernels::{Multipliers, Positions, energy_sweep};
+                use crate::xpbd::kernels::{Multipliers, Positions, energy_sweep};
                 let data = self.packed.serial[bi].data();
                 // SAFETY: one thread; the mesh was validated, so its node indices fit positions,
                 // and lambdas holds one multiplier per element.
@@ -601,10 +601,10 @@ impl Simulation {
     /// The parallel sweep: same-colour elements touch disjoint nodes and multipliers, so they
     /// are projected concurrently and the result does not depend on the scheduling. On two or
     /// more threads, large blocks of the energy formulation are swept slab by slab
-    /// ([`crate::kernels::Partition`]), which depends on the thread count.
+    /// ([`crate::xpbd::kernels::Partition`]), which depends on the thread count.
     fn project_elements_parallel(&mut self, inv_dt2: f64) -> Result<(), BadElement> {
         use rayon::prelude::*;
-        let positions = crate::kernels::SharedMut::new(&mut self.positions);
+        let positions = crate::xpbd::kernels::SharedMut::new(&mut self.positions);
         for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
             let block = &self.mesh.blocks[bi];
             let n = block.nodes_per_element();
@@ -614,10 +614,10 @@ impl Simulation {
                 // pointer, and nothing else touches them meanwhile.
                 let all = unsafe { positions.slice_mut(0, positions.len()) };
                 let threads = rayon::current_num_threads();
-                use crate::kernels::BlockSweep;
+                use crate::xpbd::kernels::BlockSweep;
                 let sweep = if threads >= 2 && block.len() >= threads.saturating_mul(self.partition_min_per_thread) {
                     if self.partitions[bi].threads != threads {
-                        self.partitions[bi] = crate::kernels::Partition::new(
+                        self.partitions[bi] = crate::xpbd::kernels::Partition::new(
                             block,
                             &self.geometry[bi],
                             &self.colours[bi],
@@ -629,7 +629,7 @@ impl Simulation {
                 } else {
                     BlockSweep::Colours(&self.packed.colour[bi])
                 };
-                let result = crate::kernels::parallel_energy_block(
+                let result = crate::xpbd::kernels::parallel_energy_block(
                     n,
                     &self.material,
                     all,
@@ -652,11 +652,11 @@ impl Simulation {
                     None => {}
                 }
             }
-            let lambdas = crate::kernels::SharedMut::new(lambdas);
+            let lambdas = crate::xpbd::kernels::SharedMut::new(lambdas);
             for colour in &self.colours[bi] {
                 let projected: Result<usize, BadElement> = colour
                     .par_iter()
-                    .with_min_len(crate::kernels::GENERIC_MIN_ELEMENTS_PER_TASK)
+                    .with_min_len(crate::xpbd::kernels::GENERIC_MIN_ELEMENTS_PER_TASK)
                     .map(|&e| {
                         let e = e as usize;
                         let nodes = block.element(e);

@@ -30,11 +30,11 @@
 //! it; ν, the model, the quadrature or a node's mass recompute it (in parallel over elements).
 
 use crate::Vec3;
-use crate::constraint::Formulation;
 use crate::fem::energy::{element_grads, element_hessian, gather};
 use crate::fem::geometry::BlockGeometry;
 use crate::material::Material;
 use crate::mesh::Mesh;
+use crate::xpbd::constraint::Formulation;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 

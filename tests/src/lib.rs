@@ -15,7 +15,6 @@
 //!   `Σ_i |R X_i + t − x_i|²`, from the SVD of the centred cross-covariance).
 
 use hox_sim::Vec3;
-use hox_sim::constraint::Formulation;
 use hox_sim::effect::{Clamp, Damping, Effect};
 use hox_sim::element::ElementType;
 use hox_sim::material::{Material, MaterialModel};
@@ -24,6 +23,7 @@ use hox_sim::mesh::Mesh;
 use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 use hox_sim::nalgebra::Matrix3;
 use hox_sim::solver::{SimError, Simulation, SolverSettings};
+use hox_sim::xpbd::constraint::Formulation;
 
 /// Standard gravity, m/s².
 pub const GRAVITY_M_S2: Vec3 = Vec3::new(0.0, 0.0, -9.81);

@@ -15,11 +15,11 @@
 //! The 10,000-frame long run is `#[ignore]`d here and run in release by `.ci/run`.
 
 use hox_sim::Vec3;
-use hox_sim::constraint::Formulation;
 use hox_sim::effect::{AxisRotation, ContactPlane, Damping, Effect, EffectState, Gravity, Prescribed};
 use hox_sim::material::{Material, MaterialModel};
 use hox_sim::mesh::Mesh;
 use hox_sim::solver::{SimError, Simulation};
+use hox_sim::xpbd::constraint::Formulation;
 use hox_tests::*;
 
 const SNH: MaterialModel = MaterialModel::StableNeoHookean;

@@ -151,7 +151,7 @@ fn element_scale(positions: &[Vec3], nodes: &[u32]) -> f64 {
 /// node), evaluated as `I + Σ_i (x_i − X_i) ⊗ ∇_X N_i` (equal, since `Σ_i X_i ⊗ ∇_X N_i = I`):
 /// computing from displacements avoids cancellation, so small strains keep their relative
 /// accuracy and an element at rest has exactly `F = I` and zero energy. The one place `F` is
-/// computed outside the specialised sweep ([`crate::kernels`], which forms the same sum in
+/// computed outside the specialised sweep ([`crate::xpbd::kernels`], which forms the same sum in
 /// registers).
 #[inline]
 pub fn deformation_gradient(x: &[Vec3], rest: &[Vec3], grads: &[Vec3]) -> Matrix3<f64> {

@@ -1,10 +1,10 @@
 //! The hot loop of the solver, specialised per element node count: the energy-constraint sweep
 //! over a block (serial in element order, or one colour's contiguous range in the parallel sweep).
 //!
-//! It computes exactly what [`crate::constraint::project_energy_constraint`] computes — for each
+//! It computes exactly what [`crate::xpbd::constraint::project_energy_constraint`] computes — for each
 //! element, `F_q = I + Σ_i (x_i − X_i) ⊗ ∇_X N_i(r_q)`, `U_e = Σ_q V_q ψ(F_q)`,
 //! `∇_i U_e = Σ_q V_q P(F_q) ∇_X N_i(r_q)`, `C = √(2U_e)` and the XPBD update of
-//! [`crate::constraint::xpbd_step`] (the paper's `Δλ = −2U / (Σ_i w_i |∇_i U|² + 2U α̃)` with
+//! [`crate::xpbd::constraint::xpbd_step`] (the paper's `Δλ = −2U / (Σ_i w_i |∇_i U|² + 2U α̃)` with
 //! λ = 0, Saillant et al. §3) — but with the node count `N` a compile-time constant, so that
 //! every per-node loop is unrolled and every scratch array lives in registers or a fixed-size
 //! stack array of exactly `N` entries; and with the material's Lamé parameters computed once per
@@ -19,11 +19,11 @@
 //! element-indexed colour sweep).
 
 use crate::Vec3;
-use crate::constraint::xpbd_step;
 use crate::fem::geometry::BlockGeometry;
 use crate::material::lane::{self, Scalar, madd};
 use crate::material::{Mat3, Material, MaterialModel, stvk};
 use crate::mesh::ElementBlock;
+use crate::xpbd::constraint::xpbd_step;
 
 /// `(ψ(F), P(F))` at one quadrature point: the material law the kernel is generic over.
 pub trait PointMaterial: Sync {
@@ -93,7 +93,7 @@ pub struct NonFiniteElement {
 
 /// A mutable slice shared across threads through a raw pointer: the parallel sweeps hand one
 /// copy to every thread of a colour (or slab), and those threads touch disjoint entries (no two
-/// elements of a colour share a node, [`crate::colouring`]; each element owns its multipliers).
+/// elements of a colour share a node, [`crate::xpbd::colouring`]; each element owns its multipliers).
 /// That disjointness, which the type cannot check, is what every `unsafe` access promises.
 /// Indices are checked against the length (a panic, never an out-of-bounds access); the hot
 /// loops that have already checked an index read and write through [`SharedMut::ptr`].
@@ -625,7 +625,7 @@ pub fn parallel_energy_block(
         let cut = |i: usize| range.start + (4 * (fours * i / chunks)).min(range.len());
         let chunk = |i: usize| cut(i)..cut(i + 1);
         // SAFETY: the chunks of a colour are disjoint ranges of elements that share no node
-        // (crate::colouring) and own their multipliers; node and element indices come from the
+        // (crate::xpbd::colouring) and own their multipliers; node and element indices come from the
         // mesh the positions and multipliers were sized for.
         let run = |i: usize| unsafe {
             colour_sweep(

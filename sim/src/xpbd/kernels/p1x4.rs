@@ -5,7 +5,7 @@
 //! non-finite check of the scalar sweep: `F = I + [u₁−u₀, u₂−u₀, u₃−u₀] G`, `(ψ, P)` by the one
 //! StVK point law ([`crate::material::stvk::energy_and_pk1`] on the four-lane [`Lane`] type),
 //! `[∇₁U ∇₂U ∇₃U] = V P Gᵀ`, `∇₀U = −Σ`, `C = √(2 max(VΨ, 0))` and the update of
-//! [`crate::constraint::xpbd_step`] with its guards (no update where `Σ w|∇U|² + α̃C² ≤
+//! [`crate::xpbd::constraint::xpbd_step`] with its guards (no update where `Σ w|∇U|² + α̃C² ≤
 //! f64::MIN_POSITIVE` or NaN, or where the step is not finite). An element whose nodes are all
 //! pinned is skipped (its multiplier and nodes untouched), as in the scalar sweep. Results equal
 //! the scalar colour sweep's up to the order of floating-point operations.

@@ -1,7 +1,7 @@
 use super::*;
-use crate::constraint::project_energy_constraint;
 use crate::fem::energy::element_grads;
 use crate::fem::energy::tests::{elements, materials};
+use crate::xpbd::constraint::project_energy_constraint;
 
 /// The specialised sweep projects one element exactly as the generic kernel does, up to the
 /// order of floating-point operations, for every element type and material; the colour-packed
@@ -109,7 +109,7 @@ fn p1_beam(refine: usize) -> (crate::mesh::Mesh, Vec<crate::fem::geometry::Block
     .build()
     .unwrap();
     let geo = crate::fem::geometry::precompute(&mesh, None).unwrap();
-    let colours = crate::colouring::colour_elements(&mesh.blocks[0], mesh.num_nodes());
+    let colours = crate::xpbd::colouring::colour_elements(&mesh.blocks[0], mesh.num_nodes());
     let packed = PackedBlock::in_colour_order(&mesh.blocks[0], &geo[0], &colours);
     (mesh, geo, colours, packed)
 }

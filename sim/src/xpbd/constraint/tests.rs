@@ -1,7 +1,7 @@
 use super::*;
-use crate::constraint::MAX_NODES;
 use crate::fem::energy::element_grads;
 use crate::fem::energy::tests::{elements, materials};
+use crate::xpbd::constraint::MAX_NODES;
 use proptest::prelude::*;
 
 #[test]
