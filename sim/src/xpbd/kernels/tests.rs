@@ -1,4 +1,5 @@
 use super::*;
+use crate::Vec3;
 use crate::fem::energy::element_grads;
 use crate::fem::energy::tests::{elements, materials};
 use crate::xpbd::constraint::project_energy_constraint;
