@@ -128,16 +128,16 @@ impl Instance {
 }
 
 /// Solves the static equilibrium of `scene` on `mesh` ([`static_problem`] with
-/// [`hox_sim::statics::solve`]); `progress` as there.
+/// [`hox_sim::solver::statics::solve`]); `progress` as there.
 pub fn solve_static(
     scene: &Scene,
     mesh: &hox_sim::mesh::Mesh,
     tolerance: f64,
     load_steps: usize,
-    progress: hox_sim::statics::Progress<'_>,
-) -> Result<hox_sim::statics::StaticSolution, SceneError> {
+    progress: hox_sim::solver::statics::Progress<'_>,
+) -> Result<hox_sim::solver::statics::StaticSolution, SceneError> {
     let (acceleration_m_s2, dirichlet) = static_problem(scene, mesh)?;
-    let problem = hox_sim::statics::StaticProblem {
+    let problem = hox_sim::solver::statics::StaticProblem {
         mesh,
         material: scene.material,
         quadrature_degree: scene.settings.quadrature_degree,
@@ -146,7 +146,7 @@ pub fn solve_static(
         tolerance,
         load_steps,
     };
-    hox_sim::statics::solve(&problem, progress).map_err(|e| SceneError::Simulation {
+    hox_sim::solver::statics::solve(&problem, progress).map_err(|e| SceneError::Simulation {
         source_name: scene.source.clone(),
         message: format!("static solve: {e}"),
     })
@@ -166,7 +166,7 @@ pub fn static_problem(
         let select = |nodes| scene.selected_nodes(mesh, k, nodes);
         match spec {
             EffectSpec::Gravity { acceleration_m_s2 } => acceleration += hox_sim::Vec3::from(*acceleration_m_s2),
-            EffectSpec::Clamp { nodes } => dirichlet.push(hox_sim::statics::clamp(select(nodes)?)),
+            EffectSpec::Clamp { nodes } => dirichlet.push(hox_sim::solver::statics::clamp(select(nodes)?)),
             EffectSpec::Prescribed { nodes, .. } => {
                 let mut p = spec.prescribed(select(nodes)?).expect("a prescribed spec");
                 p.ramp_secs = 1.0; // evaluated at "time" = load fraction

@@ -26,7 +26,7 @@
 //! duration_secs = 3       # default run length
 //! settle_damping_per_sec = 10  # velocity damping used by --settle
 //! parallel = false        # project elements colour by colour on all threads
-//! stability_guard = true   # above h·ω_max = 3, substeps with h·ω_max ≤ 1 (hox_sim::stability)
+//! stability_guard = true   # above h·ω_max = 3, substeps with h·ω_max ≤ 1 (hox_sim::solver::stability)
 //! [[effects]]             # only the effects listed are simulated
 //! type = "gravity"        # gravity | clamp | prescribed | damping | contact
 //! acceleration_m_s2 = [0, 0, -9.81]
@@ -135,7 +135,7 @@ pub struct SolverSpec {
     pub settle_damping_per_sec: f64,
     /// Project elements in parallel, colour by colour.
     pub parallel: bool,
-    /// Take more substeps when the stiffest element needs them (`hox_sim::stability`).
+    /// Take more substeps when the stiffest element needs them (`hox_sim::solver::stability`).
     pub stability_guard: bool,
 }
 

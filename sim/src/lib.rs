@@ -32,8 +32,6 @@ pub mod material;
 pub mod measure;
 pub mod mesh;
 pub mod solver;
-pub mod stability;
-pub mod statics;
 pub mod xpbd;
 
 pub use nalgebra;

@@ -392,7 +392,7 @@ fn load_and_release_within(
 /// work of gravity in the first frames (measured up to 5.3 %: Q2, energy formulation, ν = 0.49,
 /// `h ω_max` 1.43): the bound here is 10 % of `|V_g|max`. With the energy formulation at
 /// ν ≥ 0.45 the stability guard steps in from `h ω_max` 1.5 on
-/// ([`hox_sim::stability::guard_trigger_h_omega`]; at 1.57–2.09 it overshot by 10–17 % with the
+/// ([`hox_sim::solver::stability::guard_trigger_h_omega`]; at 1.57–2.09 it overshot by 10–17 % with the
 /// trigger of 3). P1's locking shows as a much smaller sag (figures printed; the static
 /// comparison is in docs/STABILITY.md).
 #[test]

@@ -22,7 +22,7 @@ pub struct Config {
     pub substeps: u32,
     pub iterations: u32,
     pub frames_per_second: f64,
-    /// More substeps where the stiffest element needs them (`hox_sim::stability`).
+    /// More substeps where the stiffest element needs them (`hox_sim::solver::stability`).
     #[serde(default = "guard_on")]
     pub stability_guard: bool,
 }

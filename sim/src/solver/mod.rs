@@ -10,6 +10,11 @@
 //! Defaults are the paper's: 50 substeps × 1 iteration, 60 frames per second. The solver
 //! gathers each element's nodes, calls a pure kernel, and scatters the corrections back.
 //!
+//! Where things are: `settings.rs` (what a run is asked to do, [`SolverSettings`]); `sweep.rs`
+//! (one Gauss–Seidel sweep over the element constraints, serial or parallel, through
+//! [`crate::xpbd`]); `nan_guard.rs` (the NaN guard below); [`stability`] (the substep guard);
+//! [`statics`] (the static equilibrium XPBD settles to, by Newton's method).
+//!
 //! **NaN guard.** A kernel whose corrections come out non-finite is not scattered: the substep
 //! stops there with [`SimError::NonFinite`] naming that element (block and index), its bad node,
 //! the frame, the substep within the frame and the time. After every substep all positions and
@@ -20,73 +25,23 @@
 //! [`Simulation::reset`] (or [`Simulation::warm_start`]): a viewer keeps showing the last sound
 //! state instead of painting garbage, and offers a reset. See `docs/STABILITY.md`.
 
+mod nan_guard;
+mod settings;
+pub mod stability;
+pub mod statics;
+mod sweep;
+
+pub use settings::SolverSettings;
+
 use crate::Vec3;
 use crate::effect::{Effect, EffectState};
-use crate::fem::energy::{element_grads, gather, total_energy};
+use crate::fem::energy::total_energy;
 use crate::fem::geometry::{BlockGeometry, GeometryError, precompute};
 use crate::fem::mass::lumped_masses_kg;
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshError};
-use crate::stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
-use crate::xpbd::constraint::{Formulation, MAX_NODES, project_energy_constraint, project_split_constraints};
-
-/// Time stepping and constraint settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SolverSettings {
-    pub substeps: u32,
-    pub iterations: u32,
-    pub frames_per_second: f64,
-    pub formulation: Formulation,
-    /// Quadrature degree for the elastic energy; None: each element type's default.
-    pub quadrature_degree: Option<usize>,
-    /// Project same-colour elements in parallel (rayon's thread pool); otherwise serially in
-    /// element order. Both are Gauss–Seidel sweeps, in different orders. On two or more
-    /// threads a large block is cut into one slab per thread instead
-    /// ([`Simulation::set_partition_threshold`]); that order depends on the thread count.
-    pub parallel: bool,
-    /// The stability guard ([`crate::stability`]): when the requested substep has `h ω_max`
-    /// above [`crate::stability::guard_trigger_h_omega`] (3; 1.5 for the energy formulation at
-    /// ν ≥ 0.45), take enough substeps for
-    /// `h ω_max ≤` [`crate::stability::GUARD_H_OMEGA`]. On by default; the paper's scenes are
-    /// below the trigger and unaffected.
-    pub stability_guard: bool,
-}
-
-impl Default for SolverSettings {
-    fn default() -> Self {
-        Self {
-            substeps: 50,
-            iterations: 1,
-            frames_per_second: 60.0,
-            formulation: Formulation::Energy,
-            quadrature_degree: None,
-            parallel: false,
-            stability_guard: true,
-        }
-    }
-}
-
-impl SolverSettings {
-    pub fn validate(&self) -> Result<(), SimError> {
-        let bad = |what: String| Err(SimError::Settings(what));
-        if self.substeps == 0 {
-            return bad("substeps must be at least 1, got 0".into());
-        }
-        if self.iterations == 0 {
-            return bad("iterations must be at least 1, got 0".into());
-        }
-        if !(self.frames_per_second.is_finite() && self.frames_per_second > 0.0) {
-            return bad(format!("frames per second must be a finite positive number, got {}", self.frames_per_second));
-        }
-        Ok(())
-    }
-    /// The substep length `h`, seconds.
-    /// `1/(fps · substeps)`: the requested substep; the one taken may be shorter
-    /// ([`Simulation::substep_dt_secs`], the stability guard).
-    pub fn substep_dt_secs(&self) -> f64 {
-        1.0 / (self.frames_per_second * self.substeps as f64)
-    }
-}
+use crate::xpbd::constraint::Formulation;
+use stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
@@ -415,7 +370,7 @@ impl Simulation {
     }
 
     /// The stability guard's findings: the fastest element mode, `h ω_max` with the requested
-    /// substeps, and the substeps per frame taken ([`crate::stability`]).
+    /// substeps, and the substeps per frame taken ([`crate::solver::stability`]).
     pub fn stability(&mut self) -> StabilityReport {
         let (omega2_normalised, block, element) = self.omega2_normalised();
         let omega_max_rad_s =
@@ -525,221 +480,6 @@ impl Simulation {
         }
     }
 
-    /// One Gauss–Seidel sweep over every element constraint: in element order, or colour by
-    /// colour with the elements of a colour projected in parallel.
-    /// Stops at the first element whose corrections come out non-finite (not scattered) and
-    /// returns it.
-    fn project_elements(&mut self, h: f64) -> Result<(), BadElement> {
-        let inv_dt2 = 1.0 / (h * h);
-        if self.settings.parallel {
-            return self.project_elements_parallel(inv_dt2);
-        }
-        let mut x = [Vec3::zeros(); MAX_NODES];
-        for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
-            let block = &self.mesh.blocks[bi];
-            let n = block.nodes_per_element();
-            if self.settings.formulation == Formulation::Energy {
-                use crate::xpbd::kernels::{Multipliers, Positions, energy_sweep};
-                let data = self.packed.serial[bi].data();
-                // SAFETY: one thread; the mesh was validated, so its node indices fit positions,
-                // and lambdas holds one multiplier per element.
-                let fast = unsafe {
-                    energy_sweep(
-                        n,
-                        &self.material,
-                        Positions::new(&mut self.positions),
-                        &self.mesh.rest_positions,
-                        &self.inv_mass,
-                        &data,
-                        0..block.len(),
-                        Multipliers::new(lambdas),
-                        inv_dt2,
-                    )
-                };
-                match fast {
-                    Some(Ok(projected)) => {
-                        self.counters.element_projections += projected;
-                        continue;
-                    }
-                    Some(Err(bad)) => {
-                        return Err(BadElement::projected(
-                            bi,
-                            bad.element,
-                            bad.node,
-                            block.element(bad.element),
-                            |i| self.positions[i],
-                        ));
-                    }
-                    None => {}
-                }
-            }
-            let per_element = lambdas.len() / block.len().max(1);
-            for (e, nodes) in block.elements().enumerate() {
-                let lambda = &mut lambdas[e * per_element..(e + 1) * per_element];
-                let ctx = ProjectionContext {
-                    rest: &self.mesh.rest_positions,
-                    inv_mass: &self.inv_mass,
-                    material: &self.material,
-                    formulation: self.settings.formulation,
-                    inv_dt2,
-                };
-                let positions = &self.positions;
-                if ctx.project(|i| positions[i], &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
-                    if let Some(node) = non_finite_node(&x[..n], nodes) {
-                        return Err(BadElement::projected(bi, e, node, nodes, |i| positions[i]));
-                    }
-                    for (xi, &node) in x.iter().zip(nodes) {
-                        self.positions[node as usize] = *xi;
-                    }
-                    self.counters.element_projections += 1;
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// The parallel sweep: same-colour elements touch disjoint nodes and multipliers, so they
-    /// are projected concurrently and the result does not depend on the scheduling. On two or
-    /// more threads, large blocks of the energy formulation are swept slab by slab
-    /// ([`crate::xpbd::kernels::Partition`]), which depends on the thread count.
-    fn project_elements_parallel(&mut self, inv_dt2: f64) -> Result<(), BadElement> {
-        use rayon::prelude::*;
-        let positions = crate::xpbd::kernels::SharedMut::new(&mut self.positions);
-        for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
-            let block = &self.mesh.blocks[bi];
-            let n = block.nodes_per_element();
-            let per_element = lambdas.len() / block.len().max(1);
-            if self.settings.formulation == Formulation::Energy {
-                // SAFETY of the aliasing: the specialised sweep writes positions through its own
-                // pointer, and nothing else touches them meanwhile.
-                let all = unsafe { positions.slice_mut(0, positions.len()) };
-                let threads = rayon::current_num_threads();
-                use crate::xpbd::kernels::BlockSweep;
-                let sweep = if threads >= 2 && block.len() >= threads.saturating_mul(self.partition_min_per_thread) {
-                    if self.partitions[bi].threads != threads {
-                        self.partitions[bi] = crate::xpbd::kernels::Partition::new(
-                            block,
-                            &self.geometry[bi],
-                            &self.colours[bi],
-                            &self.mesh.rest_positions,
-                            threads,
-                        );
-                    }
-                    BlockSweep::Slabs(&self.partitions[bi])
-                } else {
-                    BlockSweep::Colours(&self.packed.colour[bi])
-                };
-                let result = crate::xpbd::kernels::parallel_energy_block(
-                    n,
-                    &self.material,
-                    all,
-                    &self.mesh.rest_positions,
-                    &self.inv_mass,
-                    sweep,
-                    lambdas,
-                    inv_dt2,
-                    self.simd_batches,
-                );
-                match result {
-                    Some(Ok(projected)) => {
-                        self.counters.element_projections += projected;
-                        continue;
-                    }
-                    Some(Err(bad)) => {
-                        let read = |i: usize| unsafe { positions.read(i) };
-                        return Err(BadElement::projected(bi, bad.element, bad.node, block.element(bad.element), read));
-                    }
-                    None => {}
-                }
-            }
-            let lambdas = crate::xpbd::kernels::SharedMut::new(lambdas);
-            for colour in &self.colours[bi] {
-                let projected: Result<usize, BadElement> = colour
-                    .par_iter()
-                    .with_min_len(crate::xpbd::kernels::GENERIC_MIN_ELEMENTS_PER_TASK)
-                    .map(|&e| {
-                        let e = e as usize;
-                        let nodes = block.element(e);
-                        // SAFETY: no two elements of a colour share a node (colouring.rs), and
-                        // each element owns its multipliers: concurrent writes are disjoint.
-                        let lambda = unsafe { lambdas.slice_mut(e * per_element, per_element) };
-                        let ctx = ProjectionContext {
-                            rest: &self.mesh.rest_positions,
-                            inv_mass: &self.inv_mass,
-                            material: &self.material,
-                            formulation: self.settings.formulation,
-                            inv_dt2,
-                        };
-                        let mut x = [Vec3::zeros(); MAX_NODES];
-                        // SAFETY: reads only this element's nodes, which no other thread writes.
-                        let read = |i: usize| unsafe { positions.read(i) };
-                        if !ctx.project(read, &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
-                            return Ok(0);
-                        }
-                        if let Some(node) = non_finite_node(&x[..n], nodes) {
-                            return Err(BadElement::projected(bi, e, node, nodes, read));
-                        }
-                        for (xi, &node) in x.iter().zip(nodes) {
-                            // SAFETY: as above.
-                            unsafe { positions.write(node as usize, *xi) };
-                        }
-                        Ok(1)
-                    })
-                    .sum();
-                self.counters.element_projections += projected? as u64;
-            }
-        }
-        Ok(())
-    }
-
-    /// The first node whose position or velocity is not finite, with an element holding it.
-    fn first_non_finite(&self) -> Option<BadElement> {
-        let node = self
-            .positions
-            .iter()
-            .zip(&self.velocities)
-            .position(|(x, v)| !(x.iter().chain(v.iter()).all(|c| c.is_finite())))?;
-        let (block, element) = self
-            .mesh
-            .blocks
-            .iter()
-            .enumerate()
-            .find_map(|(bi, b)| b.elements().position(|el| el.contains(&(node as u32))).map(|e| (bi, e)))
-            .unwrap_or((0, 0));
-        Some(BadElement { block, element, node: node as u32, origin: ORIGIN_STATE })
-    }
-
-    /// Builds the NaN guard's error, puts the state back to the last finite positions (the
-    /// start of this substep, else the rest shape) at rest, and stops the simulation until reset.
-    fn fail(&mut self, bad: BadElement) -> SimError {
-        let err = SimError::NonFinite {
-            block: bad.block,
-            element: bad.element,
-            element_type: self
-                .mesh
-                .blocks
-                .get(bad.block)
-                .map(|b| b.element_type.to_string())
-                .unwrap_or_else(|| "none".into()),
-            node: bad.node as usize,
-            origin: bad.origin,
-            frame: self.frames + 1,
-            substep_in_frame: self.substeps_in_frame,
-            substeps_per_frame: self.substeps_per_frame,
-            substep: self.counters.substeps,
-            time_secs: self.time_secs,
-        };
-        let last = if self.prev_positions.iter().all(|x| x.iter().all(|c| c.is_finite())) {
-            &self.prev_positions
-        } else {
-            &self.mesh.rest_positions
-        };
-        self.positions.clone_from(last);
-        self.velocities.iter_mut().for_each(|v| *v = Vec3::zeros());
-        self.failure = Some(err.clone());
-        err
-    }
-
     /// Kinetic energy `½ Σ m_i |v_i|²`, joules.
     pub fn kinetic_energy_j(&self) -> f64 {
         0.5 * self.masses_kg.iter().zip(&self.velocities).map(|(m, v)| m * v.norm_squared()).sum::<f64>()
@@ -753,104 +493,6 @@ impl Simulation {
     /// Displacements `x − X` of every node.
     pub fn displacements(&self) -> Vec<Vec3> {
         self.positions.iter().zip(&self.mesh.rest_positions).map(|(x, x0)| x - x0).collect()
-    }
-}
-
-/// An element the NaN guard names: block, index in the block, one of its non-finite nodes, and
-/// what went wrong.
-#[derive(Clone, Copy, Debug)]
-struct BadElement {
-    block: usize,
-    element: usize,
-    node: u32,
-    origin: &'static str,
-}
-
-/// The guard's wording when an element's projection turned finite positions into non-finite ones.
-const ORIGIN_PROJECTION: &str = "the projection of";
-/// … when the element was handed a non-finite position (by an effect or the caller).
-const ORIGIN_INPUT: &str = "a non-finite position handed to";
-/// … when the check after the substep finds a non-finite position or velocity.
-const ORIGIN_STATE: &str = "a non-finite position or velocity in";
-
-impl BadElement {
-    /// Element `e` of block `block` produced non-finite corrections at `node`; `read` gives the
-    /// (unchanged) positions it was handed, to tell its own failure from bad input.
-    fn projected(block: usize, element: usize, node: u32, nodes: &[u32], read: impl Fn(usize) -> Vec3) -> Self {
-        let input_finite = nodes.iter().all(|&n| read(n as usize).iter().all(|c| c.is_finite()));
-        Self { block, element, node, origin: if input_finite { ORIGIN_PROJECTION } else { ORIGIN_INPUT } }
-    }
-}
-
-/// The first node of an element whose gathered position `x` is not finite.
-#[inline]
-fn non_finite_node(x: &[Vec3], nodes: &[u32]) -> Option<u32> {
-    x.iter().zip(nodes).find(|(xi, _)| !xi.iter().all(|c| c.is_finite())).map(|(_, &n)| n)
-}
-
-/// What projecting one element needs to read.
-struct ProjectionContext<'a> {
-    rest: &'a [Vec3],
-    inv_mass: &'a [f64],
-    material: &'a Material,
-    formulation: Formulation,
-    inv_dt2: f64,
-}
-
-impl ProjectionContext<'_> {
-    /// Gathers element `e`, projects its constraints into `x` (updating its multipliers) and
-    /// returns true, or false when all its nodes are pinned.
-    #[inline]
-    fn project(
-        &self,
-        read: impl Fn(usize) -> Vec3,
-        g: &BlockGeometry,
-        e: usize,
-        nodes: &[u32],
-        lambda: &mut [f64],
-        x: &mut [Vec3],
-    ) -> bool {
-        let n = x.len();
-        let mut w = [0.0; MAX_NODES];
-        let mut rest = [Vec3::zeros(); MAX_NODES];
-        let (w, rest) = (&mut w[..n], &mut rest[..n]);
-        for (wi, &node) in w.iter_mut().zip(nodes) {
-            *wi = self.inv_mass[node as usize];
-        }
-        if w.iter().all(|&wi| wi == 0.0) {
-            return false;
-        }
-        for (xi, &node) in x.iter_mut().zip(nodes) {
-            *xi = read(node as usize);
-        }
-        gather(self.rest, nodes, rest);
-        match self.formulation {
-            Formulation::Energy => {
-                project_energy_constraint(
-                    x,
-                    rest,
-                    w,
-                    element_grads(g, e),
-                    g.volumes(e),
-                    self.material,
-                    self.inv_dt2,
-                    &mut lambda[0],
-                );
-            }
-            Formulation::Split => {
-                project_split_constraints(
-                    x,
-                    rest,
-                    w,
-                    element_grads(g, e),
-                    g.volumes(e),
-                    self.material,
-                    self.inv_dt2,
-                    lambda,
-                );
-            }
-        }
-        true
     }
 }
 
