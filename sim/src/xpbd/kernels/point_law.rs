@@ -1,7 +1,7 @@
 //! The material law the sweep is generic over ([`PointMaterial`]): `(ψ(F), P(F))` at one
 //! quadrature point. [`Stvk`] is Saint-Venant–Kirchhoff with its Lamé parameters computed once
 //! per sweep, through the one StVK point law ([`crate::material::stvk::energy_and_pk1`]); every
-//! other model goes through [`AnyMaterial`] (the material's own dispatch).
+//! other model goes through [`AnyMaterial`] (its registered law: one indirect call per point).
 
 use crate::material::lane::{self, Scalar};
 use crate::material::{Mat3, Material, stvk};

@@ -52,8 +52,7 @@ pub unsafe fn energy_sweep(
     macro_rules! dispatch {
         ($(($n:literal, $p:literal)),*) => {
             match nodes_per_element {
-                $($n => Some(match material.model {
-                    MaterialModel::StVenantKirchhoff => {
+                $($n => Some(if material.model == MaterialModel::StVenantKirchhoff {
                         let l = material.lame();
                         let m = Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa };
                         #[cfg(target_arch = "x86_64")]
@@ -63,10 +62,10 @@ pub unsafe fn energy_sweep(
                         }
                         // SAFETY: forwarded from the caller.
                         unsafe { sweep::<$n, $p, false, _>(&m, io, range) }
-                    }
-                    // SAFETY: as above.
-                    _ => unsafe { sweep::<$n, $p, false, _>(&AnyMaterial(material), io, range) },
-                }),)*
+                    } else {
+                        // SAFETY: as above.
+                        unsafe { sweep::<$n, $p, false, _>(&AnyMaterial(material), io, range) }
+                    }),)*
                 _ => None,
             }
         };
