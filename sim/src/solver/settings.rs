@@ -16,7 +16,7 @@ pub struct SolverSettings {
     /// Project same-colour elements in parallel (rayon's thread pool); otherwise serially in
     /// element order. Both are Gauss–Seidel sweeps, in different orders. On two or more
     /// threads a large block is cut into one slab per thread instead
-    /// ([`Simulation::set_partition_threshold`]); that order depends on the thread count.
+    /// ([`Simulation::set_partition_threshold`](super::Simulation::set_partition_threshold)); that order depends on the thread count.
     pub parallel: bool,
     /// The stability guard ([`crate::solver::stability`]): when the requested substep has `h ω_max`
     /// above [`crate::solver::stability::guard_trigger_h_omega`] (3; 1.5 for the energy formulation at
@@ -56,7 +56,7 @@ impl SolverSettings {
     }
     /// The substep length `h`, seconds.
     /// `1/(fps · substeps)`: the requested substep; the one taken may be shorter
-    /// ([`Simulation::substep_dt_secs`], the stability guard).
+    /// ([`Simulation::substep_dt_secs`](super::Simulation::substep_dt_secs), the stability guard).
     pub fn substep_dt_secs(&self) -> f64 {
         1.0 / (self.frames_per_second * self.substeps as f64)
     }

@@ -45,7 +45,7 @@ pub struct PackedBlock {
     pub points: usize,
     /// Linear tetrahedra in colour order only: the gradients and volumes of each colour's
     /// first `4 ⌊len/4⌋` elements in batches of four, lane-interleaved (`p1x4::BATCH_VALUES`
-    /// per batch; see [`colour_sweep`]). Empty otherwise.
+    /// per batch; see [`colour_sweep`](super::colour_sweep)). Empty otherwise.
     pub p1x4: Vec<f64>,
     /// The first batch of colour `c` in [`PackedBlock::p1x4`] (one more entry than colours).
     pub colour_batches: Vec<usize>,

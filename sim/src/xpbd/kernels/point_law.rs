@@ -8,7 +8,7 @@ use crate::material::{Mat3, Material, stvk};
 
 /// `(ψ(F), P(F))` at one quadrature point: the material law the kernel is generic over.
 pub trait PointMaterial: Sync {
-    /// `FMA`: products may use fused multiply–adds ([`mul3`]).
+    /// `FMA`: products may use fused multiply–adds ([`mul3`](super::mul3)).
     fn energy_and_pk1<const FMA: bool>(&self, f: &Mat3) -> (f64, Mat3);
 }
 
