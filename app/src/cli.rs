@@ -136,7 +136,7 @@ pub struct SceneArgs {
 
 /// The stability guard's findings for a built scene; a note on stderr when it raised the
 /// substeps (docs/STABILITY.md).
-pub fn note_stability(instance: &mut Instance) -> hox_sim::stability::StabilityReport {
+pub fn note_stability(instance: &mut Instance) -> hox_sim::solver::stability::StabilityReport {
     let stability = instance.sim.stability();
     if stability.raised() {
         eprintln!("note: {}", stability.summary());

@@ -3,7 +3,7 @@
 //! Entity layout (one recording may hold several configurations side by side):
 //! - `world/<config>`: a static `Transform3D` offsetting the configuration in space;
 //! - `world/<config>/surface`: the deformed boundary surface (`Mesh3D`), curved faces tessellated
-//!   ([`hox_sim::surface`]), coloured by displacement magnitude on a fixed range (viridis);
+//!   ([`hox_sim::measure::surface`]), coloured by displacement magnitude on a fixed range (viridis);
 //! - `world/<config>/edges`: element edges (`LineStrips3D`, curved for high-order elements);
 //! - `world/<config>/rest_edges`: the rest shape's edges, static, as a ghost;
 //! - `world/<config>/probes`, `world/<config>/quadrature_points` (on request): `Points3D`;
@@ -18,7 +18,7 @@
 use crate::colour::ColourRange;
 use hox_scenes::Instance;
 use hox_sim::Vec3;
-use hox_sim::surface::{PointMap, Surface};
+use hox_sim::measure::surface::{PointMap, Surface};
 use rerun::RecordingStream;
 
 /// What to log besides the always-present surface, edges, probes and time series.
@@ -94,8 +94,9 @@ impl SimLogger {
         let name = entity_name(name);
         let mesh = instance.sim.mesh();
         let surface = Surface::new(mesh, settings.segments);
-        let quadrature =
-            settings.quadrature_points.then(|| hox_sim::surface::quadrature_points(mesh, instance.sim.geometry()));
+        let quadrature = settings
+            .quadrature_points
+            .then(|| hox_sim::measure::surface::quadrature_points(mesh, instance.sim.geometry()));
         let (lo, hi) = mesh.bounding_box();
         let extent = hi - lo;
         let colours = ColourRange { max_m: settings.colour_max_m.unwrap_or(0.2 * extent.max()) };
@@ -259,7 +260,8 @@ impl SimLogger {
                 )?;
             }
         }
-        let (min_det_f, _) = hox_sim::surface::min_det_f(mesh, sim.geometry(), &sim.positions);
+        let min_det_f =
+            hox_sim::measure::min_det_f(mesh, sim.geometry(), &sim.positions).map_or(f64::INFINITY, |m| m.det_f);
         for (quantity, value) in [
             ("kinetic_energy_j", sim.kinetic_energy_j()),
             ("elastic_energy_j", sim.elastic_energy_j()),

@@ -1,4 +1,4 @@
-//! The stability guard's figures (`hox_sim::stability`) for every built-in scene and every
+//! The stability guard's figures (`hox_sim::solver::stability`) for every built-in scene and every
 //! benchmark beam at their own settings: the fastest element mode ω_max, `h ω_max` with the
 //! requested substeps, and the substeps the guard takes. docs/STABILITY.md quotes this table.
 //!
@@ -7,7 +7,7 @@
 fn main() {
     println!("| configuration | elements | ω_max (rad/s) | substeps asked | h·ω_max | substeps taken |");
     println!("|---|---|---|---|---|---|");
-    let row = |label: String, elements: usize, r: hox_sim::stability::StabilityReport| {
+    let row = |label: String, elements: usize, r: hox_sim::solver::stability::StabilityReport| {
         println!(
             "| {label} | {elements} | {:.4e} | {} | {:.3} | {} |",
             r.omega_max_rad_s, r.requested_substeps, r.requested_h_omega, r.substeps

@@ -13,7 +13,7 @@ pub use params::{Params, SceneOverrides};
 pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, median, run, run_observed};
 pub use scene::{Drive, NodeSelector, Scene, SceneFile, SceneMesh};
 
-use hox_sim::probe::Probe;
+use hox_sim::measure::probe::Probe;
 use hox_sim::solver::Simulation;
 
 /// The built-in scenes: (name, TOML text). Adding a scene: its file plus one line here.
@@ -101,12 +101,9 @@ impl Instance {
 
     /// Writes the current state as the next frame of `series`: current positions,
     /// `displacement_m` per point and the volume-averaged von Mises stress per cell
-    /// (`von_mises_stress_pa`); see [`hox_sim::mesh::vtk`].
-    pub fn write_vtk_frame(
-        &self,
-        series: &mut hox_sim::mesh::vtk::PvdSeries,
-    ) -> Result<std::path::PathBuf, SceneError> {
-        use hox_sim::mesh::vtk::{DataArray, von_mises_stress_pa};
+    /// (`von_mises_stress_pa`); see [`hox_sim::io::vtk`].
+    pub fn write_vtk_frame(&self, series: &mut hox_sim::io::vtk::PvdSeries) -> Result<std::path::PathBuf, SceneError> {
+        use hox_sim::io::vtk::{DataArray, von_mises_stress_pa};
         let sim = &self.sim;
         let stress = von_mises_stress_pa(sim.mesh(), sim.geometry(), sim.material(), &sim.positions);
         series
@@ -133,16 +130,16 @@ impl Instance {
 }
 
 /// Solves the static equilibrium of `scene` on `mesh` ([`static_problem`] with
-/// [`hox_sim::statics::solve`]); `progress` as there.
+/// [`hox_sim::solver::statics::solve`]); `progress` as there.
 pub fn solve_static(
     scene: &Scene,
     mesh: &hox_sim::mesh::Mesh,
     tolerance: f64,
     load_steps: usize,
-    progress: hox_sim::statics::Progress<'_>,
-) -> Result<hox_sim::statics::StaticSolution, SceneError> {
+    progress: hox_sim::solver::statics::Progress<'_>,
+) -> Result<hox_sim::solver::statics::StaticSolution, SceneError> {
     let (acceleration_m_s2, dirichlet) = static_problem(scene, mesh)?;
-    let problem = hox_sim::statics::StaticProblem {
+    let problem = hox_sim::solver::statics::StaticProblem {
         mesh,
         material: scene.material(),
         quadrature_degree: scene.settings().quadrature_degree,
@@ -151,7 +148,7 @@ pub fn solve_static(
         tolerance,
         load_steps,
     };
-    hox_sim::statics::solve(&problem, progress).map_err(|e| SceneError::Simulation {
+    hox_sim::solver::statics::solve(&problem, progress).map_err(|e| SceneError::Simulation {
         source_name: scene.source.clone(),
         message: format!("static solve: {e}"),
     })
@@ -171,7 +168,7 @@ pub fn static_problem(
         let select = |nodes| scene.selected_nodes(mesh, k, nodes);
         match spec {
             EffectSpec::Gravity { acceleration_m_s2 } => acceleration += hox_sim::Vec3::from(*acceleration_m_s2),
-            EffectSpec::Clamp { nodes } => dirichlet.push(hox_sim::statics::clamp(select(nodes)?)),
+            EffectSpec::Clamp { nodes } => dirichlet.push(hox_sim::solver::statics::clamp(select(nodes)?)),
             EffectSpec::Prescribed { nodes, .. } => {
                 let mut p = spec.prescribed(select(nodes)?).expect("a prescribed spec");
                 p.ramp_secs = 1.0; // evaluated at "time" = load fraction

@@ -16,10 +16,10 @@
 //! **Adding a parameter** is one entry in the `params!` invocation below plus the code that uses
 //! the value (e.g. `SolverSettings`); nothing else lists parameters.
 
-use hox_sim::constraint::Formulation;
 use hox_sim::element::ElementType;
 use hox_sim::material::MaterialModel;
 use hox_sim::mesh::structured::TetSplit;
+use hox_sim::xpbd::constraint::Formulation;
 use serde::{Deserialize, Serialize};
 
 /// How much of a running simulation a change of a parameter invalidates (the app's rebuild
@@ -510,7 +510,7 @@ pub fn box_elements(p: &Params) -> Option<u64> {
 pub fn box_bytes(p: &Params) -> Option<u64> {
     let e = ElementType::from_name(&p.element)?;
     let nodes = e.num_nodes() as u64;
-    let qp = hox_sim::quadrature::rule(e.shape(), p.quadrature_degree.unwrap_or(e.default_quadrature_degree()))
+    let qp = hox_sim::fem::quadrature::rule(e.shape(), p.quadrature_degree.unwrap_or(e.default_quadrature_degree()))
         .map(|r| r.len() as u64)
         .unwrap_or(1);
     let per_element = nodes * 4 + qp * (nodes * 24 + 16) + nodes * 6 * 24;
@@ -638,7 +638,7 @@ params! {
         help: "Constraint sweeps per substep (the paper: 1).",
         kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 20 }, ..BASE
     }
-    /// More substeps where the stiffest element needs them (`hox_sim::stability`).
+    /// More substeps where the stiffest element needs them (`hox_sim::solver::stability`).
     stability_guard: bool = true => {
         key: "guard", group: Group::Solver, file_key: "stability_guard", label: "Stability guard",
         help: "More substeps when the stiffest element needs them (when h·ω_max would exceed 3, enough for h·ω_max ≤ 1; just below 3 your substeps are kept); off: exactly the substeps asked for, which may blow up (docs/STABILITY.md).",

@@ -41,7 +41,8 @@ pub struct RunReport {
     pub probes_last_second_mean: std::collections::BTreeMap<String, [f64; 3]>,
     pub frames: u64,
     pub sim_seconds: f64,
-    /// Median wall-clock time of one frame (stepping only), milliseconds.
+    /// Median wall-clock time of one frame (stepping only), milliseconds; NaN (`null` in JSON)
+    /// for a run of no frames.
     pub ms_per_frame: f64,
     pub settled: bool,
     pub kinetic_energy_j: f64,
@@ -146,15 +147,7 @@ pub fn run_observed(
     })
 }
 
-/// Median of `values` (0 when empty).
-pub fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    values.sort_by(f64::total_cmp);
-    let m = values.len() / 2;
-    if values.len() % 2 == 1 { values[m] } else { 0.5 * (values[m - 1] + values[m]) }
-}
+pub use hox_sim::benchmark::median;
 
 /// Time after which no listed effect drives motion any more (ramps done, planes stopped).
 fn driven_until_secs(effects: &[EffectSpec]) -> f64 {

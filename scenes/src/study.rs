@@ -2,7 +2,7 @@
 //!
 //! For each paper scene and each configuration (element type, grid, split, refinement), with the
 //! paper's solver settings (50 substeps × 1 iteration, 60 fps, StVK, energy formulation):
-//! 1. the static solution on that mesh ([`hox_sim::statics`]);
+//! 1. the static solution on that mesh ([`hox_sim::solver::statics`]);
 //! 2. XPBD settled at the paper's settings, timed (median ms per frame);
 //! 3. the substeps that bring the **solver error** (settled XPBD vs the static solution on the
 //!    same mesh) under 1 %, found from the measured 1/substeps² law and confirmed by a settled
@@ -305,7 +305,7 @@ pub struct LockingRow {
 }
 
 /// Volumetric locking, measured statically: the bending scene's static tip deflection
-/// ([`hox_sim::statics`], 4 load steps, the scene's StVK) at each of [`LOCKING_POISSON_RATIOS`],
+/// ([`hox_sim::solver::statics`], 4 load steps, the scene's StVK) at each of [`LOCKING_POISSON_RATIOS`],
 /// for P1 1,280 (and 10,240 unless `quick`), P2 160 and P3 80, against Q2 16×4×4 at the same ν.
 /// A mesh that locks grows stiffer as ν → 0.5: its share of missing sag grows.
 pub fn locking(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<LockingRow>, SceneError> {
@@ -358,8 +358,8 @@ fn static_tip_z(
         .iter()
         .find(|p| p.name == "tip")
         .ok_or_else(|| fail("the scene has no probe named tip".into()))?;
-    let probe =
-        hox_sim::probe::Probe::locate(&mesh, &tip.name, Vec3::from(tip.point_m)).map_err(|e| fail(e.to_string()))?;
+    let probe = hox_sim::measure::probe::Probe::locate(&mesh, &tip.name, Vec3::from(tip.point_m))
+        .map_err(|e| fail(e.to_string()))?;
     Ok((probe.displacement(&solution.positions, &mesh.rest_positions).z, mesh.num_elements()))
 }
 

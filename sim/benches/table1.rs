@@ -9,9 +9,9 @@
 use criterion::{BatchSize, Criterion, SamplingMode, criterion_group, criterion_main};
 use hox_sim::Vec3;
 use hox_sim::benchmark::{CASES, bending_beam};
-use hox_sim::constraint::project_energy_constraint;
-use hox_sim::energy::{element_grads, gather};
-use hox_sim::kernels::{Multipliers, PackedBlock, Positions, colour_sweep, energy_sweep};
+use hox_sim::fem::energy::{element_grads, gather};
+use hox_sim::xpbd::constraint::project_energy_constraint;
+use hox_sim::xpbd::kernels::{Multipliers, PackedBlock, Positions, colour_sweep, energy_sweep};
 use std::time::Duration;
 
 fn frames(c: &mut Criterion) {
@@ -41,7 +41,7 @@ fn frames(c: &mut Criterion) {
 }
 
 /// One sweep over every element of the beam, at its sagged state: the specialised kernel of
-/// `hox_sim::kernels` against the generic `constraint::project_energy_constraint`.
+/// `hox_sim::xpbd::kernels` against the generic `constraint::project_energy_constraint`.
 fn kernels(c: &mut Criterion) {
     for case in [&CASES[0], &CASES[3]] {
         let mut sim = bending_beam(case, false).expect("beam");
@@ -112,7 +112,7 @@ fn kernels(c: &mut Criterion) {
 }
 
 /// One colour sweep over every element of the sagged P1 beam: one element at a time against
-/// four same-colour elements per 256-bit register (`hox_sim::kernels::p1x4`).
+/// four same-colour elements per 256-bit register (`hox_sim::xpbd::kernels::p1x4`).
 fn colour_batches(c: &mut Criterion) {
     let mut sim = bending_beam(&CASES[0], true).expect("beam");
     for _ in 0..5 {
@@ -120,7 +120,7 @@ fn colour_batches(c: &mut Criterion) {
     }
     let (mesh, g, material) = (sim.mesh().clone(), sim.geometry()[0].clone(), *sim.material());
     let block = &mesh.blocks[0];
-    let colours = hox_sim::colouring::colour_elements(block, mesh.num_nodes());
+    let colours = hox_sim::xpbd::colouring::colour_elements(block, mesh.num_nodes());
     let packed = PackedBlock::in_colour_order(block, &g, &colours);
     let inv_mass = sim.inv_mass().to_vec();
     let start = sim.positions.clone();

@@ -4,7 +4,7 @@
 //! formulation, gravity, clamped at x = 0), ms per frame as the median of timed frames.
 //!
 //! **Flop count.** Per element and substep, with `N` nodes and `Q` quadrature points, the energy
-//! kernel ([`crate::kernels`]) does, counting a fused multiply–add as 2 flops:
+//! kernel ([`crate::xpbd::kernels`]) does, counting a fused multiply–add as 2 flops:
 //! - per point: `F = I + Σ_i u_i ⊗ ∇N_i` (18N), StVK `E`, `S`, `ψ`, `P = F S` (165), and
 //!   `∇_i U += V P ∇N_i` (18N + 9);
 //! - per element: displacements `u_i = x_i − X_i` (3N), `Σ_i w_i |∇_i U|²` (6N), the update
@@ -111,7 +111,13 @@ impl BenchRow {
     }
 }
 
-/// Median of `values` (sorted in place); NaN for none.
+/// Median of `values` (sorted in place, by [`f64::total_cmp`]): the middle value, or the mean
+/// of the two middle values for an even count. The one median of the workspace (hox-scenes
+/// re-exports it for its run reports and the app's timings).
+///
+/// **Empty input gives NaN**: there is no measurement, and a 0 would read as a frame that took
+/// no time (serde_json writes the NaN as `null`). NaN inputs sort after +∞ (positive NaN) or
+/// before −∞ (negative NaN), so they count as extreme values, not as errors.
 pub fn median(values: &mut [f64]) -> f64 {
     if values.is_empty() {
         return f64::NAN;
@@ -201,7 +207,7 @@ pub fn markdown(rows: &[BenchRow]) -> String {
 /// case), on each of `threads`
 /// (1: the serial sweep; more: the parallel colour sweep; with `colour_on_one`, also the
 /// colour sweep on one thread, which projects linear tetrahedra four per 256-bit register:
-/// `crate::kernels::p1x4`), reporting each row to `progress` as it is measured (what
+/// `crate::xpbd::kernels::p1x4`), reporting each row to `progress` as it is measured (what
 /// `hox bench` runs).
 pub fn run(
     filter: &str,
@@ -228,4 +234,17 @@ pub fn run(
         }
     }
     Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn median_of_odd_even_and_empty_input() {
+        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert_eq!(median(&mut [7.0]), 7.0);
+        assert!(median(&mut []).is_nan());
+    }
 }

@@ -7,39 +7,35 @@
 //! element energy `U_e = Σ_q w_q det J(X, r_q) ψ(F_q)` and its gradient
 //! `∂U_e/∂x_i = Σ_q w_q det J(X, r_q) P(F_q) ∇_X N_i(r_q)` drive XPBD constraints.
 //!
-//! Where to find things:
+//! Where to find things — one folder ("room") per concern, each reading only the rooms listed
+//! before it (no cycles):
 //! - [`element`]: reference elements (P1, P2, P3, Q1, Q2, prism, pyramid), Gmsh node order.
-//! - [`quadrature`]: Witherden–Vincent and Gauss rules per reference shape, by degree.
-//! - [`material`]: hyperelastic models ψ(F), P(F), dP/dF.
-//! - [`mesh`]: meshes (blocks of one element type), structured beams, high-order nodes.
-//! - [`geometry`]: per-element, per-quadrature-point precomputed gradients and volumes.
-//! - [`mass`]: lumped nodal masses (HRZ).
-//! - [`probe`]: material points located in the rest mesh, followed through the deformation.
-//! - [`energy`]: total elastic energy, gradient and Hessian of a mesh.
-//! - [`constraint`]: pure XPBD constraint kernels (energy and split formulations).
-//! - [`kernels`]: the hot loop, specialised per node count, and the colour-packed element data.
-//! - [`statics`]: static equilibrium by Newton's method (the reference XPBD must settle to).
-//! - [`solver`]: the stateful XPBD solver and the opt-in [`effect`]s it runs.
-//! - [`surface`]: the tessellated boundary surface and material points for display.
-//! - [`benchmark`]: timing the paper's Table 1 beams (`hox bench`, `sim/benches/`).
+//! - [`material`]: hyperelastic models ψ(F), P(F), dP/dF; each point law written once over a
+//!   [`material::lane::Lane`] (one `f64` or four SIMD lanes).
+//! - [`mesh`]: meshes (blocks of one element type), structured beams, shared high-order nodes.
+//! - [`fem`]: the finite-element model of a mesh — quadrature rules, precomputed gradients and
+//!   volumes (`geometry`, with the one Jacobian and the one deformation gradient), lumped masses,
+//!   element and mesh energy with gradient and Hessian.
+//! - [`io`]: mesh files — Gmsh import, VTK/PVD export.
+//! - [`xpbd`]: the XPBD projection — pure constraint kernels (energy and split formulations),
+//!   the hot sweep specialised per node count (`xpbd::kernels`), element colouring.
+//! - [`effect`]: opt-in effects (gravity, clamps, prescribed motion, contact, damping, drag).
+//! - [`solver`]: the stateful XPBD [`solver::Simulation`] (settings, sweep, NaN guard), the
+//!   stability guard, and static equilibrium by Newton's method (`solver::statics`).
+//! - [`measure`]: probes, the display surface, min det F.
+//! - [`benchmark`]: timing the paper's Table 1 beams (`hox bench`, `sim/benches/`), and the one
+//!   [`benchmark::median`].
 
 pub mod benchmark;
-pub mod colouring;
-pub mod constraint;
 pub mod effect;
 pub mod element;
-pub mod energy;
-pub mod geometry;
-pub mod kernels;
-pub mod mass;
+pub mod fem;
+pub mod io;
 pub mod material;
+pub mod measure;
 pub mod mesh;
-pub mod probe;
-pub mod quadrature;
 pub mod solver;
-pub mod stability;
-pub mod statics;
-pub mod surface;
+pub mod xpbd;
 
 pub use nalgebra;
 

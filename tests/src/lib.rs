@@ -7,7 +7,7 @@
 //!   elastic energy `U = Σ_e Σ_q V_q ψ(F_q)` and the potential of a uniform body acceleration `g`,
 //!   `V_g = −Σ m_i g·(x_i − X_i)` (zero at rest, so a body released at rest starts at `H = 0`);
 //! - the smallest **`det F`** over all quadrature points (`≤ 0`: an inverted element), from
-//!   [`hox_sim::energy::min_det_f`], and over a dense set of points of every element
+//!   [`hox_sim::measure::min_det_f`], and over a dense set of points of every element
 //!   ([`min_det_f_sampled`]): a curved high-order element can be inverted between its quadrature
 //!   points, where the energy does not see it;
 //! - the **distance to the rest shape**, `max_i |x_i − X_i|`, or, for an unconstrained body, the
@@ -15,15 +15,15 @@
 //!   `Σ_i |R X_i + t − x_i|²`, from the SVD of the centred cross-covariance).
 
 use hox_sim::Vec3;
-use hox_sim::constraint::Formulation;
 use hox_sim::effect::{Clamp, Damping, Effect};
 use hox_sim::element::ElementType;
-use hox_sim::energy::MinDetF;
 use hox_sim::material::{Material, MaterialModel};
+use hox_sim::measure::MinDetF;
 use hox_sim::mesh::Mesh;
 use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 use hox_sim::nalgebra::Matrix3;
 use hox_sim::solver::{SimError, Simulation, SolverSettings};
+use hox_sim::xpbd::constraint::Formulation;
 
 /// Standard gravity, m/s².
 pub const GRAVITY_M_S2: Vec3 = Vec3::new(0.0, 0.0, -9.81);
@@ -122,7 +122,7 @@ pub fn health(sim: &Simulation, gravity_m_s2: Vec3) -> Health {
         kinetic_j: sim.kinetic_energy_j(),
         elastic_j: sim.elastic_energy_j(),
         gravity_potential_j,
-        min_det_f: hox_sim::energy::min_det_f(sim.mesh(), sim.geometry(), &sim.positions)
+        min_det_f: hox_sim::measure::min_det_f(sim.mesh(), sim.geometry(), &sim.positions)
             .expect("a mesh with elements"),
         max_displacement_m,
     }
@@ -260,8 +260,8 @@ pub fn min_det_f_sampled(mesh: &Mesh, positions: &[Vec3], levels: usize) -> (f64
         for (e, nodes) in b.elements().enumerate() {
             for r in &points {
                 et.shape_gradients(r, &mut g);
-                let j_rest = hox_sim::geometry::jacobian(&mesh.rest_positions, nodes, &g).determinant();
-                let j_now = hox_sim::geometry::jacobian(positions, nodes, &g).determinant();
+                let j_rest = hox_sim::fem::geometry::jacobian(&mesh.rest_positions, nodes, &g).determinant();
+                let j_now = hox_sim::fem::geometry::jacobian(positions, nodes, &g).determinant();
                 let det = j_now / j_rest;
                 let det = if det.is_finite() { det } else { f64::NEG_INFINITY };
                 if det < best.0 {

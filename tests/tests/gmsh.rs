@@ -5,8 +5,8 @@
 
 use hox_scenes::Scene;
 use hox_sim::Vec3;
-use hox_sim::mesh::gmsh::{ImportedMesh, read_msh};
-use hox_sim::mesh::vtk;
+use hox_sim::io::gmsh::{ImportedMesh, read_msh};
+use hox_sim::io::vtk;
 use std::path::PathBuf;
 
 /// Every mesh is the paper's beam [0,2]×[0,0.5]×[0,0.5] m.
@@ -51,13 +51,13 @@ fn every_gmsh_mesh_imports_with_its_counts_groups_and_the_box_volume() {
         got.sort();
         want.sort();
         assert_eq!(got, want, "{name}");
-        let geometry = hox_sim::geometry::precompute(&m.mesh, None).unwrap();
+        let geometry = hox_sim::fem::geometry::precompute(&m.mesh, None).unwrap();
         for g in &geometry {
             for e in 0..g.num_elements() {
                 assert!(g.element_volume_m3(e) > 0.0, "{name}: element {e} of the {} block", g.element_type);
             }
         }
-        let volume = hox_sim::geometry::total_volume_m3(&geometry);
+        let volume = hox_sim::fem::geometry::total_volume_m3(&geometry);
         assert!((volume - BOX_VOLUME_M3).abs() < 1e-12, "{name}: volume {volume}");
         // the groups: clamp at x = 0, tip at x = L, body = everything
         let x_of = |group: &str| {
@@ -98,7 +98,7 @@ fn the_msh22_and_msh41_copies_of_a_mesh_are_the_same() {
 fn static_tip_uz(scene: &Scene) -> f64 {
     let mesh = scene.build_mesh().unwrap();
     let solution = hox_scenes::solve_static(scene, &mesh, 1e-10, 1, &mut |_, _, _| {}).unwrap();
-    let probe = hox_sim::probe::Probe::locate(&mesh, "tip", Vec3::new(LENGTH_M, 0.25, 0.25)).unwrap();
+    let probe = hox_sim::measure::probe::Probe::locate(&mesh, "tip", Vec3::new(LENGTH_M, 0.25, 0.25)).unwrap();
     probe.displacement(&solution.positions, &mesh.rest_positions).z
 }
 

@@ -43,7 +43,7 @@ fn reproduce(scene: Option<&str>, level: &str) {
         let solution = hox_scenes::solve_static(&scene, &mesh, 1e-10, 1, &mut |_, _, _| {}).unwrap();
         assert_eq!(solution.free_dofs as u64, reference["dofs"].as_u64().unwrap(), "{}", path.display());
         for p in &scene.file.probes {
-            let probe = hox_sim::probe::Probe::locate(&mesh, &p.name, hox_sim::Vec3::from(p.point_m)).unwrap();
+            let probe = hox_sim::measure::probe::Probe::locate(&mesh, &p.name, hox_sim::Vec3::from(p.point_m)).unwrap();
             let u = probe.displacement(&solution.positions, &mesh.rest_positions);
             let want: Vec<f64> =
                 reference["probes"][&p.name].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();

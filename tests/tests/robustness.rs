@@ -15,11 +15,11 @@
 //! The 10,000-frame long run is `#[ignore]`d here and run in release by `.ci/run`.
 
 use hox_sim::Vec3;
-use hox_sim::constraint::Formulation;
 use hox_sim::effect::{AxisRotation, ContactPlane, Damping, Effect, EffectState, Gravity, Prescribed};
 use hox_sim::material::{Material, MaterialModel};
 use hox_sim::mesh::Mesh;
 use hox_sim::solver::{SimError, Simulation};
+use hox_sim::xpbd::constraint::Formulation;
 use hox_tests::*;
 
 const SNH: MaterialModel = MaterialModel::StableNeoHookean;
@@ -392,7 +392,7 @@ fn load_and_release_within(
 /// work of gravity in the first frames (measured up to 5.3 %: Q2, energy formulation, ν = 0.49,
 /// `h ω_max` 1.43): the bound here is 10 % of `|V_g|max`. With the energy formulation at
 /// ν ≥ 0.45 the stability guard steps in from `h ω_max` 1.5 on
-/// ([`hox_sim::stability::guard_trigger_h_omega`]; at 1.57–2.09 it overshot by 10–17 % with the
+/// ([`hox_sim::solver::stability::guard_trigger_h_omega`]; at 1.57–2.09 it overshot by 10–17 % with the
 /// trigger of 3). P1's locking shows as a much smaller sag (figures printed; the static
 /// comparison is in docs/STABILITY.md).
 #[test]
@@ -1037,10 +1037,13 @@ fn degenerate_inverted_and_empty_meshes_and_zero_substeps_are_clear_errors() {
     assert!(zero.contains("substeps"), "{zero}");
     let fps = new(unit.clone(), settings(Formulation::Energy, 50, f64::NAN));
     assert!(fps.contains("frames per second"), "{fps}");
-    let probe = hox_sim::probe::Probe::locate(&unit, "far", Vec3::new(5.0, 0.0, 0.0)).expect_err("outside").to_string();
+    let probe = hox_sim::measure::probe::Probe::locate(&unit, "far", Vec3::new(5.0, 0.0, 0.0))
+        .expect_err("outside")
+        .to_string();
     assert!(probe.contains("outside the body"), "{probe}");
-    let probe =
-        hox_sim::probe::Probe::locate(&unit, "nan", Vec3::new(f64::NAN, 0.0, 0.0)).expect_err("non-finite").to_string();
+    let probe = hox_sim::measure::probe::Probe::locate(&unit, "nan", Vec3::new(f64::NAN, 0.0, 0.0))
+        .expect_err("non-finite")
+        .to_string();
     assert!(probe.contains("non-finite"), "{probe}");
     let mut s = Simulation::new(unit, mat, ok, Vec::new()).unwrap();
     let mass = s.set_mass_kg(0, -1.0).expect_err("negative mass").to_string();

@@ -9,7 +9,7 @@ fn p2_160_at_70_substeps_settles_within_one_percent_of_the_static_solution() {
     let scene = hox_scenes::by_name("bending").unwrap();
     let mesh = scene.build_mesh().unwrap();
     let (acceleration, dirichlet) = hox_scenes::static_problem(&scene, &mesh).unwrap();
-    let problem = hox_sim::statics::StaticProblem {
+    let problem = hox_sim::solver::statics::StaticProblem {
         mesh: &mesh,
         material: scene.material(),
         quadrature_degree: None,
@@ -18,8 +18,8 @@ fn p2_160_at_70_substeps_settles_within_one_percent_of_the_static_solution() {
         tolerance: 1e-8,
         load_steps: 1,
     };
-    let statics = hox_sim::statics::solve(&problem, &mut |_, _, _| {}).unwrap();
-    let probe = hox_sim::probe::Probe::locate(&mesh, "tip", hox_sim::Vec3::new(2.0, 0.25, 0.25)).unwrap();
+    let statics = hox_sim::solver::statics::solve(&problem, &mut |_, _, _| {}).unwrap();
+    let probe = hox_sim::measure::probe::Probe::locate(&mesh, "tip", hox_sim::Vec3::new(2.0, 0.25, 0.25)).unwrap();
     let u_static = probe.displacement(&statics.positions, &mesh.rest_positions);
     for formulation in ["energy", "split"] {
         let at = |substeps: u32| {

@@ -4,7 +4,7 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use hox_scenes::{Drive, Instance, Scene};
-use hox_sim::mesh::vtk::PvdSeries;
+use hox_sim::io::vtk::PvdSeries;
 use std::path::PathBuf;
 
 #[derive(Args, Clone, Debug, Default)]

@@ -2,7 +2,7 @@
 
 use anyhow::Result;
 use hox_sim::element::ElementType;
-use hox_sim::quadrature;
+use hox_sim::fem::quadrature;
 
 pub fn scenes(json: bool) -> Result<()> {
     let all = hox_scenes::registry()?;

@@ -6,13 +6,13 @@ use anyhow::{Context, Result};
 pub fn mesh_command(scene: &SceneArgs, mesh: &MeshArgs, json: bool) -> Result<()> {
     let scene = load_scene(scene)?.with_overrides(&overrides(mesh, None))?;
     let m = scene.build_mesh()?;
-    let geometry = hox_sim::geometry::precompute(&m, scene.settings().quadrature_degree)
+    let geometry = hox_sim::fem::geometry::precompute(&m, scene.settings().quadrature_degree)
         .with_context(|| format!("{}: the mesh has a bad element", scene.source))?;
     let mut out = serde_json::json!({
         "element": scene.mesh.element_names(),
         "elements": m.num_elements(),
         "nodes": m.num_nodes(),
-        "volume_m3": hox_sim::geometry::total_volume_m3(&geometry),
+        "volume_m3": hox_sim::fem::geometry::total_volume_m3(&geometry),
     });
     if let Some(imported) = scene.mesh.imported() {
         out["blocks"] = m

@@ -33,7 +33,7 @@ pub fn static_command(
     let seconds = started.elapsed().as_secs_f64();
     let mut probes = std::collections::BTreeMap::new();
     for p in &scene.file.probes {
-        let probe = hox_sim::probe::Probe::locate(&m, &p.name, hox_sim::Vec3::from(p.point_m))?;
+        let probe = hox_sim::measure::probe::Probe::locate(&m, &p.name, hox_sim::Vec3::from(p.point_m))?;
         let u = probe.displacement(&solution.positions, &m.rest_positions);
         probes.insert(p.name.clone(), [u.x, u.y, u.z]);
     }

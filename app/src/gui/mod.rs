@@ -579,7 +579,7 @@ impl HoxApp {
                         "The stability guard takes {} substeps per frame instead of {}: the stiffest element's fastest mode needs h·ω_max ≤ {} (docs/STABILITY.md). Switch it off under Solver to see the instability.",
                         sim.substeps_per_frame(),
                         s.config.substeps,
-                        hox_sim::stability::GUARD_H_OMEGA
+                        hox_sim::solver::stability::GUARD_H_OMEGA
                     ));
                 }
                 if let Some(f) = &s.failure {

@@ -8,7 +8,7 @@ use super::config::{self, Config, Invalidates};
 use hox_scenes::{Instance, Scene};
 use hox_sim::Vec3;
 use hox_sim::effect::Attachment;
-use hox_sim::surface::{PointMap, Surface};
+use hox_sim::measure::surface::{PointMap, Surface};
 use std::time::Instant;
 
 /// Samples kept for the time plots (older ones are dropped).
@@ -176,8 +176,9 @@ impl Session {
 
     /// Every quadrature point as a material point (computed on first use).
     pub fn quadrature_points(&self) -> &PointMap {
-        self.quadrature
-            .get_or_init(|| hox_sim::surface::quadrature_points(self.instance.sim.mesh(), self.instance.sim.geometry()))
+        self.quadrature.get_or_init(|| {
+            hox_sim::measure::surface::quadrature_points(self.instance.sim.mesh(), self.instance.sim.geometry())
+        })
     }
 
     /// Changes the display tessellation.
@@ -248,7 +249,13 @@ impl Session {
         let sim = &self.instance.sim;
         let mesh = sim.mesh();
         let mut grad = vec![Vec3::zeros(); mesh.num_nodes()];
-        hox_sim::energy::total_energy_and_gradient(mesh, sim.geometry(), sim.material(), &sim.positions, &mut grad);
+        hox_sim::fem::energy::total_energy_and_gradient(
+            mesh,
+            sim.geometry(),
+            sim.material(),
+            &sim.positions,
+            &mut grad,
+        );
         let g = gravity(&self.instance.scene);
         let (mut num, mut den) = (0.0, 0.0);
         for (i, w) in sim.inv_mass().iter().enumerate() {

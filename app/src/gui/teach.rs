@@ -31,9 +31,9 @@ use super::raster::{Camera, Image, Overlay, TriangleLayer};
 use eframe::egui;
 use hox_sim::Vec3;
 use hox_sim::element::{ElementType, ReferenceElement, ReferenceShape};
+use hox_sim::fem::quadrature;
+use hox_sim::measure::surface::Surface;
 use hox_sim::mesh::{ElementBlock, Mesh};
-use hox_sim::quadrature;
-use hox_sim::surface::Surface;
 
 /// Pieces per face edge of the display surface (a multiple of 2 and 3: see the module docs).
 pub const SEGMENTS: usize = 12;
@@ -152,7 +152,7 @@ fn same_point(a: &[f64; 3], b: &[f64; 3]) -> bool {
 /// `N_node(r)` at every reference point `r` of `points`: the shape function of `node` as a field.
 ///
 /// A non-finite value (a rational shape function exactly at a singular point) is replaced by its
-/// value at a node there, `δ_ij`, as the display surface's [`hox_sim::surface::PointMap`] does.
+/// value at a node there, `δ_ij`, as the display surface's [`hox_sim::measure::surface::PointMap`] does.
 pub fn shape_function_field(element: &dyn ReferenceElement, points: &[[f64; 3]], node: usize) -> Vec<f64> {
     let mut n = vec![0.0; element.num_nodes()];
     points

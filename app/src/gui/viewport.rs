@@ -5,7 +5,7 @@
 //! pulls it with an attachment that exists only while the mouse button is held.
 //!
 //! Every displayed point is a material point `r` of an element, drawn at `x(r) = Σ N_i(r) x_i`
-//! ([`hox_sim::surface`]), so curved high-order faces and edges bend as the elements do.
+//! ([`hox_sim::measure::surface`]), so curved high-order faces and edges bend as the elements do.
 
 use super::gl_view::{GlScene, GlState, paint_callback};
 use super::raster::{BACKGROUND, Camera, Image, Overlay, TriangleLayer, shade};

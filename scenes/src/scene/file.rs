@@ -27,7 +27,7 @@
 //! settle_damping_per_sec = 10  # velocity damping used by --settle
 //! damping_per_sec = 0    # velocity damping of every node, always on (0: none)
 //! parallel = false        # project elements colour by colour on all threads
-//! stability_guard = true   # above h·ω_max = 3, substeps with h·ω_max ≤ 1 (hox_sim::stability)
+//! stability_guard = true   # above h·ω_max = 3, substeps with h·ω_max ≤ 1 (hox_sim::solver::stability)
 //! [[effects]]             # only the effects listed are simulated
 //! type = "gravity"        # gravity | clamp | prescribed | damping | contact
 //! acceleration_m_s2 = [0, 0, -9.81]

@@ -12,11 +12,11 @@ pub use file::{EffectSpec, NodeSelector, ProbeSpec, SceneFile};
 pub(crate) use validate::invalid_in;
 
 use hox_sim::Vec3;
-use hox_sim::constraint::Formulation;
+use hox_sim::io::gmsh::ImportedMesh;
 use hox_sim::material::{Material, MaterialError, MaterialModel};
-use hox_sim::mesh::gmsh::ImportedMesh;
 use hox_sim::mesh::structured::BoxMeshSpec;
 use hox_sim::solver::SolverSettings;
+use hox_sim::xpbd::constraint::Formulation;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 

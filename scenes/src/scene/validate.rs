@@ -3,9 +3,9 @@
 //! probes. Errors name the source, the key and the value.
 
 use hox_sim::Vec3;
-use hox_sim::constraint::Formulation;
 use hox_sim::element::ElementType;
 use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+use hox_sim::xpbd::constraint::Formulation;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -58,7 +58,7 @@ impl Scene {
                 SceneMesh::File { imported, .. } => imported.mesh.blocks.iter().map(|b| b.element_type).collect(),
             };
             for element_type in types {
-                let max = hox_sim::quadrature::max_degree(element_type.shape());
+                let max = hox_sim::fem::quadrature::max_degree(element_type.shape());
                 if d == 0 || d > max {
                     return Err(invalid(
                         "solver.quadrature_degree",
@@ -121,7 +121,7 @@ fn mesh_of(
         {
             return Ok(SceneMesh::File { path, imported: imported.clone() });
         }
-        let imported = hox_sim::mesh::gmsh::read_msh(&path).map_err(|e| {
+        let imported = hox_sim::io::gmsh::read_msh(&path).map_err(|e| {
             // a scene built from the mesh file alone (`--mesh`) is named by the file already
             if source == path.display().to_string() {
                 SceneError::MeshFile(e.to_string())

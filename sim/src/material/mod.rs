@@ -10,6 +10,12 @@
 //! | [`MaterialModel::StableNeoHookeanLog`] | `snh-log` | μ̂/2 (I_C − 3) + λ̂/2 (J − α)² − μ̂/2 log(I_C + 1) + c | [`stable_neo_hookean_log`] |
 //! | [`MaterialModel::NeoHookean`] | `nh` | μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)² | [`neo_hookean`] |
 //!
+//! **The registry.** Each model is one file implementing [`HyperelasticModel`] and one line of
+//! [`MaterialModel::ALL`]; [`Material`] dispatches through the law there (no per-model
+//! `match`), and the `every_registered_model_*` tests check every registered model against
+//! finite differences. Point laws written once over a [`lane::Lane`] serve the SIMD kernels
+//! too ([`stvk::energy_and_pk1`]).
+//!
 //! Conventions shared by every model:
 //!
 //! * ψ is an energy per unit reference volume (J/m³ = Pa) and is exactly `0.0`
@@ -30,11 +36,10 @@
 
 use nalgebra::{Matrix3, SMatrix, SymmetricEigen, Vector3};
 
-// Declared first so its test macro is in textual scope in the model modules.
 #[cfg(test)]
-#[macro_use]
 mod testing;
 
+pub mod lane;
 pub mod neo_hookean;
 pub mod stable_neo_hookean;
 pub mod stable_neo_hookean_log;
@@ -47,48 +52,78 @@ pub type Mat3 = Matrix3<f64>;
 /// 9×9 matrix of `f64` acting on column-major vec(F) (index = row + 3·col).
 pub type Mat9 = SMatrix<f64, 9, 9>;
 
-/// The available hyperelastic constitutive models.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum MaterialModel {
-    /// Saint-Venant–Kirchhoff (the model used in Saillant et al.). See [`stvk`].
-    StVenantKirchhoff,
-    /// Stable Neo-Hookean (Smith, de Goes & Kim 2018) without the log(I_C + 1)
-    /// term, as in Macklin & Müller 2021. See [`stable_neo_hookean`].
-    StableNeoHookean,
-    /// Stable Neo-Hookean with Smith et al.'s log(I_C + 1) term (no collapse
-    /// minimum at F = 0). See [`stable_neo_hookean_log`].
-    StableNeoHookeanLog,
-    /// Classic compressible Neo-Hookean with a ln J floor. See [`neo_hookean`].
-    NeoHookean,
+/// A hyperelastic constitutive model: everything the solvers ask of a material law, at one
+/// point, for Lamé parameters `l`. Each model lives in one file and is listed once in
+/// [`MaterialModel::ALL`] (as reference elements are in [`crate::element::REGISTRY`]): adding a
+/// model is its file plus one line there, and the registry tests check it
+/// (`every_registered_model_*` below).
+pub trait HyperelasticModel: Sync + Send + 'static {
+    /// Short, stable identifier (`"stvk"`), unique in the registry: scene files and the command
+    /// line name the model by it, and models compare equal by it.
+    fn name(&self) -> &'static str;
+    /// Human-readable name.
+    fn long_name(&self) -> &'static str;
+    /// ψ(F) in J/m³, exactly 0 at F = I.
+    fn energy_density(&self, l: Lame, f: &Mat3) -> f64;
+    /// (ψ(F), P(F) = ∂ψ/∂F), sharing the common work.
+    fn energy_density_and_pk1(&self, l: Lame, f: &Mat3) -> (f64, Mat3);
+    /// dP/dF on column-major vec(F), exactly symmetric.
+    fn dpdf(&self, l: Lame, f: &Mat3) -> Mat9;
+    /// The split constraints `[deviatoric, hydrostatic]` at F.
+    fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2];
+    /// Stiffness k_t (Pa) of each split term.
+    fn split_stiffness_pa(&self, l: Lame) -> [f64; 2];
+    /// The constant c with ψ = Σ_t k_t/2 C_t² + c.
+    fn split_energy_offset(&self, l: Lame) -> f64;
+    /// The law is smooth for `det F` above this; below it the model may switch to a
+    /// continuation (Neo-Hookean's ln J floor), where finite differences are meaningless.
+    /// −∞: smooth everywhere.
+    fn smooth_above_det_f(&self) -> f64 {
+        f64::NEG_INFINITY
+    }
 }
 
+/// A hyperelastic constitutive model, by reference to its registered law (compare
+/// [`crate::element::ElementType`]). Models compare and hash by [`MaterialModel::name`].
+#[derive(Clone, Copy)]
+pub struct MaterialModel(&'static dyn HyperelasticModel);
+
+// The built-in models keep the names they had as enum variants.
+#[allow(non_upper_case_globals)]
 impl MaterialModel {
-    /// Every model, in declaration order.
+    /// **The registry**: every model, in this order (menus, tests). Adding a model: its file
+    /// plus one line here.
     pub const ALL: [MaterialModel; 4] = [
-        MaterialModel::StVenantKirchhoff,
-        MaterialModel::StableNeoHookean,
-        MaterialModel::StableNeoHookeanLog,
-        MaterialModel::NeoHookean,
+        MaterialModel(&stvk::StVenantKirchhoff),
+        MaterialModel(&stable_neo_hookean::StableNeoHookean),
+        MaterialModel(&stable_neo_hookean_log::StableNeoHookeanLog),
+        MaterialModel(&neo_hookean::NeoHookean),
     ];
+
+    /// Saint-Venant–Kirchhoff (the model used in Saillant et al.). See [`stvk`].
+    pub const StVenantKirchhoff: MaterialModel = MaterialModel(&stvk::StVenantKirchhoff);
+    /// Stable Neo-Hookean (Smith, de Goes & Kim 2018) without the log(I_C + 1)
+    /// term, as in Macklin & Müller 2021. See [`stable_neo_hookean`].
+    pub const StableNeoHookean: MaterialModel = MaterialModel(&stable_neo_hookean::StableNeoHookean);
+    /// Stable Neo-Hookean with Smith et al.'s log(I_C + 1) term (no collapse
+    /// minimum at F = 0). See [`stable_neo_hookean_log`].
+    pub const StableNeoHookeanLog: MaterialModel = MaterialModel(&stable_neo_hookean_log::StableNeoHookeanLog);
+    /// Classic compressible Neo-Hookean with a ln J floor. See [`neo_hookean`].
+    pub const NeoHookean: MaterialModel = MaterialModel(&neo_hookean::NeoHookean);
+
+    /// The model's law.
+    pub fn law(self) -> &'static dyn HyperelasticModel {
+        self.0
+    }
 
     /// Short, stable identifier: `"stvk"`, `"snh"`, `"snh-log"` or `"nh"`.
     pub fn name(self) -> &'static str {
-        match self {
-            MaterialModel::StVenantKirchhoff => "stvk",
-            MaterialModel::StableNeoHookean => "snh",
-            MaterialModel::StableNeoHookeanLog => "snh-log",
-            MaterialModel::NeoHookean => "nh",
-        }
+        self.0.name()
     }
 
     /// Human-readable name.
     pub fn long_name(self) -> &'static str {
-        match self {
-            MaterialModel::StVenantKirchhoff => "Saint-Venant–Kirchhoff",
-            MaterialModel::StableNeoHookean => "stable Neo-Hookean",
-            MaterialModel::StableNeoHookeanLog => "stable Neo-Hookean with log term",
-            MaterialModel::NeoHookean => "compressible Neo-Hookean",
-        }
+        self.0.long_name()
     }
 
     /// Parses a short name (`stvk`, `snh`, `snh-log`, `nh`), ignoring ASCII case and
@@ -96,6 +131,25 @@ impl MaterialModel {
     pub fn from_name(s: &str) -> Option<Self> {
         let s = s.trim();
         Self::ALL.into_iter().find(|m| s.eq_ignore_ascii_case(m.name()) || s.eq_ignore_ascii_case(m.long_name()))
+    }
+}
+
+impl PartialEq for MaterialModel {
+    fn eq(&self, other: &Self) -> bool {
+        self.name() == other.name()
+    }
+}
+impl Eq for MaterialModel {}
+
+impl std::hash::Hash for MaterialModel {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.name().hash(state)
+    }
+}
+
+impl std::fmt::Debug for MaterialModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "MaterialModel({})", self.name())
     }
 }
 
@@ -218,13 +272,7 @@ impl Material {
 
     /// ψ(F) in J/m³, exactly 0 at F = I for every model.
     pub fn energy_density(&self, f: &Mat3) -> f64 {
-        let l = self.lame();
-        match self.model {
-            MaterialModel::StVenantKirchhoff => stvk::energy_density(l, f),
-            MaterialModel::StableNeoHookean => stable_neo_hookean::energy_density(l, f),
-            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::energy_density(l, f),
-            MaterialModel::NeoHookean => neo_hookean::energy_density(l, f),
-        }
+        self.model.law().energy_density(self.lame(), f)
     }
 
     /// First Piola–Kirchhoff stress P = ∂ψ/∂F (Pa).
@@ -234,26 +282,14 @@ impl Material {
 
     /// (ψ(F), P(F)), sharing the common work.
     pub fn energy_density_and_pk1(&self, f: &Mat3) -> (f64, Mat3) {
-        let l = self.lame();
-        match self.model {
-            MaterialModel::StVenantKirchhoff => stvk::energy_density_and_pk1(l, f),
-            MaterialModel::StableNeoHookean => stable_neo_hookean::energy_density_and_pk1(l, f),
-            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::energy_density_and_pk1(l, f),
-            MaterialModel::NeoHookean => neo_hookean::energy_density_and_pk1(l, f),
-        }
+        self.model.law().energy_density_and_pk1(self.lame(), f)
     }
 
     /// dP/dF as a 9×9 matrix on column-major vec(F) (index = row + 3·col):
     /// `dpdf[(row_p + 3*col_p, row_f + 3*col_f)] = ∂P[row_p,col_p] / ∂F[row_f,col_f]`.
     /// Exactly symmetric (it is the Hessian of ψ).
     pub fn dpdf(&self, f: &Mat3) -> Mat9 {
-        let l = self.lame();
-        match self.model {
-            MaterialModel::StVenantKirchhoff => stvk::dpdf(l, f),
-            MaterialModel::StableNeoHookean => stable_neo_hookean::dpdf(l, f),
-            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::dpdf(l, f),
-            MaterialModel::NeoHookean => neo_hookean::dpdf(l, f),
-        }
+        self.model.law().dpdf(self.lame(), f)
     }
 
     /// [`Material::dpdf`] projected to the nearest (Frobenius) positive
@@ -267,13 +303,7 @@ impl Material {
     /// The two split constraints `[deviatoric, hydrostatic]` at F
     /// (see each model's module doc for their definitions).
     pub fn split_terms(&self, f: &Mat3) -> [SplitTerm; 2] {
-        let l = self.lame();
-        match self.model {
-            MaterialModel::StVenantKirchhoff => stvk::split_terms(f),
-            MaterialModel::StableNeoHookean => stable_neo_hookean::split_terms(l, f),
-            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::split_terms(l, f),
-            MaterialModel::NeoHookean => neo_hookean::split_terms(f),
-        }
+        self.model.law().split_terms(self.lame(), f)
     }
 
     /// Stiffness k_t (Pa) of each split term, so that
@@ -284,26 +314,14 @@ impl Material {
     /// for ν < 0 (and 0 for ν = 0); `snh` uses λ̂ = λ + μ > 0; `snh-log` uses
     /// [μ̂, λ̂] = [4μ/3, λ + 5μ/6], both > 0.
     pub fn split_stiffness_pa(&self) -> [f64; 2] {
-        let l = self.lame();
-        match self.model {
-            MaterialModel::StVenantKirchhoff => stvk::split_stiffness_pa(l),
-            MaterialModel::StableNeoHookean => stable_neo_hookean::split_stiffness_pa(l),
-            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::split_stiffness_pa(l),
-            MaterialModel::NeoHookean => neo_hookean::split_stiffness_pa(l),
-        }
+        self.model.law().split_stiffness_pa(self.lame())
     }
 
     /// The constant c (J/m³) with ψ(F) = Σ_t k_t/2 · C_t(F)² + c:
     /// 0 for `stvk` and `nh`, −3μ/2 − μ²/(2λ̂) for `snh`,
     /// μ̂ (log 2 − 3/2) − 9μ̂²/(32λ̂) for `snh-log`.
     pub fn split_energy_offset(&self) -> f64 {
-        let l = self.lame();
-        match self.model {
-            MaterialModel::StVenantKirchhoff => stvk::split_energy_offset(l),
-            MaterialModel::StableNeoHookean => stable_neo_hookean::split_energy_offset(l),
-            MaterialModel::StableNeoHookeanLog => stable_neo_hookean_log::split_energy_offset(l),
-            MaterialModel::NeoHookean => neo_hookean::split_energy_offset(l),
-        }
+        self.model.law().split_energy_offset(self.lame())
     }
 }
 
@@ -388,6 +406,45 @@ mod tests {
     use super::testing;
     use super::*;
     use proptest::prelude::*;
+
+    /// Every shared check of `testing` (finite differences of ψ → P → dP/dF and of the split
+    /// terms, symmetry, rest state, rotation invariance, linearisation), on every model of the
+    /// registry, [`MaterialModel::ALL`]: a new model is checked as soon as it is registered.
+    macro_rules! every_registered_model {
+        ($($test:ident: $check:ident),* $(,)?) => {$(
+            #[test]
+            fn $test() {
+                for model in MaterialModel::ALL {
+                    eprintln!("{}: {model}", stringify!($check)); // names the model of a failure
+                    testing::$check(model);
+                }
+            }
+        )*};
+    }
+
+    every_registered_model! {
+        every_registered_model_has_zero_energy_and_stress_at_rest: check_rest_state,
+        every_registered_model_has_pk1_matching_energy_finite_differences: check_pk1_matches_energy_fd,
+        every_registered_model_has_dpdf_matching_pk1_finite_differences: check_dpdf_matches_pk1_fd,
+        every_registered_model_has_dpdf_with_major_symmetry: check_dpdf_symmetric,
+        every_registered_model_projects_dpdf_to_the_nearest_psd: check_projected_psd,
+        every_registered_model_has_projected_dpdf_equal_to_dpdf_at_rest: check_projected_at_rest,
+        every_registered_model_is_rotation_invariant: check_rotation_invariance,
+        every_registered_model_satisfies_the_split_energy_identity: check_split_identity,
+        every_registered_model_has_split_gradients_matching_finite_differences: check_split_gradients_fd,
+        every_registered_model_linearises_to_linear_elasticity_at_rest: check_linearisation_at_rest,
+        every_registered_model_agrees_between_energy_and_pk1_and_separate_calls: check_energy_and_pk1_consistent,
+    }
+
+    #[test]
+    fn registered_names_are_unique() {
+        for (i, a) in MaterialModel::ALL.iter().enumerate() {
+            for b in &MaterialModel::ALL[i + 1..] {
+                assert_ne!(a.name(), b.name());
+                assert_ne!(a, b);
+            }
+        }
+    }
 
     #[test]
     fn names_round_trip() {

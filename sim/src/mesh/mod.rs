@@ -1,13 +1,13 @@
 //! Meshes: rest node positions and blocks of elements of one type each (a mesh may mix types).
 //!
 //! Connectivity uses the element's Gmsh node order ([`crate::element`]). [`structured`] builds
-//! the paper's beams; [`high_order`] adds shared edge/face/interior nodes to linear meshes;
-//! [`gmsh`] imports `.msh` files with their physical groups; [`vtk`] exports VTU/PVD for ParaView.
+//! the paper's beams; [`high_order`] adds shared edge/face/interior nodes to linear meshes. Mesh
+//! files (Gmsh import, VTK export) are in [`crate::io`]. This room reads only the reference
+//! elements: element shape (inverted or flat at rest) is checked by `crate::fem::geometry`,
+//! which reads meshes, not the other way round.
 
-pub mod gmsh;
 pub mod high_order;
 pub mod structured;
-pub mod vtk;
 
 use crate::Vec3;
 use crate::element::ElementType;
@@ -80,7 +80,7 @@ impl Mesh {
 
     /// Checks the structure: non-empty, finite coordinates, indices in range, no repeated node
     /// within an element. (Element shape — inverted or flat — is checked by
-    /// [`crate::geometry`], which knows the quadrature points.)
+    /// `crate::fem::geometry`, which knows the quadrature points.)
     pub fn validate(&self) -> Result<(), MeshError> {
         if self.num_elements() == 0 {
             return Err(MeshError::Empty);

@@ -28,18 +28,18 @@ fn clamped_at_x0(mesh: &Mesh) -> Vec<u32> {
 }
 
 /// Static equilibrium `∇U(x) = M g` with clamped nodes, by Newton's method
-/// ([`crate::statics`]): independent of XPBD.
+/// ([`crate::solver::statics`]): independent of XPBD.
 fn static_equilibrium(mesh: &Mesh, material: &Material, degree: Option<usize>, clamped: &[u32]) -> Vec<Vec3> {
-    let problem = crate::statics::StaticProblem {
+    let problem = crate::solver::statics::StaticProblem {
         mesh,
         material: *material,
         quadrature_degree: degree,
         acceleration_m_s2: G,
-        dirichlet: vec![crate::statics::clamp(clamped.to_vec())],
+        dirichlet: vec![crate::solver::statics::clamp(clamped.to_vec())],
         tolerance: 1e-10,
         load_steps: 1,
     };
-    crate::statics::solve(&problem, &mut |_, _, _| {}).unwrap().positions
+    crate::solver::statics::solve(&problem, &mut |_, _, _| {}).unwrap().positions
 }
 
 /// The circular frequencies (rad/s) of the clamped mesh's lowest and highest modes at `x`:
@@ -51,7 +51,7 @@ fn frequency_range(mesh: &Mesh, material: &Material, clamped: &[u32], x: &[Vec3]
     let mut free = vec![true; n];
     clamped.iter().for_each(|&c| free[c as usize] = false);
     let dof: Vec<usize> = (0..3 * n).filter(|d| free[d / 3]).collect();
-    let k = crate::statics::assemble_dense(mesh, &geo, material, x);
+    let k = crate::solver::statics::assemble_dense(mesh, &geo, material, x);
     let s = DMatrix::from_fn(dof.len(), dof.len(), |i, j| {
         k[(dof[i], dof[j])] / (masses[dof[i] / 3] * masses[dof[j] / 3]).sqrt()
     });
@@ -364,14 +364,14 @@ fn the_stability_guard_follows_material_mass_and_settings_changes() {
     let settings = SolverSettings { substeps: 1, ..SolverSettings::default() };
     let mut sim = Simulation::new(mesh, soft, settings, Vec::new()).unwrap();
     let r = sim.stability();
-    assert!(!r.raised() && r.requested_h_omega < crate::stability::GUARD_TRIGGER_H_OMEGA, "{}", r.summary());
+    assert!(!r.raised() && r.requested_h_omega < crate::solver::stability::GUARD_TRIGGER_H_OMEGA, "{}", r.summary());
     assert_eq!(sim.substeps_per_frame(), 1);
     // 10⁴ × stiffer: ω × 100, above the trigger
     sim.set_material(Material::new(MaterialModel::StableNeoHookean, 1.0e9, 0.3, 1000.0).unwrap()).unwrap();
     let stiff = sim.stability();
     assert!((stiff.omega_max_rad_s / r.omega_max_rad_s - 100.0).abs() < 1e-9 * 100.0);
     assert!(stiff.raised() && sim.substeps_per_frame() == stiff.substeps);
-    assert!(sim.substep_dt_secs() * stiff.omega_max_rad_s <= crate::stability::GUARD_H_OMEGA * (1.0 + 1e-12));
+    assert!(sim.substep_dt_secs() * stiff.omega_max_rad_s <= crate::solver::stability::GUARD_H_OMEGA * (1.0 + 1e-12));
     // a denser material lowers it again (ω ∝ √(E/ρ)), exactly as a recomputation would
     sim.set_material(Material::new(MaterialModel::StableNeoHookean, 1.0e9, 0.3, 1.0e7).unwrap()).unwrap();
     let dense = sim.stability().omega_max_rad_s;

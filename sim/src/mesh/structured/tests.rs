@@ -31,8 +31,8 @@ fn the_paper_meshes_have_the_paper_counts() {
         assert_eq!((m.num_elements(), m.num_nodes()), (elements, nodes), "{e} {cells:?} {split:?} refine {refine}");
         // every element has det J > 0 at every quadrature point (precompute checks it) and the
         // element volumes add up to the box
-        let geo = crate::geometry::precompute(&m, None).unwrap_or_else(|err| panic!("{e} {cells:?}: {err}"));
-        let v = crate::geometry::total_volume_m3(&geo);
+        let geo = crate::fem::geometry::precompute(&m, None).unwrap_or_else(|err| panic!("{e} {cells:?}: {err}"));
+        let v = crate::fem::geometry::total_volume_m3(&geo);
         assert!((v - len * 0.25).abs() < 1e-10, "{e} {cells:?}: volume {v}");
     }
 }

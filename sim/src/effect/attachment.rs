@@ -1,0 +1,62 @@
+//! A node pulled towards a target by a compliant XPBD distance constraint ([`Attachment`]).
+
+use super::{Effect, EffectState};
+use crate::Vec3;
+
+/// Pulls one node towards a target point through a compliant distance constraint
+/// `C = |x − target|` with compliance `α` (m/N), solved by the XPBD update
+/// ([`crate::xpbd::constraint::xpbd_step`]). The app creates one while a node is dragged.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Attachment {
+    pub node: u32,
+    pub target_m: Vec3,
+    pub compliance_m_per_n: f64,
+    lambda: f64,
+}
+
+impl Attachment {
+    pub fn new(node: u32, target_m: Vec3, compliance_m_per_n: f64) -> Self {
+        Self { node, target_m, compliance_m_per_n, lambda: 0.0 }
+    }
+}
+
+impl Effect for Attachment {
+    fn name(&self) -> &'static str {
+        "attachment"
+    }
+    fn after_prediction(&mut self, _s: &mut EffectState<'_>) {
+        self.lambda = 0.0;
+    }
+    fn after_projection(&mut self, s: &mut EffectState<'_>) {
+        let i = self.node as usize;
+        let w = s.inv_mass[i];
+        let d = s.positions[i] - self.target_m;
+        let c = d.norm();
+        if w == 0.0 || c == 0.0 {
+            return;
+        }
+        let alpha_tilde = self.compliance_m_per_n / (s.dt_secs * s.dt_secs);
+        if let Some((d_lambda, step)) = crate::xpbd::constraint::xpbd_step(c, 1.0, w, alpha_tilde, self.lambda) {
+            self.lambda += d_lambda;
+            s.positions[i] += d / c * (step * w);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effect::test_state as state;
+
+    #[test]
+    fn a_stiff_attachment_brings_its_node_to_the_target() {
+        let mut a = Attachment::new(0, Vec3::new(1.0, 2.0, 3.0), 0.0);
+        let rest = [Vec3::zeros()];
+        let mut x = [Vec3::zeros()];
+        let prev = x;
+        let mut v = [Vec3::zeros()];
+        let w = [0.5];
+        a.after_projection(&mut state(0.0, &rest, &mut x, &prev, &mut v, &w));
+        assert!((x[0] - Vec3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
+    }
+}

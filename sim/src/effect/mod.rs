@@ -1,0 +1,82 @@
+//! Effects: opt-in units a scene lists (gravity, clamps, …). The solver runs only the effects
+//! it was given, so a scene without gravity does no gravity work and one without contact never
+//! tests for contact.
+//!
+//! An effect may pin nodes (their inverse mass becomes 0: the solver's constraints never move
+//! them) and hooks into the substep at four places:
+//! 1. [`Effect::before_prediction`]: external accelerations (`v += h a`);
+//! 2. [`Effect::after_prediction`]: positions of pinned or driven nodes at the new time;
+//! 3. [`Effect::after_projection`]: constraints of its own after each solver iteration (contact);
+//! 4. [`Effect::after_velocity_update`]: velocity changes (damping).
+//!
+//! Files: `body.rs` body loads and losses ([`Gravity`], [`Damping`]); `drive.rs` nodes held or
+//! moved by prescription ([`Clamp`], [`Prescribed`] with [`smooth_ramp`] and [`AxisRotation`]);
+//! `contact.rs` a moving plane with friction ([`ContactPlane`]); `attachment.rs` a node pulled
+//! by a compliant XPBD constraint ([`Attachment`], the app's drag).
+
+mod attachment;
+mod body;
+mod contact;
+mod drive;
+
+pub use attachment::Attachment;
+pub use body::{Damping, Gravity};
+pub use contact::ContactPlane;
+pub use drive::{AxisRotation, Clamp, Prescribed, smooth_ramp};
+
+use crate::Vec3;
+use crate::mesh::Mesh;
+
+/// The part of the solver state an effect may read and change during a substep.
+pub struct EffectState<'a> {
+    /// Time at the end of the substep being taken, seconds.
+    pub time_secs: f64,
+    /// Substep length, seconds.
+    pub dt_secs: f64,
+    pub rest_positions: &'a [Vec3],
+    pub positions: &'a mut [Vec3],
+    pub prev_positions: &'a [Vec3],
+    pub velocities: &'a mut [Vec3],
+    pub inv_mass: &'a [f64],
+}
+
+/// An opt-in effect. Every hook defaults to doing nothing.
+pub trait Effect: Send + Sync {
+    /// A short name for counters, logs and error messages ("gravity", "clamp", …).
+    fn name(&self) -> &'static str;
+    /// Nodes this effect positions itself (clamped or driven): the solver gives them zero
+    /// inverse mass.
+    fn pinned_nodes(&self, _mesh: &Mesh) -> Vec<u32> {
+        Vec::new()
+    }
+    fn before_prediction(&mut self, _state: &mut EffectState<'_>) {}
+    fn after_prediction(&mut self, _state: &mut EffectState<'_>) {}
+    fn after_projection(&mut self, _state: &mut EffectState<'_>) {}
+    fn after_velocity_update(&mut self, _state: &mut EffectState<'_>) {}
+    /// Work done so far (for example nodes accelerated or contact tests made), for the tests
+    /// that show an effect not called for costs nothing.
+    fn work_count(&self) -> u64 {
+        0
+    }
+}
+
+/// An [`EffectState`] over the given slices, `dt_secs` = 0.01, for the effects' tests.
+#[cfg(test)]
+pub(crate) fn test_state<'a>(
+    t: f64,
+    rest: &'a [Vec3],
+    x: &'a mut [Vec3],
+    prev: &'a [Vec3],
+    v: &'a mut [Vec3],
+    w: &'a [f64],
+) -> EffectState<'a> {
+    EffectState {
+        time_secs: t,
+        dt_secs: 0.01,
+        rest_positions: rest,
+        positions: x,
+        prev_positions: prev,
+        velocities: v,
+        inv_mass: w,
+    }
+}

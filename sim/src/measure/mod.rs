@@ -1,0 +1,16 @@
+//! Measuring a deformed body: material points followed through the deformation and whether any
+//! element is inverted.
+//!
+//! - [`probe`]: material points located once in the rest mesh by inverting an element's map
+//!   `X(r) = Σ_i N_i(r) X_i` (Newton's method), then moving as `x(p) = Σ_i N_i(r) x_i`.
+//! - [`surface`]: the boundary tessellated for display (curved faces follow the elements' own
+//!   maps) and quadrature points as material points.
+//! - [`min_det_f`]: the smallest `det F` over every quadrature point ([`MinDetF`]).
+//!
+//! It reads meshes and the finite-element model; the solvers do not read it.
+
+mod inversion;
+pub mod probe;
+pub mod surface;
+
+pub use inversion::{MinDetF, min_det_f};

@@ -1,0 +1,500 @@
+//! The XPBD solver with small steps (Macklin, Storey, Lu, Terdiman, Chentanez, Jeschke &
+//! Müller 2019, "Small steps in physics simulation"): a frame of `1/fps` seconds is `n`
+//! substeps of `h = 1/(fps · n)`; each substep
+//! 1. applies the effects' accelerations, `v ← v + h a`;
+//! 2. predicts `x ← x + h v` (keeping `x_prev`), then lets effects place pinned/driven nodes;
+//! 3. resets every multiplier `λ ← 0` and runs `k` Gauss–Seidel iterations over the element
+//!    constraints ([`crate::xpbd::constraint`]), each followed by the effects' own projections;
+//! 4. updates velocities `v ← (x − x_prev)/h`, then lets effects damp them.
+//!
+//! Defaults are the paper's: 50 substeps × 1 iteration, 60 frames per second. The solver
+//! gathers each element's nodes, calls a pure kernel, and scatters the corrections back.
+//!
+//! Where things are: `settings.rs` (what a run is asked to do, [`SolverSettings`]); `sweep.rs`
+//! (one Gauss–Seidel sweep over the element constraints, serial or parallel, through
+//! [`crate::xpbd`]); `nan_guard.rs` (the NaN guard below); [`stability`] (the substep guard);
+//! [`statics`] (the static equilibrium XPBD settles to, by Newton's method).
+//!
+//! **NaN guard.** A kernel whose corrections come out non-finite is not scattered: the substep
+//! stops there with [`SimError::NonFinite`] naming that element (block and index), its bad node,
+//! the frame, the substep within the frame and the time. After every substep all positions and
+//! velocities are checked as well (an effect, or a caller writing `positions`, can also bring a
+//! NaN or an infinity in), naming an element that holds the first bad node. On either failure the
+//! positions go back to the last finite state (the start of the failing substep, or the rest shape
+//! if that was not finite either), velocities to zero, and the simulation refuses to step until
+//! [`Simulation::reset`] (or [`Simulation::warm_start`]): a viewer keeps showing the last sound
+//! state instead of painting garbage, and offers a reset. See `docs/STABILITY.md`.
+
+mod nan_guard;
+mod settings;
+pub mod stability;
+pub mod statics;
+mod sweep;
+
+pub use settings::SolverSettings;
+
+use crate::Vec3;
+use crate::effect::{Effect, EffectState};
+use crate::fem::energy::total_energy;
+use crate::fem::geometry::{BlockGeometry, GeometryError, precompute};
+use crate::fem::mass::lumped_masses_kg;
+use crate::material::Material;
+use crate::mesh::{Mesh, MeshError};
+use crate::xpbd::constraint::Formulation;
+use stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    #[error("invalid mesh: {0}")]
+    Mesh(#[from] MeshError),
+    #[error(transparent)]
+    Geometry(#[from] GeometryError),
+    #[error("invalid solver settings: {0}")]
+    Settings(String),
+    #[error("effect '{effect}' refers to node {node}, but the mesh has {num_nodes} nodes")]
+    EffectNode { effect: &'static str, node: u32, num_nodes: usize },
+    #[error("node {node}: {reason}")]
+    Mass { node: usize, reason: String },
+    #[error(
+        "the simulation blew up at frame {frame}, substep {substep_in_frame} of {substeps_per_frame} (t = {time_secs:.6} s): {origin} element {element} of block {block} ({element_type}), at its node {node}; the last finite state is kept — reset, or use more substeps, a softer material or stable Neo-Hookean"
+    )]
+    NonFinite {
+        /// Element block and index within it.
+        block: usize,
+        element: usize,
+        element_type: String,
+        /// A non-finite node of that element (global index).
+        node: usize,
+        /// What went wrong: "the projection of" (the kernel's output) or "a non-finite position
+        /// or velocity in" (found after the substep).
+        origin: &'static str,
+        /// The frame being advanced, counted from 1.
+        frame: u64,
+        /// The substep within that frame, counted from 1, and the substeps per frame.
+        substep_in_frame: u32,
+        substeps_per_frame: u32,
+        /// Substeps taken since the start (or the last reset), the failing one included.
+        substep: u64,
+        time_secs: f64,
+    },
+}
+
+/// Counters of the work done, for tests and the status line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SolverCounters {
+    pub substeps: u64,
+    pub element_projections: u64,
+    pub effect_hook_calls: u64,
+}
+
+/// A running XPBD simulation of one mesh.
+pub struct Simulation {
+    mesh: Mesh,
+    geometry: Vec<BlockGeometry>,
+    material: Material,
+    settings: SolverSettings,
+    pub positions: Vec<Vec3>,
+    pub velocities: Vec<Vec3>,
+    prev_positions: Vec<Vec3>,
+    masses_kg: Vec<f64>,
+    inv_mass: Vec<f64>,
+    lambdas: Vec<Vec<f64>>,
+    effects: Vec<Box<dyn Effect>>,
+    /// Per block, the elements grouped by colour (no two elements of a colour share a node).
+    colours: Vec<Vec<Vec<u32>>>,
+    /// Per block, the element data packed for the sweeps (element order and colour order).
+    packed: crate::xpbd::kernels::SolverData,
+    /// The colour sweep projects linear tetrahedra four at a time ([`crate::xpbd::kernels::p1x4`]).
+    simd_batches: bool,
+    /// Per block, its cut into one slab per thread for the parallel sweep on two or more
+    /// threads (built for the current thread count on first use).
+    partitions: Vec<crate::xpbd::kernels::Partition>,
+    /// Fewest elements per thread for which a block is partitioned.
+    partition_min_per_thread: usize,
+    time_secs: f64,
+    frames: u64,
+    /// Substeps taken in the frame being advanced.
+    substeps_in_frame: u32,
+    /// Set when the NaN guard stopped the simulation; cleared by reset or warm start.
+    failure: Option<SimError>,
+    counters: SolverCounters,
+    /// The stability guard's `ω_max² ρ / E` (it scales exactly with E/ρ) and where it is;
+    /// None until needed after a change of ν, model, quadrature or a node's mass.
+    omega2_per_e_over_rho: Option<(f64, usize, usize)>,
+    /// A node's mass was set by hand since the masses were last computed from the density.
+    masses_overridden: bool,
+    /// Substeps per frame being taken (the requested ones or the guard's).
+    substeps_per_frame: u32,
+}
+
+impl Simulation {
+    /// Validates the mesh and settings, precomputes geometry and masses, pins the nodes the
+    /// effects position themselves, and starts at rest.
+    pub fn new(
+        mesh: Mesh,
+        material: Material,
+        settings: SolverSettings,
+        effects: Vec<Box<dyn Effect>>,
+    ) -> Result<Self, SimError> {
+        mesh.validate()?;
+        settings.validate()?;
+        let geometry = precompute(&mesh, settings.quadrature_degree)?;
+        let masses_kg = lumped_masses_kg(&mesh, material.density_kg_m3)?;
+        let inv_mass: Vec<f64> = masses_kg.iter().map(|m| 1.0 / m).collect();
+        let positions = mesh.rest_positions.clone();
+        let n = positions.len();
+        let lambdas = Self::multipliers(&geometry, settings.formulation);
+        let mut sim = Self {
+            mesh,
+            geometry,
+            material,
+            settings,
+            prev_positions: positions.clone(),
+            positions,
+            velocities: vec![Vec3::zeros(); n],
+            masses_kg,
+            inv_mass,
+            lambdas,
+            effects: Vec::with_capacity(effects.len()),
+            colours: Vec::new(),
+            packed: crate::xpbd::kernels::SolverData::default(),
+            simd_batches: true,
+            partitions: Vec::new(),
+            partition_min_per_thread: crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD,
+            time_secs: 0.0,
+            frames: 0,
+            substeps_in_frame: 0,
+            failure: None,
+            counters: SolverCounters::default(),
+            omega2_per_e_over_rho: None,
+            masses_overridden: false,
+            substeps_per_frame: settings.substeps,
+        };
+        for e in effects {
+            sim.add_effect(e)?;
+        }
+        sim.colours =
+            sim.mesh.blocks.iter().map(|b| crate::xpbd::colouring::colour_elements(b, sim.mesh.num_nodes())).collect();
+        sim.pack_colours();
+        sim.update_guard();
+        Ok(sim)
+    }
+
+    fn pack_colours(&mut self) {
+        self.packed = crate::xpbd::kernels::SolverData::new(&self.mesh.blocks, &self.geometry, &self.colours);
+        self.partitions = vec![crate::xpbd::kernels::Partition::default(); self.mesh.blocks.len()];
+    }
+
+    fn multipliers(geometry: &[BlockGeometry], formulation: Formulation) -> Vec<Vec<f64>> {
+        geometry
+            .iter()
+            .map(|g| vec![0.0; g.num_elements() * formulation.multipliers_per_element(g.points_per_element)])
+            .collect()
+    }
+
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+    pub fn geometry(&self) -> &[BlockGeometry] {
+        &self.geometry
+    }
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+    pub fn settings(&self) -> &SolverSettings {
+        &self.settings
+    }
+    pub fn masses_kg(&self) -> &[f64] {
+        &self.masses_kg
+    }
+    pub fn inv_mass(&self) -> &[f64] {
+        &self.inv_mass
+    }
+    pub fn time_secs(&self) -> f64 {
+        self.time_secs
+    }
+    pub fn frames(&self) -> u64 {
+        self.frames
+    }
+    pub fn counters(&self) -> SolverCounters {
+        self.counters
+    }
+    pub fn effects(&self) -> &[Box<dyn Effect>] {
+        &self.effects
+    }
+    /// Whether the colour sweep (`SolverSettings::parallel`) projects linear tetrahedra with
+    /// StVK four at a time in one 256-bit register per quantity (on by default where the CPU
+    /// has AVX2 and FMA; equal to the one-at-a-time colour sweep up to round-off). Off: one at
+    /// a time, for comparison.
+    pub fn set_simd_batches(&mut self, on: bool) {
+        self.simd_batches = on;
+    }
+
+    /// On two or more threads the parallel sweep cuts a block of at least `per_thread` elements
+    /// per thread into one slab per thread ([`crate::xpbd::kernels::Partition`]: two synchronisations
+    /// per sweep instead of one per colour); smaller blocks are swept colour by colour. Default
+    /// [`crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD`]; `usize::MAX`: never.
+    pub fn set_partition_threshold(&mut self, per_thread: usize) {
+        self.partition_min_per_thread = per_thread;
+    }
+
+    /// Number of element colours per block (elements of one colour share no node).
+    pub fn num_colours(&self) -> Vec<usize> {
+        self.colours.iter().map(Vec::len).collect()
+    }
+
+    /// Number of XPBD constraints per solver iteration.
+    pub fn num_constraints(&self) -> usize {
+        self.lambdas.iter().map(Vec::len).sum()
+    }
+
+    /// Adds an effect to the running simulation (pinning the nodes it positions).
+    pub fn add_effect(&mut self, effect: Box<dyn Effect>) -> Result<(), SimError> {
+        for node in effect.pinned_nodes(&self.mesh) {
+            let slot = self.inv_mass.get_mut(node as usize).ok_or(SimError::EffectNode {
+                effect: effect.name(),
+                node,
+                num_nodes: self.mesh.num_nodes(),
+            })?;
+            *slot = 0.0;
+        }
+        self.effects.push(effect);
+        Ok(())
+    }
+
+    /// Removes the effects named `name` (for example the attachment that exists only while a
+    /// node is dragged); nodes they pinned get their mass back. Returns how many were removed.
+    pub fn remove_effects_named(&mut self, name: &str) -> usize {
+        let before = self.effects.len();
+        let (removed, kept): (Vec<_>, Vec<_>) =
+            std::mem::take(&mut self.effects).into_iter().partition(|e| e.name() == name);
+        self.effects = kept;
+        let still_pinned: std::collections::HashSet<u32> =
+            self.effects.iter().flat_map(|e| e.pinned_nodes(&self.mesh)).collect();
+        for e in &removed {
+            for node in e.pinned_nodes(&self.mesh) {
+                if !still_pinned.contains(&node) {
+                    self.inv_mass[node as usize] = 1.0 / self.masses_kg[node as usize];
+                }
+            }
+        }
+        before - self.effects.len()
+    }
+
+    /// The error that stopped the simulation, if the NaN guard did (until reset).
+    pub fn failure(&self) -> Option<&SimError> {
+        self.failure.as_ref()
+    }
+
+    /// Sets one node's lumped mass (for example a heavy bead on a soft body). A pinned node
+    /// stays pinned. A density change ([`Simulation::set_material`]) recomputes every mass.
+    pub fn set_mass_kg(&mut self, node: usize, mass_kg: f64) -> Result<(), SimError> {
+        let n = self.masses_kg.len();
+        if node >= n {
+            return Err(SimError::Mass { node, reason: format!("the mesh has {n} nodes") });
+        }
+        if !(mass_kg.is_finite() && mass_kg > 0.0) {
+            return Err(SimError::Mass {
+                node,
+                reason: format!("a mass must be a finite positive number of kilograms, got {mass_kg}"),
+            });
+        }
+        self.masses_kg[node] = mass_kg;
+        if self.inv_mass[node] > 0.0 {
+            self.inv_mass[node] = 1.0 / mass_kg;
+        }
+        self.masses_overridden = true;
+        self.omega2_per_e_over_rho = None;
+        self.update_guard();
+        Ok(())
+    }
+
+    /// Changes the material, keeping positions and velocities (masses follow the density).
+    pub fn set_material(&mut self, material: Material) -> Result<(), SimError> {
+        if material.density_kg_m3 != self.material.density_kg_m3 {
+            let masses = lumped_masses_kg(&self.mesh, material.density_kg_m3)?;
+            for ((w, m_old), m) in self.inv_mass.iter_mut().zip(&mut self.masses_kg).zip(masses) {
+                if *w > 0.0 {
+                    *w = 1.0 / m;
+                }
+                *m_old = m;
+            }
+            if self.masses_overridden {
+                self.omega2_per_e_over_rho = None;
+                self.masses_overridden = false;
+            }
+        }
+        if (material.model, material.poisson_ratio) != (self.material.model, self.material.poisson_ratio) {
+            self.omega2_per_e_over_rho = None;
+        }
+        self.material = material;
+        self.update_guard();
+        Ok(())
+    }
+
+    /// Changes time stepping (and formulation), keeping the state. A new quadrature degree
+    /// recomputes the element geometry.
+    pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), SimError> {
+        settings.validate()?;
+        if settings.quadrature_degree != self.settings.quadrature_degree {
+            self.geometry = precompute(&self.mesh, settings.quadrature_degree)?;
+            self.pack_colours();
+            self.omega2_per_e_over_rho = None;
+        }
+        self.lambdas = Self::multipliers(&self.geometry, settings.formulation);
+        self.settings = settings;
+        self.update_guard();
+        Ok(())
+    }
+
+    /// Continues from another run's state: positions copied, velocities zero, clock at
+    /// `time_secs` (so prescribed motions are where they were).
+    pub fn warm_start(&mut self, positions: &[Vec3], time_secs: f64) {
+        self.positions.copy_from_slice(positions);
+        self.prev_positions.copy_from_slice(positions);
+        self.velocities.iter_mut().for_each(|v| *v = Vec3::zeros());
+        self.time_secs = time_secs;
+        self.substeps_in_frame = 0;
+        self.failure = None;
+    }
+
+    /// Back to the rest shape at t = 0.
+    pub fn reset(&mut self) {
+        self.positions.clone_from(&self.mesh.rest_positions);
+        self.prev_positions.clone_from(&self.mesh.rest_positions);
+        self.velocities.iter_mut().for_each(|v| *v = Vec3::zeros());
+        self.time_secs = 0.0;
+        self.frames = 0;
+        self.substeps_in_frame = 0;
+        self.failure = None;
+    }
+
+    /// The stability guard's findings: the fastest element mode, `h ω_max` with the requested
+    /// substeps, and the substeps per frame taken ([`crate::solver::stability`]).
+    pub fn stability(&mut self) -> StabilityReport {
+        let (omega2_normalised, block, element) = self.omega2_normalised();
+        let omega_max_rad_s =
+            (omega2_normalised * self.material.youngs_modulus_pa / self.material.density_kg_m3).sqrt();
+        let s = &self.settings;
+        let trigger_h_omega = guard_trigger_h_omega(s.formulation, &self.material);
+        let (substeps, capped) = if s.stability_guard {
+            guarded_substeps(s.substeps, s.frames_per_second, omega_max_rad_s, trigger_h_omega, GUARD_H_OMEGA)
+        } else {
+            (s.substeps, false)
+        };
+        StabilityReport {
+            omega_max_rad_s,
+            block,
+            element,
+            requested_h_omega: omega_max_rad_s * s.substep_dt_secs(),
+            trigger_h_omega,
+            requested_substeps: s.substeps,
+            substeps,
+            guard: s.stability_guard,
+            capped,
+        }
+    }
+
+    /// Substeps per frame being taken: the requested ones, or more (the stability guard).
+    pub fn substeps_per_frame(&self) -> u32 {
+        self.substeps_per_frame
+    }
+
+    /// The substep being taken, `1/(fps · substeps_per_frame)`, seconds.
+    pub fn substep_dt_secs(&self) -> f64 {
+        1.0 / (self.settings.frames_per_second * self.substeps_per_frame as f64)
+    }
+
+    fn omega2_normalised(&mut self) -> (f64, usize, usize) {
+        if let Some(v) = self.omega2_per_e_over_rho {
+            return v;
+        }
+        let (omega2, block, element) = mesh_omega2_max(&self.mesh, &self.geometry, &self.material, &self.masses_kg);
+        let v = (omega2 * self.material.density_kg_m3 / self.material.youngs_modulus_pa, block, element);
+        self.omega2_per_e_over_rho = Some(v);
+        v
+    }
+
+    /// Recomputes the substeps per frame after a change of settings, material or masses.
+    fn update_guard(&mut self) {
+        self.substeps_per_frame =
+            if self.settings.stability_guard { self.stability().substeps } else { self.settings.substeps };
+    }
+
+    /// Advances one frame (`substeps` substeps, or more: the stability guard).
+    pub fn step_frame(&mut self) -> Result<(), SimError> {
+        for _ in 0..self.substeps_per_frame {
+            self.substep()?;
+        }
+        self.frames += 1;
+        self.substeps_in_frame = 0;
+        Ok(())
+    }
+
+    /// Advances one substep of `h = 1/(fps · substeps_per_frame)`.
+    pub fn substep(&mut self) -> Result<(), SimError> {
+        if let Some(e) = &self.failure {
+            return Err(e.clone());
+        }
+        let h = self.substep_dt_secs();
+        self.time_secs += h;
+        self.counters.substeps += 1;
+        self.substeps_in_frame += 1;
+        macro_rules! hook {
+            ($name:ident) => {
+                for e in self.effects.iter_mut() {
+                    self.counters.effect_hook_calls += 1;
+                    e.$name(&mut EffectState {
+                        time_secs: self.time_secs,
+                        dt_secs: h,
+                        rest_positions: &self.mesh.rest_positions,
+                        positions: &mut self.positions,
+                        prev_positions: &self.prev_positions,
+                        velocities: &mut self.velocities,
+                        inv_mass: &self.inv_mass,
+                    });
+                }
+            };
+        }
+        hook!(before_prediction);
+        self.prev_positions.copy_from_slice(&self.positions);
+        for (x, v) in self.positions.iter_mut().zip(&self.velocities) {
+            *x += v * h;
+        }
+        hook!(after_prediction);
+        self.lambdas.iter_mut().for_each(|l| l.fill(0.0));
+        for _ in 0..self.settings.iterations {
+            if let Err(bad) = self.project_elements(h) {
+                return Err(self.fail(bad));
+            }
+            hook!(after_projection);
+        }
+        let inv_h = 1.0 / h;
+        for ((v, x), xp) in self.velocities.iter_mut().zip(&self.positions).zip(&self.prev_positions) {
+            *v = (x - xp) * inv_h;
+        }
+        hook!(after_velocity_update);
+        match self.first_non_finite() {
+            Some(bad) => Err(self.fail(bad)),
+            None => Ok(()),
+        }
+    }
+
+    /// Kinetic energy `½ Σ m_i |v_i|²`, joules.
+    pub fn kinetic_energy_j(&self) -> f64 {
+        0.5 * self.masses_kg.iter().zip(&self.velocities).map(|(m, v)| m * v.norm_squared()).sum::<f64>()
+    }
+
+    /// Elastic energy `Σ_e U_e`, joules.
+    pub fn elastic_energy_j(&self) -> f64 {
+        total_energy(&self.mesh, &self.geometry, &self.material, &self.positions)
+    }
+
+    /// Displacements `x − X` of every node.
+    pub fn displacements(&self) -> Vec<Vec3> {
+        self.positions.iter().zip(&self.mesh.rest_positions).map(|(x, x0)| x - x0).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,248 @@
+//! One Gauss–Seidel sweep over every element constraint of a [`Simulation`]: in element order,
+//! or colour by colour with the elements of a colour projected in parallel. The energy
+//! formulation goes through the specialised sweep ([`crate::xpbd::kernels`]); the split
+//! formulation (and any node count without a specialised sweep) through the generic kernels of
+//! [`crate::xpbd::constraint`], element by element: gather, project, check, scatter.
+
+use super::Simulation;
+use super::nan_guard::{BadElement, non_finite_node};
+use crate::Vec3;
+use crate::fem::energy::{element_grads, gather};
+use crate::fem::geometry::BlockGeometry;
+use crate::material::Material;
+use crate::xpbd::constraint::{Formulation, MAX_NODES, project_energy_constraint, project_split_constraints};
+
+impl Simulation {
+    /// One Gauss–Seidel sweep over every element constraint: in element order, or colour by
+    /// colour with the elements of a colour projected in parallel.
+    /// Stops at the first element whose corrections come out non-finite (not scattered) and
+    /// returns it.
+    pub(super) fn project_elements(&mut self, h: f64) -> Result<(), BadElement> {
+        let inv_dt2 = 1.0 / (h * h);
+        if self.settings.parallel {
+            return self.project_elements_parallel(inv_dt2);
+        }
+        let mut x = [Vec3::zeros(); MAX_NODES];
+        for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
+            let block = &self.mesh.blocks[bi];
+            let n = block.nodes_per_element();
+            if self.settings.formulation == Formulation::Energy {
+                use crate::xpbd::kernels::{Multipliers, Positions, energy_sweep};
+                let data = self.packed.serial[bi].data();
+                // SAFETY: one thread; the mesh was validated, so its node indices fit positions,
+                // and lambdas holds one multiplier per element.
+                let fast = unsafe {
+                    energy_sweep(
+                        n,
+                        &self.material,
+                        Positions::new(&mut self.positions),
+                        &self.mesh.rest_positions,
+                        &self.inv_mass,
+                        &data,
+                        0..block.len(),
+                        Multipliers::new(lambdas),
+                        inv_dt2,
+                    )
+                };
+                match fast {
+                    Some(Ok(projected)) => {
+                        self.counters.element_projections += projected;
+                        continue;
+                    }
+                    Some(Err(bad)) => {
+                        return Err(BadElement::projected(
+                            bi,
+                            bad.element,
+                            bad.node,
+                            block.element(bad.element),
+                            |i| self.positions[i],
+                        ));
+                    }
+                    None => {}
+                }
+            }
+            let per_element = lambdas.len() / block.len().max(1);
+            for (e, nodes) in block.elements().enumerate() {
+                let lambda = &mut lambdas[e * per_element..(e + 1) * per_element];
+                let ctx = ProjectionContext {
+                    rest: &self.mesh.rest_positions,
+                    inv_mass: &self.inv_mass,
+                    material: &self.material,
+                    formulation: self.settings.formulation,
+                    inv_dt2,
+                };
+                let positions = &self.positions;
+                if ctx.project(|i| positions[i], &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
+                    if let Some(node) = non_finite_node(&x[..n], nodes) {
+                        return Err(BadElement::projected(bi, e, node, nodes, |i| positions[i]));
+                    }
+                    for (xi, &node) in x.iter().zip(nodes) {
+                        self.positions[node as usize] = *xi;
+                    }
+                    self.counters.element_projections += 1;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The parallel sweep: same-colour elements touch disjoint nodes and multipliers, so they
+    /// are projected concurrently and the result does not depend on the scheduling. On two or
+    /// more threads, large blocks of the energy formulation are swept slab by slab
+    /// ([`crate::xpbd::kernels::Partition`]), which depends on the thread count.
+    fn project_elements_parallel(&mut self, inv_dt2: f64) -> Result<(), BadElement> {
+        use rayon::prelude::*;
+        let positions = crate::xpbd::kernels::SharedMut::new(&mut self.positions);
+        for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
+            let block = &self.mesh.blocks[bi];
+            let n = block.nodes_per_element();
+            let per_element = lambdas.len() / block.len().max(1);
+            if self.settings.formulation == Formulation::Energy {
+                // SAFETY of the aliasing: the specialised sweep writes positions through its own
+                // pointer, and nothing else touches them meanwhile.
+                let all = unsafe { positions.slice_mut(0, positions.len()) };
+                let threads = rayon::current_num_threads();
+                use crate::xpbd::kernels::BlockSweep;
+                let sweep = if threads >= 2 && block.len() >= threads.saturating_mul(self.partition_min_per_thread) {
+                    if self.partitions[bi].threads != threads {
+                        self.partitions[bi] = crate::xpbd::kernels::Partition::new(
+                            block,
+                            &self.geometry[bi],
+                            &self.colours[bi],
+                            &self.mesh.rest_positions,
+                            threads,
+                        );
+                    }
+                    BlockSweep::Slabs(&self.partitions[bi])
+                } else {
+                    BlockSweep::Colours(&self.packed.colour[bi])
+                };
+                let result = crate::xpbd::kernels::parallel_energy_block(
+                    n,
+                    &self.material,
+                    all,
+                    &self.mesh.rest_positions,
+                    &self.inv_mass,
+                    sweep,
+                    lambdas,
+                    inv_dt2,
+                    self.simd_batches,
+                );
+                match result {
+                    Some(Ok(projected)) => {
+                        self.counters.element_projections += projected;
+                        continue;
+                    }
+                    Some(Err(bad)) => {
+                        let read = |i: usize| unsafe { positions.read(i) };
+                        return Err(BadElement::projected(bi, bad.element, bad.node, block.element(bad.element), read));
+                    }
+                    None => {}
+                }
+            }
+            let lambdas = crate::xpbd::kernels::SharedMut::new(lambdas);
+            for colour in &self.colours[bi] {
+                let projected: Result<usize, BadElement> = colour
+                    .par_iter()
+                    .with_min_len(crate::xpbd::kernels::GENERIC_MIN_ELEMENTS_PER_TASK)
+                    .map(|&e| {
+                        let e = e as usize;
+                        let nodes = block.element(e);
+                        // SAFETY: no two elements of a colour share a node (colouring.rs), and
+                        // each element owns its multipliers: concurrent writes are disjoint.
+                        let lambda = unsafe { lambdas.slice_mut(e * per_element, per_element) };
+                        let ctx = ProjectionContext {
+                            rest: &self.mesh.rest_positions,
+                            inv_mass: &self.inv_mass,
+                            material: &self.material,
+                            formulation: self.settings.formulation,
+                            inv_dt2,
+                        };
+                        let mut x = [Vec3::zeros(); MAX_NODES];
+                        // SAFETY: reads only this element's nodes, which no other thread writes.
+                        let read = |i: usize| unsafe { positions.read(i) };
+                        if !ctx.project(read, &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
+                            return Ok(0);
+                        }
+                        if let Some(node) = non_finite_node(&x[..n], nodes) {
+                            return Err(BadElement::projected(bi, e, node, nodes, read));
+                        }
+                        for (xi, &node) in x.iter().zip(nodes) {
+                            // SAFETY: as above.
+                            unsafe { positions.write(node as usize, *xi) };
+                        }
+                        Ok(1)
+                    })
+                    .sum();
+                self.counters.element_projections += projected? as u64;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What projecting one element needs to read.
+struct ProjectionContext<'a> {
+    rest: &'a [Vec3],
+    inv_mass: &'a [f64],
+    material: &'a Material,
+    formulation: Formulation,
+    inv_dt2: f64,
+}
+
+impl ProjectionContext<'_> {
+    /// Gathers element `e`, projects its constraints into `x` (updating its multipliers) and
+    /// returns true, or false when all its nodes are pinned.
+    #[inline]
+    fn project(
+        &self,
+        read: impl Fn(usize) -> Vec3,
+        g: &BlockGeometry,
+        e: usize,
+        nodes: &[u32],
+        lambda: &mut [f64],
+        x: &mut [Vec3],
+    ) -> bool {
+        let n = x.len();
+        let mut w = [0.0; MAX_NODES];
+        let mut rest = [Vec3::zeros(); MAX_NODES];
+        let (w, rest) = (&mut w[..n], &mut rest[..n]);
+        for (wi, &node) in w.iter_mut().zip(nodes) {
+            *wi = self.inv_mass[node as usize];
+        }
+        if w.iter().all(|&wi| wi == 0.0) {
+            return false;
+        }
+        for (xi, &node) in x.iter_mut().zip(nodes) {
+            *xi = read(node as usize);
+        }
+        gather(self.rest, nodes, rest);
+        match self.formulation {
+            Formulation::Energy => {
+                project_energy_constraint(
+                    x,
+                    rest,
+                    w,
+                    element_grads(g, e),
+                    g.volumes(e),
+                    self.material,
+                    self.inv_dt2,
+                    &mut lambda[0],
+                );
+            }
+            Formulation::Split => {
+                project_split_constraints(
+                    x,
+                    rest,
+                    w,
+                    element_grads(g, e),
+                    g.volumes(e),
+                    self.material,
+                    self.inv_dt2,
+                    lambda,
+                );
+            }
+        }
+        true
+    }
+}

@@ -1,0 +1,50 @@
+//! The hot loop of the solver, specialised per element node count: the energy-constraint sweep
+//! over a block (serial in element order, or one colour's contiguous range in the parallel sweep).
+//!
+//! It computes exactly what [`crate::xpbd::constraint::project_energy_constraint`] computes — for each
+//! element, `F_q = I + Σ_i (x_i − X_i) ⊗ ∇_X N_i(r_q)`, `U_e = Σ_q V_q ψ(F_q)`,
+//! `∇_i U_e = Σ_q V_q P(F_q) ∇_X N_i(r_q)`, `C = √(2U_e)` and the XPBD update of
+//! [`crate::xpbd::constraint::xpbd_step`] (the paper's `Δλ = −2U / (Σ_i w_i |∇_i U|² + 2U α̃)` with
+//! λ = 0, Saillant et al. §3) — but with the node count `N` a compile-time constant, so that
+//! every per-node loop is unrolled and every scratch array lives in registers or a fixed-size
+//! stack array of exactly `N` entries; and with the material's Lamé parameters computed once per
+//! sweep instead of once per quadrature point ([`Stvk`]). Results equal the generic kernel's up
+//! to the order of floating-point operations.
+//!
+//! Both sweeps read the element data from a [`PackedBlock`] copy: connectivity, material
+//! gradients (as structure of arrays per element and point, so the loops over the `N` nodes
+//! vectorise) and quadrature volumes; for the parallel sweep reordered colour by colour, so that each colour is a
+//! contiguous range of memory handed to the threads in contiguous chunks (the elements of a
+//! colour keep their increasing element order, so the result is bitwise the one of the
+//! element-indexed colour sweep).
+//!
+//! Files, one concern each: `sweep.rs` the sweep and the per-element projections
+//! ([`energy_sweep`], [`colour_sweep`], [`project_p1`], [`project_energy`]); `point_law.rs` the
+//! material law it is generic over ([`PointMaterial`], [`Stvk`]); `simd.rs` the lane helpers
+//! ([`mul3`], [`LANES`]); `shared.rs` the raw shared pointers ([`SharedMut`]); `pack.rs` the
+//! packed element data ([`PackedBlock`]); `schedule.rs` the parallel schedules and every
+//! threshold that cuts work between threads ([`parallel_energy_block`], [`Partition`]);
+//! [`p1x4`] four linear tetrahedra per AVX2 register.
+
+mod pack;
+mod point_law;
+mod schedule;
+mod shared;
+mod simd;
+mod sweep;
+
+#[cfg(target_arch = "x86_64")]
+pub mod p1x4;
+
+pub use pack::{BATCH_VALUES, BlockData, PackedBlock, SolverData};
+pub use point_law::{AnyMaterial, PointMaterial, Stvk};
+pub use schedule::{
+    BlockSweep, GENERIC_MIN_ELEMENTS_PER_TASK, PARTITION_MIN_ELEMENTS_PER_THREAD, Partition,
+    SWEEP_MIN_ELEMENTS_PER_THREAD, parallel_energy_block,
+};
+pub use shared::{Multipliers, Positions, SharedMut};
+pub use simd::{LANES, mul3, padded};
+pub use sweep::{NonFiniteElement, SPECIALISED_NODE_COUNTS, colour_sweep, energy_sweep, project_energy, project_p1};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,161 @@
+//! The element data as the sweeps read it: a block's connectivity, material gradients (structure
+//! of arrays per element and point, padded to [`super::LANES`]) and quadrature volumes, copied
+//! in element order (the serial sweep) or colour by colour (the parallel sweeps, so that a
+//! colour is one contiguous range), plus the lane-interleaved batches of four linear tetrahedra
+//! ([`super::p1x4`]).
+
+use super::simd::padded;
+use crate::fem::geometry::BlockGeometry;
+use crate::mesh::ElementBlock;
+
+/// One block's element data as the sweep reads it (a view of a [`PackedBlock`]).
+#[derive(Clone, Copy, Debug)]
+pub struct BlockData<'a> {
+    /// `N` node indices per element.
+    pub nodes: &'a [u32],
+    /// Material gradients, structure of arrays per element and point: for packed element `k`
+    /// and point `q`, the `3P` values from `(k Q + q) 3P` (`P` = [`padded`]`(N)`) are
+    /// `∂N_i/∂X` for `i < P` (zero for `i ≥ N`), then `∂N_i/∂Y`, then `∂N_i/∂Z`, so that the
+    /// loops over nodes run in whole vector registers.
+    pub grads: &'a [f64],
+    /// `Q` quadrature volumes per element.
+    pub volumes: &'a [f64],
+    pub points: usize,
+    /// `element_ids[k]`: the block's element index of packed element `k` (its multiplier and
+    /// the name the NaN guard reports). None: packed element `k` is element `k`.
+    pub element_ids: Option<&'a [u32]>,
+}
+
+/// Doubles stored per batch of four linear tetrahedra in [`PackedBlock::p1x4`]: 9 gradient
+/// entries and the volume, four lanes each.
+pub const BATCH_VALUES: usize = 40;
+
+/// A block's element data packed for the sweep: in element order (the serial sweep), or
+/// reordered colour by colour (the parallel sweep; see the module doc), gradients as structure
+/// of arrays ([`BlockData::grads`]). Packed element `k` is element `element_ids[k]`; colour `c`
+/// is the packed range `colour_starts[c]..colour_starts[c + 1]` (one range for element order).
+#[derive(Clone, Debug, Default)]
+pub struct PackedBlock {
+    pub nodes: Vec<u32>,
+    pub grads: Vec<f64>,
+    pub volumes: Vec<f64>,
+    /// None in element order.
+    pub element_ids: Option<Vec<u32>>,
+    pub colour_starts: Vec<usize>,
+    pub points: usize,
+    /// Linear tetrahedra in colour order only: the gradients and volumes of each colour's
+    /// first `4 ⌊len/4⌋` elements in batches of four, lane-interleaved (`p1x4::BATCH_VALUES`
+    /// per batch; see [`colour_sweep`](super::colour_sweep)). Empty otherwise.
+    pub p1x4: Vec<f64>,
+    /// The first batch of colour `c` in [`PackedBlock::p1x4`] (one more entry than colours).
+    pub colour_batches: Vec<usize>,
+}
+
+impl PackedBlock {
+    /// `block`'s data in element order.
+    pub fn in_element_order(block: &ElementBlock, geometry: &BlockGeometry) -> Self {
+        let all: Vec<u32> = (0..block.len() as u32).collect();
+        let mut packed = Self::new(block, geometry, std::slice::from_ref(&all), false);
+        packed.element_ids = None;
+        packed
+    }
+
+    /// `block`'s data in the order of `colours` (element indices per colour).
+    pub fn in_colour_order(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>]) -> Self {
+        Self::new(block, geometry, colours, true)
+    }
+
+    fn new(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>], batches: bool) -> Self {
+        let (n, q) = (block.nodes_per_element(), geometry.points_per_element);
+        let total: usize = colours.iter().map(Vec::len).sum();
+        let mut ids = Vec::with_capacity(total);
+        let mut packed = Self {
+            nodes: Vec::with_capacity(total * n),
+            grads: Vec::with_capacity(total * 3 * padded(n) * q),
+            volumes: Vec::with_capacity(total * q),
+            element_ids: None,
+            colour_starts: Vec::with_capacity(colours.len() + 1),
+            points: q,
+            p1x4: Vec::new(),
+            colour_batches: vec![0],
+        };
+        packed.colour_starts.push(0);
+        for colour in colours {
+            for &e in colour {
+                let e = e as usize;
+                packed.nodes.extend_from_slice(block.element(e));
+                for p in 0..q {
+                    let g = geometry.gradients(e, p);
+                    for axis in 0..3 {
+                        packed.grads.extend(g.iter().map(|gi| gi[axis]));
+                        packed.grads.extend(std::iter::repeat_n(0.0, padded(n) - n));
+                    }
+                }
+                packed.volumes.extend_from_slice(geometry.volumes(e));
+                ids.push(e as u32);
+            }
+            packed.colour_starts.push(ids.len());
+            if batches && n == 4 && q == 1 {
+                for four in colour.chunks_exact(4) {
+                    for r in 1..4 {
+                        for c in 0..3 {
+                            packed.p1x4.extend(four.iter().map(|&e| geometry.gradients(e as usize, 0)[r][c]));
+                        }
+                    }
+                    packed.p1x4.extend(four.iter().map(|&e| geometry.volumes(e as usize)[0]));
+                }
+                packed.colour_batches.push(packed.p1x4.len() / BATCH_VALUES);
+            }
+        }
+        packed.element_ids = Some(ids);
+        packed
+    }
+
+    pub fn data(&self) -> BlockData<'_> {
+        BlockData {
+            nodes: &self.nodes,
+            grads: &self.grads,
+            volumes: &self.volumes,
+            points: self.points,
+            element_ids: self.element_ids.as_deref(),
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.colour_starts.last().copied().unwrap_or(0)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The packed range of colour `c`.
+    pub fn colour(&self, c: usize) -> std::ops::Range<usize> {
+        self.colour_starts[c]..self.colour_starts[c + 1]
+    }
+
+    pub fn num_colours(&self) -> usize {
+        self.colour_starts.len().saturating_sub(1)
+    }
+}
+
+/// The packed data of every block of a simulation: element order and colour order.
+#[derive(Clone, Debug, Default)]
+pub struct SolverData {
+    pub serial: Vec<PackedBlock>,
+    pub colour: Vec<PackedBlock>,
+}
+
+impl SolverData {
+    pub fn new(blocks: &[ElementBlock], geometry: &[BlockGeometry], colours: &[Vec<Vec<u32>>]) -> Self {
+        Self {
+            serial: blocks.iter().zip(geometry).map(|(b, g)| PackedBlock::in_element_order(b, g)).collect(),
+            colour: blocks
+                .iter()
+                .zip(geometry)
+                .zip(colours)
+                .map(|((b, g), c)| PackedBlock::in_colour_order(b, g, c))
+                .collect(),
+        }
+    }
+}

@@ -1,0 +1,338 @@
+//! The energy-constraint sweep itself, specialised per node count (see the module doc of
+//! [`super`]): [`energy_sweep`] over a packed range in order, [`colour_sweep`] over one colour
+//! with the four-lane P1 batches, and the per-element projections [`project_p1`] and
+//! [`project_energy`] they run.
+
+use super::pack::{BATCH_VALUES, BlockData, PackedBlock};
+use super::point_law::{AnyMaterial, PointMaterial, Stvk};
+use super::shared::{Multipliers, Positions};
+use super::simd::{LANES, axpy_lanes, fma_lanes, mul3};
+use crate::Vec3;
+use crate::material::{Mat3, Material, MaterialModel};
+use crate::xpbd::constraint::xpbd_step;
+
+#[cfg(target_arch = "x86_64")]
+use super::p1x4;
+
+/// What the sweep hands back when an element's corrections come out non-finite: its element
+/// index in the block and its first non-finite node (nothing was scattered for it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NonFiniteElement {
+    pub element: usize,
+    pub node: u32,
+}
+
+/// Node counts with a specialised sweep (P1, pyramid, prism, Q1, P2, P3, Q2).
+pub const SPECIALISED_NODE_COUNTS: [usize; 7] = [4, 5, 6, 8, 10, 20, 27];
+
+/// The sweep of the energy formulation over packed elements `range` of `data`, in order.
+/// Returns the number of elements projected (those with a free node), or the first element
+/// whose corrections came out non-finite. None when `nodes_per_element` has no specialised
+/// sweep (the caller falls back to the generic kernel).
+///
+/// # Safety
+/// `positions` and `lambdas` must be valid for the whole sweep, every node index of `data` must
+/// be below `positions.len()`, every element id below `lambdas.len()`, and no other thread may
+/// touch the nodes and multipliers of the elements in `range` meanwhile.
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn energy_sweep(
+    nodes_per_element: usize,
+    material: &Material,
+    positions: Positions,
+    rest: &[Vec3],
+    inv_mass: &[f64],
+    data: &BlockData<'_>,
+    range: std::ops::Range<usize>,
+    lambdas: Multipliers,
+    inv_dt2: f64,
+) -> Option<Result<u64, NonFiniteElement>> {
+    let io = SweepIo { positions, rest, inv_mass, data, lambdas, inv_dt2 };
+    #[cfg(target_arch = "x86_64")]
+    let wide = std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma");
+    macro_rules! dispatch {
+        ($(($n:literal, $p:literal)),*) => {
+            match nodes_per_element {
+                $($n => Some(if material.model == MaterialModel::StVenantKirchhoff {
+                        let l = material.lame();
+                        let m = Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa };
+                        #[cfg(target_arch = "x86_64")]
+                        if wide {
+                            // SAFETY: forwarded from the caller; AVX2 and FMA were detected.
+                            return Some(unsafe { sweep_avx2::<$n, $p, _>(&m, io, range) });
+                        }
+                        // SAFETY: forwarded from the caller.
+                        unsafe { sweep::<$n, $p, false, _>(&m, io, range) }
+                    } else {
+                        // SAFETY: as above.
+                        unsafe { sweep::<$n, $p, false, _>(&AnyMaterial(material), io, range) }
+                    }),)*
+                _ => None,
+            }
+        };
+    }
+    dispatch!((4, 4), (5, 8), (6, 8), (8, 8), (10, 12), (20, 20), (27, 28))
+}
+
+/// What a sweep reads and writes, besides the material and the range of packed elements.
+#[derive(Clone, Copy)]
+struct SweepIo<'a> {
+    positions: Positions,
+    rest: &'a [Vec3],
+    inv_mass: &'a [f64],
+    data: &'a BlockData<'a>,
+    lambdas: Multipliers,
+    inv_dt2: f64,
+}
+
+/// [`sweep`] compiled for AVX2 with FMA (selected at run time).
+///
+/// # Safety
+/// See [`energy_sweep`]; the CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn sweep_avx2<const N: usize, const P: usize, M: PointMaterial>(
+    material: &M,
+    io: SweepIo<'_>,
+    range: std::ops::Range<usize>,
+) -> Result<u64, NonFiniteElement> {
+    // SAFETY: forwarded.
+    unsafe { sweep::<N, P, true, M>(material, io, range) }
+}
+
+/// [`energy_sweep`] for `N` nodes per element and material law `M`.
+///
+/// # Safety
+/// See [`energy_sweep`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMaterial>(
+    material: &M,
+    io: SweepIo<'_>,
+    range: std::ops::Range<usize>,
+) -> Result<u64, NonFiniteElement> {
+    let SweepIo { positions, rest, inv_mass, data, lambdas, inv_dt2 } = io;
+    let q = data.points;
+    let mut projected = 0;
+    for k in range {
+        let nodes: &[u32; N] = data.nodes[k * N..(k + 1) * N].try_into().expect("N nodes");
+        let w: [f64; N] = std::array::from_fn(|i| inv_mass[nodes[i] as usize]);
+        if w.iter().all(|&wi| wi == 0.0) {
+            continue;
+        }
+        let e = data.element_ids.map_or(k, |ids| ids[k] as usize);
+        assert!(e < lambdas.len());
+        // SAFETY: node indices are checked against the length; the caller guarantees no other
+        // thread touches these nodes and this multiplier.
+        let mut x: [Vec3; N] = std::array::from_fn(|i| unsafe { positions.read(nodes[i] as usize) });
+        let d: [Vec3; N] = std::array::from_fn(|i| x[i] - rest[nodes[i] as usize]);
+        let lambda = unsafe { &mut *lambdas.ptr().add(e) };
+        let grads = &data.grads[k * q * 3 * P..(k + 1) * q * 3 * P];
+        let volumes = &data.volumes[k * q..(k + 1) * q];
+        if N == 4 && q == 1 {
+            // the linear tetrahedron: one point, constant gradients
+            let x4: &mut [Vec3; 4] = (&mut x[..]).try_into().expect("4 nodes");
+            let (d4, w4): (&[Vec3; 4], &[f64; 4]) =
+                (d[..].try_into().expect("4 nodes"), w[..].try_into().expect("4 nodes"));
+            project_p1::<FMA, M>(x4, d4, w4, grads, volumes[0], material, inv_dt2, lambda);
+        } else {
+            let mut u = [[0.0; P]; 3];
+            for i in 0..N {
+                for a in 0..3 {
+                    u[a][i] = d[i][a];
+                }
+            }
+            project_energy::<N, P, FMA, M>(&mut x, &u, &w, grads, volumes, material, inv_dt2, lambda);
+        }
+        // x·0 is 0 for a finite x and NaN otherwise: one sum checks every coordinate
+        let mut check = 0.0;
+        for xi in &x {
+            check += xi.x * 0.0 + xi.y * 0.0 + xi.z * 0.0;
+        }
+        if check != 0.0 {
+            let i = x.iter().position(|xi| !xi.iter().all(|c| c.is_finite())).unwrap_or(0);
+            return Err(NonFiniteElement { element: e, node: nodes[i] });
+        }
+        for i in 0..N {
+            // SAFETY: as above.
+            unsafe { positions.ptr().add(nodes[i] as usize).write(x[i]) };
+        }
+        projected += 1;
+    }
+    Ok(projected)
+}
+
+/// [`project_energy`] for the linear tetrahedron (one quadrature point, constant gradients
+/// `g_i = ∇_X N_i`, `Σ_i g_i = 0`): `F = I + Σ_{i=1..3} (u_i − u_0) ⊗ g_i` (the paper's
+/// `F = D_s D_m⁻¹` written in displacements), `∇_i U = V P g_i` for `i = 1..3` and
+/// `∇_0 U = −Σ_{i≥1} ∇_i U` (Bender et al.'s FEM tetrahedron), all as 3×3 products.
+/// `grads` is the point's `3 × 4` structure-of-arrays block; `v` its volume.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn project_p1<const FMA: bool, M: PointMaterial>(
+    x: &mut [Vec3; 4],
+    u: &[Vec3; 4],
+    w: &[f64; 4],
+    grads: &[f64],
+    v: f64,
+    material: &M,
+    inv_dt2: f64,
+    lambda: &mut f64,
+) -> f64 {
+    // g[(i − 1, b)] = ∂N_i/∂X_b
+    let g = Mat3::new(grads[1], grads[5], grads[9], grads[2], grads[6], grads[10], grads[3], grads[7], grads[11]);
+    let du = Mat3::from_columns(&[u[1] - u[0], u[2] - u[0], u[3] - u[0]]);
+    let f = Mat3::identity() + mul3::<FMA>(&du, &g);
+    let (psi, p) = material.energy_and_pk1::<FMA>(&f);
+    // columns: ∇_1 U, ∇_2 U, ∇_3 U
+    let h = mul3::<FMA>(&(p * v), &g.transpose());
+    let g0 = -(h.column(0) + h.column(1) + h.column(2));
+    let grad = [g0, h.column(0).into_owned(), h.column(1).into_owned(), h.column(2).into_owned()];
+    let energy = (v * psi).max(0.0);
+    let c = (2.0 * energy).sqrt();
+    let sum_w_grad2 = w[0] * grad[0].norm_squared()
+        + w[1] * grad[1].norm_squared()
+        + w[2] * grad[2].norm_squared()
+        + w[3] * grad[3].norm_squared();
+    if let Some((d_lambda, step)) = xpbd_step(c, c, sum_w_grad2, inv_dt2, *lambda) {
+        *lambda += d_lambda;
+        for i in 0..4 {
+            x[i] += grad[i] * (step * w[i]);
+        }
+    }
+    energy
+}
+
+/// Projects one element's energy constraint `C = √(2U_e)` (compliance 1): `x` gathered
+/// positions (updated), `u[a][i] = x_ia − X_ia` the displacements (zero for `N ≤ i < P`), `w` inverse masses,
+/// `grads` (`points × 3P`, structure of arrays, see [`BlockData::grads`]) and `volumes` its
+/// rest data. Returns the element energy before projection.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn project_energy<const N: usize, const P: usize, const FMA: bool, M: PointMaterial>(
+    x: &mut [Vec3; N],
+    u: &[[f64; P]; 3],
+    w: &[f64; N],
+    grads: &[f64],
+    volumes: &[f64],
+    material: &M,
+    inv_dt2: f64,
+    lambda: &mut f64,
+) -> f64 {
+    let mut grad = [[0.0; P]; 3];
+    let mut energy = 0.0;
+    for (gq, v) in grads.chunks_exact(3 * P).zip(volumes) {
+        let g: [&[f64; P]; 3] = std::array::from_fn(|b| gq[b * P..(b + 1) * P].try_into().expect("P gradients"));
+        // F_ab = δ_ab + Σ_i u_ai g_bi, summed in LANES partial sums (one vector register)
+        let mut acc = [[[0.0; LANES]; 3]; 3];
+        for c in 0..P / LANES {
+            for a in 0..3 {
+                for b in 0..3 {
+                    let r = c * LANES..(c + 1) * LANES;
+                    fma_lanes::<FMA>(&mut acc[a][b], &u[a][r.clone()], &g[b][r]);
+                }
+            }
+        }
+        let mut f = Mat3::identity();
+        for a in 0..3 {
+            for b in 0..3 {
+                let s = &acc[a][b];
+                f[(a, b)] += (s[0] + s[1]) + (s[2] + s[3]);
+            }
+        }
+        let (psi, p) = material.energy_and_pk1::<FMA>(&f);
+        energy += v * psi;
+        let vp = p * *v;
+        for a in 0..3 {
+            let (p0, p1, p2) = (vp[(a, 0)], vp[(a, 1)], vp[(a, 2)]);
+            for c in 0..P / LANES {
+                let r = c * LANES..(c + 1) * LANES;
+                let out: &mut [f64; LANES] = (&mut grad[a][r.clone()]).try_into().expect("LANES");
+                for (pb, gb) in [p0, p1, p2].into_iter().zip(g) {
+                    axpy_lanes::<FMA>(out, pb, &gb[r.clone()]);
+                }
+            }
+        }
+    }
+    // as the generic kernel: the stable Neo-Hookean energy can dip below its rest value
+    let energy = energy.max(0.0);
+    let c = (2.0 * energy).sqrt();
+    let mut sum_w_grad2 = 0.0;
+    for i in 0..N {
+        sum_w_grad2 += w[i] * (grad[0][i] * grad[0][i] + grad[1][i] * grad[1][i] + grad[2][i] * grad[2][i]);
+    }
+    if let Some((d_lambda, step)) = xpbd_step(c, c, sum_w_grad2, inv_dt2, *lambda) {
+        *lambda += d_lambda;
+        for i in 0..N {
+            let s = step * w[i];
+            x[i] += Vec3::new(grad[0][i], grad[1][i], grad[2][i]) * s;
+        }
+    }
+    energy
+}
+
+/// The colour sweep over packed range `range` of colour `colour` of `packed` (a colour-ordered
+/// block), whose start is a multiple of 4 elements from the colour's start: as [`energy_sweep`],
+/// but with `batched` the linear tetrahedra with StVK go four at a time through
+/// [`p1x4::batches_avx2`] where the CPU has AVX2 and FMA (the colour's last `len mod 4`
+/// elements, and every other case, through the scalar sweep). Which elements are batched
+/// depends only on the colour, not on how its range is cut, so the result does not depend on
+/// the thread count.
+///
+/// # Safety
+/// As [`energy_sweep`].
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn colour_sweep(
+    nodes_per_element: usize,
+    material: &Material,
+    positions: Positions,
+    rest: &[Vec3],
+    inv_mass: &[f64],
+    packed: &PackedBlock,
+    colour: usize,
+    range: std::ops::Range<usize>,
+    lambdas: Multipliers,
+    inv_dt2: f64,
+    batched: bool,
+) -> Option<Result<u64, NonFiniteElement>> {
+    let data = packed.data();
+    let colour_start = packed.colour_starts[colour];
+    assert!((range.start - colour_start).is_multiple_of(4) && range.end <= packed.colour_starts[colour + 1]);
+    let mut tail = range.clone();
+    let mut projected = 0;
+    #[cfg(target_arch = "x86_64")]
+    if batched
+        && nodes_per_element == 4
+        && packed.points == 1
+        && material.model == MaterialModel::StVenantKirchhoff
+        && packed.colour_batches.len() == packed.colour_starts.len()
+        && std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+    {
+        let first = packed.colour_batches[colour] + (range.start - colour_start) / 4;
+        let batches = (range.len() / 4).min(packed.colour_batches[colour + 1] - first);
+        let ids = data.element_ids.expect("colour order");
+        let io = p1x4::BatchIo {
+            positions,
+            rest,
+            inv_mass,
+            nodes: &data.nodes[range.start * 4..(range.start + 4 * batches) * 4],
+            values: &packed.p1x4[first * BATCH_VALUES..(first + batches) * BATCH_VALUES],
+            element_ids: &ids[range.start..range.start + 4 * batches],
+            lambdas,
+            inv_dt2,
+        };
+        let l = material.lame();
+        // SAFETY: forwarded from the caller; AVX2 and FMA were detected; the elements of a
+        // batch are of one colour.
+        match unsafe { p1x4::batches_avx2(&Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa }, io, batches) } {
+            Ok(k) => projected = k,
+            Err(bad) => return Some(Err(bad)),
+        }
+        tail.start += 4 * batches;
+    }
+    // SAFETY: forwarded from the caller.
+    let rest_of =
+        unsafe { energy_sweep(nodes_per_element, material, positions, rest, inv_mass, &data, tail, lambdas, inv_dt2) }?;
+    Some(rest_of.map(|k| k + projected))
+}

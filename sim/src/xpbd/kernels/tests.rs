@@ -1,0 +1,310 @@
+use super::*;
+use crate::Vec3;
+use crate::fem::energy::element_grads;
+use crate::fem::energy::tests::{elements, materials};
+use crate::xpbd::constraint::project_energy_constraint;
+
+/// The specialised sweep projects one element exactly as the generic kernel does, up to the
+/// order of floating-point operations, for every element type and material; the colour-packed
+/// copy holds the same data.
+#[test]
+fn specialised_sweep_matches_the_generic_kernel() {
+    for (et, mesh, geo) in elements() {
+        let n = et.num_nodes();
+        assert!(SPECIALISED_NODE_COUNTS.contains(&n), "{et}");
+        let g = &geo[0];
+        let block = &mesh.blocks[0];
+        let deformed: Vec<Vec3> = mesh
+            .rest_positions
+            .iter()
+            .enumerate()
+            .map(|(i, p)| p + 0.05 * Vec3::new((i as f64 * 0.7).sin(), (i as f64 * 1.3).cos(), (i as f64 * 0.4).sin()))
+            .collect();
+        let w: Vec<f64> = (0..mesh.num_nodes()).map(|i| if i == 0 { 0.0 } else { 1.0 + 0.1 * i as f64 }).collect();
+        for material in materials() {
+            let mut expected = deformed.clone();
+            let mut lambda_expected = 0.0;
+            project_energy_constraint(
+                &mut expected,
+                &mesh.rest_positions,
+                &w,
+                element_grads(g, 0),
+                g.volumes(0),
+                &material,
+                1e4,
+                &mut lambda_expected,
+            );
+
+            let (serial, colour) =
+                (PackedBlock::in_element_order(block, g), PackedBlock::in_colour_order(block, g, &[vec![0]]));
+            for data in [serial.data(), colour.data()] {
+                let mut x = deformed.clone();
+                let mut lambdas = vec![0.0];
+                // SAFETY: one thread, sizes from the mesh.
+                let done = unsafe {
+                    energy_sweep(
+                        n,
+                        &material,
+                        Positions::new(&mut x),
+                        &mesh.rest_positions,
+                        &w,
+                        &data,
+                        0..1,
+                        Multipliers::new(&mut lambdas),
+                        1e4,
+                    )
+                };
+                assert_eq!(done, Some(Ok(1)), "{et}");
+                let scale = expected.iter().zip(&deformed).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+                assert!(scale > 0.0, "{et} {:?}: nothing moved", material.model);
+                let gap = x.iter().zip(&expected).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+                assert!(gap <= 1e-12 * scale.max(1.0), "{et} {:?}: {gap:e}", material.model);
+                assert!(
+                    (lambdas[0] - lambda_expected).abs() <= 1e-12 * lambda_expected.abs(),
+                    "{et} {:?}",
+                    material.model
+                );
+                assert_eq!(x[0], deformed[0], "a pinned node stays");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_non_finite_correction_is_reported_and_not_scattered() {
+    let (et, mesh, geo) = elements().remove(0);
+    let mut x = mesh.rest_positions.clone();
+    x[1].y = f64::INFINITY;
+    let before = x.clone();
+    let w = vec![1.0; mesh.num_nodes()];
+    let mut lambdas = vec![0.0];
+    let material = materials()[0];
+    // SAFETY: one thread, sizes from the mesh.
+    let done = unsafe {
+        energy_sweep(
+            et.num_nodes(),
+            &material,
+            Positions::new(&mut x),
+            &mesh.rest_positions,
+            &w,
+            &PackedBlock::in_element_order(&mesh.blocks[0], &geo[0]).data(),
+            0..1,
+            Multipliers::new(&mut lambdas),
+            1e4,
+        )
+    };
+    assert!(matches!(done, Some(Err(NonFiniteElement { element: 0, .. }))), "{done:?}");
+    assert_eq!(x.iter().map(|p| p.x).collect::<Vec<_>>(), before.iter().map(|p| p.x).collect::<Vec<_>>());
+}
+
+/// The 2 × 0.5 × 0.5 m P1 beam of 8 × 2 × 2 cells refined `refine` times, its geometry,
+/// colouring and colour-packed block.
+fn p1_beam(refine: usize) -> (crate::mesh::Mesh, Vec<crate::fem::geometry::BlockGeometry>, Vec<Vec<u32>>, PackedBlock) {
+    use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+    let mesh = BoxMeshSpec {
+        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(2.0, 0.5, 0.5), cells: [8, 2, 2] },
+        element_type: crate::element::ElementType::from_name("p1").unwrap(),
+        split: TetSplit::Five,
+        refine,
+    }
+    .build()
+    .unwrap();
+    let geo = crate::fem::geometry::precompute(&mesh, None).unwrap();
+    let colours = crate::xpbd::colouring::colour_elements(&mesh.blocks[0], mesh.num_nodes());
+    let packed = PackedBlock::in_colour_order(&mesh.blocks[0], &geo[0], &colours);
+    (mesh, geo, colours, packed)
+}
+
+/// The colour sweep of a P1 beam over the colour-packed data projects exactly what the generic
+/// kernel does element after element in the same order, up to round-off.
+#[test]
+fn p1_colour_sweep_matches_the_generic_kernel() {
+    let (mesh, geo, colours, packed) = p1_beam(0);
+    let block = &mesh.blocks[0];
+    let material = materials()[0];
+    let deformed: Vec<Vec3> = mesh
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p + 0.02 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin()))
+        .collect();
+    let w: Vec<f64> = mesh.rest_positions.iter().map(|p| if p.x < 1e-12 { 0.0 } else { 1.0 }).collect();
+    let inv_dt2 = 9e6;
+
+    let mut expected = deformed.clone();
+    let mut lambdas_expected = vec![0.0; block.len()];
+    for &e in colours.iter().flatten() {
+        let e = e as usize;
+        let nodes = block.element(e);
+        if nodes.iter().all(|&n| w[n as usize] == 0.0) {
+            continue;
+        }
+        let mut x: Vec<Vec3> = nodes.iter().map(|&n| expected[n as usize]).collect();
+        let rest: Vec<Vec3> = nodes.iter().map(|&n| mesh.rest_positions[n as usize]).collect();
+        let we: Vec<f64> = nodes.iter().map(|&n| w[n as usize]).collect();
+        project_energy_constraint(
+            &mut x,
+            &rest,
+            &we,
+            element_grads(&geo[0], e),
+            geo[0].volumes(e),
+            &material,
+            inv_dt2,
+            &mut lambdas_expected[e],
+        );
+        for (xi, &n) in x.iter().zip(nodes) {
+            expected[n as usize] = *xi;
+        }
+    }
+
+    let mut x = deformed.clone();
+    let mut lambdas = vec![0.0; block.len()];
+    let mut done = 0;
+    for c in 0..packed.num_colours() {
+        // SAFETY: one thread, sizes from the mesh.
+        let r = unsafe {
+            energy_sweep(
+                4,
+                &material,
+                Positions::new(&mut x),
+                &mesh.rest_positions,
+                &w,
+                &packed.data(),
+                packed.colour(c),
+                Multipliers::new(&mut lambdas),
+                inv_dt2,
+            )
+        };
+        done += r.unwrap().unwrap();
+    }
+    assert!(done > 0);
+    let scale = expected.iter().zip(&deformed).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    let gap = x.iter().zip(&expected).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    assert!(scale > 0.0 && gap <= 1e-12 * scale.max(1.0), "{gap:e} against {scale:e}");
+    for (a, b) in lambdas.iter().zip(&lambdas_expected) {
+        assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{a} {b}");
+    }
+}
+
+/// A P1 beam, its colour-packed block, a deformed state and inverse masses with every node at
+/// x < 0.3 pinned (so whole elements are pinned too).
+fn p1_colour_case() -> (crate::mesh::Mesh, PackedBlock, Vec<Vec3>, Vec<f64>) {
+    let (mesh, _, _, packed) = p1_beam(1);
+    let deformed: Vec<Vec3> = mesh
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p + 0.02 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin()))
+        .collect();
+    let w: Vec<f64> = mesh
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| if p.x < 0.3 { 0.0 } else { 1.0 + 0.01 * (i % 7) as f64 })
+        .collect();
+    (mesh, packed, deformed, w)
+}
+
+/// Every colour of `packed` through [`colour_sweep`], batched or not; the first error stops.
+fn sweep_colours(
+    packed: &PackedBlock,
+    rest: &[Vec3],
+    w: &[f64],
+    x: &mut [Vec3],
+    lambdas: &mut [f64],
+    batched: bool,
+) -> Result<u64, NonFiniteElement> {
+    let material = materials()[0];
+    let mut done = 0;
+    for c in 0..packed.num_colours() {
+        // SAFETY: one thread, sizes from the mesh.
+        done += unsafe {
+            colour_sweep(
+                4,
+                &material,
+                Positions::new(x),
+                rest,
+                w,
+                packed,
+                c,
+                packed.colour(c),
+                Multipliers::new(lambdas),
+                9e6,
+                batched,
+            )
+        }
+        .unwrap()?;
+    }
+    Ok(done)
+}
+
+/// Four same-colour linear tetrahedra per 256-bit register give the one-at-a-time colour
+/// sweep's positions and multipliers up to round-off, skip the same pinned elements, and name
+/// the same element when one comes out non-finite, with the same nodes scattered before it.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn p1_batches_of_four_match_the_scalar_colour_sweep() {
+    if !(std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")) {
+        return;
+    }
+    let (mesh, packed, deformed, w) = p1_colour_case();
+    assert!(packed.colour_batches.last().copied().unwrap_or(0) * 4 > packed.len() / 2, "most elements in batches");
+    let n = mesh.blocks[0].len();
+    let run = |batched: bool, x: &mut Vec<Vec3>, lambdas: &mut Vec<f64>| {
+        let mut done = 0;
+        for _ in 0..5 {
+            lambdas.fill(0.0);
+            done += sweep_colours(&packed, &mesh.rest_positions, &w, x, lambdas, batched).unwrap();
+        }
+        done
+    };
+    let (mut x1, mut l1, mut x4, mut l4) = (deformed.clone(), vec![0.0; n], deformed.clone(), vec![0.0; n]);
+    let (done1, done4) = (run(false, &mut x1, &mut l1), run(true, &mut x4, &mut l4));
+    assert_eq!(done1, done4);
+    assert!(done1 < 5 * n as u64, "some elements are all pinned");
+    let scale = x1.iter().zip(&deformed).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    let gap = x1.iter().zip(&x4).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    assert!(scale > 1e-3 && gap <= 1e-12 * scale, "{gap:e} against {scale:e}");
+    for (a, b) in l1.iter().zip(&l4) {
+        assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{a} {b}");
+    }
+    for (i, (a, b)) in x4.iter().zip(&deformed).enumerate() {
+        if w[i] == 0.0 {
+            assert_eq!(a, b, "a pinned node stays");
+        }
+    }
+
+    // a non-finite node first met (in sweep order) in the third lane of a batch past the first colour
+    let mut first_seen = vec![usize::MAX; mesh.num_nodes()];
+    for (k, four) in packed.nodes.chunks_exact(4).enumerate() {
+        for &nd in four {
+            first_seen[nd as usize] = first_seen[nd as usize].min(k);
+        }
+    }
+    let c = (1..packed.num_colours()).find(|&c| packed.colour(c).len() >= 8).unwrap();
+    let k = (packed.colour(c).start..packed.colour(c).end - 4)
+        .find(|&k| {
+            (k - packed.colour(c).start) % 4 == 2
+                && first_seen[packed.nodes[4 * k + 1] as usize] == k
+                && w[packed.nodes[4 * k + 1] as usize] > 0.0
+        })
+        .expect("a node first met in a third lane");
+    let bad_node = packed.nodes[4 * k + 1];
+    let (mut x1, mut l1, mut x4, mut l4) = (deformed.clone(), vec![0.0; n], deformed.clone(), vec![0.0; n]);
+    x1[bad_node as usize].y = f64::NAN;
+    x4[bad_node as usize].y = f64::NAN;
+    let (r1, r4) = (
+        sweep_colours(&packed, &mesh.rest_positions, &w, &mut x1, &mut l1, false),
+        sweep_colours(&packed, &mesh.rest_positions, &w, &mut x4, &mut l4, true),
+    );
+    let bad = r1.unwrap_err();
+    assert_eq!(bad, r4.unwrap_err());
+    assert_eq!(bad.node, bad_node);
+    assert_eq!(bad.element, packed.element_ids.as_ref().unwrap()[k] as usize);
+    for (a, b) in x1.iter().zip(&x4) {
+        assert!((a - b).norm() <= 1e-12 || a.y.is_nan() && b.y.is_nan(), "{a} {b}");
+    }
+    for (a, b) in l1.iter().zip(&l4) {
+        assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{a} {b}");
+    }
+}
