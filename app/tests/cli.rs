@@ -336,3 +336,10 @@ fn a_mistyped_compare_key_is_named_even_alone() {
     fails_with(&["record", "--scene", "bending", "--out", rrd, "--compare", "youngz=1e6"], "did you mean 'youngs'");
     fails_with(&["record", "--scene", "bending", "--out", rrd, "--compare", "element=p1"], "two or more");
 }
+
+#[test]
+fn a_grid_too_large_for_memory_is_refused_naming_the_grid() {
+    // 1.3 million P3 elements: under the element limit, over the memory one
+    fails_with(&["mesh", "--scene", "bending", "--element", "p3", "--grid", "64x64x64"], "--grid");
+    fails_with(&["mesh", "--scene", "bending", "--element", "p3", "--grid", "64x64x64"], "1,310,720 elements");
+}

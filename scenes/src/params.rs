@@ -482,9 +482,14 @@ pub fn is_tetrahedral(p: &Params) -> bool {
     ElementType::from_name(&p.element).is_some_and(|e| e.shape() == hox_sim::element::ReferenceShape::Tetrahedron)
 }
 
-/// The largest mesh a box scene may ask for, elements. Measured: the 81,920-element P1 beam (the
-/// largest of the paper's Table 1) takes about 0.2 GB; ten times that is still interactive.
+/// The largest mesh a box scene may ask for, elements: 24 times the paper's largest beam (P1
+/// 81,920), whose run measured 63 MB of resident memory in all (about 25 MB above the binary's
+/// own; [`box_bytes`] estimates 58 MB, an upper bound).
 pub const MAX_BOX_ELEMENTS: u64 = 2_000_000;
+
+/// The most memory a box scene may ask for by [`box_bytes`], bytes (a third of this machine's
+/// 24 GiB): high-order elements reach it before the element limit.
+pub const MAX_BOX_BYTES: u64 = 8_000_000_000;
 
 /// Elements a box mesh of `p` would have (without building it).
 pub fn box_elements(p: &Params) -> Option<u64> {
@@ -517,23 +522,33 @@ pub fn box_bytes(p: &Params) -> Option<u64> {
     Some(box_elements(p)?.saturating_mul(per_element))
 }
 
-/// `--refine` may ask for more elements than a simulation can hold: refuse with the count and the
-/// memory it would take. Checked on `refine` alone: without refinement the largest grid (64³ cells
-/// of six tetrahedra, 1,572,864 elements) stays under the limit.
+/// A box may ask for more elements or memory than a simulation can hold: refuse with the count
+/// and the memory it would take.
 fn check_box_size(p: &Params) -> Result<(), String> {
     let (Some(elements), Some(bytes)) = (box_elements(p), box_bytes(p)) else { return Ok(()) };
-    if elements <= MAX_BOX_ELEMENTS {
+    if elements <= MAX_BOX_ELEMENTS && bytes <= MAX_BOX_BYTES {
         return Ok(());
     }
     let [x, y, z] = p.grid;
     Err(format!(
-        "{} {x}×{y}×{z} refined {} time(s) would be {} elements and take about {:.1} GB; at most {} elements",
+        "{} {x}×{y}×{z}{} would be {} elements and take about {:.1} GB; at most {} elements and {:.0} GB",
         p.element.to_uppercase(),
-        p.refine,
+        if p.refine > 0 { format!(" refined {} time(s)", p.refine) } else { String::new() },
         thousands(elements),
         bytes as f64 / 1e9,
-        thousands(MAX_BOX_ELEMENTS)
+        thousands(MAX_BOX_ELEMENTS),
+        MAX_BOX_BYTES as f64 / 1e9
     ))
+}
+
+/// The size check, reported on the grid when nothing is refined ...
+fn check_grid_size(p: &Params) -> Result<(), String> {
+    if p.refine == 0 { check_box_size(p) } else { Ok(()) }
+}
+
+/// ... and on the refinement otherwise (each multiplies the elements by 8).
+fn check_refine_size(p: &Params) -> Result<(), String> {
+    if p.refine > 0 { check_box_size(p) } else { Ok(()) }
 }
 
 /// 5242880 → "5,242,880".
@@ -566,14 +581,15 @@ params! {
     grid: [usize; 3] = [8, 2, 2] => {
         key: "grid", group: Group::Mesh, file_key: "grid", label: "Grid",
         help: "Hexahedral cells along x, y and z before any splitting (each 1–64), NXxNYxNZ.",
-        kind: Kind::Grid { min: 1, max: 64 }, invalidates: Invalidates::Mesh, required: true, box_only: true, ..BASE
+        kind: Kind::Grid { min: 1, max: 64 }, invalidates: Invalidates::Mesh, required: true, box_only: true,
+        check_with: Some(check_grid_size), ..BASE
     }
     /// 1-to-8 refinements of the tetrahedra.
     refine: usize = 0 => {
         key: "refine", group: Group::Mesh, file_key: "refine", label: "Refine",
         help: "1-to-8 refinements of the tetrahedra (each multiplies the element count by 8; tetrahedra only).",
         kind: Kind::Whole { min: 0, max: 3, soft_max: 3 }, invalidates: Invalidates::Mesh, box_only: true,
-        applies: Some(is_tetrahedral), check_with: Some(check_box_size), ..BASE
+        applies: Some(is_tetrahedral), check_with: Some(check_refine_size), ..BASE
     }
     /// The box's lower corner, metres.
     box_min_m: [f64; 3] = [0.0; 3] => {
@@ -883,5 +899,13 @@ mod tests {
         p.split = "six".into();
         p.refine = 1;
         assert!(check_box_size(&p).unwrap_err().contains("12,582,912 elements"));
+        assert!(check_grid_size(&p).is_ok(), "reported on the refinement, not the grid");
+        // high order reaches the memory limit first, and unrefined it is the grid's
+        p.element = "p3".into();
+        p.split = "five".into();
+        p.refine = 0;
+        let e = check_grid_size(&p).unwrap_err();
+        assert!(e.contains("1,310,720 elements") && e.contains("GB"), "{e}");
+        assert!(check_refine_size(&p).is_ok());
     }
 }
