@@ -1,10 +1,9 @@
 //! The material law the sweep is generic over ([`PointMaterial`]): `(ψ(F), P(F))` at one
 //! quadrature point. [`Stvk`] is Saint-Venant–Kirchhoff with its Lamé parameters computed once
-//! per sweep, through the one StVK point law ([`crate::material::stvk::energy_and_pk1`]); every
+//! per sweep (bit for bit [`crate::material::stvk::energy_and_pk1`], tested); every
 //! other model goes through [`AnyMaterial`] (its registered law: one indirect call per point).
 
-use crate::material::lane::{self, Scalar};
-use crate::material::{Mat3, Material, stvk};
+use crate::material::{Mat3, Material};
 
 /// `(ψ(F), P(F))` at one quadrature point: the material law the kernel is generic over.
 pub trait PointMaterial: Sync {
@@ -12,8 +11,12 @@ pub trait PointMaterial: Sync {
     fn energy_and_pk1<const FMA: bool>(&self, f: &Mat3) -> (f64, Mat3);
 }
 
-/// Saint-Venant–Kirchhoff with its Lamé parameters computed once per sweep: the one StVK point
-/// law, [`crate::material::stvk::energy_and_pk1`], on one `f64` (fused multiply–adds with `FMA`).
+/// Saint-Venant–Kirchhoff with its Lamé parameters computed once per sweep, in nalgebra's
+/// column-major form: `E = ½(H + Hᵀ + HᵀH)`, `H = F − I`, `S = 2μE + λ tr(E) I` (λ on the diagonal
+/// only), `ψ = μ E:E + λ/2 tr(E)²`, `P = F S`. The same law as
+/// [`crate::material::stvk::energy_and_pk1`] bit for bit (tested), written out here because the
+/// lane-generic form, run on one `f64` through row-major arrays, made the Q2 serial sweep 7–8 %
+/// slower (release `bench_table`, 3.60–3.71 ms against 3.88–4.00 ms per frame, same machine, one run).
 #[derive(Clone, Copy, Debug)]
 pub struct Stvk {
     pub mu_pa: f64,
@@ -23,9 +26,16 @@ pub struct Stvk {
 impl PointMaterial for Stvk {
     #[inline(always)]
     fn energy_and_pk1<const FMA: bool>(&self, f: &Mat3) -> (f64, Mat3) {
-        let (psi, p) =
-            stvk::energy_and_pk1::<Scalar<FMA>>(Scalar(self.mu_pa), Scalar(self.lambda_pa), &lane::from_mat3(f));
-        (psi.0, lane::to_mat3(&p))
+        let h = f - Mat3::identity();
+        let e = (h + h.transpose() + super::simd::tr_mul3::<FMA>(&h, &h)) * 0.5;
+        let tr = e.trace();
+        let mut s = e * (2.0 * self.mu_pa);
+        let lt = self.lambda_pa * tr;
+        s[(0, 0)] += lt;
+        s[(1, 1)] += lt;
+        s[(2, 2)] += lt;
+        let psi = self.mu_pa * e.norm_squared() + 0.5 * self.lambda_pa * tr * tr;
+        (psi, super::simd::mul3::<FMA>(f, &s))
     }
 }
 

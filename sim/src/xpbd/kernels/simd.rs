@@ -12,6 +12,12 @@ pub fn mul3<const FMA: bool>(a: &Mat3, b: &Mat3) -> Mat3 {
     Mat3::from_fn(|r, c| madd::<FMA>(a[(r, 2)], b[(2, c)], madd::<FMA>(a[(r, 1)], b[(1, c)], a[(r, 0)] * b[(0, c)])))
 }
 
+/// `aᵀ b` for 3×3 matrices, as [`mul3`].
+#[inline(always)]
+pub fn tr_mul3<const FMA: bool>(a: &Mat3, b: &Mat3) -> Mat3 {
+    Mat3::from_fn(|r, c| madd::<FMA>(a[(2, r)], b[(2, c)], madd::<FMA>(a[(1, r)], b[(1, c)], a[(0, r)] * b[(0, c)])))
+}
+
 /// `acc ← acc + a ∘ b` on [`LANES`] lanes (`a`, `b`: at least `LANES` long): one AVX2 fused
 /// multiply–add when `FMA` (set only by [`sweep_avx2`], where the CPU has both).
 #[inline(always)]

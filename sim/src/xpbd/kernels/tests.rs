@@ -308,3 +308,30 @@ fn p1_batches_of_four_match_the_scalar_colour_sweep() {
         assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{a} {b}");
     }
 }
+
+/// The sweep's StVK ([`Stvk`], nalgebra's column-major form, kept for speed) is the material's
+/// one StVK point law ([`crate::material::stvk::energy_and_pk1`]) bit for bit, with and without
+/// fused multiply–adds, so the two cannot drift apart.
+#[test]
+fn the_sweeps_stvk_is_the_materials_point_law_bit_for_bit() {
+    use crate::material::Mat3;
+    use crate::material::lane::{Scalar, from_mat3, to_mat3};
+    use crate::material::stvk::energy_and_pk1;
+    let law = Stvk { mu_pa: 1.1e6, lambda_pa: 2.3e6 };
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
+    };
+    for _ in 0..2000 {
+        let f = Mat3::from_fn(|r, c| if r == c { 1.0 } else { 0.0 } + next());
+        let (psi, p) = law.energy_and_pk1::<false>(&f);
+        let (psi_l, p_l) = energy_and_pk1::<Scalar<false>>(Scalar(law.mu_pa), Scalar(law.lambda_pa), &from_mat3(&f));
+        assert_eq!((psi.to_bits(), p.map(f64::to_bits)), (psi_l.0.to_bits(), to_mat3(&p_l).map(f64::to_bits)));
+        let (psi, p) = law.energy_and_pk1::<true>(&f);
+        let (psi_l, p_l) = energy_and_pk1::<Scalar<true>>(Scalar(law.mu_pa), Scalar(law.lambda_pa), &from_mat3(&f));
+        assert_eq!((psi.to_bits(), p.map(f64::to_bits)), (psi_l.0.to_bits(), to_mat3(&p_l).map(f64::to_bits)));
+    }
+}
