@@ -61,11 +61,16 @@ pub fn simulate(
         println!("{out}");
     } else {
         println!(
-            "{}: {} frames, {:.3} s simulated, {:.2} ms per frame{}",
+            "{}: {} frames, {:.3} s simulated, {}{}",
             instance.scene.name(),
             report.frames,
             report.sim_seconds,
-            report.ms_per_frame,
+            // the median of no frame is NaN (JSON null): nothing was timed
+            if report.frames > 0 {
+                format!("{:.2} ms per frame", report.ms_per_frame)
+            } else {
+                "no frame timed".into()
+            },
             if settle { if report.settled { ", settled" } else { ", NOT settled (cap reached)" } } else { "" }
         );
         for (name, u) in &report.probes {
