@@ -9,7 +9,7 @@ the same beams run right after, so the ratio is measured in one run.
 (set HOX_CARGO="flock /tmp/hox-cargo.lock cargo" where builds must take turns).
 
 Installs pypbd into bench/.venv (a virtualenv) on first use. The meshes come from hox itself
-(`cargo run --release -p hox-sim --example beam_mesh -- LABEL`), so both solve identical meshes.
+(`cargo run --release -p hox-scenes --example beam_mesh -- LABEL`), so both solve identical meshes.
 PBD's solid method 3 is its XPBD FEM tetrahedron (the constitutive model of Bender et al.
 2014 / PBD's `FEMTetConstraint`): one constraint per tetrahedron, like hox's energy
 formulation; stiffness is Young's modulus, 3 MPa, Poisson ratio 0.35. Times are medians of ms
@@ -100,7 +100,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--frames", type=int, default=20)
     parser.add_argument("--method", type=int, default=3, help="PBD solid method (3: XPBD FEM tetrahedra)")
-    parser.add_argument("--hox", default="run --quiet --release -p hox-sim --example bench_table --",
+    parser.add_argument("--hox", default="run --quiet --release -p hox-scenes --example bench_table --",
                         help="cargo arguments that print the hox bench table for FRAMES THREADS FILTER")
     parser.add_argument("--inner", help=argparse.SUPPRESS)
     args = parser.parse_args()

@@ -19,8 +19,8 @@ fn main() {
         let elements = instance.sim.mesh().num_elements();
         row(format!("scene {name}"), elements, instance.sim.stability());
     }
-    for case in hox_sim::benchmark::CASES.iter() {
-        let mut sim = hox_sim::benchmark::bending_beam(case, false).expect("benchmark beam");
+    for case in hox_scenes::bench::CASES.iter() {
+        let mut sim = hox_scenes::bench::bending_beam(case, false).expect("benchmark beam");
         let elements = sim.mesh().num_elements();
         row(format!("bench {}", case.label()), elements, sim.stability());
     }

@@ -3,7 +3,9 @@
 //! Each built-in scene is a TOML file in `assets/scenes/` (embedded in the binary, so `hox`
 //! runs from anywhere); [`scene`] documents the format. [`Instance`] builds a scene into a
 //! running simulation with its probes, and [`run`] advances it for a time or until it settles.
+//! [`bench`] times the bending scene's beam (`hox bench`).
 
+pub mod bench;
 pub mod params;
 pub mod run;
 pub mod scene;

@@ -147,7 +147,7 @@ pub fn run_observed(
     })
 }
 
-pub use hox_sim::benchmark::median;
+pub use hox_sim::measure::median;
 
 /// Time after which no listed effect drives motion any more (ramps done, planes stopped).
 fn driven_until_secs(effects: &[EffectSpec]) -> f64 {

@@ -22,11 +22,11 @@
 //! - [`effect`]: opt-in effects (gravity, clamps, prescribed motion, contact, damping, drag).
 //! - [`solver`]: the stateful XPBD [`solver::Simulation`] (settings, sweep, NaN guard), the
 //!   stability guard, and static equilibrium by Newton's method (`solver::statics`).
-//! - [`measure`]: probes, the display surface, min det F.
-//! - [`benchmark`]: timing the paper's Table 1 beams (`hox bench`, `sim/benches/`), and the one
-//!   [`benchmark::median`].
+//! - [`measure`]: probes, the display surface, min det F, the one [`measure::median`].
+//!
+//! Timing the paper's Table 1 beams (`hox bench`) lives in the scenes crate (`hox_scenes::bench`):
+//! the beam is the bending scene file's.
 
-pub mod benchmark;
 pub mod effect;
 pub mod element;
 pub mod fem;

@@ -6,7 +6,7 @@ pub fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool) 
     if frames == 0 || threads.contains(&0) {
         bail!("--frames and every --threads count must be at least 1");
     }
-    let rows = hox_sim::benchmark::run(only, threads, colour_on_one, frames, &mut |r| {
+    let rows = hox_scenes::bench::run(only, threads, colour_on_one, frames, &mut |r| {
         eprintln!(
             "{} on {} thread(s), parallel {}: {:.2} ms/frame",
             r.case.label(),
@@ -18,6 +18,6 @@ pub fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool) 
     if rows.is_empty() {
         bail!("no configuration matches '{only}'");
     }
-    print!("{}", hox_sim::benchmark::markdown(&rows));
+    print!("{}", hox_scenes::bench::markdown(&rows));
     Ok(())
 }

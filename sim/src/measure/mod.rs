@@ -6,11 +6,14 @@
 //! - [`surface`]: the boundary tessellated for display (curved faces follow the elements' own
 //!   maps) and quadrature points as material points.
 //! - [`min_det_f`]: the smallest `det F` over every quadrature point ([`MinDetF`]).
+//! - [`median`]: the one median (frame timings, run reports; empty input is NaN).
 //!
 //! It reads meshes and the finite-element model; the solvers do not read it.
 
 mod inversion;
+mod median;
 pub mod probe;
 pub mod surface;
 
 pub use inversion::{MinDetF, min_det_f};
+pub use median::median;

@@ -306,6 +306,16 @@ fn serial_colour_and_slab_sweeps_agree_and_settle_on_a_p1_beam() {
     sweeps_agree_and_settle(beam(ElementType::from_name("p1").unwrap(), [8, 2, 2]), &[(1, usize::MAX), (2, 0)]);
 }
 
+/// 1,280 linear tetrahedra (16 × 4 × 4 cells) under gravity, clamped at x = 0, colour sweep.
+fn sagging_p1_beam() -> Simulation {
+    let mesh = beam(ElementType::from_name("p1").unwrap(), [16, 4, 4]);
+    let clamped = clamped_at_x0(&mesh);
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 3.0e6, 0.35, 1000.0).unwrap();
+    let settings = SolverSettings { parallel: true, ..SolverSettings::default() };
+    let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped })];
+    Simulation::new(mesh, material, settings, effects).unwrap()
+}
+
 /// The slab sweep is deterministic for a given thread count, uses its slabs, and keeps every
 /// slab element inside its slab.
 #[test]
@@ -313,7 +323,7 @@ fn slab_sweep_is_deterministic_for_a_thread_count() {
     let run = || {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
         pool.install(|| {
-            let mut sim = crate::benchmark::bending_beam(&crate::benchmark::CASES[0], true).unwrap();
+            let mut sim = sagging_p1_beam();
             sim.set_partition_threshold(0);
             for _ in 0..3 {
                 sim.step_frame().unwrap();
@@ -340,9 +350,8 @@ fn slab_sweep_is_deterministic_for_a_thread_count() {
 /// colour sweep does, up to round-off, over several substeps.
 #[test]
 fn p1_simd_batches_follow_the_scalar_colour_sweep_on_a_sagging_beam() {
-    let case = &crate::benchmark::CASES[0];
-    let mut scalar = crate::benchmark::bending_beam(case, true).unwrap();
-    let mut batched = crate::benchmark::bending_beam(case, true).unwrap();
+    let mut scalar = sagging_p1_beam();
+    let mut batched = sagging_p1_beam();
     scalar.set_simd_batches(false);
     for _ in 0..10 {
         scalar.substep().unwrap();

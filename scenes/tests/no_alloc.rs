@@ -1,7 +1,7 @@
 //! No heap allocation inside a frame: a counting global allocator around `step_frame`, for the
 //! serial sweep and for the parallel sweep run inside a rayon pool (issue #7).
 
-use hox_sim::benchmark::{CASES, bending_beam};
+use hox_scenes::bench::{CASES, bending_beam};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -32,7 +32,7 @@ fn allocations_per_run(parallel: bool, element: &str) -> u64 {
     allocations_of(CASES.iter().find(|c| c.element == element).expect("case"), parallel)
 }
 
-fn allocations_of(case: &hox_sim::benchmark::BenchCase, parallel: bool) -> u64 {
+fn allocations_of(case: &hox_scenes::bench::BenchCase, parallel: bool) -> u64 {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     pool.install(|| {
         let mut sim = bending_beam(case, parallel).unwrap();

@@ -1,10 +1,12 @@
 //! Timing the XPBD loop on the paper's bending beam (Saillant et al., Table 1): the five
-//! configurations of Table 1 plus Q1, Q2, prism and pyramid beams, at the paper's settings
-//! (StVK E = 3 MPa, ν = 0.35, ρ = 1000 kg/m³, 50 substeps × 1 iteration, 60 fps, energy
-//! formulation, gravity, clamped at x = 0), ms per frame as the median of timed frames.
+//! configurations of Table 1 plus Q1, Q2, prism and pyramid beams, ms per frame as the median of
+//! timed frames. The beam is the built-in `bending` scene (`assets/scenes/bending.toml`: StVK
+//! E = 3 MPa, ν = 0.35, ρ = 1000 kg/m³, 50 substeps × 1 iteration, 60 fps, energy formulation,
+//! gravity, clamped at x = 0) with only the element type, grid, refinement and sweep of each
+//! case overridden: change the scene file and the benchmark follows.
 //!
 //! **Flop count.** Per element and substep, with `N` nodes and `Q` quadrature points, the energy
-//! kernel ([`crate::xpbd::kernels`]) does, counting a fused multiply–add as 2 flops:
+//! kernel ([`hox_sim::xpbd::kernels`]) does, counting a fused multiply–add as 2 flops:
 //! - per point: `F = I + Σ_i u_i ⊗ ∇N_i` (18N), StVK `E`, `S`, `ψ`, `P = F S` (165), and
 //!   `∇_i U += V P ∇N_i` (18N + 9);
 //! - per element: displacements `u_i = x_i − X_i` (3N), `Σ_i w_i |∇_i U|²` (6N), the update
@@ -13,12 +15,10 @@
 //! So `flops = Q (36 N + 174) + 16 N + 10`: 384 for P1. Achieved GFLOP/s = flops × elements ×
 //! substeps / time. The machine's peak is stated in [`PEAK_GFLOPS_PER_CORE`].
 
-use crate::Vec3;
-use crate::effect::{Clamp, Effect, Gravity};
-use crate::element::ElementType;
-use crate::material::{Material, MaterialModel};
-use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
-use crate::solver::{SimError, Simulation, SolverSettings};
+use crate::params::SceneOverrides;
+use crate::{Instance, SceneError};
+use hox_sim::measure::median;
+use hox_sim::solver::Simulation;
 use std::time::Instant;
 
 /// Peak double-precision rate of one core of this machine with the instructions the kernels
@@ -61,24 +61,17 @@ pub const CASES: [BenchCase; 9] = [
     BenchCase { element: "pyramid", grid: [12, 3, 3], refine: 0, paper_ms_per_frame: None },
 ];
 
-/// The paper's bending beam for `case`, at rest; `parallel` selects the colour sweep.
-pub fn bending_beam(case: &BenchCase, parallel: bool) -> Result<Simulation, SimError> {
-    let element_type = ElementType::from_name(case.element).ok_or_else(|| {
-        SimError::Settings(format!("unknown element type '{}' (known: {})", case.element, ElementType::names()))
-    })?;
-    let mesh = BoxMeshSpec {
-        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(2.0, 0.5, 0.5), cells: case.grid },
-        element_type,
-        split: TetSplit::Five,
-        refine: case.refine,
-    }
-    .build()?;
-    let material = Material::new(MaterialModel::StVenantKirchhoff, 3.0e6, 0.35, 1000.0)
-        .map_err(|e| SimError::Settings(e.to_string()))?;
-    let clamped = mesh.nodes_where(|p| p.x.abs() < 1e-12);
-    let effects: Vec<Box<dyn Effect>> =
-        vec![Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))), Box::new(Clamp { nodes: clamped })];
-    Simulation::new(mesh, material, SolverSettings { parallel, ..SolverSettings::default() }, effects)
+/// The paper's bending beam for `case`, at rest: the `bending` scene with the case's element
+/// type, grid and refinement; `parallel` selects the colour sweep.
+pub fn bending_beam(case: &BenchCase, parallel: bool) -> Result<Simulation, SceneError> {
+    let overrides = SceneOverrides {
+        element: Some(case.element.to_string()),
+        grid: Some(case.grid),
+        refine: Some(case.refine),
+        parallel: Some(parallel),
+        ..SceneOverrides::default()
+    };
+    Ok(Instance::new(crate::by_name("bending")?.with_overrides(&overrides)?)?.sim)
 }
 
 /// Flops of one energy-constraint projection of an element with `nodes` nodes and `points`
@@ -111,22 +104,6 @@ impl BenchRow {
     }
 }
 
-/// Median of `values` (sorted in place, by [`f64::total_cmp`]): the middle value, or the mean
-/// of the two middle values for an even count. The one median of the workspace (hox-scenes
-/// re-exports it for its run reports and the app's timings).
-///
-/// **Empty input gives NaN**: there is no measurement, and a 0 would read as a frame that took
-/// no time (serde_json writes the NaN as `null`). NaN inputs sort after +∞ (positive NaN) or
-/// before −∞ (negative NaN), so they count as extreme values, not as errors.
-pub fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) }
-}
-
 /// Times `case` with the serial sweep or the `parallel` colour sweep, in a rayon pool of
 /// `threads`: `warmup_frames` untimed, then the median of `frames` timed frames. Frames are
 /// also capped by `budget_secs` of timed work (at least 3 frames).
@@ -137,20 +114,24 @@ pub fn measure(
     warmup_frames: usize,
     frames: usize,
     budget_secs: f64,
-) -> Result<BenchRow, SimError> {
+) -> Result<BenchRow, SceneError> {
     let threads = threads.max(1);
-    let pool =
-        rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| SimError::Settings(e.to_string()))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| SceneError::Simulation { source_name: "bench".into(), message: e.to_string() })?;
+    let failed =
+        |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: case.label(), message: e.to_string() };
     pool.install(|| {
         let mut sim = bending_beam(case, parallel)?;
         for _ in 0..warmup_frames {
-            sim.step_frame()?;
+            sim.step_frame().map_err(failed)?;
         }
         let mut times_ms = Vec::with_capacity(frames);
         let start = Instant::now();
         for i in 0..frames.max(1) {
             let clock = Instant::now();
-            sim.step_frame()?;
+            sim.step_frame().map_err(failed)?;
             times_ms.push(clock.elapsed().as_secs_f64() * 1e3);
             if i >= 2 && start.elapsed().as_secs_f64() > budget_secs {
                 break;
@@ -207,7 +188,7 @@ pub fn markdown(rows: &[BenchRow]) -> String {
 /// case), on each of `threads`
 /// (1: the serial sweep; more: the parallel colour sweep; with `colour_on_one`, also the
 /// colour sweep on one thread, which projects linear tetrahedra four per 256-bit register:
-/// `crate::xpbd::kernels::p1x4`), reporting each row to `progress` as it is measured (what
+/// `hox_sim::xpbd::kernels::p1x4`), reporting each row to `progress` as it is measured (what
 /// `hox bench` runs).
 pub fn run(
     filter: &str,
@@ -215,7 +196,7 @@ pub fn run(
     colour_on_one: bool,
     frames: usize,
     progress: &mut dyn FnMut(&BenchRow),
-) -> Result<Vec<BenchRow>, SimError> {
+) -> Result<Vec<BenchRow>, SceneError> {
     let filter = filter.to_uppercase();
     // a whole label picks that case alone ("P1 16x4x4" is also part of its refinements' labels)
     let exact = CASES.iter().any(|c| c.label().to_uppercase() == filter);
@@ -238,13 +219,23 @@ pub fn run(
 
 #[cfg(test)]
 mod tests {
-    use super::median;
+    use super::*;
 
+    /// The benchmark's beam is the bending scene's: its box, material, settings and effects come
+    /// from `assets/scenes/bending.toml`; a case changes only the element type, grid, refinement
+    /// and sweep.
     #[test]
-    fn median_of_odd_even_and_empty_input() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
-        assert_eq!(median(&mut [7.0]), 7.0);
-        assert!(median(&mut []).is_nan());
+    fn the_benchmark_beam_is_the_bending_scene_file() {
+        let scene = crate::by_name("bending").unwrap();
+        let case = BenchCase { element: "q1", grid: [4, 1, 1], refine: 0, paper_ms_per_frame: None };
+        let sim = bending_beam(&case, true).unwrap();
+        assert_eq!(*sim.material(), scene.material());
+        assert_eq!(*sim.settings(), hox_sim::solver::SolverSettings { parallel: true, ..scene.settings() });
+        let (lo, hi) = sim.mesh().bounding_box();
+        assert_eq!([lo, hi].map(|p| [p.x, p.y, p.z]), [scene.params().box_min_m, scene.params().box_max_m]);
+        assert_eq!(sim.mesh().num_elements(), 4);
+        assert_eq!(sim.mesh().blocks[0].element_type.name(), "q1");
+        let effects: Vec<&str> = sim.effects().iter().map(|e| e.name()).collect();
+        assert_eq!(effects, ["gravity", "clamp"]);
     }
 }

@@ -1,5 +1,5 @@
 //! Prints the `hox bench` table without building the app:
-//! `cargo run --release -p hox-sim --example bench_table [-- FRAMES [THREADS [FILTER]]]`
+//! `cargo run --release -p hox-scenes --example bench_table [-- FRAMES [THREADS [FILTER]]]`
 //! (THREADS: comma-separated, default 1,2; FILTER: a substring of the configuration label;
 //! on one thread both the serial sweep and the colour sweep are timed, the latter with linear
 //! tetrahedra four per 256-bit register; HOX_BENCH_COLOUR_ON_ONE=0 times the serial sweep only).
@@ -12,7 +12,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => vec![1, 2],
     };
     let filter = args.next().unwrap_or_default();
-    let rows = hox_sim::benchmark::run(
+    let rows = hox_scenes::bench::run(
         &filter,
         &threads,
         std::env::var("HOX_BENCH_COLOUR_ON_ONE").map_or(true, |v| v != "0"),
@@ -27,6 +27,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             )
         },
     )?;
-    print!("{}", hox_sim::benchmark::markdown(&rows));
+    print!("{}", hox_scenes::bench::markdown(&rows));
     Ok(())
 }

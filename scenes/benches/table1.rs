@@ -4,11 +4,11 @@
 //! specialised energy kernel against the generic one on P1 and P2; and on P1 the colour sweep
 //! one element at a time against four per register.
 //!
-//! `cargo bench -p hox-sim --bench table1` (all), or with a filter: `… -- "P1 16x4x4 r2"`.
+//! `cargo bench -p hox-scenes --bench table1` (all), or with a filter: `… -- "P1 16x4x4 r2"`.
 
 use criterion::{BatchSize, Criterion, SamplingMode, criterion_group, criterion_main};
+use hox_scenes::bench::{CASES, bending_beam};
 use hox_sim::Vec3;
-use hox_sim::benchmark::{CASES, bending_beam};
 use hox_sim::fem::energy::{element_grads, gather};
 use hox_sim::xpbd::constraint::project_energy_constraint;
 use hox_sim::xpbd::kernels::{Multipliers, PackedBlock, Positions, colour_sweep, energy_sweep};
