@@ -9,6 +9,7 @@
 
 mod cli;
 mod colour;
+mod display;
 mod gui;
 mod output;
 mod recording;

@@ -16,6 +16,7 @@
 //! rest shape are logged once as static data; a frame logs only what moves.
 
 use crate::colour::ColourRange;
+use crate::display::{SurfaceFrame, f32s};
 use hox_scenes::Instance;
 use hox_sim::Vec3;
 use hox_sim::measure::surface::{PointMap, Surface};
@@ -27,7 +28,8 @@ pub struct LogSettings {
     /// Pieces per edge of curved or quadrilateral faces.
     pub segments: usize,
     /// Upper end of the displacement colour range, metres (default: a fifth of the body's
-    /// largest extent).
+    /// largest extent, [`crate::display::colour_range`]). Configurations recorded side by side
+    /// are given the first one's range, as the viewport shows them.
     pub colour_max_m: Option<f64>,
     /// Also log the quadrature points.
     pub quadrature_points: bool,
@@ -45,10 +47,10 @@ pub struct SimLogger {
     surface: Surface,
     quadrature: Option<PointMap>,
     colours: ColourRange,
-    // frame buffers, reused
-    x: Vec<Vec3>,
-    u: Vec<Vec3>,
-    normals: Vec<Vec3>,
+    /// What is drawn this frame (the viewport's display frame).
+    frame: SurfaceFrame,
+    /// Quadrature points this frame, reused.
+    points: Vec<Vec3>,
 }
 
 /// A name usable as one entity path part: lowercase letters, digits and `_`.
@@ -78,10 +80,6 @@ pub fn config_label(instance: &Instance) -> String {
     format!("{} {}", types.join("+"), mesh.num_elements())
 }
 
-fn f32s(v: &Vec3) -> [f32; 3] {
-    [v.x as f32, v.y as f32, v.z as f32]
-}
-
 impl SimLogger {
     /// Logs the static data of `instance` under `world/<name>` offset by `offset_m`.
     pub fn new(
@@ -98,8 +96,7 @@ impl SimLogger {
             .quadrature_points
             .then(|| hox_sim::measure::surface::quadrature_points(mesh, instance.sim.geometry()));
         let (lo, hi) = mesh.bounding_box();
-        let extent = hi - lo;
-        let colours = ColourRange { max_m: settings.colour_max_m.unwrap_or(0.2 * extent.max()) };
+        let colours = crate::display::colour_range(Some(mesh), settings.colour_max_m);
         let root = format!("world/{name}");
         rec.log_static(root.as_str(), &rerun::Transform3D::from_translation(f32s(&offset_m)))?;
         rec.log_static(
@@ -141,7 +138,7 @@ impl SimLogger {
             )?;
         }
         Self::log_legend(rec, &name, &root, &colours, lo, hi, &configuration_markdown(instance))?;
-        Ok(SimLogger { name, surface, quadrature, colours, x: Vec::new(), u: Vec::new(), normals: Vec::new() })
+        Ok(SimLogger { name, surface, quadrature, colours, frame: SurfaceFrame::default(), points: Vec::new() })
     }
 
     /// A vertical colour bar beside the body (its lower end at the body's rest bottom, height the
@@ -221,21 +218,16 @@ impl SimLogger {
         rec.set_time_sequence("frame", sim.frames() as i64);
         rec.set_duration_secs("sim_time", sim.time_secs());
         let root = format!("world/{}", self.name);
-        self.surface.vertices.eval_into(&sim.positions, &mut self.x);
-        self.surface.vertices.displacements_into(&sim.positions, &mesh.rest_positions, &mut self.u);
-        self.surface.vertex_normals(&self.x, &mut self.normals);
-        let colours = self.colours;
+        self.frame.update(&self.surface, sim, &self.colours);
+        let frame = &self.frame;
         rec.log(
             format!("{root}/surface"),
             &rerun::Mesh3D::update_fields()
-                .with_vertex_positions(self.x.iter().map(f32s))
-                .with_vertex_normals(self.normals.iter().map(f32s))
-                .with_vertex_colors(self.u.iter().map(|u| {
-                    let c = colours.colour(u.norm());
-                    rerun::Color::from_rgb(c[0], c[1], c[2])
-                })),
+                .with_vertex_positions(frame.positions_m.iter().map(f32s))
+                .with_vertex_normals(frame.normals.iter().map(f32s))
+                .with_vertex_colors(frame.colours.iter().map(|c| rerun::Color::from_rgb(c[0], c[1], c[2]))),
         )?;
-        let x = &self.x;
+        let x = &frame.positions_m;
         rec.log(
             format!("{root}/edges"),
             &rerun::LineStrips3D::update_fields().with_strips(
@@ -246,10 +238,10 @@ impl SimLogger {
             instance.probes.iter().map(|p| f32s(&p.position(&sim.positions))).collect();
         rec.log(format!("{root}/probes"), &rerun::Points3D::update_fields().with_positions(probe_positions))?;
         if let Some(q) = &self.quadrature {
-            q.eval_into(&sim.positions, &mut self.x);
+            q.eval_into(&sim.positions, &mut self.points);
             rec.log(
                 format!("{root}/quadrature_points"),
-                &rerun::Points3D::update_fields().with_positions(self.x.iter().map(f32s)),
+                &rerun::Points3D::update_fields().with_positions(self.points.iter().map(f32s)),
             )?;
         }
         for (name, u) in instance.probe_displacements() {

@@ -116,15 +116,14 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         .recording_name(format!("hox record {}", instances[0].scene.name()))
         .save(&args.out)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
+    // one layout and one colour range for every configuration, as the app's viewport draws them
+    let first_mesh = instances[0].sim.mesh();
+    let offsets = crate::display::side_by_side_offsets(first_mesh, instances.len());
     let settings = LogSettings {
         segments: args.tessellation,
-        colour_max_m: args.colour_max_m,
+        colour_max_m: Some(crate::display::colour_range(Some(first_mesh), args.colour_max_m).max_m),
         quadrature_points: args.quadrature_points,
     };
-    // configurations side by side along y, one body width plus a gap apart
-    let (lo, hi) = instances[0].sim.mesh().bounding_box();
-    let extent = hi - lo;
-    let spacing_m = extent.y + (0.5 * extent.y).max(0.25 * extent.max());
     let mut names = BTreeSet::new();
     let mut loggers = Vec::new();
     for (k, inst) in instances.iter().enumerate() {
@@ -133,8 +132,7 @@ pub fn record(args: &RecordArgs) -> Result<()> {
             name = format!("{name}_{}", k + 1);
             names.insert(name.clone());
         }
-        let offset = hox_sim::Vec3::new(0.0, k as f64 * spacing_m, 0.0);
-        loggers.push(SimLogger::new(&rec, &name, inst, offset, &settings)?);
+        loggers.push(SimLogger::new(&rec, &name, inst, offsets[k], &settings)?);
     }
 
     // VTK series beside the recording (one folder per configuration when comparing)

@@ -321,13 +321,10 @@ impl HoxApp {
         self.viewport.reset_camera(&self.sessions, &self.offsets());
     }
 
-    /// World offsets of the sessions (side by side along y).
+    /// World offsets of the sessions (side by side along y, [`crate::display`]).
     pub fn offsets(&self) -> Vec<Vec3> {
         let Some(first) = self.sessions.first() else { return Vec::new() };
-        let (lo, hi) = first.instance.sim.mesh().bounding_box();
-        let e = hi - lo;
-        let spacing = e.y + (0.5 * e.y).max(0.25 * e.max());
-        (0..self.sessions.len()).map(|k| Vec3::new(0.0, k as f64 * spacing, 0.0)).collect()
+        crate::display::side_by_side_offsets(first.instance.sim.mesh(), self.sessions.len())
     }
 
     /// Applies `new` to the active session and, in compare mode, the linked fields to the
@@ -472,7 +469,7 @@ impl HoxApp {
         if link.generation != self.generation {
             let settings = LogSettings {
                 segments: segments(&self.view),
-                colour_max_m: self.view.colour_max_m,
+                colour_max_m: Some(Viewport::colour_range(&self.sessions, &self.view).max_m),
                 quadrature_points: self.view.quadrature_points,
             };
             link.loggers.clear();

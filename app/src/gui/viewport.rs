@@ -11,6 +11,8 @@ use super::gl_view::{GlScene, GlState, paint_callback};
 use super::raster::{BACKGROUND, Camera, Image, Overlay, TriangleLayer, shade};
 use super::session::{Drag, Session};
 use crate::colour::ColourRange;
+use crate::display::SurfaceFrame;
+pub use crate::display::f32s;
 use eframe::egui;
 use hox_sim::Vec3;
 use std::sync::Arc;
@@ -60,6 +62,8 @@ pub struct Viewport {
     image: Image,
     texture: Option<egui::TextureHandle>,
     layers: Vec<TriangleLayer>,
+    /// The display frame of each session (shared with the recording, [`crate::display`]).
+    frames: Vec<SurfaceFrame>,
     /// Wall time of the last render (rasterise + upload), milliseconds.
     pub render_ms: f64,
     /// Node picked for dragging: session index and node.
@@ -79,6 +83,7 @@ impl Viewport {
             image: Image::new(1, 1),
             texture: None,
             layers: Vec::new(),
+            frames: Vec::new(),
             render_ms: 0.0,
             dragging: None,
             gl_state: GlState::default(),
@@ -102,11 +107,7 @@ impl Viewport {
 
     /// The colour range of the first session (shared by all, so colours compare).
     pub fn colour_range(sessions: &[Session], opts: &ViewOptions) -> ColourRange {
-        let extent = sessions.first().map(|s| {
-            let (lo, hi) = s.instance.sim.mesh().bounding_box();
-            (hi - lo).max()
-        });
-        ColourRange { max_m: opts.colour_max_m.unwrap_or(0.2 * extent.unwrap_or(1.0)) }
+        crate::display::colour_range(sessions.first().map(|s| s.instance.sim.mesh()), opts.colour_max_m)
     }
 
     /// Shows the view; `gl` says whether the frame has an OpenGL context to draw it with (else,
@@ -180,19 +181,15 @@ impl Viewport {
         let started = Instant::now();
         let colours = Self::colour_range(sessions, opts);
         self.layers.resize_with(sessions.len(), TriangleLayer::default);
+        self.frames.resize_with(sessions.len(), SurfaceFrame::default);
         let mut overlay = Overlay::default();
         let mut x = Vec::new();
-        let mut u = Vec::new();
-        let mut normals = Vec::new();
-        for ((s, layer), o) in sessions.iter().zip(&mut self.layers).zip(offsets) {
+        for (((s, layer), frame), o) in sessions.iter().zip(&mut self.layers).zip(&mut self.frames).zip(offsets) {
             let sim = &s.instance.sim;
-            let mesh = sim.mesh();
-            s.surface.vertices.eval_into(&sim.positions, &mut x);
-            s.surface.vertices.displacements_into(&sim.positions, &mesh.rest_positions, &mut u);
-            s.surface.vertex_normals(&x, &mut normals);
-            layer.positions = x.iter().map(|p| f32s(&(p + o))).collect();
-            layer.normals = normals.iter().map(f32s).collect();
-            layer.colours = u.iter().map(|d| colours.colour(d.norm())).collect();
+            frame.update(&s.surface, sim, &colours);
+            layer.positions = frame.positions_m.iter().map(|p| f32s(&(p + o))).collect();
+            layer.normals = frame.normals.iter().map(f32s).collect();
+            layer.colours.clone_from(&frame.colours);
             layer.triangles.clone_from(&s.surface.triangles);
             if opts.edges {
                 for e in &s.surface.edges {
@@ -411,8 +408,4 @@ fn legend_ui(painter: &egui::Painter, rect: egui::Rect, colours: &ColourRange) {
         egui::FontId::proportional(12.0),
         egui::Color32::WHITE,
     );
-}
-
-pub fn f32s(v: &Vec3) -> [f32; 3] {
-    [v.x as f32, v.y as f32, v.z as f32]
 }
