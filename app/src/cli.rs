@@ -115,7 +115,7 @@ pub enum Command {
     /// Record a scene to a Rerun file (.rrd) without a display: the deformed surface coloured by
     /// displacement, element edges, probes and time series; --compare records several
     /// configurations side by side.
-    Record(record::RecordArgs),
+    Record(Box<record::RecordArgs>),
     /// Read a Rerun recording back and list its entities, components and frame counts.
     Inspect(record::InspectArgs),
     /// Open the interactive app (the default when no command is given).

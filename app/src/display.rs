@@ -28,14 +28,18 @@ pub fn side_by_side_offsets(first: &Mesh, count: usize) -> Vec<Vec3> {
     (0..count).map(|k| Vec3::new(0.0, k as f64 * spacing_m, 0.0)).collect()
 }
 
-/// The displacement colour range every configuration shares: `[0, colour_max_m]`, or, when
-/// that is not given, `[0, ⅕ × the first body's largest extent]` (`first`: None gives 1 m).
-pub fn colour_range(first: Option<&Mesh>, colour_max_m: Option<f64>) -> ColourRange {
+/// The displacement colour range every configuration shares: `[0, colour_max_m]` (the display
+/// parameter `colour_max_m` of the first configuration), or, when that is 0 (automatic),
+/// `[0, ⅕ × the first body's largest extent]` (`first`: None gives 1 m).
+pub fn colour_range(first: Option<&Mesh>, colour_max_m: f64) -> ColourRange {
+    if colour_max_m > 0.0 {
+        return ColourRange { max_m: colour_max_m };
+    }
     let extent_m = first.map_or(1.0, |m| {
         let (lo, hi) = m.bounding_box();
         (hi - lo).max()
     });
-    ColourRange { max_m: colour_max_m.unwrap_or(0.2 * extent_m) }
+    ColourRange { max_m: 0.2 * extent_m }
 }
 
 /// One configuration's surface as drawn this frame; buffers are reused from frame to frame.
@@ -79,9 +83,9 @@ mod tests {
         let instance = hox_scenes::Instance::new(scene).unwrap();
         let mesh = instance.sim.mesh();
         assert_eq!(side_by_side_offsets(mesh, 2), [Vec3::zeros(), Vec3::new(0.0, 1.0, 0.0)]);
-        assert_eq!(colour_range(Some(mesh), None).max_m, 0.4);
-        assert_eq!(colour_range(Some(mesh), Some(0.1)).max_m, 0.1);
-        assert_eq!(colour_range(None, None).max_m, 0.2);
+        assert_eq!(colour_range(Some(mesh), 0.0).max_m, 0.4);
+        assert_eq!(colour_range(Some(mesh), 0.1).max_m, 0.1);
+        assert_eq!(colour_range(None, 0.0).max_m, 0.2);
     }
 
     /// A body at rest is drawn at its rest surface, in the colour of zero displacement; moved

@@ -27,17 +27,18 @@ use rerun::RecordingStream;
 pub struct LogSettings {
     /// Pieces per edge of curved or quadrilateral faces.
     pub segments: usize,
-    /// Upper end of the displacement colour range, metres (default: a fifth of the body's
-    /// largest extent, [`crate::display::colour_range`]). Configurations recorded side by side
-    /// are given the first one's range, as the viewport shows them.
-    pub colour_max_m: Option<f64>,
+    /// The displacement colour range ([`crate::display::colour_range`]): configurations
+    /// recorded side by side share the first one's, as the viewport shows them.
+    pub colours: ColourRange,
     /// Also log the quadrature points.
     pub quadrature_points: bool,
 }
 
-impl Default for LogSettings {
-    fn default() -> Self {
-        Self { segments: 4, colour_max_m: None, quadrature_points: false }
+impl LogSettings {
+    /// The display parameters of a configuration (`[display]` of the parameter table), drawn on
+    /// the shared colour range `colours`.
+    pub fn new(params: &hox_scenes::Params, colours: ColourRange) -> LogSettings {
+        LogSettings { segments: params.tessellation, colours, quadrature_points: params.quadrature_points }
     }
 }
 
@@ -96,7 +97,7 @@ impl SimLogger {
             .quadrature_points
             .then(|| hox_sim::measure::surface::quadrature_points(mesh, instance.sim.geometry()));
         let (lo, hi) = mesh.bounding_box();
-        let colours = crate::display::colour_range(Some(mesh), settings.colour_max_m);
+        let colours = settings.colours;
         let root = format!("world/{name}");
         rec.log_static(root.as_str(), &rerun::Transform3D::from_translation(f32s(&offset_m)))?;
         rec.log_static(

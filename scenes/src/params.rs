@@ -1,4 +1,5 @@
-//! The parameter table: every mesh, material and solver parameter of a scene, defined once.
+//! The parameter table: every mesh, material, solver, effect and display parameter of a scene,
+//! defined once.
 //!
 //! Each entry of [`PARAMS`] states a parameter's key (`youngs`: the CLI flag `--youngs`, the
 //! `--compare youngs=…` key, the app's link), its scene-file key (`material.youngs_modulus_pa`),
@@ -7,8 +8,8 @@
 //!
 //! - the typed values [`Params`] (one field per entry, persisted by the app) and the typed
 //!   [`SceneOverrides`] (the same fields, each optional);
-//! - the scene file's `[mesh]`, `[material]` and `[solver]` keys, their parsing and their range
-//!   checks ([`crate::scene`]);
+//! - the scene file's `[mesh]`, `[material]`, `[solver]`, `[effect]` and `[display]` keys, their
+//!   parsing and their range checks ([`crate::scene`]);
 //! - the command line's flags and the `--compare key=value` keys (the app's `cli` room);
 //! - the app's controls, their links in compare mode and their rebuild levels (the app's `gui`
 //!   room), and the configuration a recording states.
@@ -42,16 +43,22 @@ pub enum Group {
     Mesh,
     Material,
     Solver,
+    /// Effects every scene can switch on, besides the effects it lists (`[[effects]]`).
+    Effect,
+    /// How the configuration is drawn (the app's viewport and recordings); never the physics.
+    Display,
 }
 
 impl Group {
-    pub const ALL: [Group; 3] = [Group::Mesh, Group::Material, Group::Solver];
-    /// The scene file's table (`[mesh]`, `[material]`, `[solver]`).
+    pub const ALL: [Group; 5] = [Group::Mesh, Group::Material, Group::Solver, Group::Effect, Group::Display];
+    /// The scene file's table (`[mesh]`, `[material]`, `[solver]`, `[effect]`, `[display]`).
     pub fn section(self) -> &'static str {
         match self {
             Group::Mesh => "mesh",
             Group::Material => "material",
             Group::Solver => "solver",
+            Group::Effect => "effect",
+            Group::Display => "display",
         }
     }
     pub fn heading(self) -> &'static str {
@@ -59,6 +66,8 @@ impl Group {
             Group::Mesh => "Mesh",
             Group::Material => "Material",
             Group::Solver => "Solver",
+            Group::Effect => "Effects",
+            Group::Display => "Display",
         }
     }
 }
@@ -667,13 +676,6 @@ params! {
         kind: Kind::Number { min: 0.0, min_inclusive: false, max: f64::INFINITY, max_inclusive: false, soft: Some((10.0, 240.0)) },
         ..BASE
     }
-    /// Velocity damping of every node, 1/s (0: none).
-    damping_per_sec: f64 = 0.0 => {
-        key: "damping", group: Group::Solver, file_key: "damping_per_sec", label: "Damping", unit: "1/s",
-        help: "Velocity damping rate of every node per second, on top of any damping effect the scene lists (0: none); a swinging beam comes to rest at a rate of about this many e-foldings per second. A change restarts the run.",
-        kind: Kind::Number { min: 0.0, min_inclusive: true, max: f64::INFINITY, max_inclusive: false, soft: None },
-        invalidates: Invalidates::Mesh, ..BASE
-    }
     /// Project elements in parallel, colour by colour.
     parallel: bool = false => {
         key: "parallel", group: Group::Solver, file_key: "parallel", label: "Parallel",
@@ -693,6 +695,32 @@ params! {
         help: "Velocity damping rate a run to rest (--settle) adds, per second.",
         kind: Kind::Number { min: 0.0, min_inclusive: true, max: f64::INFINITY, max_inclusive: false, soft: None },
         invalidates: Invalidates::Nothing, surfaces: FILE_ONLY, ..BASE
+    }
+    /// Velocity damping of every node, 1/s (0: none).
+    damping_per_sec: f64 = 0.0 => {
+        key: "damping", group: Group::Effect, file_key: "damping_per_sec", label: "Damping", unit: "1/s",
+        help: "Velocity damping rate of every node per second, on top of any damping effect the scene lists (0: none); a swinging beam comes to rest at a rate of about this many e-foldings per second. A change restarts the run.",
+        kind: Kind::Number { min: 0.0, min_inclusive: true, max: f64::INFINITY, max_inclusive: false, soft: None },
+        invalidates: Invalidates::Mesh, ..BASE
+    }
+    /// Pieces per edge of drawn curved and quadrilateral faces.
+    tessellation: usize = 4 => {
+        key: "tessellation", group: Group::Display, file_key: "tessellation", label: "Face segments",
+        help: "Pieces per edge when drawing curved (high-order) and quadrilateral faces: more shows the curvature of P2, P3 and Q2 elements more smoothly, at more drawing cost.",
+        kind: Kind::Whole { min: 1, max: 16, soft_max: 12 }, invalidates: Invalidates::Nothing, ..BASE
+    }
+    /// Top of the displacement colour range, metres (0: a fifth of the body's largest extent).
+    colour_max_m: f64 = 0.0 => {
+        key: "colour-max-m", group: Group::Display, file_key: "colour_max_m", label: "Colour range top", unit: "m",
+        help: "Displacement magnitude shown yellow (the top of the fixed viridis range from 0 m), metres; 0: a fifth of the body's largest extent. Compared configurations share the first one's range.",
+        kind: Kind::Number { min: 0.0, min_inclusive: true, max: f64::INFINITY, max_inclusive: false, soft: None },
+        invalidates: Invalidates::Nothing, ..BASE
+    }
+    /// Draw (or record) every quadrature point.
+    quadrature_points: bool = false => {
+        key: "quadrature-points", group: Group::Display, file_key: "quadrature_points", label: "Quadrature points",
+        help: "Also draw (and record) every quadrature point, where the solver samples F.",
+        kind: Kind::Flag, switch: Some(("quadrature-points", true)), invalidates: Invalidates::Nothing, ..BASE
     }
 }
 

@@ -13,9 +13,17 @@ pub struct MeshArgs {
     pub overrides: SceneOverrides,
 }
 
-/// The material and solver parameters (`--material --youngs … --parallel --no-stability-guard`).
+/// The material, solver and effect parameters (`--material --youngs … --parallel
+/// --no-stability-guard --damping`).
 #[derive(Clone, Debug, Default)]
 pub struct PhysicsArgs {
+    pub overrides: SceneOverrides,
+}
+
+/// The display parameters (`--tessellation --colour-max-m --quadrature-points`), for the
+/// commands that draw (`hox record`).
+#[derive(Clone, Debug, Default)]
+pub struct DisplayArgs {
     pub overrides: SceneOverrides,
 }
 
@@ -77,7 +85,8 @@ fn read(m: &ArgMatches, groups: &'static [Group]) -> SceneOverrides {
 }
 
 const MESH: &[Group] = &[Group::Mesh];
-const PHYSICS: &[Group] = &[Group::Material, Group::Solver];
+const PHYSICS: &[Group] = &[Group::Material, Group::Solver, Group::Effect];
+const DISPLAY: &[Group] = &[Group::Display];
 
 macro_rules! param_args {
     ($ty:ident, $groups:expr) => {
@@ -103,6 +112,7 @@ macro_rules! param_args {
 
 param_args!(MeshArgs, MESH);
 param_args!(PhysicsArgs, PHYSICS);
+param_args!(DisplayArgs, DISPLAY);
 
 /// The overrides the command line gives.
 pub fn overrides(mesh: &MeshArgs, physics: Option<&PhysicsArgs>) -> SceneOverrides {

@@ -12,6 +12,16 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
+/// `--compare`'s help: its keys are the parameter table's.
+fn compare_help() -> String {
+    format!(
+        "Record several configurations of the scene side by side (give it two or more times). Each value lists \
+         option=value pairs applied on top of the other options, e.g. `--compare element=p1,refine=1 --compare \
+         element=p2`. Options: {}",
+        hox_scenes::params::compare_keys()
+    )
+}
+
 #[derive(clap::Args)]
 pub struct RecordArgs {
     #[command(flatten)]
@@ -28,21 +38,11 @@ pub struct RecordArgs {
     pub out: PathBuf,
     /// Record several configurations of the scene side by side (give it two or more times).
     /// Each value lists option=value pairs applied on top of the other options, e.g.
-    /// `--compare element=p1,refine=1 --compare element=p2`. Options: every scene parameter of
-    /// the command line by its key (element, grid, split, refine, material, youngs, poisson,
-    /// density, formulation, quadrature, substeps, iterations, guard (on/off), fps, parallel).
-    #[arg(long, value_name = "OPTION=VALUE,...")]
+    /// `--compare element=p1,refine=1 --compare element=p2`.
+    #[arg(long, value_name = "OPTION=VALUE,...", help = compare_help())]
     pub compare: Vec<String>,
-    /// Pieces per edge when tessellating curved (high-order) and quadrilateral faces.
-    #[arg(long, default_value_t = 4)]
-    pub tessellation: usize,
-    /// Top of the displacement colour range, metres (default: a fifth of the body's largest
-    /// extent). The range is fixed for the whole recording.
-    #[arg(long)]
-    pub colour_max_m: Option<f64>,
-    /// Also log every quadrature point.
-    #[arg(long)]
-    pub quadrature_points: bool,
+    #[command(flatten)]
+    pub display: super::params::DisplayArgs,
     #[command(flatten)]
     pub vtk: super::gmsh::VtkArgs,
     /// Print a JSON summary on stdout.
@@ -76,7 +76,7 @@ pub fn parse_compare(spec: &str, base: &SceneOverrides) -> Result<SceneOverrides
 
 pub fn record(args: &RecordArgs) -> Result<()> {
     let scene = load_scene(&args.scene)?;
-    let base = overrides(&args.mesh, Some(&args.physics));
+    let base = overrides(&args.mesh, Some(&args.physics)).merged(&args.display.overrides);
     // every value is checked first, so a mistyped key is named even when only one is given
     let compared: Vec<SceneOverrides> =
         args.compare.iter().map(|spec| parse_compare(spec, &base)).collect::<Result<_>>()?;
@@ -85,14 +85,6 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         1 => bail!("--compare needs two or more configurations (give it once per configuration)"),
         _ => compared,
     };
-    if args.tessellation == 0 || args.tessellation > 32 {
-        bail!("--tessellation must be between 1 and 32 pieces per edge, got {}", args.tessellation);
-    }
-    if let Some(c) = args.colour_max_m
-        && !(c.is_finite() && c > 0.0)
-    {
-        bail!("--colour-max-m must be a finite positive length in metres, got {c}");
-    }
     let mut instances = Vec::new();
     for (k, o) in configurations.iter().enumerate() {
         let s = scene.with_overrides(o).with_context(|| {
@@ -119,11 +111,7 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     // one layout and one colour range for every configuration, as the app's viewport draws them
     let first_mesh = instances[0].sim.mesh();
     let offsets = crate::display::side_by_side_offsets(first_mesh, instances.len());
-    let settings = LogSettings {
-        segments: args.tessellation,
-        colour_max_m: Some(crate::display::colour_range(Some(first_mesh), args.colour_max_m).max_m),
-        quadrature_points: args.quadrature_points,
-    };
+    let colours = crate::display::colour_range(Some(first_mesh), instances[0].scene.params().colour_max_m);
     let mut names = BTreeSet::new();
     let mut loggers = Vec::new();
     for (k, inst) in instances.iter().enumerate() {
@@ -132,6 +120,7 @@ pub fn record(args: &RecordArgs) -> Result<()> {
             name = format!("{name}_{}", k + 1);
             names.insert(name.clone());
         }
+        let settings = LogSettings::new(inst.scene.params(), colours);
         loggers.push(SimLogger::new(&rec, &name, inst, offsets[k], &settings)?);
     }
 

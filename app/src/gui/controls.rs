@@ -350,44 +350,10 @@ fn view_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
             .on_hover_text("Element edges on the surface (curved for high-order elements).");
         ui.checkbox(&mut v.nodes, "nodes")
             .on_hover_text("Corner nodes white, high-order (edge, face, interior) nodes cyan.");
-        ui.checkbox(&mut v.quadrature_points, "quadrature points")
-            .on_hover_text("Where the elastic energy is sampled (orange).");
         ui.checkbox(&mut v.boundary_conditions, "clamped / driven")
             .on_hover_text("Clamped nodes blue, nodes with prescribed motion magenta.");
         ui.checkbox(&mut v.ghost, "rest shape").on_hover_text("The undeformed shape's edges as a faint ghost.");
         ui.checkbox(&mut v.probes, "probes").on_hover_text("The probe points the study measures (red).");
-    });
-    let mut segments = v.segments;
-    ui.horizontal(|ui| {
-        let l = label(
-            ui,
-            "Curved-face pieces",
-            "Pieces per edge when drawing curved (high-order) and quadrilateral faces.",
-        );
-        ui.add(egui::Slider::new(&mut segments, 1..=12)).labelled_by(l.id);
-    });
-    if segments != app.view.segments {
-        app.view.segments = segments;
-        for s in &mut app.sessions {
-            s.set_segments(segments);
-        }
-    }
-    let mut auto = app.view.colour_max_m.is_none();
-    ui.horizontal(|ui| {
-        let l = label(
-            ui,
-            "Colour range",
-            "Top of the displacement colour map, metres (auto: a fifth of the body's largest extent).",
-        );
-        ui.checkbox(&mut auto, "auto");
-        let mut max = app
-            .view
-            .colour_max_m
-            .unwrap_or_else(|| super::viewport::Viewport::colour_range(&app.sessions, &app.view).max_m);
-        if !auto {
-            ui.add(egui::DragValue::new(&mut max).range(1e-6..=1e3).speed(0.01).suffix(" m")).labelled_by(l.id);
-        }
-        app.view.colour_max_m = (!auto).then_some(max);
     });
 }
 

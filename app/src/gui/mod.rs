@@ -187,9 +187,12 @@ pub struct HoxApp {
     started: Instant,
 }
 
-/// Pieces per face edge of the display surface for a session.
-fn segments(view: &ViewOptions) -> usize {
-    view.segments.clamp(1, 16)
+/// Whether a change from `old` to `new` changes how a configuration is drawn (a `[display]`
+/// parameter of the table).
+fn redraws(old: &Config, new: &Config) -> bool {
+    old.changed_keys(new)
+        .iter()
+        .any(|k| hox_scenes::params::by_key(k).is_some_and(|p| p.group == hox_scenes::params::Group::Display))
 }
 
 impl HoxApp {
@@ -267,8 +270,7 @@ impl HoxApp {
         let mut sessions = Vec::new();
         for c in wanted.into_iter().take(2) {
             // a saved configuration the scene no longer accepts falls back to the scene's own
-            let s = Session::new(base.clone(), c, segments(&self.view))
-                .or_else(|_| Session::new(base.clone(), defaults.clone(), segments(&self.view)))?;
+            let s = Session::new(base.clone(), c).or_else(|_| Session::new(base.clone(), defaults.clone()))?;
             sessions.push(s);
         }
         self.scene = source;
@@ -299,8 +301,8 @@ impl HoxApp {
                 c.element = "p2".into();
                 c.refine = 0;
             }
-            let second = Session::new(first.base.clone(), c.clone(), segments(&self.view))
-                .or_else(|_| Session::new(first.base.clone(), first.config.clone(), segments(&self.view)));
+            let second = Session::new(first.base.clone(), c.clone())
+                .or_else(|_| Session::new(first.base.clone(), first.config.clone()));
             match second {
                 Ok(s) => {
                     // P1 first, so the pair reads "P1 vs P2" left to right
@@ -335,7 +337,8 @@ impl HoxApp {
         match self.sessions[k].apply(new.clone()) {
             Ok(what) => {
                 self.refusal = None;
-                if what == config::Invalidates::Mesh {
+                // a new mesh, or a new way of drawing it: Rerun logs the static data again
+                if what == config::Invalidates::Mesh || redraws(&old, &new) {
                     self.rebuilt();
                 }
             }
@@ -354,6 +357,7 @@ impl HoxApp {
             }
             match self.sessions[other].apply(follow) {
                 Ok(config::Invalidates::Mesh) => self.rebuilt(),
+                Ok(_) if redraws(&old, &new) => self.rebuilt(),
                 Ok(_) => {}
                 Err(reason) => {
                     self.refusal = Some((control.to_string(), format!("the other configuration refused it: {reason}")))
@@ -467,14 +471,11 @@ impl HoxApp {
         let offsets = self.offsets();
         let Some(link) = &mut self.rerun else { return };
         if link.generation != self.generation {
-            let settings = LogSettings {
-                segments: segments(&self.view),
-                colour_max_m: Some(Viewport::colour_range(&self.sessions, &self.view).max_m),
-                quadrature_points: self.view.quadrature_points,
-            };
+            let colours = Viewport::colour_range(&self.sessions);
             link.loggers.clear();
             for (k, (s, o)) in self.sessions.iter().zip(&offsets).enumerate() {
                 let name = format!("{}_{}", ["a", "b"][k.min(1)], s.label());
+                let settings = LogSettings::new(&s.config, colours);
                 match SimLogger::new(&link.rec, &name, &s.instance, *o, &settings) {
                     Ok(l) => link.loggers.push(l),
                     Err(e) => {

@@ -75,7 +75,6 @@ pub struct Session {
     pub clamped: Vec<u32>,
     pub driven: Vec<u32>,
     quadrature: std::cell::OnceCell<PointMap>,
-    segments: usize,
 }
 
 impl Session {
@@ -84,10 +83,12 @@ impl Session {
         config::label(&self.config, &self.base)
     }
 
-    pub fn new(base: Scene, config: Config, segments: usize) -> Result<Session, String> {
+    /// The configuration `config` of `base`, drawn with `config.tessellation` pieces per face
+    /// edge.
+    pub fn new(base: Scene, config: Config) -> Result<Session, String> {
         let scene = config::resolve(&config, &base)?;
         let instance = Instance::new(scene).map_err(|e| e.to_string())?;
-        let surface = Surface::new(instance.sim.mesh(), segments);
+        let surface = Surface::new(instance.sim.mesh(), config.tessellation);
         let reference = hox_scenes::study::reference(base.name()).unwrap_or_default();
         let mut s = Session {
             base,
@@ -106,7 +107,6 @@ impl Session {
             clamped: Vec::new(),
             driven: Vec::new(),
             quadrature: std::cell::OnceCell::new(),
-            segments,
         };
         s.mesh_changed();
         s.residual = s.force_residual();
@@ -116,15 +116,16 @@ impl Session {
     /// Applies `new`, rebuilding only what it invalidates. On refusal nothing changes and the
     /// reason is returned.
     pub fn apply(&mut self, new: Config) -> Result<Invalidates, String> {
-        let what = self.config.invalidated_by(&new);
-        if what == Invalidates::Nothing {
-            return Ok(what);
+        if new == self.config {
+            return Ok(Invalidates::Nothing);
         }
+        let what = self.config.invalidated_by(&new);
+        // every change is checked against the table, a display one too
         let scene = config::resolve(&new, &self.base)?;
         match what {
             Invalidates::Mesh => {
                 let instance = Instance::new(scene).map_err(|e| e.to_string())?;
-                self.surface = Surface::new(instance.sim.mesh(), self.segments);
+                self.surface = Surface::new(instance.sim.mesh(), new.tessellation);
                 self.instance = instance;
                 self.history = History::default();
                 self.failure = None;
@@ -143,7 +144,10 @@ impl Session {
                 self.instance.scene = scene;
                 self.quadrature = std::cell::OnceCell::new();
             }
-            Invalidates::Nothing => {}
+            Invalidates::Nothing => self.instance.scene = scene,
+        }
+        if what != Invalidates::Mesh && new.tessellation != self.config.tessellation {
+            self.set_segments(new.tessellation);
         }
         self.config = new;
         Ok(what)
@@ -182,12 +186,9 @@ impl Session {
     }
 
     /// Changes the display tessellation.
-    pub fn set_segments(&mut self, segments: usize) {
-        if segments != self.segments {
-            self.segments = segments;
-            self.surface = Surface::new(self.instance.sim.mesh(), segments);
-            self.surface.vertices.eval_into(&self.instance.sim.mesh().rest_positions, &mut self.rest_vertices);
-        }
+    fn set_segments(&mut self, segments: usize) {
+        self.surface = Surface::new(self.instance.sim.mesh(), segments);
+        self.surface.vertices.eval_into(&self.instance.sim.mesh().rest_positions, &mut self.rest_vertices);
     }
 
     /// Back to the rest state at t = 0.
@@ -302,7 +303,7 @@ mod tests {
     fn bending() -> Session {
         let scene = hox_scenes::by_name("bending").unwrap();
         let config = config::from_scene(&scene);
-        Session::new(scene, config, 2).unwrap()
+        Session::new(scene, Config { tessellation: 2, ..config }).unwrap()
     }
 
     #[test]

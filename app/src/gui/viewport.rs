@@ -23,28 +23,14 @@ use std::time::Instant;
 pub struct ViewOptions {
     pub edges: bool,
     pub nodes: bool,
-    pub quadrature_points: bool,
     pub boundary_conditions: bool,
     pub ghost: bool,
     pub probes: bool,
-    /// Pieces per curved face edge.
-    pub segments: usize,
-    /// Top of the displacement colour range, metres (None: a fifth of the body's largest extent).
-    pub colour_max_m: Option<f64>,
 }
 
 impl Default for ViewOptions {
     fn default() -> Self {
-        Self {
-            edges: true,
-            nodes: false,
-            quadrature_points: false,
-            boundary_conditions: true,
-            ghost: true,
-            probes: true,
-            segments: 4,
-            colour_max_m: None,
-        }
+        Self { edges: true, nodes: false, boundary_conditions: true, ghost: true, probes: true }
     }
 }
 
@@ -106,8 +92,9 @@ impl Viewport {
     }
 
     /// The colour range of the first session (shared by all, so colours compare).
-    pub fn colour_range(sessions: &[Session], opts: &ViewOptions) -> ColourRange {
-        crate::display::colour_range(sessions.first().map(|s| s.instance.sim.mesh()), opts.colour_max_m)
+    pub fn colour_range(sessions: &[Session]) -> ColourRange {
+        let first = sessions.first();
+        crate::display::colour_range(first.map(|s| s.instance.sim.mesh()), first.map_or(0.0, |s| s.config.colour_max_m))
     }
 
     /// Shows the view; `gl` says whether the frame has an OpenGL context to draw it with (else,
@@ -179,7 +166,7 @@ impl Viewport {
 
         // --- scene
         let started = Instant::now();
-        let colours = Self::colour_range(sessions, opts);
+        let colours = Self::colour_range(sessions);
         self.layers.resize_with(sessions.len(), TriangleLayer::default);
         self.frames.resize_with(sessions.len(), SurfaceFrame::default);
         let mut overlay = Overlay::default();
@@ -228,7 +215,7 @@ impl Viewport {
                     overlay.points.push((f32s(&(sim.positions[n as usize] + o)), 2.0, DRIVEN));
                 }
             }
-            if opts.quadrature_points {
+            if s.config.quadrature_points {
                 let q = s.quadrature_points();
                 q.eval_into(&sim.positions, &mut x);
                 overlay.points.extend(x.iter().map(|p| (f32s(&(p + o)), 2.0, QUADRATURE_POINT)));

@@ -25,9 +25,14 @@
 //! quadrature_degree = 2   # omit for each element type's default
 //! duration_secs = 3       # default run length
 //! settle_damping_per_sec = 10  # velocity damping used by --settle
-//! damping_per_sec = 0    # velocity damping of every node, always on (0: none)
 //! parallel = false        # project elements colour by colour on all threads
 //! stability_guard = true   # above h·ω_max = 3, substeps with h·ω_max ≤ 1 (hox_sim::solver::stability)
+//! [effect]                # optional: effects any scene can switch on
+//! damping_per_sec = 0     # velocity damping of every node, always on (0: none)
+//! [display]               # optional: how the app and recordings draw it
+//! tessellation = 4        # pieces per edge of curved and quadrilateral faces
+//! colour_max_m = 0        # top of the |u| colour range (0: a fifth of the largest extent)
+//! quadrature_points = false
 //! [[effects]]             # only the effects listed are simulated
 //! type = "gravity"        # gravity | clamp | prescribed | damping | contact
 //! acceleration_m_s2 = [0, 0, -9.81]
@@ -86,7 +91,7 @@ pub struct SceneFile {
     pub probes: Vec<ProbeSpec>,
 }
 
-/// The file's layout; the three parameter tables are read through the parameter table.
+/// The file's layout; the parameter tables (one per [`Group`]) are read through the parameter table.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawSceneFile {
@@ -98,14 +103,18 @@ struct RawSceneFile {
     #[serde(default)]
     solver: toml::Table,
     #[serde(default)]
+    effect: toml::Table,
+    #[serde(default)]
+    display: toml::Table,
+    #[serde(default)]
     effects: Vec<EffectSpec>,
     #[serde(default)]
     probes: Vec<ProbeSpec>,
 }
 
 impl SceneFile {
-    /// Parses a scene file's text: the layout, then each `[mesh]`, `[material]` and `[solver]`
-    /// key through its entry in the parameter table (type checked here, range when validated).
+    /// Parses a scene file's text: the layout, then each `[mesh]`, `[material]`, `[solver]`,
+    /// `[effect]` and `[display]` key through its entry in the parameter table (type checked here, range when validated).
     pub fn parse(text: &str, source: &str) -> Result<SceneFile, SceneError> {
         let raw: RawSceneFile = toml::from_str(text)
             .map_err(|e| SceneError::Parse { source_name: source.to_string(), message: e.to_string() })?;
@@ -119,8 +128,14 @@ impl SceneFile {
             effects: raw.effects,
             probes: raw.probes,
         };
-        for (group, table) in [(Group::Mesh, &raw.mesh), (Group::Material, &raw.material), (Group::Solver, &raw.solver)]
-        {
+        for group in Group::ALL {
+            let table = match group {
+                Group::Mesh => &raw.mesh,
+                Group::Material => &raw.material,
+                Group::Solver => &raw.solver,
+                Group::Effect => &raw.effect,
+                Group::Display => &raw.display,
+            };
             for (key, value) in table {
                 let path = format!("{}.{key}", group.section());
                 if group == Group::Mesh && key == "file" {
