@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 
 mod bench;
 mod gmsh;
+mod inspect;
 mod list;
 mod mesh;
 mod params;
@@ -117,7 +118,7 @@ pub enum Command {
     /// configurations side by side.
     Record(Box<record::RecordArgs>),
     /// Read a Rerun recording back and list its entities, components and frame counts.
-    Inspect(record::InspectArgs),
+    Inspect(inspect::InspectArgs),
     /// Open the interactive app (the default when no command is given).
     App(crate::gui::AppArgs),
 }
@@ -158,7 +159,7 @@ pub fn main(cli: Cli) -> Result<()> {
             statics::static_command(&scene, &mesh, &physics, tolerance, load_steps, json)
         }
         Command::Record(args) => record::record(&args),
-        Command::Inspect(args) => record::inspect(&args),
+        Command::Inspect(args) => inspect::inspect(&args),
         Command::App(args) => crate::gui::run(args),
     }
 }

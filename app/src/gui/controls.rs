@@ -56,12 +56,12 @@ pub fn menu_bar_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
             }
         });
         ui.separator();
-        let play = if app.playing { "Pause" } else { "Play" };
+        let play = if app.playback.playing { "Pause" } else { "Play" };
         if ui.button(play).on_hover_text("Run or pause the simulation (space).").clicked() {
-            app.playing = !app.playing;
+            app.playback.playing = !app.playback.playing;
         }
         if ui.button("Step").on_hover_text("Advance exactly one frame (S).").clicked() {
-            app.playing = false;
+            app.playback.playing = false;
             app.step(1);
         }
         if ui.button("Reset").on_hover_text("Back to the rest shape at t = 0 (R).").clicked() {
@@ -325,11 +325,15 @@ fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
 fn playback_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Playback");
     ui.horizontal(|ui| {
-        if ui.button(if app.playing { "Pause" } else { "Play" }).on_hover_text("Run or pause (space).").clicked() {
-            app.playing = !app.playing;
+        if ui
+            .button(if app.playback.playing { "Pause" } else { "Play" })
+            .on_hover_text("Run or pause (space).")
+            .clicked()
+        {
+            app.playback.playing = !app.playback.playing;
         }
         if ui.button("Step").on_hover_text("One frame (S).").clicked() {
-            app.playing = false;
+            app.playback.playing = false;
             app.step(1);
         }
         if ui.button("Reset").on_hover_text("Rest shape, t = 0 (R).").clicked() {
@@ -338,7 +342,7 @@ fn playback_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     });
     ui.horizontal(|ui| {
         let l = label(ui, "Time scale", "Simulated seconds per real second (1 = real time; the simulation slows down by itself when a frame costs more than real time).");
-        ui.add(egui::Slider::new(&mut app.time_scale, 0.05..=4.0).logarithmic(true).suffix("×")).labelled_by(l.id);
+        ui.add(egui::Slider::new(&mut app.playback.time_scale, 0.05..=4.0).logarithmic(true).suffix("×")).labelled_by(l.id);
     });
 }
 

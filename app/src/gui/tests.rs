@@ -2,6 +2,7 @@
 //! window, no GPU).
 
 use super::*;
+use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT, Queryable};
 

@@ -1,0 +1,121 @@
+//! Playing the simulation: play/pause and the time scale, the clock that turns displayed time
+//! into simulated frames, the keyboard shortcuts, and stepping on a background thread while the
+//! window paints.
+
+use super::HoxApp;
+use super::session::Session;
+use eframe::egui;
+
+/// Playing or paused, how fast, and the clock's remainder.
+pub struct Playback {
+    pub playing: bool,
+    /// Simulated seconds per real second.
+    pub time_scale: f64,
+    /// Simulated time owed but not yet stepped, seconds.
+    pub(super) frame_budget_secs: f64,
+    /// A frame has been shown (the first frame's clock step is not a real interval).
+    pub(super) last_clock_frame: bool,
+}
+
+impl Playback {
+    pub(super) fn new(playing: bool, time_scale: f64) -> Playback {
+        Playback { playing, time_scale, frame_budget_secs: 0.0, last_clock_frame: false }
+    }
+
+    /// The frames of `frame_secs` due after `real_dt_secs` of real time (at most 4); the
+    /// remainder, less than a frame, is kept for the next call.
+    fn frames_due(&mut self, real_dt_secs: f64, frame_secs: f64) -> usize {
+        self.frame_budget_secs += real_dt_secs.min(0.25) * self.time_scale;
+        let frames = ((self.frame_budget_secs / frame_secs).floor() as usize).min(4);
+        self.frame_budget_secs = (self.frame_budget_secs - frames as f64 * frame_secs).min(frame_secs);
+        frames
+    }
+}
+
+impl HoxApp {
+    /// Steps the frames `advance` deferred on a background thread, so that the simulation runs
+    /// while the window paints (the paint is the longer part of a frame with a software renderer;
+    /// docs/APP.md). The next frame starts by taking the sessions back.
+    pub(super) fn start_background_step(&mut self) {
+        let frames = std::mem::take(&mut self.deferred_frames);
+        if frames == 0 || self.background.is_some() || self.sessions.is_empty() {
+            return;
+        }
+        let mut sessions = std::mem::take(&mut self.sessions);
+        let handle = std::thread::spawn(move || {
+            for _ in 0..frames {
+                step_sessions(&mut sessions);
+            }
+            sessions
+        });
+        self.background = Some((handle, frames));
+    }
+
+    /// Takes back the sessions stepped in the background (no-op if none are).
+    pub fn join_background(&mut self) {
+        let Some((handle, frames)) = self.background.take() else { return };
+        match handle.join() {
+            Ok(sessions) => self.sessions = sessions,
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
+        if let Some(m) = &mut self.measure {
+            m.sim_frames += frames as u64;
+        }
+    }
+
+    /// Steps now, or after the UI is built when the window can overlap stepping with painting
+    /// (not with a live Rerun link, which logs every frame in order).
+    fn step_or_defer(&mut self, frames: usize) {
+        if self.gl_available && self.rerun.is_none() {
+            self.deferred_frames += frames;
+        } else {
+            self.step(frames);
+        }
+    }
+
+    /// Keyboard shortcuts (when no text field has the keyboard).
+    pub(super) fn shortcuts(&mut self, ctx: &egui::Context) {
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let (space, s, r) =
+            ctx.input(|i| (i.key_pressed(egui::Key::Space), i.key_pressed(egui::Key::S), i.key_pressed(egui::Key::R)));
+        if space {
+            self.playback.playing = !self.playback.playing;
+        }
+        if s {
+            self.playback.playing = false;
+            self.step(1);
+        }
+        if r {
+            self.reset();
+        }
+    }
+
+    /// Steps as much simulated time as passed in real time × time scale (at most 4 frames per
+    /// displayed frame, so a slow configuration slows down instead of freezing the window).
+    pub(super) fn advance(&mut self, real_dt_secs: f64) {
+        if !self.playback.playing || self.sessions.iter().all(|s| s.failure.is_some()) {
+            self.playback.frame_budget_secs = 0.0;
+            return;
+        }
+        let frame_secs = 1.0 / self.sessions[0].config.frames_per_second;
+        if self.measure.is_some() {
+            // measuring: one simulation frame per displayed frame
+            self.step_or_defer(1);
+            return;
+        }
+        let frames = self.playback.frames_due(real_dt_secs, frame_secs);
+        self.step_or_defer(frames);
+    }
+}
+
+/// One frame of every session (in parallel in compare mode).
+pub(super) fn step_sessions(sessions: &mut [Session]) {
+    use rayon::prelude::*;
+    if sessions.len() > 1 {
+        sessions.par_iter_mut().for_each(|s| s.step(1));
+    } else if let Some(s) = sessions.first_mut() {
+        s.step(1);
+    }
+}

@@ -1,0 +1,90 @@
+//! Opening the native window: `hox app`'s checks of its options, eframe's window and renderer
+//! settings, and the app built on the saved settings.
+
+use super::{AppArgs, HoxApp, Persisted};
+use eframe::egui;
+use hox_scenes::Scene;
+
+/// Whether an OpenGL renderer name is a software rasteriser (Mesa's llvmpipe or softpipe,
+/// SwiftShader, Microsoft's GDI renderer).
+pub fn is_software_renderer(name: &str) -> bool {
+    let n = name.to_ascii_lowercase();
+    ["llvmpipe", "softpipe", "swiftshader", "software rasterizer", "gdi generic"].iter().any(|k| n.contains(k))
+}
+
+/// Window size in points when neither --size nor a saved geometry gives one.
+const DEFAULT_WINDOW_SIZE: &str = "1400x900";
+
+/// Opens the window (blocking until it is closed).
+pub fn run(args: AppArgs) -> anyhow::Result<()> {
+    let size = args.size.as_deref().unwrap_or(DEFAULT_WINDOW_SIZE);
+    let (w, h) = size
+        .split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((w.trim().parse::<f32>().ok()?, h.trim().parse::<f32>().ok()?)))
+        .filter(|(w, h)| *w >= 320.0 && *h >= 240.0)
+        .ok_or_else(|| anyhow::anyhow!("--size must be WIDTHxHEIGHT in points, at least 320x240, got '{size}'"))?;
+    if let Some(p) = &args.screenshot {
+        crate::output::check_writable(p)?;
+    }
+    // fail before opening a window on a bad scene
+    if let Some(name) = &args.scene {
+        hox_scenes::by_name(name)?;
+    }
+    if let Some(path) = &args.scene_file {
+        Scene::load(path)?;
+    }
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size([w, h])
+            .with_title("hox — high-order elements in XPBD"),
+        glow_options: eframe::egui_glow::GlowConfiguration { vsync: !args.no_vsync, ..Default::default() },
+        // an explicit --size (or --fresh) wins over the window geometry eframe saved last time
+        persist_window: args.size.is_none() && !args.fresh,
+        // egui's dithering costs a noise function per pixel in the software renderer and buys
+        // nothing for a flat-shaded 3D view and 8-bit widgets
+        dithering: false,
+        // the 3D view is drawn with depth testing (gui/gl_view.rs)
+        depth_buffer: 24,
+        ..Default::default()
+    };
+    let mut error = None;
+    let result = eframe::run_native(
+        "hox",
+        options,
+        Box::new(|cc| {
+            // eframe restores the last window geometry before this point; an explicit --size or
+            // --fresh asks for the given (or default) size instead
+            if args.size.is_some() || args.fresh {
+                cc.egui_ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(egui::vec2(w, h)));
+            }
+            if args.fresh {
+                // egui's own saved state too (panel sizes, open windows)
+                cc.egui_ctx.memory_mut(|m| *m = egui::Memory::default());
+            }
+            let renderer = cc.gl.as_ref().map(|gl| {
+                use eframe::glow::HasContext;
+                // SAFETY: a plain query on the context eframe has just made current
+                unsafe { gl.get_parameter_string(eframe::glow::RENDERER) }
+            });
+            // Anti-aliasing feathers double the triangles egui hands to the driver; a software
+            // renderer pays for each one on the CPU (docs/APP.md), so shapes go without there.
+            let software = renderer.as_deref().is_some_and(is_software_renderer);
+            cc.egui_ctx.tessellation_options_mut(|o| o.feathering = !software);
+            let saved = cc.storage.and_then(Persisted::load);
+            match HoxApp::new(&args, saved) {
+                Ok(mut app) => {
+                    app.renderer = renderer;
+                    Ok(Box::new(app) as Box<dyn eframe::App>)
+                }
+                Err(e) => {
+                    error = Some(e.clone());
+                    Err(e.into())
+                }
+            }
+        }),
+    );
+    if let Some(e) = error {
+        anyhow::bail!(e);
+    }
+    result.map_err(|e| anyhow::anyhow!("the window could not be opened: {e} (no display? run the headless commands, e.g. `hox simulate`, or run the app in a virtual display: scripts/app-headless.sh)"))
+}
