@@ -811,12 +811,13 @@ impl Params {
         }
     }
 
-    /// What changing from `self` to `new` invalidates.
+    /// What changing from `self` to `new` invalidates (Nothing: a display or run-length change,
+    /// which a running simulation does not see).
     pub fn invalidated_by(&self, new: &Params) -> Invalidates {
         PARAMS
             .iter()
             .filter(|p| (p.get)(self) != (p.get)(new))
-            .map(|p| p.invalidates.max(Invalidates::Settings))
+            .map(|p| p.invalidates)
             .max()
             .unwrap_or(Invalidates::Nothing)
     }

@@ -173,6 +173,26 @@ fn the_damping_parameter_adds_a_damping_effect_only_when_set() {
     assert!(err.to_string().contains("--damping"), "{err}");
 }
 
+/// `[effect]` and `[display]` are tables of the scene file like the others: read through the
+/// parameter table, range-checked, written back.
+#[test]
+fn effect_and_display_keys_are_read_checked_and_written_back() {
+    let text = crate::BUILTIN.iter().find(|(n, _)| *n == "bending").unwrap().1;
+    let with = format!(
+        "{text}\n[effect]\ndamping_per_sec = 1.5\n[display]\ntessellation = 8\ncolour_max_m = 0.1\nquadrature_points = true\n"
+    );
+    let scene = Scene::from_toml(&with, "test").unwrap();
+    let p = scene.params();
+    assert_eq!((p.damping_per_sec, p.tessellation, p.colour_max_m, p.quadrature_points), (1.5, 8, 0.1, true));
+    assert_eq!(Scene::from_toml(&scene.file.to_toml(), "again").unwrap().params(), p);
+    let bad = with.replace("tessellation = 8", "tessellation = 40");
+    let err = Scene::from_toml(&bad, "test").unwrap_err().to_string();
+    assert!(err.contains("display.tessellation") && err.contains("1 to 16"), "{err}");
+    let unknown = with.replace("tessellation = 8", "tesselation = 8");
+    let err = Scene::from_toml(&unknown, "test").unwrap_err().to_string();
+    assert!(err.contains("display.tesselation") && err.contains("unknown key"), "{err}");
+}
+
 #[test]
 fn a_scene_file_written_back_parses_to_the_same_scene() {
     for scene in crate::registry().unwrap() {

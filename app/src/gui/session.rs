@@ -333,6 +333,30 @@ mod tests {
         assert_eq!(s.config, before);
     }
 
+    /// A display parameter changes only the drawing: checked against the table, stored, the
+    /// surface re-tessellated, the simulation's state kept (regression: such a change used to be
+    /// dropped without being stored or checked).
+    #[test]
+    fn a_display_change_is_checked_kept_and_redraws_only() {
+        let mut s = bending();
+        s.step(3);
+        let positions = s.instance.sim.positions.clone();
+        let vertices = s.surface.vertices.len();
+        let mut c = s.config.clone();
+        c.tessellation = 6;
+        c.quadrature_points = true;
+        assert_eq!(s.apply(c.clone()), Ok(Invalidates::Nothing));
+        assert_eq!(s.config, c);
+        assert!(s.surface.vertices.len() > vertices, "{} vs {vertices}", s.surface.vertices.len());
+        assert_eq!(s.rest_vertices.len(), s.surface.vertices.len());
+        assert_eq!(s.instance.sim.positions, positions);
+        let mut bad = c.clone();
+        bad.tessellation = 0;
+        let err = s.apply(bad).unwrap_err();
+        assert!(err.contains("tessellation"), "{err}");
+        assert_eq!(s.config, c);
+    }
+
     #[test]
     fn dragging_pulls_the_node_and_leaves_no_effect_behind() {
         let mut s = bending();
