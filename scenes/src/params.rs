@@ -504,15 +504,8 @@ pub const MAX_BOX_BYTES: u64 = 8_000_000_000;
 pub fn box_elements(p: &Params) -> Option<u64> {
     let e = ElementType::from_name(&p.element)?;
     let cells: u64 = p.grid.iter().map(|&c| c as u64).product();
-    let per_cell = match e.name() {
-        _ if is_tetrahedral(p) => match TetSplit::from_name(&p.split)? {
-            TetSplit::Five => 5,
-            TetSplit::Six => 6,
-        },
-        "prism" => 2,
-        "pyramid" => 6,
-        _ => 1,
-    };
+    let split = if is_tetrahedral(p) { TetSplit::from_name(&p.split)? } else { TetSplit::default() };
+    let per_cell = hox_sim::mesh::structured::elements_per_cell(e.shape(), split) as u64;
     let refine = u32::try_from(p.refine).ok().filter(|r| *r <= 20)?;
     Some(cells.saturating_mul(per_cell).saturating_mul(8u64.saturating_pow(refine)))
 }
@@ -574,10 +567,10 @@ pub fn thousands(n: u64) -> String {
 }
 
 params! {
-    /// Element type of a box mesh: p1 p2 p3 q1 q2 prism pyramid.
+    /// Element type of a box mesh: a registered element type's name ([`ElementType::all`]).
     element: String = "p2".into() => {
         key: "element", group: Group::Mesh, file_key: "element", label: "Element",
-        help: "The element type: P1/P2/P3 tetrahedra (order 1–3), Q1/Q2 hexahedra, prisms, pyramids.",
+        help: "The element type: its shape (tetrahedron, hexahedron, prism, pyramid) and polynomial order; `hox elements` describes each.",
         kind: Kind::Choice(element_options), invalidates: Invalidates::Mesh, required: true, box_only: true, ..BASE
     }
     /// `five` (unbiased) or `six` (biased) tetrahedra per cell.
@@ -612,10 +605,10 @@ params! {
         help: "The box mesh's upper corner, metres; beyond the lower corner in every direction.",
         kind: Kind::Point, invalidates: Invalidates::Mesh, surfaces: FILE_ONLY, required: true, box_only: true, ..BASE
     }
-    /// stvk | snh | snh-log | nh.
+    /// A registered material model's name ([`MaterialModel::ALL`]).
     material: String = "stvk".into() => {
         key: "material", group: Group::Material, file_key: "model", label: "Model",
-        help: "The hyperelastic energy: stvk (Saint-Venant–Kirchhoff, the paper's), snh (stable Neo-Hookean), snh-log (stable Neo-Hookean with Smith et al.'s log term) or nh (Neo-Hookean).",
+        help: "The hyperelastic energy model; stvk (Saint-Venant–Kirchhoff) is the paper's.",
         kind: Kind::Choice(material_options), invalidates: Invalidates::Material, required: true, ..BASE
     }
     /// Young's modulus, Pa.

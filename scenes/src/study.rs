@@ -16,6 +16,7 @@
 
 use crate::{Instance, RunMode, SceneError, SceneOverrides, run};
 use hox_sim::Vec3;
+use hox_sim::element::{ElementType, ReferenceShape};
 use hox_sim::mesh::structured::TetSplit;
 
 /// The reference (fine Q2 static solution) of each paper scene, as committed.
@@ -63,7 +64,7 @@ impl StudyConfig {
         }
     }
     pub fn label(&self) -> String {
-        let is_tet = matches!(self.element, "p1" | "p2" | "p3");
+        let is_tet = ElementType::from_name(self.element).is_some_and(|e| e.shape() == ReferenceShape::Tetrahedron);
         let mut s = format!("{} {}x{}x{}", self.element.to_uppercase(), self.grid[0], self.grid[1], self.grid[2]);
         if is_tet {
             s.push_str(&format!(" {}", self.split.name()));
@@ -478,19 +479,34 @@ pub fn csv(rows: &[StudyRow]) -> String {
     s
 }
 
+/// The colour of an element type in the study's charts (`study.svg` and the app's), by its
+/// place in the registry: matplotlib's `tab10` colours in the order the built-in types were
+/// first drawn (p1 blue, p2 red, p3 green, q1 purple, q2 brown, prism pink, pyramid orange),
+/// then olive and cyan, repeating; grey for a name that is not registered.
+pub fn element_colour(element: &str) -> [u8; 3] {
+    const PALETTE: [[u8; 3]; 9] = [
+        [0x1f, 0x77, 0xb4],
+        [0xd6, 0x27, 0x28],
+        [0x2c, 0xa0, 0x2c],
+        [0x94, 0x67, 0xbd],
+        [0x8c, 0x56, 0x4b],
+        [0xe3, 0x77, 0xc2],
+        [0xff, 0x7f, 0x0e],
+        [0xbc, 0xbd, 0x22],
+        [0x17, 0xbe, 0xcf],
+    ];
+    ElementType::all()
+        .position(|e| e.name().eq_ignore_ascii_case(element))
+        .map_or([0x7f; 3], |i| PALETTE[i % PALETTE.len()])
+}
+
 /// `study.svg`: bending tip error versus ms per frame, log–log, one colour per element type;
 /// filled circles at the paper's settings, rings at the 1 %-solver-error settings, and the
 /// paper's Table 1 points as crosses.
 pub fn svg(rows: &[StudyRow]) -> String {
-    let colour = |element: &str| match element {
-        "p1" => "#1f77b4",
-        "p2" => "#d62728",
-        "p3" => "#2ca02c",
-        "q1" => "#9467bd",
-        "q2" => "#8c564b",
-        "prism" => "#e377c2",
-        "pyramid" => "#ff7f0e",
-        _ => "#7f7f7f",
+    let colour = |element: &str| {
+        let [r, g, b] = element_colour(element);
+        format!("#{r:02x}{g:02x}{b:02x}")
     };
     let bending: Vec<&StudyRow> = rows.iter().filter(|r| r.scene == "bending").collect();
     let mut xs: Vec<f64> = bending.iter().flat_map(|r| [r.ms_per_frame, r.ms_per_frame_1pct]).collect();
@@ -565,7 +581,7 @@ pub fn svg(rows: &[StudyRow]) -> String {
     // legend
     let lx = w - right + 15.0;
     let mut ly = top + 10.0;
-    for e in ["p1", "p2", "p3", "q1", "q2", "prism", "pyramid"] {
+    for e in ElementType::all().map(|e| e.name()) {
         s.push_str(&format!(
             r#"<circle cx="{lx}" cy="{ly}" r="5" fill="{}"/><text x="{}" y="{}">{}</text>
 "#,

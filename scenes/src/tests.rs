@@ -202,3 +202,23 @@ fn a_scene_file_written_back_parses_to_the_same_scene() {
         assert_eq!((&again.file.effects, &again.file.probes), (&scene.file.effects, &scene.file.probes));
     }
 }
+
+#[test]
+fn the_study_colours_keep_the_built_in_types_colours_and_give_every_registered_type_its_own() {
+    use crate::study::element_colour;
+    let built_in = [
+        ("p1", [0x1f, 0x77, 0xb4]),
+        ("p2", [0xd6, 0x27, 0x28]),
+        ("p3", [0x2c, 0xa0, 0x2c]),
+        ("q1", [0x94, 0x67, 0xbd]),
+        ("q2", [0x8c, 0x56, 0x4b]),
+        ("prism", [0xe3, 0x77, 0xc2]),
+        ("pyramid", [0xff, 0x7f, 0x0e]),
+    ];
+    for (name, rgb) in built_in {
+        assert_eq!(element_colour(name), rgb, "{name}");
+    }
+    let colours: Vec<[u8; 3]> = hox_sim::element::ElementType::all().map(|e| element_colour(e.name())).collect();
+    assert!(colours.iter().all(|c| *c != [0x7f; 3]), "grey is for unregistered names");
+    assert_eq!(element_colour("no-such-element"), [0x7f; 3]);
+}

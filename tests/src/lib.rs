@@ -28,8 +28,10 @@ use hox_sim::xpbd::constraint::Formulation;
 /// Standard gravity, m/s².
 pub const GRAVITY_M_S2: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 
-/// Every element type, by name, in the registry's order.
-pub const ELEMENT_TYPES: [&str; 7] = ["p1", "p2", "p3", "q1", "q2", "prism", "pyramid"];
+/// Every registered element type, by name, in the registry's order.
+pub fn element_types() -> Vec<&'static str> {
+    ElementType::all().map(|e| e.name()).collect()
+}
 
 /// An element type by name (test input: panics on a typo).
 pub fn element_type(name: &str) -> ElementType {

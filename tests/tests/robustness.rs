@@ -181,7 +181,7 @@ fn run_inverted(mut s: Simulation, secs: f64, growth: f64) -> Result<(Simulation
 /// [`p3_mirrored_under_strong_damping_is_trapped_inverted_between_its_quadrature_points`].
 #[test]
 fn stable_neo_hookean_recovers_from_elements_mirrored_through_a_face() {
-    each_configuration("1 mirrored, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("1 mirrored, snh", &element_types(), &BOTH, &[], |et, f| {
         let (damping, secs) = if et == "p3" { (2.0, 8.0) } else { (10.0, 5.0) };
         let (s, start, end, _) = run_inverted(mirrored_cantilever(et, SNH, f, damping), secs, 1.0 + 1e-6)?;
         Ok(format!("damping {damping}/s, U(0) = {:.3e} J; {}", start.elastic_j, recovered(&s, &end, false)?))
@@ -260,7 +260,7 @@ fn trapped_states_are_minima_of_the_near_exactly_integrated_energy() {
 
 #[test]
 fn stable_neo_hookean_recovers_from_a_corner_pushed_through_its_element() {
-    each_configuration("1 corner through, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("1 corner through, snh", &element_types(), &BOTH, &[], |et, f| {
         let (s, start, end, _) = run_inverted(corner_pushed_through(et, SNH, f), 3.0, 1.0 + 1e-6)?;
         Ok(format!("min det F(0) = {:.3}; {}", start.min_det_f.det_f, recovered(&s, &end, false)?))
     });
@@ -272,7 +272,7 @@ fn stable_neo_hookean_recovers_from_a_corner_pushed_through_its_element() {
 /// it does stay mirrored, as documented.
 #[test]
 fn stvk_mirrored_through_a_face_is_a_rest_state_it_stays_in_bounded() {
-    each_configuration("1 mirrored, stvk", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("1 mirrored, stvk", &element_types(), &BOTH, &[], |et, f| {
         let (_, start, end, _) = run_inverted(mirrored_cantilever(et, STVK, f, 10.0), 1.0, 1.0 + 1e-6)?;
         if !(start.elastic_j.abs() < 1e-9 && end.max_displacement_m > 0.4) {
             return Err(format!(
@@ -289,7 +289,7 @@ fn stvk_mirrored_through_a_face_is_a_rest_state_it_stays_in_bounded() {
 #[test]
 #[ignore = "release: CI runs it with --release --ignored"]
 fn stvk_corner_pushed_through_its_element_stays_bounded() {
-    each_configuration("1 corner through, stvk", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("1 corner through, stvk", &element_types(), &BOTH, &[], |et, f| {
         let (s, _, end, _) = run_inverted(corner_pushed_through(et, STVK, f), 3.0, 1.0 + 1e-6)?;
         Ok(match recovered(&s, &end, false) {
             Ok(r) => format!("recovers: {r}"),
@@ -306,7 +306,7 @@ fn stvk_corner_pushed_through_its_element_stays_bounded() {
 #[test]
 #[ignore = "release: CI runs it with --release --ignored"]
 fn neo_hookean_inverted_starts_stay_bounded() {
-    each_configuration("1 inverted, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("1 inverted, nh", &element_types(), &BOTH, &[], |et, f| {
         let mut out = Vec::new();
         for (what, s) in
             [("mirrored", mirrored_cantilever(et, NH, f, 10.0)), ("corner", corner_pushed_through(et, NH, f))]
@@ -409,7 +409,7 @@ fn near_incompressible_stvk_cantilevers_do_not_blow_up() {
 fn near_incompressible(model: MaterialModel) {
     let mut problems = Vec::new();
     for nu in [0.45, 0.49, 0.499] {
-        problems.extend(configurations(&format!("2 ν = {nu}, {model}"), &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+        problems.extend(configurations(&format!("2 ν = {nu}, {model}"), &element_types(), &BOTH, &[], |et, f| {
             load_and_release_within(
                 gravity_cantilever(et, 1.0, 4, material(model, 1.0e6, nu), f, 50, 60.0),
                 1.0,
@@ -481,7 +481,7 @@ fn guarded_cantilever(
 #[test]
 #[ignore = "release: CI runs it with --release --ignored (hundreds of substeps per frame)"]
 fn a_stiff_cantilever_with_one_substep_per_frame_is_stable_under_the_stability_guard() {
-    each_configuration("3 E = 1e9 Pa, 1 substep asked, guard, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("3 E = 1e9 Pa, 1 substep asked, guard, snh", &element_types(), &BOTH, &[], |et, f| {
         guarded_cantilever(et, SNH, f, 1.0e9, 1, 60.0, 10.0, 2.0)
     });
 }
@@ -523,7 +523,7 @@ fn the_one_substep_cantilever_is_stable_below_the_stability_limit() {
 /// form is [`known_failure_a_very_soft_p1_cantilever_with_the_papers_stable_neo_hookean_stays_hanging`].
 #[test]
 fn a_very_soft_cantilever_hangs_and_springs_back() {
-    each_configuration("3 E = 1e3 Pa, snh-log", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("3 E = 1e3 Pa, snh-log", &element_types(), &BOTH, &[], |et, f| {
         load_and_release(gravity_cantilever(et, 0.1, 4, material(SNH_LOG, 1.0e3, 0.3), f, 50, 60.0), 2.0, 5.0, 6.0)
     });
 }
@@ -534,7 +534,7 @@ fn a_very_soft_cantilever_hangs_and_springs_back() {
 /// `det F` ≈ 0.63, not inverted) — the model's energy is not convex there; `snh-log` returns.
 #[test]
 fn known_failure_a_very_soft_p1_cantilever_with_the_papers_stable_neo_hookean_stays_hanging() {
-    each_configuration("3 E = 1e3 Pa, snh", &ELEMENT_TYPES, &BOTH, &["p1 energy", "p1 split"], |et, f| {
+    each_configuration("3 E = 1e3 Pa, snh", &element_types(), &BOTH, &["p1 energy", "p1 split"], |et, f| {
         load_and_release(gravity_cantilever(et, 0.1, 4, material(SNH, 1.0e3, 0.3), f, 50, 60.0), 2.0, 5.0, 6.0)
     });
 }
@@ -611,7 +611,7 @@ fn stretch(by_m: f64, ramp_secs: f64) -> impl Fn(Vec<u32>) -> Prescribed {
 /// Torsion to 720°: shear strain `θ r / L` = 4π × 0.177 ≈ 2.2 at the corners.
 #[test]
 fn torsion_to_720_degrees_and_back() {
-    each_configuration("4 torsion 720°, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("4 torsion 720°, snh", &element_types(), &BOTH, &[], |et, f| {
         drive_and_release(et, SNH, f, twist(720.0, 2.0), 2.0, 4.0 * std::f64::consts::PI * 0.177)
     });
 }
@@ -624,12 +624,12 @@ fn torsion_to_720_degrees_and_back() {
 /// [`trapped_states_are_minima_of_the_near_exactly_integrated_energy`]).
 #[test]
 fn stretch_to_three_times_the_length_and_back() {
-    each_configuration("4 stretch 3×, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("4 stretch 3×, nh", &element_types(), &BOTH, &[], |et, f| {
         drive_and_release(et, NH, f, stretch(2.0, 1.0), 1.0, 2.0)
     });
     each_configuration(
         "4 stretch 3×, snh",
-        &ELEMENT_TYPES,
+        &element_types(),
         &BOTH,
         &["p2 energy", "p2 split", "p3 energy", "p3 split"],
         |et, f| drive_and_release(et, SNH, f, stretch(2.0, 1.0), 1.0, 2.0),
@@ -641,7 +641,7 @@ fn stretch_to_three_times_the_length_and_back() {
 #[test]
 #[ignore = "release: CI runs it with --release --ignored"]
 fn stvk_under_extreme_drives_stays_bounded() {
-    each_configuration("4 torsion 720° and stretch 3×, stvk", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("4 torsion 720° and stretch 3×, stvk", &element_types(), &BOTH, &[], |et, f| {
         let mut out = Vec::new();
         for (what, result) in [
             ("torsion", drive_and_release(et, STVK, f, twist(720.0, 2.0), 2.0, 4.0 * std::f64::consts::PI * 0.177)),
@@ -690,14 +690,14 @@ fn squash(et: &str, model: MaterialModel, f: Formulation) -> Result<String, Stri
 /// 0.2 by a quadratic penalty that every element type survives): squashed to 10 % and back.
 #[test]
 fn squash_to_ten_percent_between_plates_and_back() {
-    each_configuration("4 squash to 10 %, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| squash(et, NH, f));
+    each_configuration("4 squash to 10 %, nh", &element_types(), &BOTH, &[], |et, f| squash(et, NH, f));
 }
 
 /// Stable Neo-Hookean with Smith et al.'s `log(I_C + 1)` term (`snh-log`): no spurious minimum
 /// at `F = 0` (`hox_sim::material::stable_neo_hookean_log`), so squashed elements come back.
 #[test]
 fn stable_neo_hookean_with_the_log_term_squashed_to_ten_percent_and_back() {
-    each_configuration("4 squash to 10 %, snh-log", &ELEMENT_TYPES, &BOTH, &[], |et, f| squash(et, SNH_LOG, f));
+    each_configuration("4 squash to 10 %, snh-log", &element_types(), &BOTH, &[], |et, f| squash(et, SNH_LOG, f));
 }
 
 /// **Known failure (case 4, squash), kept visible.** Stable Neo-Hookean without Smith et al.'s
@@ -739,7 +739,7 @@ fn bent_and_twisted(rest: &[Vec3], length_m: f64) -> Vec<Vec3> {
 /// shape (after rigid alignment). No external work: `H ≤ H(0)`.
 #[test]
 fn a_node_ten_thousand_times_heavier_than_its_neighbours() {
-    each_configuration("5 heavy node ×1e4, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("5 heavy node ×1e4, snh", &element_types(), &BOTH, &[], |et, f| {
         let mesh = beam(et, 0.5, 2);
         let corner =
             mesh.rest_positions.iter().position(|p| (p - Vec3::new(0.5, 0.0, 0.0)).norm() < 1e-12).expect("corner");
@@ -764,7 +764,7 @@ fn a_node_ten_thousand_times_heavier_than_its_neighbours() {
 #[test]
 #[ignore = "release: CI runs it with --release --ignored (the guard takes 309–3,911 substeps per frame; about 6 minutes)"]
 fn elements_one_millimetre_next_to_elements_one_metre() {
-    each_configuration("5 sizes 1 mm – 1 m, snh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("5 sizes 1 mm – 1 m, snh", &element_types(), &BOTH, &[], |et, f| {
         let mut mesh = box_mesh(et, [2.0; 3], [2, 2, 2]);
         let map = |c: f64| if c <= 1.0 { 1e-3 * c } else { 1e-3 + (c - 1.0) };
         mesh.rest_positions.iter_mut().for_each(|p| *p = p.map(map));
@@ -791,12 +791,12 @@ fn gravity_cantilever_from(mesh: Mesh, material: Material, formulation: Formulat
 /// with a thin inverted layer (as in cases 1 and 4), listed.
 #[test]
 fn ten_frames_per_second_with_one_substep_is_stable_under_the_stability_guard() {
-    each_configuration("6 10 fps × 1 substep asked, E = 1e5 Pa, guard, nh", &ELEMENT_TYPES, &BOTH, &[], |et, f| {
+    each_configuration("6 10 fps × 1 substep asked, E = 1e5 Pa, guard, nh", &element_types(), &BOTH, &[], |et, f| {
         guarded_cantilever(et, NH, f, 1.0e5, 1, 10.0, 5.0, 6.0)
     });
     each_configuration(
         "6 10 fps × 1 substep asked, E = 1e5 Pa, guard, snh",
-        &ELEMENT_TYPES,
+        &element_types(),
         &BOTH,
         &["p3 energy", "p3 split"],
         |et, f| guarded_cantilever(et, SNH, f, 1.0e5, 1, 10.0, 5.0, 6.0),
@@ -868,13 +868,13 @@ mod perturbed {
         /// ν = 0.3.
         #[test]
         fn randomly_perturbed_rest_meshes_stay_stable(
-            et in 0..ELEMENT_TYPES.len(),
+            et in 0..element_types().len(),
             split in any::<bool>(),
             seed in proptest::collection::vec(-1.0..1.0f64, 28),
             amplitude in 0.0..0.3f64,
             jitter in 0.0..0.2f64,
         ) {
-            let et = ELEMENT_TYPES[et];
+            let et = element_types()[et];
             let f = if split { Formulation::Split } else { Formulation::Energy };
             let mut mesh = beam(et, 0.5, 2);
             perturb(&mut mesh, &seed, amplitude, jitter, 0.125);
@@ -960,7 +960,7 @@ fn scene_error(edit: impl Fn(&mut String)) -> String {
 
 #[test]
 fn invalid_materials_are_clear_errors_naming_the_parameter() {
-    for model in MaterialModel::ALL {
+    for &model in MaterialModel::ALL {
         for (e, nu, rho, needle) in [
             (1e6, 0.5, 1000.0, "Poisson ratio"),
             (1e6, 0.7, 1000.0, "Poisson ratio"),

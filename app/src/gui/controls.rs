@@ -260,6 +260,26 @@ fn params_ui(app: &mut HoxApp, ui: &mut egui::Ui, group: Group) {
     }
 }
 
+/// The menu of a choice parameter: `(value, text)` for each option of its table entry
+/// ([`Kind::Choice`]), in the table's order — for the element type and the material model,
+/// the registries' ([`hox_sim::element::ElementType::all`], [`hox_sim::material::MaterialModel::ALL`]).
+/// Empty for a parameter that is not a choice.
+pub fn choice_menu(p: &Param) -> Vec<(String, String)> {
+    match p.kind {
+        Kind::Choice(options) => options().into_iter().map(|(n, d)| (n.to_string(), d)).collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// What a closed choice menu shows for the value `name`: the option's name in capitals when
+/// its text starts with them ("P2 — quadratic tetrahedron" shows "P2"), else its text; a value
+/// that is not an option, in capitals.
+fn choice_shown(entries: &[(String, String)], name: &str) -> String {
+    entries.iter().find(|(n, _)| n == name).map_or(name.to_uppercase(), |(n, d)| {
+        if d.starts_with(&n.to_uppercase()) { n.to_uppercase() } else { d.clone() }
+    })
+}
+
 /// One parameter's row.
 fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
     let k = app.active;
@@ -272,16 +292,11 @@ fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
     };
     match p.kind {
         Kind::Number { soft: None, .. } => number_ui(app, ui, p),
-        Kind::Choice(options) => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
+        Kind::Choice(_) => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
             let Value::Text(name) = v else { return ui.label("?") };
-            let options = options();
-            let shown = options.iter().find(|(n, _)| *n == name.as_str()).map_or(name.to_uppercase(), |(n, d)| {
-                if d.starts_with(&n.to_uppercase()) { n.to_uppercase() } else { d.clone() }
-            });
-            ui.add_enabled_ui(enabled, |ui| {
-                combo(ui, (p.key, k), name, shown, options.into_iter().map(|(n, d)| (n.to_string(), d)).collect())
-            })
-            .inner
+            let entries = choice_menu(p);
+            let shown = choice_shown(&entries, name);
+            ui.add_enabled_ui(enabled, |ui| combo(ui, (p.key, k), name, shown, entries)).inner
         }),
         Kind::Whole { min, soft_max, .. } => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
             let Value::Whole(n) = v else { return ui.label("?") };
@@ -470,4 +485,40 @@ pub(super) fn mesh_scene_file(mesh: &std::path::Path, clamp_group: &str) -> Resu
     // validate now, so a missing group is reported in the dialog
     hox_scenes::Scene::load(&path).map_err(|e| e.to_string())?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hox_sim::element::ElementType;
+    use hox_sim::material::MaterialModel;
+
+    fn menu(key: &str) -> Vec<(String, String)> {
+        let p = params::by_key(key).unwrap_or_else(|| panic!("no parameter {key}"));
+        assert!(p.surfaces.app, "{key} has a control in the app");
+        choice_menu(p)
+    }
+
+    #[test]
+    fn the_element_and_material_menus_list_exactly_the_registered_types_and_models() {
+        let values = |key| menu(key).into_iter().map(|(v, _)| v).collect::<Vec<_>>();
+        let elements: Vec<String> = ElementType::all().map(|e| e.name().to_string()).collect();
+        let models: Vec<String> = MaterialModel::ALL.iter().map(|m| m.name().to_string()).collect();
+        assert_eq!(values("element"), elements);
+        assert_eq!(values("material"), models);
+    }
+
+    #[test]
+    fn a_closed_menu_shows_the_short_name_or_the_description() {
+        let elements = menu("element");
+        for e in ElementType::all() {
+            assert_eq!(choice_shown(&elements, e.name()), e.name().to_uppercase(), "{e}");
+        }
+        let models = menu("material");
+        for m in MaterialModel::ALL {
+            assert_eq!(choice_shown(&models, m.name()), m.long_name(), "{m}");
+        }
+        assert_eq!(choice_shown(&elements, "p9"), "P9");
+        assert!(menu("youngs").is_empty());
+    }
 }

@@ -16,6 +16,7 @@
 
 use eframe::egui;
 use egui_plot::{GridInput, GridMark, HoverPosition, Legend, MarkerShape, Plot, PlotPoint, PlotPoints, Points, Text};
+use hox_sim::element::ElementType;
 use std::ops::RangeInclusive;
 use std::sync::OnceLock;
 
@@ -98,20 +99,10 @@ fn study_records() -> &'static Result<Vec<StudyRecord>, String> {
     RECORDS.get_or_init(|| parse_study_csv(STUDY_CSV))
 }
 
-/// The element types in the study's order, with the colours of `study.svg`.
-const ELEMENT_COLOURS: [(&str, [u8; 3]); 7] = [
-    ("p1", [0x1f, 0x77, 0xb4]),
-    ("p2", [0xd6, 0x27, 0x28]),
-    ("p3", [0x2c, 0xa0, 0x2c]),
-    ("q1", [0x94, 0x67, 0xbd]),
-    ("q2", [0x8c, 0x56, 0x4b]),
-    ("prism", [0xe3, 0x77, 0xc2]),
-    ("pyramid", [0xff, 0x7f, 0x0e]),
-];
-
+/// The colour of `study.svg` for an element type ([`hox_scenes::study::element_colour`]).
 fn element_colour(element: &str) -> egui::Color32 {
-    let c = ELEMENT_COLOURS.iter().find(|(e, _)| e.eq_ignore_ascii_case(element)).map_or([0x7f; 3], |(_, c)| *c);
-    egui::Color32::from_rgb(c[0], c[1], c[2])
+    let [r, g, b] = hox_scenes::study::element_colour(element);
+    egui::Color32::from_rgb(r, g, b)
 }
 
 /// `10^exponent` written with superscript digits, e.g. `10⁻³`.
@@ -205,7 +196,7 @@ pub fn study_chart_ui(ui: &mut egui::Ui, scene: &str, current: &[StudyPoint]) {
 
     let mut labelled: Vec<Labelled> = Vec::new();
     let mut series: Vec<Points<'static>> = Vec::new();
-    for (element, _) in ELEMENT_COLOURS {
+    for element in ElementType::all().map(|e| e.name()) {
         let of_element: Vec<&&StudyRecord> = rows.iter().filter(|r| r.element.eq_ignore_ascii_case(element)).collect();
         if of_element.is_empty() {
             continue;
@@ -363,7 +354,7 @@ mod tests {
                     assert!(v.is_finite() && v > 0.0, "{scene} {}: {v}", r.configuration);
                 }
                 assert!(r.substeps_for_1pct > 0, "{scene} {}", r.configuration);
-                assert!(ELEMENT_COLOURS.iter().any(|(e, _)| *e == r.element), "unknown element {}", r.element);
+                assert!(ElementType::from_name(&r.element).is_some(), "unknown element {}", r.element);
             }
         }
     }

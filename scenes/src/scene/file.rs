@@ -8,12 +8,12 @@
 //!               # [mesh] file = "beam.msh" (relative to the scene file; see docs/MESHES.md)
 //! box_min_m = [0, 0, 0]
 //! box_max_m = [2, 0.5, 0.5]
-//! element = "p2"          # p1 p2 p3 q1 q2 prism pyramid
+//! element = "p2"          # a registered element type (`hox elements`)
 //! grid = [8, 2, 2]        # hexahedral cells per direction
 //! split = "five"          # five (unbiased) | six (biased): tetrahedra per cell
 //! refine = 0              # 1-to-8 refinements of the tetrahedra
 //! [material]
-//! model = "stvk"          # stvk | snh | snh-log | nh
+//! model = "stvk"          # a registered model (hox_sim::material::MaterialModel::ALL)
 //! youngs_modulus_pa = 3e6
 //! poisson_ratio = 0.35
 //! density_kg_m3 = 1000

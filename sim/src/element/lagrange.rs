@@ -71,10 +71,10 @@ impl LagrangeBasis {
 
     /// `out[i] = N_i(r)`.
     pub fn values(&self, r: &[f64; 3], out: &mut [f64]) {
-        let pows = powers(r, self.max_power);
+        let pows = Powers::new(r, self.max_power);
         out.fill(0.0);
         for (k, e) in self.exponents.iter().enumerate() {
-            let m = pows[0][e[0] as usize] * pows[1][e[1] as usize] * pows[2][e[2] as usize];
+            let m = pows.get(0, e[0]) * pows.get(1, e[1]) * pows.get(2, e[2]);
             for (i, o) in out.iter_mut().enumerate() {
                 *o += self.coefficients[(k, i)] * m;
             }
@@ -83,10 +83,10 @@ impl LagrangeBasis {
 
     /// `out[i] = ∂N_i/∂r(r)`.
     pub fn gradients(&self, r: &[f64; 3], out: &mut [[f64; 3]]) {
-        let pows = powers(r, self.max_power);
-        let p = |d: usize, e: u32| pows[d][e as usize];
+        let pows = Powers::new(r, self.max_power);
+        let p = |d: usize, e: u32| pows.get(d, e);
         // d/dx x^a = a x^(a-1)
-        let dp = |d: usize, e: u32| if e == 0 { 0.0 } else { e as f64 * pows[d][e as usize - 1] };
+        let dp = |d: usize, e: u32| if e == 0 { 0.0 } else { e as f64 * pows.get(d, e - 1) };
         out.fill([0.0; 3]);
         for (k, e) in self.exponents.iter().enumerate() {
             let g = [
@@ -109,14 +109,31 @@ pub fn monomial(e: &Exponents, r: &[f64; 3]) -> f64 {
     r[0].powi(e[0] as i32) * r[1].powi(e[1] as i32) * r[2].powi(e[2] as i32)
 }
 
-fn powers(r: &[f64; 3], max_power: usize) -> [[f64; 8]; 3] {
-    let mut p = [[1.0; 8]; 3];
-    for d in 0..3 {
-        for k in 1..=max_power.min(7) {
-            p[d][k] = p[d][k - 1] * r[d];
+/// The powers `r_d^k` of a point: tabulated by repeated products up to `k = 7` (every
+/// built-in element's basis is of degree 3 at most), `powi` beyond (an element of higher order).
+struct Powers {
+    table: [[f64; 8]; 3],
+    r: [f64; 3],
+}
+
+impl Powers {
+    fn new(r: &[f64; 3], max_power: usize) -> Self {
+        let mut table = [[1.0; 8]; 3];
+        for d in 0..3 {
+            for k in 1..=max_power.min(7) {
+                table[d][k] = table[d][k - 1] * r[d];
+            }
+        }
+        Self { table, r: *r }
+    }
+
+    #[inline]
+    fn get(&self, d: usize, k: u32) -> f64 {
+        match self.table[d].get(k as usize) {
+            Some(&v) => v,
+            None => self.r[d].powi(k as i32),
         }
     }
-    p
 }
 
 /// A polynomial element defined by its node table and monomial space: the shared
@@ -132,6 +149,9 @@ pub struct LagrangeElement {
     pub default_quadrature_degree: usize,
     pub mass_quadrature_degree: usize,
     pub gmsh_type: u32,
+    /// VTK cell type and Gmsh → VTK node permutation ([`super::ReferenceElement::vtk_node_order`]).
+    pub vtk_cell_type: u8,
+    pub vtk_node_order: &'static [usize],
     pub basis: std::sync::OnceLock<LagrangeBasis>,
     pub faces: std::sync::OnceLock<Vec<super::Face>>,
 }
@@ -175,5 +195,11 @@ impl super::ReferenceElement for LagrangeElement {
     }
     fn gmsh_type(&self) -> u32 {
         self.gmsh_type
+    }
+    fn vtk_cell_type(&self) -> u8 {
+        self.vtk_cell_type
+    }
+    fn vtk_node_order(&self) -> &'static [usize] {
+        self.vtk_node_order
     }
 }

@@ -28,9 +28,21 @@ pub mod q2;
 
 use std::fmt;
 
-/// Every element type hox knows. Adding an element type: its file plus one line here.
-pub static REGISTRY: [&'static dyn ReferenceElement; 7] =
-    [&p1::P1, &p2::P2, &p3::P3, &q1::Q1, &q2::Q2, &prism::PRISM, &pyramid::PYRAMID];
+/// **The registry**: every element type hox knows, in this order (menus, `hox elements`, tests).
+///
+/// Adding an element type is its file `sim/src/element/NAME.rs` (a `static` implementing
+/// [`ReferenceElement`]: name, nodes, shape functions, quadrature degrees, Gmsh type, VTK cell
+/// type and node order), its `pub mod NAME;` line above, and one entry here, `&NAME::STATIC,`.
+/// Everything else reads the registry: name lookup and the scene-file, command-line and app
+/// choices, Gmsh import (by [`ReferenceElement::gmsh_type`]), VTK export (by
+/// [`ReferenceElement::vtk_cell_type`]), box meshing (by shape: a higher-order element raises
+/// the registered order-1 element of its shape, [`ElementType::linear`]), the display surface
+/// and the kernels (a node count without a specialised sweep takes the generic kernel). The
+/// element tests (`tests.rs` here) and `tests/tests/registries.rs` run every entry through all
+/// of these. (A new reference *shape* is more than an entry: a [`ReferenceShape`] variant, its
+/// quadrature rules and its box-cutting recipe.)
+pub static REGISTRY: &[&dyn ReferenceElement] =
+    &[&p1::P1, &p2::P2, &p3::P3, &q1::Q1, &q2::Q2, &prism::PRISM, &pyramid::PYRAMID];
 
 /// The geometric shape of a reference element.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -128,8 +140,10 @@ pub enum FaceShape {
 /// A face of a reference element with its high-order nodes.
 ///
 /// `nodes` are element-local node indices in the face's own Gmsh order as a 2D element of the
-/// same order (3-, 6- or 10-node triangle; 4- or 9-node quadrangle): corners counter-clockwise
-/// seen from outside, then edge nodes edge by edge (edges `(0,1), (1,2), …`), then interior nodes.
+/// same order (3-, 6-, 10-, 15-node … triangle; 4-, 9-, 16-node … quadrangle): corners
+/// counter-clockwise seen from outside, then edge nodes edge by edge (edges `(0,1), (1,2), …`),
+/// then the interior nodes, ordered in turn as a triangle of order − 3 (quadrangle of
+/// order − 2) inside the face.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Face {
     pub shape: FaceShape,
@@ -170,6 +184,11 @@ pub trait ReferenceElement: Send + Sync + 'static {
     fn mass_quadrature_degree(&self) -> usize;
     /// Gmsh element type number (`.msh` files).
     fn gmsh_type(&self) -> u32;
+    /// VTK cell type number (`.vtu` files), e.g. 24 for `VTK_QUADRATIC_TETRA`.
+    fn vtk_cell_type(&self) -> u8;
+    /// The Gmsh → VTK node permutation: VTK's node `i` is the element's (Gmsh-ordered) node
+    /// `vtk_node_order()[i]`; a permutation of `0..num_nodes()`.
+    fn vtk_node_order(&self) -> &'static [usize];
 
     fn num_nodes(&self) -> usize {
         self.nodes().len()
@@ -198,6 +217,17 @@ impl ElementType {
     /// Looks an element type up by its Gmsh element type number.
     pub fn from_gmsh_type(gmsh_type: u32) -> Option<ElementType> {
         Self::all().find(|e| e.gmsh_type() == gmsh_type)
+    }
+
+    /// Looks an element type up by its VTK cell type number.
+    pub fn from_vtk_cell_type(cell_type: u8) -> Option<ElementType> {
+        Self::all().find(|e| e.vtk_cell_type() == cell_type)
+    }
+
+    /// The registered linear (order-1) element of `shape` (P1 for tetrahedra, Q1 for
+    /// hexahedra, …): what box meshes are cut into before their order is raised.
+    pub fn linear(shape: ReferenceShape) -> Option<ElementType> {
+        Self::all().find(|e| e.shape() == shape && e.order() == 1)
     }
 
     /// The comma-separated list of names, for error messages and help texts.
@@ -250,9 +280,10 @@ impl std::str::FromStr for ElementType {
 }
 
 /// Builds the faces of an element from its shape's outward corner lists, by locating each
-/// face node (corners, edge nodes, interior nodes in the face's Gmsh order) among the element's
-/// reference nodes. Used by every element file; a face node that cannot be found is a bug in the
-/// element's node table and panics (the element tests exercise every element).
+/// face node (corners, edge nodes, interior nodes in the face's Gmsh order, [`face_points`])
+/// among the element's reference nodes. Used by every element file, for any order; a face node
+/// that cannot be found is a bug in the element's node table and panics (the element tests
+/// exercise every registered element).
 pub(crate) fn build_faces(shape: ReferenceShape, order: usize, nodes: &[[f64; 3]]) -> Vec<Face> {
     let verts = shape.vertices();
     let find = |p: [f64; 3]| -> usize {
@@ -261,34 +292,68 @@ pub(crate) fn build_faces(shape: ReferenceShape, order: usize, nodes: &[[f64; 3]
             .position(|q| (0..3).all(|d| (q[d] - p[d]).abs() < 1e-12))
             .unwrap_or_else(|| panic!("no node of the {shape:?} at {p:?}"))
     };
-    let lerp = |a: [f64; 3], b: [f64; 3], t: f64| -> [f64; 3] {
-        [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])]
-    };
     shape
         .faces()
         .iter()
         .map(|corners| {
             let c: Vec<[f64; 3]> = corners.iter().map(|&v| verts[v]).collect();
-            let mut pts: Vec<[f64; 3]> = c.clone();
             let n = c.len();
-            for e in 0..n {
-                for j in 1..order {
-                    pts.push(lerp(c[e], c[(e + 1) % n], j as f64 / order as f64));
-                }
-            }
-            match (n, order) {
-                (3, 3) => pts.push(lerp(lerp(c[0], c[1], 0.5), c[2], 1.0 / 3.0)),
-                (4, 2) => pts.push(lerp(lerp(c[0], c[1], 0.5), lerp(c[3], c[2], 0.5), 0.5)),
-                (_, o) if o <= 2 => {}
-                _ => panic!("face construction for {n}-gons of order {order} is not implemented"),
-            }
+            // (s, t) of the face's Gmsh nodes, mapped onto the reference face: affinely from
+            // corners 0, 1, 2 on a triangle, bilinearly on a quadrilateral (whose reference
+            // faces are parallelograms, so the map is affine there too)
+            let at = |[s, t]: [f64; 2]| -> [f64; 3] {
+                std::array::from_fn(|d| match n {
+                    3 => c[0][d] + s * (c[1][d] - c[0][d]) + t * (c[2][d] - c[0][d]),
+                    _ => {
+                        (1.0 - s) * (1.0 - t) * c[0][d]
+                            + s * (1.0 - t) * c[1][d]
+                            + s * t * c[2][d]
+                            + (1.0 - s) * t * c[3][d]
+                    }
+                })
+            };
+            let unit: &[[f64; 2]] =
+                if n == 3 { &[[0., 0.], [1., 0.], [0., 1.]] } else { &[[0., 0.], [1., 0.], [1., 1.], [0., 1.]] };
             Face {
                 shape: if n == 3 { FaceShape::Triangle } else { FaceShape::Quadrilateral },
                 order,
-                nodes: pts.into_iter().map(find).collect(),
+                nodes: face_points(unit, order).into_iter().map(|p| find(at(p))).collect(),
             }
         })
         .collect()
+}
+
+/// The nodes of a Lagrange triangle (3 corners) or quadrangle (4 corners, counter-clockwise)
+/// of `order` in Gmsh's order, in the plane of `corners`: the corners, then `order − 1` nodes
+/// along each edge `(0,1), (1,2), …` from its first corner, then the interior nodes, which
+/// Gmsh orders as a triangle of order − 3 (quadrangle of order − 2) whose corners are the
+/// interior nodes nearest the outer corners; order 0 is the single centre point.
+fn face_points(corners: &[[f64; 2]], order: usize) -> Vec<[f64; 2]> {
+    let n = corners.len();
+    let lerp = |a: [f64; 2], b: [f64; 2], t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+    if order == 0 {
+        let centre = corners.iter().fold([0.0; 2], |acc, c| [acc[0] + c[0], acc[1] + c[1]]);
+        return vec![centre.map(|x| x / n as f64)];
+    }
+    let mut pts = corners.to_vec();
+    for e in 0..n {
+        for j in 1..order {
+            pts.push(lerp(corners[e], corners[(e + 1) % n], j as f64 / order as f64));
+        }
+    }
+    let inner_order = if n == 3 { order.checked_sub(3) } else { order.checked_sub(2) };
+    if let Some(inner_order) = inner_order {
+        // corner i of the inner element: one step from corner i along each of its two edges
+        let h = 1.0 / order as f64;
+        let inner: Vec<[f64; 2]> = (0..n)
+            .map(|i| {
+                let (c, next, prev) = (corners[i], corners[(i + 1) % n], corners[(i + n - 1) % n]);
+                [c[0] + h * (next[0] - c[0]) + h * (prev[0] - c[0]), c[1] + h * (next[1] - c[1]) + h * (prev[1] - c[1])]
+            })
+            .collect();
+        pts.extend(face_points(&inner, inner_order));
+    }
+    pts
 }
 
 #[cfg(test)]

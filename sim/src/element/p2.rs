@@ -8,6 +8,9 @@
 //!
 //! Default quadrature degree 2 (4 points, Witherden–Vincent): exact for the stiffness integrand
 //! `∇N_i · ∇N_j` of straight-sided elements, the usual full integration for quadratic tetrahedra.
+//!
+//! VTK: `VTK_QUADRATIC_TETRA` (24); its last two edge nodes are those of edges (1,3) and (2,3),
+//! Gmsh's (3,2) and (3,1) swapped.
 
 use super::ReferenceShape;
 use super::lagrange::{LagrangeElement, total_degree_exponents};
@@ -33,6 +36,8 @@ pub static P2: LagrangeElement = LagrangeElement {
     default_quadrature_degree: 2,
     mass_quadrature_degree: 4,
     gmsh_type: 11,
+    vtk_cell_type: 24,
+    vtk_node_order: &[0, 1, 2, 3, 4, 5, 6, 7, 9, 8],
     basis: std::sync::OnceLock::new(),
     faces: std::sync::OnceLock::new(),
 };

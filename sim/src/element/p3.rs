@@ -10,6 +10,9 @@
 //!
 //! Default quadrature degree 4 (Witherden–Vincent has no 4-exact tetrahedron rule smaller than
 //! its degree-5 rule, 14 points): exact for `∇N_i · ∇N_j` of straight-sided elements.
+//!
+//! VTK: `VTK_LAGRANGE_TETRAHEDRON` (71); VTK's last three edges are (0,3), (1,3), (2,3), each
+//! run towards vertex 3, and its faces come in the order (0,1,3), (1,2,3), (0,2,3), (0,1,2).
 
 use super::ReferenceShape;
 use super::lagrange::{LagrangeElement, total_degree_exponents};
@@ -55,6 +58,8 @@ pub static P3: LagrangeElement = LagrangeElement {
     default_quadrature_degree: 4,
     mass_quadrature_degree: 6,
     gmsh_type: 29,
+    vtk_cell_type: 71,
+    vtk_node_order: &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 10, 15, 14, 13, 12, 17, 19, 18, 16],
     basis: std::sync::OnceLock::new(),
     faces: std::sync::OnceLock::new(),
 };

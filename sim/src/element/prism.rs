@@ -4,6 +4,8 @@
 //! (nodes 0–2), plus for the top (nodes 3–5): the Lagrange basis of P1(triangle) ⊗ P1(segment),
 //! i.e. the monomials 1, x, y, z, xz, yz. (The paper lists only five of the six functions.)
 //! Default quadrature degree 2 (Witherden–Vincent, 5 points).
+//!
+//! VTK: `VTK_WEDGE` (13), nodes in Gmsh's order (see `io::vtk`).
 
 use super::ReferenceShape;
 use super::lagrange::{Exponents, LagrangeElement};
@@ -22,6 +24,8 @@ pub static PRISM: LagrangeElement = LagrangeElement {
     default_quadrature_degree: 2,
     mass_quadrature_degree: 4,
     gmsh_type: 6,
+    vtk_cell_type: 13,
+    vtk_node_order: &[0, 1, 2, 3, 4, 5],
     basis: std::sync::OnceLock::new(),
     faces: std::sync::OnceLock::new(),
 };

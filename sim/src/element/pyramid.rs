@@ -10,6 +10,8 @@
 //! quadrature rule used by hox samples the apex, and evaluation exactly there uses the limit
 //! along the axis. (The paper's pyramid is the same element with its base rotated by 45°.)
 //! Default quadrature degree 2 (Witherden–Vincent, 5 interior points).
+//!
+//! VTK: `VTK_PYRAMID` (14), nodes in Gmsh's order (see `io::vtk`).
 
 use super::{Face, ReferenceElement, ReferenceShape};
 use std::sync::OnceLock;
@@ -72,5 +74,11 @@ impl ReferenceElement for Pyramid {
     }
     fn gmsh_type(&self) -> u32 {
         7
+    }
+    fn vtk_cell_type(&self) -> u8 {
+        14
+    }
+    fn vtk_node_order(&self) -> &'static [usize] {
+        &[0, 1, 2, 3, 4]
     }
 }

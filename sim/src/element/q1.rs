@@ -3,6 +3,8 @@
 //! `N_i = ⅛ (1 + x x_i)(1 + y y_i)(1 + z z_i)` with `(x_i, y_i, z_i)` the corner coordinates,
 //! which is the Lagrange basis of Q1 on the corners. Default quadrature: 2×2×2 Gauss–Legendre
 //! (degree 3 in each variable), exact for the stiffness of parallelepiped elements.
+//!
+//! VTK: `VTK_HEXAHEDRON` (12), nodes in Gmsh's order.
 
 use super::ReferenceShape;
 use super::lagrange::{LagrangeElement, tensor_exponents};
@@ -17,6 +19,8 @@ pub static Q1: LagrangeElement = LagrangeElement {
     default_quadrature_degree: 3,
     mass_quadrature_degree: 3,
     gmsh_type: 5,
+    vtk_cell_type: 12,
+    vtk_node_order: &[0, 1, 2, 3, 4, 5, 6, 7],
     basis: std::sync::OnceLock::new(),
     faces: std::sync::OnceLock::new(),
 };

@@ -5,6 +5,9 @@
 //! z = −1, y = −1, x = −1, x = +1, y = +1, z = +1; the cell centre. The basis is the tensor
 //! product of 1D quadratic Lagrange polynomials, built here by the Lagrange construction on Q2.
 //! Default quadrature: 3×3×3 Gauss–Legendre (degree 5 in each variable).
+//!
+//! VTK: `VTK_TRIQUADRATIC_HEXAHEDRON` (29); VTK lists the edges of the bottom face, of the top
+//! face, then the vertical ones, and the faces x = −1, x = +1, y = −1, y = +1, z = −1, z = +1.
 
 use super::ReferenceShape;
 use super::lagrange::{LagrangeElement, tensor_exponents};
@@ -50,6 +53,8 @@ pub static Q2: LagrangeElement = LagrangeElement {
     default_quadrature_degree: 5,
     mass_quadrature_degree: 5,
     gmsh_type: 12,
+    vtk_cell_type: 29,
+    vtk_node_order: &[0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 13, 9, 16, 18, 19, 17, 10, 12, 14, 15, 22, 23, 21, 24, 20, 25, 26],
     basis: std::sync::OnceLock::new(),
     faces: std::sync::OnceLock::new(),
 };

@@ -33,6 +33,71 @@ fn reproduced_space(e: ElementType) -> Vec<Exponents> {
     }
 }
 
+/// A quartic tetrahedron P4 (35 nodes, order-4 faces of 15 nodes) that is **not** registered:
+/// what adding an element type brings, so that tests can run every generic path (meshing,
+/// faces, the generic kernels, the surface, VTK) on an element of order 4 with more nodes than
+/// any built-in one. A [`LagrangeElement`](super::lagrange::LagrangeElement) of the lattice
+/// points `i/4`: the vertices, then three nodes per edge in Gmsh's edge order, then the face and
+/// interior points in lexicographic order (not Gmsh's: it is never read from a file). Its VTK
+/// node order is the identity (not checked against VTK's Lagrange tetrahedron).
+pub(crate) fn unregistered_p4() -> ElementType {
+    use super::lagrange::LagrangeElement;
+    use std::sync::OnceLock;
+    static P4: OnceLock<&'static LagrangeElement> = OnceLock::new();
+    let p4: &'static LagrangeElement = P4.get_or_init(|| {
+        let k = 4;
+        let verts = ReferenceShape::Tetrahedron.vertices();
+        let mut nodes: Vec<[f64; 3]> = verts.to_vec();
+        for [a, b] in ReferenceShape::Tetrahedron.edges() {
+            for j in 1..k {
+                let t = j as f64 / k as f64;
+                nodes.push(std::array::from_fn(|d| verts[*a][d] + t * (verts[*b][d] - verts[*a][d])));
+            }
+        }
+        for a in 0..=k {
+            for b in 0..=k - a {
+                for c in 0..=k - a - b {
+                    let r = [a, b, c].map(|i| i as f64 / k as f64);
+                    if !nodes.iter().any(|q| (0..3).all(|d| (q[d] - r[d]).abs() < 1e-12)) {
+                        nodes.push(r);
+                    }
+                }
+            }
+        }
+        let identity: Vec<usize> = (0..nodes.len()).collect();
+        Box::leak(Box::new(LagrangeElement {
+            name: "p4",
+            description: "quartic tetrahedron (35 nodes), unregistered, for tests",
+            shape: ReferenceShape::Tetrahedron,
+            order: 4,
+            nodes: Box::leak(nodes.into_boxed_slice()),
+            exponents: || total_degree_exponents(4),
+            // ∇N_i · ∇N_j is of degree 6; N_i N_j of degree 8
+            default_quadrature_degree: 6,
+            mass_quadrature_degree: 8,
+            gmsh_type: 30,
+            vtk_cell_type: 71,
+            vtk_node_order: Box::leak(identity.into_boxed_slice()),
+            basis: OnceLock::new(),
+            faces: OnceLock::new(),
+        }))
+    });
+    ElementType(p4)
+}
+
+/// The registered element types and the unregistered P4.
+fn registered_and_p4() -> impl Iterator<Item = ElementType> {
+    ElementType::all().chain(std::iter::once(unregistered_p4()))
+}
+
+#[test]
+fn the_unregistered_p4_has_35_nodes_and_15_node_faces_and_is_not_registered() {
+    let p4 = unregistered_p4();
+    assert_eq!(p4.num_nodes(), 35);
+    assert!(p4.faces().iter().all(|f| f.nodes.len() == 15 && f.order == 4));
+    assert!(ElementType::from_name("p4").is_none() && ElementType::from_gmsh_type(30).is_none());
+}
+
 fn unit4() -> impl Strategy<Value = [f64; 4]> {
     [0.0..1.0f64, 0.0..1.0f64, 0.0..1.0f64, 0.0..1.0f64]
 }
@@ -46,12 +111,12 @@ fn eval(e: ElementType, r: &[f64; 3]) -> (Vec<f64>, Vec<[f64; 3]>) {
 }
 
 #[test]
-fn registry_has_seven_types_with_gmsh_node_counts_and_unique_names() {
+fn registry_starts_with_the_seven_built_in_types_with_gmsh_node_counts_and_unique_names_and_codes() {
     let counts: Vec<(String, usize, u32)> =
         ElementType::all().map(|e| (e.name().to_string(), e.num_nodes(), e.gmsh_type())).collect();
     assert_eq!(
-        counts,
-        vec![
+        counts[..7],
+        [
             ("p1".into(), 4, 4),
             ("p2".into(), 10, 11),
             ("p3".into(), 20, 29),
@@ -61,14 +126,26 @@ fn registry_has_seven_types_with_gmsh_node_counts_and_unique_names() {
             ("pyramid".into(), 5, 7),
         ]
     );
+    // names, Gmsh types and VTK cell types each find one element
+    for e in ElementType::all() {
+        assert_eq!(ElementType::from_name(&e.name().to_uppercase()), Some(e));
+        assert_eq!(ElementType::from_gmsh_type(e.gmsh_type()), Some(e), "{e}: Gmsh type {}", e.gmsh_type());
+        assert_eq!(ElementType::from_vtk_cell_type(e.vtk_cell_type()), Some(e), "{e}: VTK type {}", e.vtk_cell_type());
+        let linear = ElementType::linear(e.shape()).unwrap_or_else(|| panic!("{e}: no linear {:?}", e.shape()));
+        assert_eq!((linear.shape(), linear.order()), (e.shape(), 1), "{e}");
+    }
     assert_eq!(ElementType::from_name("P2").unwrap().name(), "p2");
-    assert!("p4".parse::<ElementType>().unwrap_err().contains("p1, p2, p3, q1, q2, prism, pyramid"));
+    let unknown = "p9".parse::<ElementType>().unwrap_err();
+    assert!(
+        unknown.contains(&ElementType::names()) && unknown.contains("p1, p2, p3, q1, q2, prism, pyramid"),
+        "{unknown}"
+    );
     assert_eq!(ElementType::from_gmsh_type(29).unwrap().name(), "p3");
 }
 
 #[test]
 fn kronecker_property_at_the_nodes() {
-    for e in ElementType::all() {
+    for e in registered_and_p4() {
         for (j, r) in e.nodes().iter().enumerate() {
             let (n, _) = eval(e, r);
             for (i, v) in n.iter().enumerate() {
@@ -81,7 +158,7 @@ fn kronecker_property_at_the_nodes() {
 
 #[test]
 fn vertices_come_first_and_nodes_lie_in_the_reference_domain() {
-    for e in ElementType::all() {
+    for e in registered_and_p4() {
         let verts = e.shape().vertices();
         assert_eq!(&e.nodes()[..verts.len()], verts, "{e}");
         assert!(e.nodes().iter().all(|r| e.shape().contains(r, 1e-14)), "{e}");
@@ -98,7 +175,7 @@ fn vertices_come_first_and_nodes_lie_in_the_reference_domain() {
 fn high_order_nodes_sit_on_their_gmsh_edges() {
     // Gmsh: edge nodes follow the vertices, edge by edge in the shape's edge order, each edge
     // traversed from its first to its second vertex.
-    for e in ElementType::all().filter(|e| e.order() > 1) {
+    for e in registered_and_p4().filter(|e| e.order() > 1) {
         let verts = e.shape().vertices();
         let k = e.order();
         let mut idx = verts.len();
@@ -116,7 +193,7 @@ fn high_order_nodes_sit_on_their_gmsh_edges() {
 
 #[test]
 fn faces_are_outward_planar_and_have_the_high_order_node_count() {
-    for e in ElementType::all() {
+    for e in registered_and_p4() {
         let centroid = e.shape().centroid();
         let nodes = e.nodes();
         let mut covered = vec![false; e.num_nodes()];
@@ -139,10 +216,7 @@ fn faces_are_outward_planar_and_have_the_high_order_node_count() {
             }
         }
         // every node but interior ones lies on some face
-        let interior = match e.name() {
-            "q2" => 1,
-            _ => 0,
-        };
+        let interior = nodes.iter().filter(|r| e.shape().contains(r, -1e-9)).count();
         assert_eq!(covered.iter().filter(|c| !**c).count(), interior, "{e}");
     }
 }
@@ -152,7 +226,7 @@ proptest! {
 
     #[test]
     fn partition_of_unity_and_gradients_sum_to_zero(u in unit4()) {
-        for e in ElementType::all() {
+        for e in registered_and_p4() {
             let r = point_in(e.shape(), u);
             let (n, g) = eval(e, &r);
             let sum: f64 = n.iter().sum();
@@ -166,7 +240,7 @@ proptest! {
 
     #[test]
     fn polynomials_of_the_element_space_are_reproduced_exactly(u in unit4()) {
-        for e in ElementType::all() {
+        for e in registered_and_p4() {
             let r = point_in(e.shape(), u);
             let (n, g) = eval(e, &r);
             for m in reproduced_space(e) {
@@ -189,7 +263,7 @@ proptest! {
     #[test]
     fn gradients_match_finite_differences(u in unit4()) {
         let h = 1e-6;
-        for e in ElementType::all() {
+        for e in registered_and_p4() {
             let r = point_in(e.shape(), u);
             let (_, g) = eval(e, &r);
             for d in 0..3 {
@@ -205,4 +279,30 @@ proptest! {
             }
         }
     }
+}
+
+/// The Lagrange construction has no order limit: a degree-9 tetrahedron basis (220 lattice
+/// nodes, monomial powers beyond the tabulated 7) is nodal and sums to one.
+#[test]
+fn the_lagrange_construction_works_beyond_the_tabulated_powers() {
+    use super::lagrange::LagrangeBasis;
+    let k = 9;
+    let mut nodes = Vec::new();
+    for a in 0..=k {
+        for b in 0..=k - a {
+            for c in 0..=k - a - b {
+                nodes.push([a, b, c].map(|i| i as f64 / k as f64));
+            }
+        }
+    }
+    let basis = LagrangeBasis::new(&nodes, total_degree_exponents(k as u32));
+    let mut n = vec![0.0; nodes.len()];
+    for (j, r) in nodes.iter().enumerate().step_by(7) {
+        basis.values(r, &mut n);
+        for (i, v) in n.iter().enumerate() {
+            assert!((v - if i == j { 1.0 } else { 0.0 }).abs() < 1e-6, "N_{i}(node {j}) = {v}");
+        }
+    }
+    basis.values(&[0.1, 0.2, 0.3], &mut n);
+    assert!((n.iter().sum::<f64>() - 1.0).abs() < 1e-6);
 }

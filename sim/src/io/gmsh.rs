@@ -3,10 +3,11 @@
 //!
 //! What becomes what:
 //! - **3D elements** become [`ElementBlock`]s, one per hox element type, in the order the types
-//!   first appear: 4-, 10- and 20-node tetrahedra (Gmsh types 4, 11, 29 → P1, P2, P3), 8- and
-//!   27-node hexahedra (5, 12 → Q1, Q2), 6-node prisms (6) and 5-node pyramids (7). hox's
-//!   elements use Gmsh's node order, so connectivity is copied as it is. Any other 3D type
-//!   (20-node hexahedra, 18-node prisms, …) is an error naming it.
+//!   first appear: each registered element type reads the Gmsh type of its file
+//!   ([`crate::element::ReferenceElement::gmsh_type`]: 4, 11, 29 → P1, P2, P3; 5, 12 → Q1, Q2;
+//!   6 → prism; 7 → pyramid). hox's elements use Gmsh's node order, so connectivity is copied
+//!   as it is. Any other 3D type (20-node hexahedra, 18-node prisms, …) is an error naming it
+//!   and listing the registered ones.
 //! - **Lower-dimensional elements** (points, lines, triangles, quadrangles of any order) are kept
 //!   only for the physical groups they belong to.
 //! - **Physical groups** become named node sets (every node of every element of the group, the
@@ -75,9 +76,17 @@ pub enum GmshError {
     #[error("{file}{at}: {message}")]
     Parse { file: String, at: String, message: String },
     #[error(
-        "{file}{at}: element {element_tag} is a {description} (Gmsh type {gmsh_type}), which hox does not simulate; supported volume elements: 4-, 10- and 20-node tetrahedra, 8- and 27-node hexahedra, 6-node prisms, 5-node pyramids"
+        "{file}{at}: element {element_tag} is a {description} (Gmsh type {gmsh_type}), which hox does not simulate; supported volume elements (Gmsh type: hox element): {supported}"
     )]
-    UnsupportedElement { file: String, at: String, element_tag: u64, gmsh_type: u32, description: String },
+    UnsupportedElement {
+        file: String,
+        at: String,
+        element_tag: u64,
+        gmsh_type: u32,
+        description: String,
+        /// The registered element types: "4: p1, linear tetrahedron (4 nodes); …".
+        supported: String,
+    },
     #[error("{file}{at}: element {element_tag} has unknown Gmsh element type {gmsh_type}")]
     UnknownElementType { file: String, at: String, element_tag: u64, gmsh_type: u32 },
     #[error("{file}{at}: element {element_tag} refers to node {node_tag}, which the $Nodes section does not define")]
@@ -122,8 +131,23 @@ pub fn read_msh_str(text: &str, source: &str) -> Result<ImportedMesh, GmshError>
 // ---------------------------------------------------------------------------------------------
 // Gmsh element types
 
-/// What hox knows of a Gmsh element type: dimension, node count, description.
+/// The registered element types as Gmsh types, for messages.
+fn supported_volume_elements() -> String {
+    ElementType::all()
+        .map(|e| format!("{}: {}, {}", e.gmsh_type(), e.name(), e.description()))
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// What hox knows of a Gmsh element type: dimension, node count, description. A registered
+/// element type whose Gmsh type the table below does not list is known by its own file.
 fn gmsh_type_info(gmsh_type: u32) -> Option<(u8, usize, &'static str)> {
+    gmsh_type_table(gmsh_type)
+        .or_else(|| ElementType::from_gmsh_type(gmsh_type).map(|e| (3, e.num_nodes(), e.description())))
+}
+
+/// Gmsh's element types, as far as hox needs them.
+fn gmsh_type_table(gmsh_type: u32) -> Option<(u8, usize, &'static str)> {
     Some(match gmsh_type {
         15 => (0, 1, "point"),
         1 => (1, 2, "2-node line"),
@@ -224,6 +248,7 @@ fn build(raw: RawMsh, file: &str) -> Result<ImportedMesh, GmshError> {
                 element_tag: el.tag,
                 gmsh_type: el.gmsh_type,
                 description: description.into(),
+                supported: supported_volume_elements(),
             });
         }
         if el.nodes.len() != expected {

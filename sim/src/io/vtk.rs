@@ -3,17 +3,9 @@
 //! reads these files back (round-trip tests).
 //!
 //! Cell types and node orders. hox stores elements in Gmsh node order; VTK's orders differ for
-//! some types. Each cell is written as `vtk[i] = gmsh[P[i]]` with (see `docs/MESHES.md`):
-//!
-//! | hox | VTK cell type | P (Gmsh → VTK) |
-//! |---|---|---|
-//! | p1 | `VTK_TETRA` (10) | identity |
-//! | p2 | `VTK_QUADRATIC_TETRA` (24) | 0 1 2 3 4 5 6 7 9 8 |
-//! | p3 | `VTK_LAGRANGE_TETRAHEDRON` (71) | 0 1 2 3 4 5 6 7 8 9 11 10 15 14 13 12 17 19 18 16 |
-//! | q1 | `VTK_HEXAHEDRON` (12) | identity |
-//! | q2 | `VTK_TRIQUADRATIC_HEXAHEDRON` (29) | 0 1 2 3 4 5 6 7 8 11 13 9 16 18 19 17 10 12 14 15 22 23 21 24 20 25 26 |
-//! | prism | `VTK_WEDGE` (13) | identity |
-//! | pyramid | `VTK_PYRAMID` (14) | identity |
+//! some types. Each element type's file gives its VTK cell type and Gmsh → VTK permutation `P`
+//! ([`crate::element::ReferenceElement::vtk_cell_type`] and `vtk_node_order`; the table is in
+//! `docs/MESHES.md`), and each cell is written as `vtk[i] = gmsh[P[i]]`.
 //!
 //! Points are the current positions; point data holds `displacement_m` (current − rest) and any
 //! further arrays the caller passes; cell data may hold, e.g., the von Mises stress
@@ -40,25 +32,14 @@ pub enum VtkError {
     Invalid(String),
 }
 
-/// VTK cell type and Gmsh → VTK node permutation of a hox element type.
+/// VTK cell type and Gmsh → VTK node permutation of a hox element type (its file's).
 pub fn vtk_cell(element_type: ElementType) -> (u8, &'static [usize]) {
-    match element_type.name() {
-        "p1" => (10, &[0, 1, 2, 3]),
-        "p2" => (24, &[0, 1, 2, 3, 4, 5, 6, 7, 9, 8]),
-        "p3" => (71, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 10, 15, 14, 13, 12, 17, 19, 18, 16]),
-        "q1" => (12, &[0, 1, 2, 3, 4, 5, 6, 7]),
-        "q2" => {
-            (29, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 13, 9, 16, 18, 19, 17, 10, 12, 14, 15, 22, 23, 21, 24, 20, 25, 26])
-        }
-        "prism" => (13, &[0, 1, 2, 3, 4, 5]),
-        "pyramid" => (14, &[0, 1, 2, 3, 4]),
-        other => unreachable!("element type {other} has no VTK cell type: add it to vtk_cell"),
-    }
+    (element_type.vtk_cell_type(), element_type.vtk_node_order())
 }
 
 /// The hox element type of a VTK cell type (the inverse of [`vtk_cell`]).
 pub fn element_type_of_vtk(cell_type: u8) -> Option<ElementType> {
-    ElementType::all().find(|&et| vtk_cell(et).0 == cell_type)
+    ElementType::from_vtk_cell_type(cell_type)
 }
 
 /// A named data array: `components` values per point (or cell), flattened.

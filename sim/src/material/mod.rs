@@ -10,11 +10,11 @@
 //! | [`MaterialModel::StableNeoHookeanLog`] | `snh-log` | μ̂/2 (I_C − 3) + λ̂/2 (J − α)² − μ̂/2 log(I_C + 1) + c | [`stable_neo_hookean_log`] |
 //! | [`MaterialModel::NeoHookean`] | `nh` | μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)² | [`neo_hookean`] |
 //!
-//! **The registry.** Each model is one file implementing [`HyperelasticModel`] and one line of
-//! [`MaterialModel::ALL`]; [`Material`] dispatches through the law there (no per-model
-//! `match`), and the `every_registered_model_*` tests check every registered model against
-//! finite differences. Point laws written once over a [`lane::Lane`] serve the SIMD kernels
-//! too ([`stvk::energy_and_pk1`]).
+//! **The registry.** Each model is one file implementing [`HyperelasticModel`] and one entry of
+//! [`MaterialModel::ALL`] (the table above is documentation); [`Material`] dispatches through
+//! the law there (no per-model `match`), and the `every_registered_model_*` tests check every
+//! registered model against finite differences. Point laws written once over a [`lane::Lane`]
+//! serve the SIMD kernels too ([`stvk::energy_and_pk1`]).
 //!
 //! Conventions shared by every model:
 //!
@@ -55,8 +55,8 @@ pub type Mat9 = SMatrix<f64, 9, 9>;
 /// A hyperelastic constitutive model: everything the solvers ask of a material law, at one
 /// point, for Lamé parameters `l`. Each model lives in one file and is listed once in
 /// [`MaterialModel::ALL`] (as reference elements are in [`crate::element::REGISTRY`]): adding a
-/// model is its file plus one line there, and the registry tests check it
-/// (`every_registered_model_*` below).
+/// model is its file, its `mod` line and one entry there (see [`MaterialModel::ALL`]), and the
+/// registry tests check it (`every_registered_model_*` below).
 pub trait HyperelasticModel: Sync + Send + 'static {
     /// Short, stable identifier (`"stvk"`), unique in the registry: scene files and the command
     /// line name the model by it, and models compare equal by it.
@@ -91,9 +91,19 @@ pub struct MaterialModel(&'static dyn HyperelasticModel);
 // The built-in models keep the names they had as enum variants.
 #[allow(non_upper_case_globals)]
 impl MaterialModel {
-    /// **The registry**: every model, in this order (menus, tests). Adding a model: its file
-    /// plus one line here.
-    pub const ALL: [MaterialModel; 4] = [
+    /// **The registry**: every model, in this order (menus, tests).
+    ///
+    /// Adding a model is its file `sim/src/material/NAME.rs` (a unit struct implementing
+    /// [`HyperelasticModel`]), its `pub mod NAME;` line above, and one entry here,
+    /// `MaterialModel(&NAME::Struct),`. Everything else reads the registry:
+    /// [`MaterialModel::from_name`], the scene file's `material.model`, `--material`, the app's
+    /// menu and their help texts (the parameter table's choices, `scenes/src/params.rs`), the
+    /// kernels (through the law) and the tests: the `every_registered_model_*` tests below
+    /// check it against finite differences, and `tests/tests/registries.rs` runs it through a
+    /// scene with every element type. (A named constant such as
+    /// [`MaterialModel::StVenantKirchhoff`] is only for code that wants that one model; the
+    /// kernels' StVK fast path is optional speed, every other model takes the generic law.)
+    pub const ALL: &'static [MaterialModel] = &[
         MaterialModel(&stvk::StVenantKirchhoff),
         MaterialModel(&stable_neo_hookean::StableNeoHookean),
         MaterialModel(&stable_neo_hookean_log::StableNeoHookeanLog),
@@ -130,7 +140,7 @@ impl MaterialModel {
     /// surrounding whitespace. The long names are accepted as well.
     pub fn from_name(s: &str) -> Option<Self> {
         let s = s.trim();
-        Self::ALL.into_iter().find(|m| s.eq_ignore_ascii_case(m.name()) || s.eq_ignore_ascii_case(m.long_name()))
+        Self::ALL.iter().copied().find(|m| s.eq_ignore_ascii_case(m.name()) || s.eq_ignore_ascii_case(m.long_name()))
     }
 }
 
@@ -414,7 +424,7 @@ mod tests {
         ($($test:ident: $check:ident),* $(,)?) => {$(
             #[test]
             fn $test() {
-                for model in MaterialModel::ALL {
+                for &model in MaterialModel::ALL {
                     eprintln!("{}: {model}", stringify!($check)); // names the model of a failure
                     testing::$check(model);
                 }
@@ -448,13 +458,15 @@ mod tests {
 
     #[test]
     fn names_round_trip() {
-        for m in MaterialModel::ALL {
+        for &m in MaterialModel::ALL {
             assert_eq!(MaterialModel::from_name(m.name()), Some(m));
             assert_eq!(MaterialModel::from_name(&m.name().to_uppercase()), Some(m));
             assert_eq!(MaterialModel::from_name(m.long_name()), Some(m));
             assert_eq!(m.to_string(), m.name());
         }
-        assert_eq!(MaterialModel::ALL.map(MaterialModel::name), ["stvk", "snh", "snh-log", "nh"]);
+        // the built-in models keep their names and places (a new model goes after them)
+        let names: Vec<&str> = MaterialModel::ALL.iter().map(|m| m.name()).collect();
+        assert_eq!(names[..4], ["stvk", "snh", "snh-log", "nh"]);
         assert_eq!(MaterialModel::from_name(" SNH-Log "), Some(MaterialModel::StableNeoHookeanLog));
         assert_eq!(
             MaterialModel::from_name("stable Neo-Hookean with log term"),
@@ -482,7 +494,7 @@ mod tests {
 
     #[test]
     fn new_accepts_valid_parameters() {
-        for model in MaterialModel::ALL {
+        for &model in MaterialModel::ALL {
             for nu in [-0.99, -0.5, 0.0, 0.3, 0.49, 0.4999] {
                 let m = Material::new(model, 1.0e6, nu, 1100.0).expect("valid parameters");
                 assert_eq!(m.model, model);
@@ -502,7 +514,7 @@ mod tests {
 
     #[test]
     fn new_rejects_invalid_parameters_with_named_messages() {
-        for model in MaterialModel::ALL {
+        for &model in MaterialModel::ALL {
             for nu in [0.5, 0.7, -1.0, -1.5, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
                 let msg = err(model, 1.0e6, nu, 1000.0);
                 assert!(msg.contains("Poisson ratio"), "{msg}");
@@ -595,7 +607,7 @@ mod tests {
     #[test]
     fn split_stiffness_is_positive_for_nonnegative_poisson_ratio() {
         testing::run((0.0f64..0.49, 3.0f64..9.0), |(nu, log_e)| {
-            for model in MaterialModel::ALL {
+            for &model in MaterialModel::ALL {
                 let m = Material::new(model, 10f64.powf(log_e), nu, 1000.0).expect("valid");
                 let k = m.split_stiffness_pa();
                 prop_assert!(k[0] > 0.0);

@@ -1,4 +1,5 @@
-//! Raising the order of a linear mesh (P1 → P2/P3, Q1 → Q2) with shared high-order nodes.
+//! Raising the order of a linear mesh (P1 → P2/P3, Q1 → Q2, and so on for any registered
+//! element of order > 1) with shared high-order nodes.
 //!
 //! Each node of the target element sits at reference point `r`; its position is mapped by the
 //! linear element, `X = Σ_j N^lin_j(r) X_j`. A node is identified by the global vertices whose
@@ -19,7 +20,7 @@ pub fn linear_counterpart(target: ElementType) -> Option<ElementType> {
     if target.order() == 1 {
         return None;
     }
-    ElementType::all().find(|e| e.shape() == target.shape() && e.order() == 1)
+    ElementType::linear(target.shape())
 }
 
 /// Converts every block of `mesh` whose linear type matches `target`'s shape to `target`.

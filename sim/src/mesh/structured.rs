@@ -74,6 +74,19 @@ const FIVE_ODD: [[usize; 4]; 5] = [[1, 0, 2, 5], [3, 2, 0, 7], [4, 5, 7, 0], [6,
 const SIX: [[usize; 4]; 6] = [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]];
 const PRISMS: [[usize; 6]; 2] = [[0, 1, 2, 4, 5, 6], [0, 2, 3, 4, 6, 7]];
 
+/// Elements of `shape` one hexahedral cell of a box is cut into (before any refinement).
+pub fn elements_per_cell(shape: ReferenceShape, split: TetSplit) -> usize {
+    match shape {
+        ReferenceShape::Tetrahedron => match split {
+            TetSplit::Five => FIVE_EVEN.len(),
+            TetSplit::Six => SIX.len(),
+        },
+        ReferenceShape::Hexahedron => 1,
+        ReferenceShape::Prism => PRISMS.len(),
+        ReferenceShape::Pyramid => ReferenceShape::Hexahedron.faces().len(),
+    }
+}
+
 impl BoxMeshSpec {
     pub fn build(&self) -> Result<Mesh, MeshError> {
         let [nx, ny, nz] = self.grid.cells;
@@ -107,7 +120,13 @@ impl BoxMeshSpec {
         let vid = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
         let cells = (0..nz).flat_map(|k| (0..ny).flat_map(move |j| (0..nx).map(move |i| (i, j, k))));
         let corners = |(i, j, k): (usize, usize, usize)| CELL.map(|[a, b, c]| vid(i + a, j + b, k + c));
-        let named = |n: &str| ElementType::from_name(n).expect("registered");
+        // the box is cut into the linear element of the shape, then raised to the element's order
+        let linear = ElementType::linear(shape).ok_or_else(|| {
+            MeshError::InvalidRequest(format!(
+                "cannot mesh a box of {}: no linear (order-1) {shape:?} element is registered",
+                self.element_type
+            ))
+        })?;
         let mut mesh = match shape {
             ReferenceShape::Tetrahedron => {
                 let mut conn = Vec::new();
@@ -122,7 +141,7 @@ impl BoxMeshSpec {
                         conn.extend(t.iter().map(|&c| v[c]));
                     }
                 }
-                let mut m = Mesh { rest_positions: positions, blocks: vec![ElementBlock::new(named("p1"), conn)] };
+                let mut m = Mesh { rest_positions: positions, blocks: vec![ElementBlock::new(linear, conn)] };
                 orient_positively(&mut m);
                 for _ in 0..self.refine {
                     m = refine_tetrahedra(&m);
@@ -131,7 +150,7 @@ impl BoxMeshSpec {
             }
             ReferenceShape::Hexahedron => {
                 let conn = cells.flat_map(corners).collect();
-                Mesh { rest_positions: positions, blocks: vec![ElementBlock::new(named("q1"), conn)] }
+                Mesh { rest_positions: positions, blocks: vec![ElementBlock::new(linear, conn)] }
             }
             ReferenceShape::Prism => {
                 let mut conn = Vec::new();
@@ -141,7 +160,7 @@ impl BoxMeshSpec {
                         conn.extend(p.iter().map(|&c| v[c]));
                     }
                 }
-                Mesh { rest_positions: positions, blocks: vec![ElementBlock::new(named("prism"), conn)] }
+                Mesh { rest_positions: positions, blocks: vec![ElementBlock::new(linear, conn)] }
             }
             ReferenceShape::Pyramid => {
                 let mut conn = Vec::new();
@@ -156,7 +175,7 @@ impl BoxMeshSpec {
                         conn.push(apex);
                     }
                 }
-                Mesh { rest_positions: positions, blocks: vec![ElementBlock::new(named("pyramid"), conn)] }
+                Mesh { rest_positions: positions, blocks: vec![ElementBlock::new(linear, conn)] }
             }
         };
         orient_positively(&mut mesh);
@@ -215,7 +234,7 @@ pub fn refine_tetrahedra(mesh: &Mesh) -> Mesh {
     };
     let mut blocks = Vec::new();
     for b in &mesh.blocks {
-        if b.element_type.name() != "p1" {
+        if b.element_type.shape() != ReferenceShape::Tetrahedron || b.element_type.order() != 1 {
             blocks.push(b.clone());
             continue;
         }

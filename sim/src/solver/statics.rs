@@ -363,7 +363,7 @@ mod tests {
                     Prescribed { nodes: vec![n], translation_m: a * x0 + b - x0, rotation: None, ramp_secs: 1.0 }
                 })
                 .collect();
-            for model in MaterialModel::ALL {
+            for &model in MaterialModel::ALL {
                 let problem = StaticProblem {
                     mesh: &mesh,
                     material: Material::new(model, 1e5, 0.3, 1000.0).unwrap(),

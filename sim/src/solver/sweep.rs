@@ -10,7 +10,7 @@ use crate::Vec3;
 use crate::fem::energy::{element_grads, gather};
 use crate::fem::geometry::BlockGeometry;
 use crate::material::Material;
-use crate::xpbd::constraint::{Formulation, MAX_NODES, project_energy_constraint, project_split_constraints};
+use crate::xpbd::constraint::{Formulation, NodeScratch, project_energy_constraint, project_split_constraints};
 
 impl Simulation {
     /// One Gauss–Seidel sweep over every element constraint: in element order, or colour by
@@ -22,7 +22,6 @@ impl Simulation {
         if self.settings.parallel {
             return self.project_elements_parallel(inv_dt2);
         }
-        let mut x = [Vec3::zeros(); MAX_NODES];
         for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
             let block = &self.mesh.blocks[bi];
             let n = block.nodes_per_element();
@@ -62,6 +61,8 @@ impl Simulation {
                 }
             }
             let per_element = lambdas.len() / block.len().max(1);
+            let mut x = NodeScratch::new(Vec3::zeros(), n);
+            let x = x.as_mut_slice();
             for (e, nodes) in block.elements().enumerate() {
                 let lambda = &mut lambdas[e * per_element..(e + 1) * per_element];
                 let ctx = ProjectionContext {
@@ -72,8 +73,8 @@ impl Simulation {
                     inv_dt2,
                 };
                 let positions = &self.positions;
-                if ctx.project(|i| positions[i], &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
-                    if let Some(node) = non_finite_node(&x[..n], nodes) {
+                if ctx.project(|i| positions[i], &self.geometry[bi], e, nodes, lambda, x) {
+                    if let Some(node) = non_finite_node(x, nodes) {
                         return Err(BadElement::projected(bi, e, node, nodes, |i| positions[i]));
                     }
                     for (xi, &node) in x.iter().zip(nodes) {
@@ -158,13 +159,14 @@ impl Simulation {
                             formulation: self.settings.formulation,
                             inv_dt2,
                         };
-                        let mut x = [Vec3::zeros(); MAX_NODES];
+                        let mut x = NodeScratch::new(Vec3::zeros(), n);
+                        let x = x.as_mut_slice();
                         // SAFETY: reads only this element's nodes, which no other thread writes.
                         let read = |i: usize| unsafe { positions.read(i) };
-                        if !ctx.project(read, &self.geometry[bi], e, nodes, lambda, &mut x[..n]) {
+                        if !ctx.project(read, &self.geometry[bi], e, nodes, lambda, x) {
                             return Ok(0);
                         }
-                        if let Some(node) = non_finite_node(&x[..n], nodes) {
+                        if let Some(node) = non_finite_node(x, nodes) {
                             return Err(BadElement::projected(bi, e, node, nodes, read));
                         }
                         for (xi, &node) in x.iter().zip(nodes) {
@@ -204,9 +206,8 @@ impl ProjectionContext<'_> {
         x: &mut [Vec3],
     ) -> bool {
         let n = x.len();
-        let mut w = [0.0; MAX_NODES];
-        let mut rest = [Vec3::zeros(); MAX_NODES];
-        let (w, rest) = (&mut w[..n], &mut rest[..n]);
+        let (mut w, mut rest) = (NodeScratch::new(0.0, n), NodeScratch::new(Vec3::zeros(), n));
+        let (w, rest) = (w.as_mut_slice(), rest.as_mut_slice());
         for (wi, &node) in w.iter_mut().zip(nodes) {
             *wi = self.inv_mass[node as usize];
         }

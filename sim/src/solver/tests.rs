@@ -100,8 +100,9 @@ fn settled_xpbd_error(
 /// the settled error is small, and halving the step divides it by about four.
 #[test]
 fn settled_xpbd_converges_to_the_static_equilibrium_for_every_element_type_and_formulation() {
-    let cases = ElementType::all()
-        .flat_map(|et| MaterialModel::ALL.map(|model| (et, Material::new(model, 1.0e5, 0.3, 1000.0).unwrap())));
+    let cases = ElementType::all().flat_map(|et| {
+        MaterialModel::ALL.iter().map(move |&model| (et, Material::new(model, 1.0e5, 0.3, 1000.0).unwrap()))
+    });
     for (et, material) in cases {
         let mesh = one_cell_cantilever(et);
         let clamped = clamped_at_x0(&mesh);
@@ -395,4 +396,42 @@ fn the_stability_guard_follows_material_mass_and_settings_changes() {
     assert_eq!(sim.substeps_per_frame(), 1);
     sim.step_frame().unwrap();
     assert_eq!(sim.counters().substeps, 1);
+}
+
+/// What adding an element type brings, without registering one: a quartic tetrahedron (35
+/// nodes — more than the kernels' stack scratch, no specialised sweep — with order-4 faces) is
+/// meshed from the registered P1 box, steps with both sweeps and both formulations (the generic
+/// kernels) and sags under gravity, and its display surface and VTK cells are built.
+#[test]
+fn an_unregistered_p4_meshes_steps_with_the_generic_kernels_and_builds_its_surface_and_vtk_cells() {
+    let p4 = crate::element::tests::unregistered_p4();
+    let mesh = beam(p4, [2, 1, 1]);
+    assert_eq!((mesh.blocks[0].element_type, mesh.num_elements()), (p4, 10));
+    let volume = crate::fem::geometry::total_volume_m3(&precompute(&mesh, None).unwrap());
+    assert!((volume - 0.0625).abs() < 1e-12, "{volume}");
+    let clamped = clamped_at_x0(&mesh);
+    let tip = mesh.nodes_where(|p| (p.x - 1.0).abs() < 1e-12);
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e6, 0.3, 1000.0).unwrap();
+    for formulation in Formulation::ALL {
+        for parallel in [false, true] {
+            let settings = SolverSettings { substeps: 10, formulation, parallel, ..SolverSettings::default() };
+            let effects: Vec<Box<dyn Effect>> =
+                vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.clone() })];
+            let mut sim = Simulation::new(mesh.clone(), material, settings, effects).unwrap();
+            for _ in 0..3 {
+                sim.step_frame().unwrap();
+            }
+            assert!(sim.positions.iter().all(|p| p.iter().all(|c| c.is_finite())), "{formulation} {parallel}");
+            let sag = tip.iter().map(|&n| sim.positions[n as usize].z - mesh.rest_positions[n as usize].z).sum::<f64>()
+                / tip.len() as f64;
+            assert!(sag < -1e-4, "{formulation} parallel {parallel}: the tip moved {sag} m");
+            assert!(sim.counters().element_projections > 0);
+        }
+    }
+    let surface = crate::measure::surface::Surface::new(&mesh, 2);
+    assert!(!surface.triangles.is_empty() && !surface.vertices.is_empty());
+    let vtu = crate::io::vtk::vtu_string(&mesh, &mesh.rest_positions, &[], &[]).unwrap();
+    let cells = crate::io::vtk::parse_vtu(&vtu).unwrap().cells;
+    assert_eq!(cells.len(), 10);
+    assert!(cells.iter().all(|(ty, nodes)| *ty == 71 && nodes.len() == 35));
 }

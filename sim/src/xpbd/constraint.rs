@@ -28,8 +28,33 @@ use crate::fem::energy::element_energy_and_gradient;
 use crate::fem::geometry::deformation_gradient;
 use crate::material::{Material, SplitTerm};
 
-/// Largest number of nodes of an element (Q2): kernels keep their scratch on the stack.
+/// Nodes per element up to which the generic kernels keep their per-node scratch on the stack
+/// (Q2's 27: every built-in element); a larger element takes it from the heap
+/// ([`NodeScratch`]), so any registered element goes through the generic kernels.
 pub const MAX_NODES: usize = 27;
+
+/// Per-node scratch of `len` values: on the stack for up to [`MAX_NODES`] nodes, on the heap
+/// beyond (an element larger than every built-in one).
+pub struct NodeScratch<T> {
+    stack: [T; MAX_NODES],
+    heap: Vec<T>,
+    len: usize,
+}
+
+impl<T: Copy> NodeScratch<T> {
+    /// `len` copies of `fill`.
+    #[inline]
+    pub fn new(fill: T, len: usize) -> Self {
+        let heap = if len > MAX_NODES { vec![fill; len] } else { Vec::new() };
+        Self { stack: [fill; MAX_NODES], heap, len }
+    }
+
+    /// The `len` values.
+    #[inline]
+    pub fn as_mut_slice(&mut self) -> &mut [T] {
+        if self.len <= MAX_NODES { &mut self.stack[..self.len] } else { &mut self.heap }
+    }
+}
 
 /// How element energies become XPBD constraints.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -172,9 +197,8 @@ pub fn project_energy_constraint(
     inv_dt2: f64,
     lambda: &mut f64,
 ) -> f64 {
-    let n = x.len();
-    let mut grad = [Vec3::zeros(); MAX_NODES];
-    let grad = &mut grad[..n];
+    let mut grad = NodeScratch::new(Vec3::zeros(), x.len());
+    let grad = grad.as_mut_slice();
     // ψ ≥ 0 for StVK and Neo-Hookean; the stable Neo-Hookean energy can dip below its rest
     // value under extreme compression: the constraint then has nothing to restore.
     let energy = element_energy_and_gradient(x, rest, grads, volumes, material, grad).max(0.0);
@@ -202,11 +226,12 @@ pub fn project_split_constraints(
 ) {
     let n = x.len();
     let stiffness = material.split_stiffness_pa();
-    let mut g = [[Vec3::zeros(); MAX_NODES]; 2];
+    let (mut g0, mut g1) = (NodeScratch::new(Vec3::zeros(), n), NodeScratch::new(Vec3::zeros(), n));
+    let (g0, g1) = (g0.as_mut_slice(), g1.as_mut_slice());
     for (q, v) in volumes.iter().enumerate() {
         let gq = &grads[q * n..(q + 1) * n];
-        let terms = split_terms_and_gradients(x, rest, gq, material, &mut g);
-        let [g0, g1] = [&g[0][..n], &g[1][..n]];
+        let terms = split_terms_and_gradients(x, rest, gq, material, [&mut *g0, &mut *g1]);
+        let (g0, g1) = (&*g0, &*g1);
         let (a, b, d) = (weighted_dot(w, g0, g0), weighted_dot(w, g0, g1), weighted_dot(w, g1, g1));
         let alpha_tilde = [inv_dt2 / (stiffness[0] * v), inv_dt2 / (stiffness[1] * v)];
         let lambda = [lambdas[2 * q], lambdas[2 * q + 1]];
@@ -222,18 +247,18 @@ pub fn project_split_constraints(
 }
 
 /// The split terms (deviatoric, hydrostatic) at one quadrature point, with their scaled node
-/// gradients `g_out[t][i] = s_t ∂C_t/∂x_i = s_t (∂C_t/∂F) ∇_X N_i`.
+/// gradients `g_out[t][i] = s_t ∂C_t/∂x_i = s_t (∂C_t/∂F) ∇_X N_i` (one entry per node).
 pub fn split_terms_and_gradients(
     x: &[Vec3],
     rest: &[Vec3],
     grads_q: &[Vec3],
     material: &Material,
-    g_out: &mut [[Vec3; MAX_NODES]; 2],
+    g_out: [&mut [Vec3]; 2],
 ) -> [SplitTerm; 2] {
     let f = deformation_gradient(x, rest, grads_q);
     let terms = material.split_terms(&f);
-    for (t, term) in terms.iter().enumerate() {
-        for (gi, ni) in g_out[t].iter_mut().zip(grads_q) {
+    for (g, term) in g_out.into_iter().zip(&terms) {
+        for (gi, ni) in g.iter_mut().zip(grads_q) {
             *gi = term.grad_f_scaled * ni;
         }
     }

@@ -96,6 +96,10 @@ fn unknown_and_unsupported_element_types_are_named() {
     let hex20 = msh22(&format!("17 2 2 1 {}", (1..=20).map(|_| "1").collect::<Vec<_>>().join(" ")));
     let e = error(&hex20);
     assert!(e.contains("20-node hexahedron (Gmsh type 17)") && e.contains("which hox does not simulate"), "{e}");
+    // the supported types are the registry's
+    for et in ElementType::all() {
+        assert!(e.contains(&format!("{}: {}, {}", et.gmsh_type(), et.name(), et.description())), "{et}: {e}");
+    }
 }
 
 #[test]

@@ -38,9 +38,11 @@ fn the_paper_meshes_have_the_paper_counts() {
 }
 
 #[test]
-fn no_two_nodes_share_a_position() {
-    for e in ["p1", "p2", "p3", "q1", "q2", "prism", "pyramid"] {
+fn no_two_nodes_share_a_position_and_every_cell_holds_its_shapes_element_count() {
+    for e in ElementType::all().map(|e| e.name()) {
         let m = beam(e, [3, 2, 2], TetSplit::Five, 0, 1.5);
+        let shape = ElementType::from_name(e).unwrap().shape();
+        assert_eq!(m.num_elements(), 12 * elements_per_cell(shape, TetSplit::Five), "{e}");
         let mut keys: Vec<[i64; 3]> =
             m.rest_positions.iter().map(|p| [p.x, p.y, p.z].map(|c| (c * 1e9).round() as i64)).collect();
         keys.sort_unstable();
@@ -52,9 +54,11 @@ fn no_two_nodes_share_a_position() {
 
 #[test]
 fn high_order_meshes_are_conforming_every_interior_face_is_shared_by_two_elements() {
-    for e in ["p1", "p2", "p3", "q1", "q2", "prism", "pyramid"] {
+    for e in ElementType::all().map(|e| e.name()) {
         for split in [TetSplit::Five, TetSplit::Six] {
             let m = beam(e, [3, 2, 2], split, 0, 1.5);
+            let shape = ElementType::from_name(e).unwrap().shape();
+            assert_eq!(m.num_elements(), 12 * elements_per_cell(shape, split), "{e} {split:?}");
             // A conforming box mesh has boundary faces only on the box surface.
             let (lo, hi) = m.bounding_box();
             for (b, el, f) in m.boundary_faces() {

@@ -5,13 +5,15 @@ use crate::fem::energy::tests::{elements, materials};
 use crate::xpbd::constraint::project_energy_constraint;
 
 /// The specialised sweep projects one element exactly as the generic kernel does, up to the
-/// order of floating-point operations, for every element type and material; the colour-packed
-/// copy holds the same data.
+/// order of floating-point operations, for every element type and material (a node count
+/// without one is declined, for the generic kernel); the colour-packed copy holds the same data.
 #[test]
 fn specialised_sweep_matches_the_generic_kernel() {
     for (et, mesh, geo) in elements() {
         let n = et.num_nodes();
-        assert!(SPECIALISED_NODE_COUNTS.contains(&n), "{et}");
+        // a node count without a specialised sweep is optional speed: the sweep declines it and
+        // the caller takes the generic kernel (every built-in element has one)
+        let specialised = SPECIALISED_NODE_COUNTS.contains(&n);
         let g = &geo[0];
         let block = &mesh.blocks[0];
         let deformed: Vec<Vec3> = mesh
@@ -54,6 +56,10 @@ fn specialised_sweep_matches_the_generic_kernel() {
                         1e4,
                     )
                 };
+                if !specialised {
+                    assert_eq!(done, None, "{et}: no specialised sweep");
+                    continue;
+                }
                 assert_eq!(done, Some(Ok(1)), "{et}");
                 let scale = expected.iter().zip(&deformed).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
                 assert!(scale > 0.0, "{et} {:?}: nothing moved", material.model);
