@@ -5,7 +5,10 @@
 //! quadrature volumes `V_q = w_q det J(X, r_q)`:
 //! - `U_e = Σ_q V_q ψ(F_q)`, `F_q = Σ_i x_i ⊗ ∇_X N_i(r_q)`;
 //! - `∂U_e/∂x_i = Σ_q V_q P(F_q) ∇_X N_i(r_q)`;
-//! - `∂²U_e/∂x_{ia}∂x_{jb} = Σ_q V_q Σ_{c,d} ∂P_{ac}/∂F_{bd} (∇_X N_i)_c (∇_X N_j)_d`.
+//! - `∂²U_e/∂x_{ia}∂x_{jb} = Σ_q V_q Σ_{c,d} ∂P_{ac}/∂F_{bd} (∇_X N_i)_c (∇_X N_j)_d`;
+//! - one node's share ([`element_node_gradient_and_block`], what a vertex block descent step of
+//!   Chen et al., "Vertex Block Descent", SIGGRAPH 2024, needs): `∂U_e/∂x_a` and the 3 × 3
+//!   diagonal block `∂²U_e/∂x_a∂x_a`, without the rest of the element Hessian.
 //!
 //! For the linear tetrahedron this is Bender et al.'s `V_0 P(F) D_m⁻ᵀ` (the paper, §2).
 
@@ -84,6 +87,44 @@ pub fn element_hessian(
         }
     }
     h
+}
+
+/// One node's share of an element: `∂U_e/∂x_a = Σ_q V_q P(F_q) ∇_X N_a(r_q)` and the diagonal
+/// block `B_ab = Σ_q V_q Σ_{c,d} ∂P_{ac}/∂F_{bd} (∇_X N_a)_c (∇_X N_a)_d` of the element Hessian
+/// for local node `a` (with `projected`, `dP/dF` projected to positive semi-definite at each point
+/// as in [`element_hessian`], which makes the block positive semi-definite).
+pub fn element_node_gradient_and_block(
+    x: &[Vec3],
+    rest: &[Vec3],
+    grads: &[Vec3],
+    volumes: &[f64],
+    material: &Material,
+    a: usize,
+    projected: bool,
+) -> (Vec3, nalgebra::Matrix3<f64>) {
+    let n = x.len();
+    let mut grad = Vec3::zeros();
+    let mut block = nalgebra::Matrix3::zeros();
+    for (q, v) in volumes.iter().enumerate() {
+        let g = &grads[q * n..(q + 1) * n];
+        let f = deformation_gradient(x, rest, g);
+        let (_, p) = material.energy_density_and_pk1(&f);
+        grad += (p * g[a]) * *v;
+        let c = if projected { material.dpdf_projected(&f) } else { material.dpdf(&f) };
+        let ga = g[a];
+        for r in 0..3 {
+            for k in 0..3 {
+                let mut sum = 0.0;
+                for cc in 0..3 {
+                    for d in 0..3 {
+                        sum += c[(r + 3 * cc, k + 3 * d)] * ga[cc] * ga[d];
+                    }
+                }
+                block[(r, k)] += v * sum;
+            }
+        }
+    }
+    (grad, block)
 }
 
 /// Gathers the positions of an element's nodes into `out`.

@@ -1,11 +1,13 @@
 //! Meshes: rest node positions and blocks of elements of one type each (a mesh may mix types).
 //!
 //! Connectivity uses the element's Gmsh node order ([`crate::element`]). [`structured`] builds
-//! the paper's beams; [`high_order`] adds shared edge/face/interior nodes to linear meshes. Mesh
+//! the paper's beams; [`high_order`] adds shared edge/face/interior nodes to linear meshes;
+//! [`adjacency`] lists the elements holding each node and colours the nodes. Mesh
 //! files (Gmsh import, VTK export) are in [`crate::io`]. This room reads only the reference
 //! elements: element shape (inverted or flat at rest) is checked by `crate::fem::geometry`,
 //! which reads meshes, not the other way round.
 
+pub mod adjacency;
 pub mod high_order;
 pub mod structured;
 

@@ -26,28 +26,13 @@ pub fn colour_elements(block: &ElementBlock, num_nodes: usize) -> Vec<Vec<u32>> 
             fill[n as usize] += 1;
         }
     }
-    let mut colour_of = vec![u32::MAX; block.len()];
-    let mut taken: Vec<bool> = Vec::new();
-    let mut colours: Vec<Vec<u32>> = Vec::new();
-    for (e, el) in block.elements().enumerate() {
-        taken.iter_mut().for_each(|t| *t = false);
-        for &n in el {
+    crate::mesh::adjacency::greedy_colours(block.len(), |e, neighbour| {
+        for &n in block.element(e) {
             for &other in &adjacent[start[n as usize]..start[n as usize + 1]] {
-                let c = colour_of[other as usize];
-                if c != u32::MAX {
-                    taken[c as usize] = true;
-                }
+                neighbour(other);
             }
         }
-        let c = taken.iter().position(|t| !t).unwrap_or(taken.len());
-        if c == taken.len() {
-            taken.push(false);
-            colours.push(Vec::new());
-        }
-        colour_of[e] = c as u32;
-        colours[c].push(e as u32);
-    }
-    colours
+    })
 }
 
 #[cfg(test)]

@@ -169,3 +169,39 @@ fn the_p1_gradient_is_benders_v0_p_dm_inv_t() {
     }
     assert!((grad[0] + h.column(0) + h.column(1) + h.column(2)).norm() < 1e-9 * h.norm());
 }
+
+/// A node's gradient and diagonal block (what vertex block descent needs) are the node's rows of
+/// the element gradient and the diagonal 3 × 3 block of the element Hessian, projected or not,
+/// for every element type and material at a deformed state.
+#[test]
+fn node_block_is_the_diagonal_block_of_the_element_hessian() {
+    let seed: Vec<f64> = (0..81).map(|k| ((k * 37 % 101) as f64 / 50.0) - 1.0).collect();
+    for (et, mesh, geo) in elements() {
+        let x = perturbed(&mesh, &seed);
+        let block = &mesh.blocks[0];
+        let nodes = block.element(0);
+        let (mut xe, mut rest) = (vec![Vec3::zeros(); nodes.len()], vec![Vec3::zeros(); nodes.len()]);
+        gather(&x, nodes, &mut xe);
+        gather(&mesh.rest_positions, nodes, &mut rest);
+        let (grads, volumes) = (element_grads(&geo[0], 0), geo[0].volumes(0));
+        for material in materials() {
+            let mut grad = vec![Vec3::zeros(); nodes.len()];
+            element_energy_and_gradient(&xe, &rest, grads, volumes, &material, &mut grad);
+            for projected in [false, true] {
+                let h = element_hessian(&xe, &rest, grads, volumes, &material, projected);
+                let scale = h.abs().max().max(1e-300);
+                for a in 0..nodes.len() {
+                    let (g, b) = element_node_gradient_and_block(&xe, &rest, grads, volumes, &material, a, projected);
+                    let gscale = grad.iter().map(|v| v.norm()).fold(0.0, f64::max).max(1e-300);
+                    assert!((g - grad[a]).norm() <= 1e-12 * gscale, "{et} {:?} node {a}: gradient", material.model);
+                    let expected = h.fixed_view::<3, 3>(3 * a, 3 * a);
+                    assert!(
+                        (b - expected).abs().max() <= 1e-12 * scale,
+                        "{et} {:?} node {a} projected {projected}: {b} vs {expected}",
+                        material.model
+                    );
+                }
+            }
+        }
+    }
+}
