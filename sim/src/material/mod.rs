@@ -389,27 +389,44 @@ fn dpdf_from_directional(dp: impl Fn(&Mat3) -> Mat3) -> Mat9 {
     (out + out.transpose()) * 0.5
 }
 
-/// Nearest PSD matrix (Frobenius norm) to the symmetric part of `m`.
-fn project_psd(m: &Mat9) -> Mat9 {
-    if !m.iter().all(|x| x.is_finite()) {
-        return *m;
-    }
-    let sym = (m + m.transpose()) * 0.5;
-    match SymmetricEigen::try_new(sym, f64::EPSILON, 10_000) {
-        Some(eig) => {
-            if eig.eigenvalues.iter().all(|&l| l >= 0.0) {
-                return sym;
+/// The nearest (Frobenius) positive semi-definite matrix to the symmetric part of `m`, written
+/// once for each size: negative eigenvalues clamped to 0; the symmetric part unchanged when
+/// already PSD; non-finite input returned as is.
+macro_rules! project_psd_fn {
+    ($(#[$doc:meta])* $vis:vis fn $name:ident($ty:ty)) => {
+        $(#[$doc])*
+        $vis fn $name(m: &$ty) -> $ty {
+            if !m.iter().all(|x| x.is_finite()) {
+                return *m;
             }
-            let clamped = eig.eigenvalues.map(|l| l.max(0.0));
-            let q = &eig.eigenvectors;
-            let out = q * Mat9::from_diagonal(&clamped) * q.transpose();
-            (out + out.transpose()) * 0.5
+            let sym = (m + m.transpose()) * 0.5;
+            match SymmetricEigen::try_new(sym, f64::EPSILON, 10_000) {
+                Some(eig) => {
+                    if eig.eigenvalues.iter().all(|&l| l >= 0.0) {
+                        return sym;
+                    }
+                    let clamped = eig.eigenvalues.map(|l| l.max(0.0));
+                    let q = &eig.eigenvectors;
+                    let out = q * <$ty>::from_diagonal(&clamped) * q.transpose();
+                    (out + out.transpose()) * 0.5
+                }
+                // Not expected for finite symmetric input; fall back to a PSD
+                // (diagonal, clamped) approximation rather than failing.
+                None => <$ty>::from_diagonal(&sym.diagonal().map(|d| d.max(0.0))),
+            }
         }
-        // Not expected for finite symmetric input; fall back to a PSD
-        // (diagonal, clamped) approximation rather than failing.
-        None => Mat9::from_diagonal(&sym.diagonal().map(|d| d.max(0.0))),
-    }
+    };
 }
+
+project_psd_fn!(
+    /// Nearest PSD matrix (Frobenius norm) to the symmetric part of `m` (a `dP/dF`).
+    fn project_psd(Mat9)
+);
+project_psd_fn!(
+    /// Nearest PSD matrix to the symmetric part of a 3 × 3 block (a node's Hessian block in
+    /// vertex block descent).
+    pub fn project_psd3(Matrix3<f64>)
+);
 
 #[cfg(test)]
 mod tests {
@@ -615,5 +632,31 @@ mod tests {
             }
             Ok(())
         });
+    }
+}
+
+#[cfg(test)]
+mod psd3_tests {
+    use super::project_psd3;
+    use nalgebra::{Matrix3, SymmetricEigen};
+
+    /// A positive definite block comes back as it was; an indefinite one comes back with its
+    /// negative eigenvalues at 0 and its eigenvectors kept (the nearest PSD matrix); non-finite
+    /// input is returned as is.
+    #[test]
+    fn psd3_projection_keeps_pd_blocks_and_clamps_negative_eigenvalues() {
+        let pd = Matrix3::new(4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0);
+        assert_eq!(project_psd3(&pd), pd);
+        let indefinite = Matrix3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, -3.0); // eigenvalues 3, -1, -3
+        let p = project_psd3(&indefinite);
+        let eig = SymmetricEigen::new(p).eigenvalues;
+        let mut e: Vec<f64> = eig.iter().copied().collect();
+        e.sort_by(f64::total_cmp);
+        assert!(e[0].abs() < 1e-12 && e[1].abs() < 1e-12 && (e[2] - 3.0).abs() < 1e-12, "{e:?}");
+        // the kept eigenvector (1, 1, 0)/√2 with eigenvalue 3
+        let v = nalgebra::Vector3::new(1.0, 1.0, 0.0).normalize();
+        assert!((p * v - 3.0 * v).norm() < 1e-12);
+        let bad = Matrix3::new(f64::NAN, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+        assert!(project_psd3(&bad)[(0, 0)].is_nan());
     }
 }
