@@ -17,15 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &threads,
         std::env::var("HOX_BENCH_COLOUR_ON_ONE").map_or(true, |v| v != "0"),
         frames,
-        &mut |r| {
-            eprintln!(
-                "{} on {} thread(s), parallel {}: {:.2} ms/frame",
-                r.case.label(),
-                r.threads,
-                r.parallel,
-                r.ms_per_frame
-            )
-        },
+        &mut |r| eprintln!("{}", r.progress_line()),
     )?;
     print!("{}", hox_scenes::bench::markdown(&rows));
     Ok(())

@@ -98,6 +98,18 @@ pub struct BenchRow {
 }
 
 impl BenchRow {
+    /// The progress line printed as each row is measured, e.g.
+    /// `P2 8x2x2 on 1 thread(s), parallel false: 2.08 ms/frame`.
+    pub fn progress_line(&self) -> String {
+        format!(
+            "{} on {} thread(s), parallel {}: {:.2} ms/frame",
+            self.case.label(),
+            self.threads,
+            self.parallel,
+            self.ms_per_frame
+        )
+    }
+
     /// The paper's time over ours.
     pub fn speedup_over_paper(&self) -> Option<f64> {
         self.case.paper_ms_per_frame.map(|p| p / self.ms_per_frame)

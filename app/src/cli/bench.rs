@@ -6,15 +6,8 @@ pub fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool) 
     if frames == 0 || threads.contains(&0) {
         bail!("--frames and every --threads count must be at least 1");
     }
-    let rows = hox_scenes::bench::run(only, threads, colour_on_one, frames, &mut |r| {
-        eprintln!(
-            "{} on {} thread(s), parallel {}: {:.2} ms/frame",
-            r.case.label(),
-            r.threads,
-            r.parallel,
-            r.ms_per_frame
-        )
-    })?;
+    let rows =
+        hox_scenes::bench::run(only, threads, colour_on_one, frames, &mut |r| eprintln!("{}", r.progress_line()))?;
     if rows.is_empty() {
         bail!("no configuration matches '{only}'");
     }

@@ -135,19 +135,55 @@ pub fn gather(positions: &[Vec3], nodes: &[u32], out: &mut [Vec3]) {
     }
 }
 
-/// Total elastic energy of the mesh at `positions`.
-pub fn total_energy(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, positions: &[Vec3]) -> f64 {
+/// One element with its node positions gathered, as [`for_each_element`] visits it.
+pub struct GatheredElement<'a> {
+    pub block: usize,
+    pub element: usize,
+    pub nodes: &'a [u32],
+    pub geometry: &'a BlockGeometry,
+    /// Deformed positions of the element's nodes.
+    pub x: &'a [Vec3],
+    /// Rest positions of the element's nodes.
+    pub rest: &'a [Vec3],
+}
+
+impl GatheredElement<'_> {
+    /// The material gradients of all its quadrature points (`points × nodes`).
+    pub fn grads(&self) -> &[Vec3] {
+        element_grads(self.geometry, self.element)
+    }
+    /// Its quadrature volumes `V_q`.
+    pub fn volumes(&self) -> &[f64] {
+        self.geometry.volumes(self.element)
+    }
+}
+
+/// Visits every element (block by block, in element order) with its deformed (`positions`) and
+/// rest node positions gathered into reused buffers.
+pub fn for_each_element(
+    mesh: &Mesh,
+    geometry: &[BlockGeometry],
+    positions: &[Vec3],
+    mut visit: impl FnMut(&GatheredElement),
+) {
     let (mut x, mut rest) = (Vec::new(), Vec::new());
-    let mut total = 0.0;
-    for (b, g) in mesh.blocks.iter().zip(geometry) {
+    for (block, (b, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
         x.resize(b.nodes_per_element(), Vec3::zeros());
         rest.resize(b.nodes_per_element(), Vec3::zeros());
-        for (e, nodes) in b.elements().enumerate() {
+        for (element, nodes) in b.elements().enumerate() {
             gather(positions, nodes, &mut x);
             gather(&mesh.rest_positions, nodes, &mut rest);
-            total += element_energy(&x, &rest, element_grads(g, e), g.volumes(e), material);
+            visit(&GatheredElement { block, element, nodes, geometry: g, x: &x, rest: &rest });
         }
     }
+}
+
+/// Total elastic energy of the mesh at `positions`.
+pub fn total_energy(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, positions: &[Vec3]) -> f64 {
+    let mut total = 0.0;
+    for_each_element(mesh, geometry, positions, |el| {
+        total += element_energy(el.x, el.rest, el.grads(), el.volumes(), material);
+    });
     total
 }
 
@@ -160,21 +196,15 @@ pub fn total_energy_and_gradient(
     gradient_out: &mut [Vec3],
 ) -> f64 {
     gradient_out.iter_mut().for_each(|g| *g = Vec3::zeros());
-    let (mut x, mut rest, mut ge) = (Vec::new(), Vec::new(), Vec::new());
+    let mut ge = Vec::new();
     let mut total = 0.0;
-    for (b, g) in mesh.blocks.iter().zip(geometry) {
-        x.resize(b.nodes_per_element(), Vec3::zeros());
-        rest.resize(b.nodes_per_element(), Vec3::zeros());
-        ge.resize(b.nodes_per_element(), Vec3::zeros());
-        for (e, nodes) in b.elements().enumerate() {
-            gather(positions, nodes, &mut x);
-            gather(&mesh.rest_positions, nodes, &mut rest);
-            total += element_energy_and_gradient(&x, &rest, element_grads(g, e), g.volumes(e), material, &mut ge);
-            for (&n, gi) in nodes.iter().zip(&ge) {
-                gradient_out[n as usize] += gi;
-            }
+    for_each_element(mesh, geometry, positions, |el| {
+        ge.resize(el.nodes.len(), Vec3::zeros());
+        total += element_energy_and_gradient(el.x, el.rest, el.grads(), el.volumes(), material, &mut ge);
+        for (&n, gi) in el.nodes.iter().zip(&ge) {
+            gradient_out[n as usize] += gi;
         }
-    }
+    });
     total
 }
 

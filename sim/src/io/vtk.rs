@@ -14,7 +14,7 @@
 
 use crate::Vec3;
 use crate::element::ElementType;
-use crate::fem::energy::gather;
+use crate::fem::energy::for_each_element;
 use crate::fem::geometry::{BlockGeometry, deformation_gradient};
 use crate::material::Material;
 use crate::mesh::Mesh;
@@ -196,28 +196,21 @@ pub fn von_mises_stress_pa(
     positions: &[Vec3],
 ) -> Vec<f64> {
     let mut out = Vec::with_capacity(mesh.num_elements());
-    let (mut x, mut rest) = (Vec::new(), Vec::new());
-    for (b, g) in mesh.blocks.iter().zip(geometry) {
-        x.resize(b.nodes_per_element(), Vec3::zeros());
-        rest.resize(b.nodes_per_element(), Vec3::zeros());
-        for (e, nodes) in b.elements().enumerate() {
-            gather(positions, nodes, &mut x);
-            gather(&mesh.rest_positions, nodes, &mut rest);
-            let (mut sum, mut volume) = (0.0, 0.0);
-            for (q, &v) in g.volumes(e).iter().enumerate() {
-                let f = deformation_gradient(&x, &rest, g.gradients(e, q));
-                let j = f.determinant();
-                let sigma = material.pk1(&f) * f.transpose() / j;
-                let dev = sigma - nalgebra::Matrix3::identity() * (sigma.trace() / 3.0);
-                let vm = (1.5 * dev.norm_squared()).sqrt();
-                if vm.is_finite() {
-                    sum += vm * v;
-                    volume += v;
-                }
+    for_each_element(mesh, geometry, positions, |el| {
+        let (mut sum, mut volume) = (0.0, 0.0);
+        for (q, &v) in el.volumes().iter().enumerate() {
+            let f = deformation_gradient(el.x, el.rest, el.geometry.gradients(el.element, q));
+            let j = f.determinant();
+            let sigma = material.pk1(&f) * f.transpose() / j;
+            let dev = sigma - nalgebra::Matrix3::identity() * (sigma.trace() / 3.0);
+            let vm = (1.5 * dev.norm_squared()).sqrt();
+            if vm.is_finite() {
+                sum += vm * v;
+                volume += v;
             }
-            out.push(if volume > 0.0 { sum / volume } else { f64::NAN });
         }
-    }
+        out.push(if volume > 0.0 { sum / volume } else { f64::NAN });
+    });
     out
 }
 

@@ -4,7 +4,7 @@
 //! exactly 1 at rest.
 
 use crate::Vec3;
-use crate::fem::energy::gather;
+use crate::fem::energy::for_each_element;
 use crate::fem::geometry::{BlockGeometry, deformation_gradient};
 use crate::mesh::Mesh;
 
@@ -26,24 +26,16 @@ pub struct MinDetF {
 /// NaN positions are never reported as healthy. Ties keep the first point (block, element,
 /// point order).
 pub fn min_det_f(mesh: &Mesh, geometry: &[BlockGeometry], positions: &[Vec3]) -> Option<MinDetF> {
-    let (mut x, mut rest) = (Vec::new(), Vec::new());
     let mut best: Option<MinDetF> = None;
-    for (bi, (b, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
-        let n = b.nodes_per_element();
-        x.resize(n, Vec3::zeros());
-        rest.resize(n, Vec3::zeros());
-        for (e, nodes) in b.elements().enumerate() {
-            gather(positions, nodes, &mut x);
-            gather(&mesh.rest_positions, nodes, &mut rest);
-            for q in 0..g.points_per_element {
-                let det = deformation_gradient(&x, &rest, g.gradients(e, q)).determinant();
-                let det = if det.is_finite() { det } else { f64::NEG_INFINITY };
-                if best.is_none_or(|m| det < m.det_f) {
-                    best = Some(MinDetF { det_f: det, block: bi, element: e, point: q });
-                }
+    for_each_element(mesh, geometry, positions, |el| {
+        for q in 0..el.geometry.points_per_element {
+            let det = deformation_gradient(el.x, el.rest, el.geometry.gradients(el.element, q)).determinant();
+            let det = if det.is_finite() { det } else { f64::NEG_INFINITY };
+            if best.is_none_or(|m| det < m.det_f) {
+                best = Some(MinDetF { det_f: det, block: el.block, element: el.element, point: q });
             }
         }
-    }
+    });
     best
 }
 
