@@ -194,3 +194,27 @@ fn ctrl_c_leaves_a_playable_file_up_to_the_last_frame() {
     // every entity holds the same, complete frames
     ok_json(&["inspect", file.to_str().unwrap(), "--expect-frames", &frames.to_string(), "--json"]);
 }
+
+/// A refused option of a single configuration reads "error: builtin:bending: …" (regression: an
+/// empty context made it "error: : builtin:bending: …"); a compared one names its --compare value.
+#[test]
+fn a_refused_record_option_names_the_problem_without_an_empty_prefix() {
+    let out_file = temp("refused.rrd");
+    let out = hox(&["record", "--scene", "bending", "--out", out_file.to_str().unwrap(), "--tessellation", "0"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.starts_with("error: builtin:bending: display.tessellation (--tessellation) = 0"), "{err}");
+    let out = hox(&[
+        "record",
+        "--scene",
+        "bending",
+        "--out",
+        out_file.to_str().unwrap(),
+        "--compare",
+        "element=p1",
+        "--compare",
+        "refine=7",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.starts_with("error: --compare 'refine=7':"), "{err}");
+}

@@ -75,9 +75,12 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     };
     let mut instances = Vec::new();
     for (k, o) in configurations.iter().enumerate() {
-        let s = scene.with_overrides(o).with_context(|| {
-            if args.compare.is_empty() { String::new() } else { format!("--compare '{}'", args.compare[k]) }
-        })?;
+        let s = match scene.with_overrides(o) {
+            Ok(s) => s,
+            // a compared configuration's error names its --compare value
+            Err(e) if !args.compare.is_empty() => return Err(e).context(format!("--compare '{}'", args.compare[k])),
+            Err(e) => return Err(e.into()),
+        };
         let mut instance = Instance::new(s)?;
         super::note_stability(&mut instance);
         instances.push(instance);
