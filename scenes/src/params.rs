@@ -20,6 +20,7 @@
 use hox_sim::element::ElementType;
 use hox_sim::material::MaterialModel;
 use hox_sim::mesh::structured::TetSplit;
+use hox_sim::solver::{Method, VbdInit};
 use hox_sim::xpbd::constraint::Formulation;
 use serde::{Deserialize, Serialize};
 
@@ -486,6 +487,38 @@ fn formulation_options() -> Vec<(&'static str, String)> {
     Formulation::ALL.iter().map(|f| (f.name(), f.name().to_string())).collect()
 }
 
+fn method_options() -> Vec<(&'static str, String)> {
+    Method::ALL
+        .iter()
+        .map(|m| {
+            let long = match m {
+                Method::Xpbd => "XPBD (the paper's)",
+                Method::Vbd => "VBD (vertex block descent)",
+                Method::Newton => "Newton (implicit Euler)",
+            };
+            (m.name(), long.to_string())
+        })
+        .collect()
+}
+fn vbd_init_options() -> Vec<(&'static str, String)> {
+    VbdInit::ALL.iter().map(|i| (i.name(), i.name().to_string())).collect()
+}
+
+/// Whether the solver is the paper's XPBD (substeps, iterations, formulation and guard apply).
+pub fn is_xpbd(p: &Params) -> bool {
+    Method::from_name(&p.method).is_none_or(|m| m == Method::Xpbd)
+}
+/// Whether the solver is implicit (VBD or Newton: steps per frame apply).
+pub fn is_implicit(p: &Params) -> bool {
+    !is_xpbd(p)
+}
+fn is_vbd(p: &Params) -> bool {
+    Method::from_name(&p.method) == Some(Method::Vbd)
+}
+fn is_newton(p: &Params) -> bool {
+    Method::from_name(&p.method) == Some(Method::Newton)
+}
+
 /// Whether the element type is a tetrahedron (P1, P2, P3): the tet split and refinement apply.
 pub fn is_tetrahedral(p: &Params) -> bool {
     ElementType::from_name(&p.element).is_some_and(|e| e.shape() == hox_sim::element::ReferenceShape::Tetrahedron)
@@ -632,11 +665,47 @@ params! {
         kind: Kind::Number { min: 0.0, min_inclusive: false, max: f64::INFINITY, max_inclusive: false, soft: None },
         invalidates: Invalidates::Material, required: true, ..BASE
     }
+    /// xpbd | vbd | newton ([`hox_sim::solver::Method`]).
+    method: String = "xpbd".into() => {
+        key: "solver", group: Group::Solver, file_key: "method", label: "Solver",
+        help: "xpbd: the paper's extended position-based dynamics (substeps × iterations); vbd: vertex block descent on implicit Euler (Chen et al. 2024); newton: implicit Euler solved by Newton's method to --newton-tolerance (sparse Cholesky). Contact needs xpbd or vbd.",
+        kind: Kind::Choice(method_options), ..BASE
+    }
+    /// Implicit steps per frame (VBD, Newton).
+    steps_per_frame: u32 = 1 => {
+        key: "steps", group: Group::Solver, file_key: "steps_per_frame", label: "Steps per frame",
+        help: "Implicit Euler steps per frame for vbd and newton (XPBD takes --substeps); more steps, less numerical damping.",
+        kind: Kind::Whole { min: 1, max: 10_000, soft_max: 20 }, applies: Some(is_implicit), ..BASE
+    }
+    /// VBD sweeps per step.
+    vbd_iterations: u32 = 20 => {
+        key: "vbd-iterations", group: Group::Solver, file_key: "vbd_iterations", label: "VBD iterations",
+        help: "Vertex block descent sweeps over the node colours per step.",
+        kind: Kind::Whole { min: 1, max: 100_000, soft_max: 200 }, applies: Some(is_vbd), ..BASE
+    }
+    /// Chebyshev acceleration's ρ for VBD (0: off).
+    chebyshev_rho: f64 = 0.0 => {
+        key: "chebyshev-rho", group: Group::Solver, file_key: "chebyshev_rho", label: "Chebyshev ρ",
+        help: "Chebyshev acceleration of the VBD sweeps, its spectral radius estimate in [0, 1) (0: off, the authors' default).",
+        kind: Kind::Number { min: 0.0, min_inclusive: true, max: 1.0, max_inclusive: false, soft: None }, applies: Some(is_vbd), ..BASE
+    }
+    /// Where a VBD step starts: adaptive | inertia | previous.
+    vbd_init: String = "adaptive".into() => {
+        key: "vbd-init", group: Group::Solver, file_key: "vbd_init", label: "VBD start",
+        help: "Where a VBD step starts: adaptive (the paper's: the last step's acceleration along gravity, so a body at rest stays at rest), inertia (the inertial prediction) or previous (the last position).",
+        kind: Kind::Choice(vbd_init_options), applies: Some(is_vbd), ..BASE
+    }
+    /// Newton's tolerance per step, relative to the load.
+    newton_tolerance: f64 = 1e-6 => {
+        key: "newton-tolerance", group: Group::Solver, file_key: "newton_tolerance", label: "Newton tolerance",
+        help: "A Newton step has converged when its unbalanced force is at most this fraction of the load (the body force, or the reactions if larger), as `hox static` measures it; in (0, 1).",
+        kind: Kind::Number { min: 0.0, min_inclusive: false, max: 1.0, max_inclusive: false, soft: None }, applies: Some(is_newton), ..BASE
+    }
     /// energy | split.
     formulation: String = "energy".into() => {
         key: "formulation", group: Group::Solver, file_key: "formulation", label: "Formulation",
         help: "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.",
-        kind: Kind::Choice(formulation_options), ..BASE
+        kind: Kind::Choice(formulation_options), applies: Some(is_xpbd), ..BASE
     }
     /// None: each element type's default degree.
     quadrature_degree: Option<usize> = None => {
@@ -648,19 +717,19 @@ params! {
     substeps: u32 = 50 => {
         key: "substeps", group: Group::Solver, file_key: "substeps", label: "Substeps",
         help: "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.",
-        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 500 }, ..BASE
+        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 500 }, applies: Some(is_xpbd), ..BASE
     }
     /// Constraint sweeps per substep.
     iterations: u32 = 1 => {
         key: "iterations", group: Group::Solver, file_key: "iterations", label: "Iterations",
         help: "Constraint sweeps per substep (the paper: 1).",
-        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 20 }, ..BASE
+        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 20 }, applies: Some(is_xpbd), ..BASE
     }
     /// More substeps where the stiffest element needs them (`hox_sim::solver::stability`).
     stability_guard: bool = true => {
         key: "guard", group: Group::Solver, file_key: "stability_guard", label: "Stability guard",
         help: "More substeps when the stiffest element needs them (when h·ω_max would exceed 3, enough for h·ω_max ≤ 1; just below 3 your substeps are kept); off: exactly the substeps asked for, which may blow up (docs/STABILITY.md).",
-        kind: Kind::Flag, switch: Some(("no-stability-guard", false)), ..BASE
+        kind: Kind::Flag, switch: Some(("no-stability-guard", false)), applies: Some(is_xpbd), ..BASE
     }
     /// Simulated frames per second; each frame is one time step.
     frames_per_second: f64 = 60.0 => {

@@ -67,6 +67,7 @@ pub fn settings(formulation: Formulation, substeps: u32, frames_per_second: f64)
         quadrature_degree: None,
         parallel: false,
         stability_guard: true,
+        ..Default::default()
     }
 }
 

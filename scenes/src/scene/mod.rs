@@ -15,7 +15,7 @@ use hox_sim::Vec3;
 use hox_sim::io::gmsh::ImportedMesh;
 use hox_sim::material::{Material, MaterialError, MaterialModel};
 use hox_sim::mesh::structured::BoxMeshSpec;
-use hox_sim::solver::SolverSettings;
+use hox_sim::solver::{Method, NewtonSettings, SolverSettings, VbdInit, VbdSettings};
 use hox_sim::xpbd::constraint::Formulation;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -141,6 +141,15 @@ impl Scene {
             quadrature_degree: p.quadrature_degree,
             parallel: p.parallel,
             stability_guard: p.stability_guard,
+            // the names were checked against the table's choices
+            method: Method::from_name(&p.method).unwrap_or_default(),
+            steps_per_frame: p.steps_per_frame,
+            vbd: VbdSettings {
+                iterations: p.vbd_iterations,
+                chebyshev_rho: p.chebyshev_rho,
+                init: VbdInit::from_name(&p.vbd_init).unwrap_or_default(),
+            },
+            newton: NewtonSettings { tolerance: p.newton_tolerance, ..Default::default() },
         }
     }
 

@@ -3,6 +3,9 @@
 use super::{Effect, EffectState};
 use crate::Vec3;
 
+/// The least compliance an attachment has as a spring under the implicit solvers, m/N.
+pub const MIN_SPRING_COMPLIANCE_M_PER_N: f64 = 1e-9;
+
 /// Pulls one node towards a target point through a compliant distance constraint
 /// `C = |x − target|` with compliance `α` (m/N), solved by the XPBD update
 /// ([`crate::xpbd::constraint::xpbd_step`]). The app creates one while a node is dragged.
@@ -23,6 +26,18 @@ impl Attachment {
 impl Effect for Attachment {
     fn name(&self) -> &'static str {
         "attachment"
+    }
+    fn implicit_role(&self) -> super::ImplicitRole {
+        super::ImplicitRole::Potential
+    }
+    /// For the implicit solvers, the attachment is the spring of stiffness `1/α` (α at least
+    /// [`MIN_SPRING_COMPLIANCE_M_PER_N`], so a rigid attachment stays a finite spring).
+    fn spring(&self) -> Option<super::NodeSpring> {
+        Some(super::NodeSpring {
+            node: self.node,
+            target_m: self.target_m,
+            stiffness_n_per_m: 1.0 / self.compliance_m_per_n.max(MIN_SPRING_COMPLIANCE_M_PER_N),
+        })
     }
     fn after_prediction(&mut self, _s: &mut EffectState<'_>) {
         self.lambda = 0.0;

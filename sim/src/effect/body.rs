@@ -21,6 +21,12 @@ impl Effect for Gravity {
     fn name(&self) -> &'static str {
         "gravity"
     }
+    fn implicit_role(&self) -> super::ImplicitRole {
+        super::ImplicitRole::Hooks
+    }
+    fn body_acceleration_m_s2(&self) -> Vec3 {
+        self.acceleration_m_s2
+    }
     fn before_prediction(&mut self, s: &mut EffectState<'_>) {
         let dv = self.acceleration_m_s2 * s.dt_secs;
         for (v, w) in s.velocities.iter_mut().zip(s.inv_mass) {
@@ -44,6 +50,9 @@ pub struct Damping {
 impl Effect for Damping {
     fn name(&self) -> &'static str {
         "damping"
+    }
+    fn implicit_role(&self) -> super::ImplicitRole {
+        super::ImplicitRole::Hooks
     }
     fn after_velocity_update(&mut self, s: &mut EffectState<'_>) {
         let factor = (-self.rate_per_sec * s.dt_secs).exp();

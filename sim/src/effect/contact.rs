@@ -32,6 +32,9 @@ impl Effect for ContactPlane {
     fn name(&self) -> &'static str {
         "contact"
     }
+    fn implicit_role(&self) -> super::ImplicitRole {
+        super::ImplicitRole::Projection
+    }
     fn after_projection(&mut self, s: &mut EffectState<'_>) {
         let p = self.point_at(s.time_secs);
         let n = self.normal;

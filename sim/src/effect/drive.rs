@@ -15,6 +15,9 @@ impl Effect for Clamp {
     fn name(&self) -> &'static str {
         "clamp"
     }
+    fn implicit_role(&self) -> super::ImplicitRole {
+        super::ImplicitRole::Hooks
+    }
     fn pinned_nodes(&self, _mesh: &Mesh) -> Vec<u32> {
         self.nodes.clone()
     }
@@ -71,6 +74,9 @@ impl Prescribed {
 impl Effect for Prescribed {
     fn name(&self) -> &'static str {
         "prescribed"
+    }
+    fn implicit_role(&self) -> super::ImplicitRole {
+        super::ImplicitRole::Hooks
     }
     fn pinned_nodes(&self, _mesh: &Mesh) -> Vec<u32> {
         self.nodes.clone()

@@ -9,6 +9,10 @@
 //! 3. [`Effect::after_projection`]: constraints of its own after each solver iteration (contact);
 //! 4. [`Effect::after_velocity_update`]: velocity changes (damping).
 //!
+//! The implicit solvers (VBD, Newton) run the same hooks but do not project XPBD constraints:
+//! each effect declares its [`ImplicitRole`] (hooks only, a projection, or a potential), and an
+//! effect without one is refused by them by name, so nothing is silently ignored.
+//!
 //! Files: `body.rs` body loads and losses ([`Gravity`], [`Damping`]); `drive.rs` nodes held or
 //! moved by prescription ([`Clamp`], [`Prescribed`] with [`smooth_ramp`] and [`AxisRotation`]);
 //! `contact.rs` a moving plane with friction ([`ContactPlane`]); `attachment.rs` a node pulled
@@ -19,7 +23,7 @@ mod body;
 mod contact;
 mod drive;
 
-pub use attachment::Attachment;
+pub use attachment::{Attachment, MIN_SPRING_COMPLIANCE_M_PER_N};
 pub use body::{Damping, Gravity};
 pub use contact::ContactPlane;
 pub use drive::{AxisRotation, Clamp, Prescribed, smooth_ramp};
@@ -40,6 +44,30 @@ pub struct EffectState<'a> {
     pub inv_mass: &'a [f64],
 }
 
+/// How an implicit solver (VBD, Newton: [`crate::solver::Method`]) honours an effect; XPBD runs
+/// every hook whatever the role.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImplicitRole {
+    /// Through the step's hooks alone: accelerations before the prediction, pinned or driven
+    /// positions after it, velocity changes after the update (gravity, clamps, drives, damping).
+    Hooks,
+    /// A projection of its own after every solver iteration (contact): VBD runs it after each
+    /// sweep; Newton cannot honour it.
+    Projection,
+    /// A potential added to the step's incremental potential ([`Effect::spring`]).
+    Potential,
+    /// Not declared: the implicit solvers refuse the scene, naming the effect.
+    Unsupported,
+}
+
+/// A zero-length spring pulling one node to a target: the potential `Φ = k |x − t|² / 2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeSpring {
+    pub node: u32,
+    pub target_m: Vec3,
+    pub stiffness_n_per_m: f64,
+}
+
 /// An opt-in effect. Every hook defaults to doing nothing.
 pub trait Effect: Send + Sync {
     /// A short name for counters, logs and error messages ("gravity", "clamp", …).
@@ -57,6 +85,19 @@ pub trait Effect: Send + Sync {
     /// that show an effect not called for costs nothing.
     fn work_count(&self) -> u64 {
         0
+    }
+    /// How the implicit solvers honour this effect; an effect that does not say is refused by them.
+    fn implicit_role(&self) -> ImplicitRole {
+        ImplicitRole::Unsupported
+    }
+    /// The acceleration every free node feels from this effect, m/s² (gravity): the load the
+    /// static residual measures.
+    fn body_acceleration_m_s2(&self) -> Vec3 {
+        Vec3::zeros()
+    }
+    /// The spring this effect is, for the implicit solvers ([`ImplicitRole::Potential`]).
+    fn spring(&self) -> Option<NodeSpring> {
+        None
     }
 }
 

@@ -25,13 +25,21 @@
 //! [`Simulation::reset`] (or [`Simulation::warm_start`]): a viewer keeps showing the last sound
 //! state instead of painting garbage, and offers a reset. See `docs/STABILITY.md`.
 
+mod method;
 mod nan_guard;
+mod newton;
+mod residual;
 mod settings;
+mod sparse;
 pub mod stability;
 pub mod statics;
 mod sweep;
+mod vbd;
+mod xpbd;
 
-pub use settings::SolverSettings;
+pub use method::Method;
+pub use residual::StaticResidual;
+pub use settings::{NewtonSettings, SolverSettings, VbdInit, VbdSettings};
 
 use crate::Vec3;
 use crate::effect::{Effect, EffectState};
@@ -40,7 +48,7 @@ use crate::fem::geometry::{BlockGeometry, GeometryError, precompute};
 use crate::fem::mass::lumped_masses_kg;
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshError};
-use crate::xpbd::constraint::Formulation;
+use method::{Hooks, StepInput, StepSolver};
 use stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -51,14 +59,22 @@ pub enum SimError {
     Geometry(#[from] GeometryError),
     #[error("invalid solver settings: {0}")]
     Settings(String),
+    #[error("the {solver} solver cannot honour the effect '{effect}' (supported by: {supported_by})")]
+    Unsupported { solver: &'static str, effect: &'static str, supported_by: String },
     #[error("effect '{effect}' refers to node {node}, but the mesh has {num_nodes} nodes")]
     EffectNode { effect: &'static str, node: u32, num_nodes: usize },
     #[error("node {node}: {reason}")]
     Mass { node: usize, reason: String },
     #[error(
-        "the simulation blew up at frame {frame}, substep {substep_in_frame} of {substeps_per_frame} (t = {time_secs:.6} s): {origin} element {element} of block {block} ({element_type}), at its node {node}; the last finite state is kept — reset, or use more substeps, a softer material or stable Neo-Hookean"
+        "the {solver} simulation blew up at frame {frame}, {step_word} {substep_in_frame} of {substeps_per_frame} (t = {time_secs:.6} s): {origin} element {element} of block {block} ({element_type}), at its node {node}; the last finite state is kept — reset, or use {remedy}"
     )]
     NonFinite {
+        /// The solver that was running ("xpbd", "vbd", "newton").
+        solver: &'static str,
+        /// "substep" (XPBD) or "step".
+        step_word: &'static str,
+        /// What to try instead.
+        remedy: &'static str,
         /// Element block and index within it.
         block: usize,
         element: usize,
@@ -85,9 +101,17 @@ pub struct SolverCounters {
     pub substeps: u64,
     pub element_projections: u64,
     pub effect_hook_calls: u64,
+    /// VBD sweeps or Newton iterations.
+    pub solver_iterations: u64,
+    /// VBD's node block updates.
+    pub node_updates: u64,
+    /// Newton's numeric factorisations of the stiffness.
+    pub factorizations: u64,
+    /// Newton steps that reached their iteration limit before the tolerance.
+    pub unconverged_steps: u64,
 }
 
-/// A running XPBD simulation of one mesh.
+/// A running simulation of one mesh.
 pub struct Simulation {
     mesh: Mesh,
     geometry: Vec<BlockGeometry>,
@@ -98,19 +122,11 @@ pub struct Simulation {
     prev_positions: Vec<Vec3>,
     masses_kg: Vec<f64>,
     inv_mass: Vec<f64>,
-    lambdas: Vec<Vec<f64>>,
     effects: Vec<Box<dyn Effect>>,
-    /// Per block, the elements grouped by colour (no two elements of a colour share a node).
-    colours: Vec<Vec<Vec<u32>>>,
-    /// Per block, the element data packed for the sweeps (element order and colour order).
-    packed: crate::xpbd::kernels::SolverData,
-    /// The colour sweep projects linear tetrahedra four at a time ([`crate::xpbd::kernels::p1x4`]).
-    simd_batches: bool,
-    /// Per block, its cut into one slab per thread for the parallel sweep on two or more
-    /// threads (built for the current thread count on first use).
-    partitions: Vec<crate::xpbd::kernels::Partition>,
-    /// Fewest elements per thread for which a block is partitioned.
-    partition_min_per_thread: usize,
+    /// The solver moving the free nodes within a step ([`Method`]).
+    solver: Box<dyn StepSolver>,
+    /// Bumped whenever the pinned nodes, the masses or the material may have changed.
+    model_version: u64,
     time_secs: f64,
     frames: u64,
     /// Substeps taken in the frame being advanced.
@@ -143,7 +159,7 @@ impl Simulation {
         let inv_mass: Vec<f64> = masses_kg.iter().map(|m| 1.0 / m).collect();
         let positions = mesh.rest_positions.clone();
         let n = positions.len();
-        let lambdas = Self::multipliers(&geometry, settings.formulation);
+        let solver = method::make(&mesh, &geometry, &settings);
         let mut sim = Self {
             mesh,
             geometry,
@@ -154,13 +170,9 @@ impl Simulation {
             velocities: vec![Vec3::zeros(); n],
             masses_kg,
             inv_mass,
-            lambdas,
             effects: Vec::with_capacity(effects.len()),
-            colours: Vec::new(),
-            packed: crate::xpbd::kernels::SolverData::default(),
-            simd_batches: true,
-            partitions: Vec::new(),
-            partition_min_per_thread: crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD,
+            solver,
+            model_version: 0,
             time_secs: 0.0,
             frames: 0,
             substeps_in_frame: 0,
@@ -173,23 +185,13 @@ impl Simulation {
         for e in effects {
             sim.add_effect(e)?;
         }
-        sim.colours =
-            sim.mesh.blocks.iter().map(|b| crate::xpbd::colouring::colour_elements(b, sim.mesh.num_nodes())).collect();
-        sim.pack_colours();
         sim.update_guard();
         Ok(sim)
     }
 
-    fn pack_colours(&mut self) {
-        self.packed = crate::xpbd::kernels::SolverData::new(&self.mesh.blocks, &self.geometry, &self.colours);
-        self.partitions = vec![crate::xpbd::kernels::Partition::default(); self.mesh.blocks.len()];
-    }
-
-    fn multipliers(geometry: &[BlockGeometry], formulation: Formulation) -> Vec<Vec<f64>> {
-        geometry
-            .iter()
-            .map(|g| vec![0.0; g.num_elements() * formulation.multipliers_per_element(g.points_per_element)])
-            .collect()
+    /// The solver moving the free nodes.
+    pub fn method(&self) -> Method {
+        self.solver.method()
     }
 
     pub fn mesh(&self) -> &Mesh {
@@ -227,7 +229,9 @@ impl Simulation {
     /// has AVX2 and FMA; equal to the one-at-a-time colour sweep up to round-off). Off: one at
     /// a time, for comparison.
     pub fn set_simd_batches(&mut self, on: bool) {
-        self.simd_batches = on;
+        if let Some(x) = self.solver.as_xpbd_mut() {
+            x.simd_batches = on;
+        }
     }
 
     /// On two or more threads the parallel sweep cuts a block of at least `per_thread` elements
@@ -235,21 +239,53 @@ impl Simulation {
     /// per sweep instead of one per colour); smaller blocks are swept colour by colour. Default
     /// [`crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD`]; `usize::MAX`: never.
     pub fn set_partition_threshold(&mut self, per_thread: usize) {
-        self.partition_min_per_thread = per_thread;
+        if let Some(x) = self.solver.as_xpbd_mut() {
+            x.partition_min_per_thread = per_thread;
+        }
     }
 
-    /// Number of element colours per block (elements of one colour share no node).
+    /// Number of element colours per block (elements of one colour share no node); empty for
+    /// the implicit solvers.
     pub fn num_colours(&self) -> Vec<usize> {
-        self.colours.iter().map(Vec::len).collect()
+        self.solver.as_xpbd().map(|x| x.num_colours()).unwrap_or_default()
     }
 
-    /// Number of XPBD constraints per solver iteration.
+    /// Number of XPBD constraints per solver iteration (0 for the implicit solvers).
     pub fn num_constraints(&self) -> usize {
-        self.lambdas.iter().map(Vec::len).sum()
+        self.solver.as_xpbd().map_or(0, |x| x.num_constraints())
     }
 
-    /// Adds an effect to the running simulation (pinning the nodes it positions).
+    /// The relative residual of each Newton iteration of the last step (empty for the others).
+    #[doc(hidden)]
+    pub fn last_step_residuals(&self) -> &[f64] {
+        self.solver.last_step_residuals()
+    }
+
+    /// The acceleration every free node feels from the effects (gravity), m/s².
+    pub fn body_acceleration_m_s2(&self) -> Vec3 {
+        self.effects.iter().map(|e| e.body_acceleration_m_s2()).sum()
+    }
+
+    /// How far the current positions are from static equilibrium: the unbalanced force on the
+    /// free nodes (elastic force plus body force) relative to the load ([`StaticResidual`]).
+    /// Forces of contact and of attachments are not counted.
+    pub fn static_residual(&self) -> StaticResidual {
+        let mut grad = vec![Vec3::zeros(); self.positions.len()];
+        crate::fem::energy::total_energy_and_gradient(
+            &self.mesh,
+            &self.geometry,
+            &self.material,
+            &self.positions,
+            &mut grad,
+        );
+        residual::static_residual(&grad, &self.masses_kg, self.body_acceleration_m_s2(), |i| self.inv_mass[i] > 0.0)
+    }
+
+    /// Adds an effect to the running simulation (pinning the nodes it positions); refused when
+    /// the solver cannot honour it.
     pub fn add_effect(&mut self, effect: Box<dyn Effect>) -> Result<(), SimError> {
+        method::check_effects(self.solver.method(), [effect.as_ref()])?;
+        self.model_version += 1;
         for node in effect.pinned_nodes(&self.mesh) {
             let slot = self.inv_mass.get_mut(node as usize).ok_or(SimError::EffectNode {
                 effect: effect.name(),
@@ -266,6 +302,7 @@ impl Simulation {
     /// node is dragged); nodes they pinned get their mass back. Returns how many were removed.
     pub fn remove_effects_named(&mut self, name: &str) -> usize {
         let before = self.effects.len();
+        self.model_version += 1;
         let (removed, kept): (Vec<_>, Vec<_>) =
             std::mem::take(&mut self.effects).into_iter().partition(|e| e.name() == name);
         self.effects = kept;
@@ -300,6 +337,7 @@ impl Simulation {
             });
         }
         self.masses_kg[node] = mass_kg;
+        self.model_version += 1;
         if self.inv_mass[node] > 0.0 {
             self.inv_mass[node] = 1.0 / mass_kg;
         }
@@ -311,6 +349,7 @@ impl Simulation {
 
     /// Changes the material, keeping positions and velocities (masses follow the density).
     pub fn set_material(&mut self, material: Material) -> Result<(), SimError> {
+        self.model_version += 1;
         if material.density_kg_m3 != self.material.density_kg_m3 {
             let masses = lumped_masses_kg(&self.mesh, material.density_kg_m3)?;
             for ((w, m_old), m) in self.inv_mass.iter_mut().zip(&mut self.masses_kg).zip(masses) {
@@ -332,16 +371,22 @@ impl Simulation {
         Ok(())
     }
 
-    /// Changes time stepping (and formulation), keeping the state. A new quadrature degree
-    /// recomputes the element geometry.
+    /// Changes the solver, time stepping and formulation, keeping the state. A new quadrature
+    /// degree recomputes the element geometry. A solver that cannot honour one of the effects
+    /// is refused (nothing changes).
     pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), SimError> {
         settings.validate()?;
-        if settings.quadrature_degree != self.settings.quadrature_degree {
+        method::check_effects(settings.method, self.effects.iter().map(|e| e.as_ref()))?;
+        let geometry_changed = settings.quadrature_degree != self.settings.quadrature_degree;
+        if geometry_changed {
             self.geometry = precompute(&self.mesh, settings.quadrature_degree)?;
-            self.pack_colours();
             self.omega2_per_e_over_rho = None;
         }
-        self.lambdas = Self::multipliers(&self.geometry, settings.formulation);
+        if settings.method != self.solver.method() {
+            self.solver = method::make(&self.mesh, &self.geometry, &settings);
+        } else {
+            self.solver.rebuild(&self.mesh, &self.geometry, &settings, geometry_changed);
+        }
         self.settings = settings;
         self.update_guard();
         Ok(())
@@ -356,6 +401,7 @@ impl Simulation {
         self.time_secs = time_secs;
         self.substeps_in_frame = 0;
         self.failure = None;
+        self.solver.reset_history(true, self.positions.len());
     }
 
     /// Back to the rest shape at t = 0.
@@ -367,6 +413,7 @@ impl Simulation {
         self.frames = 0;
         self.substeps_in_frame = 0;
         self.failure = None;
+        self.solver.reset_history(false, self.positions.len());
     }
 
     /// The stability guard's findings: the fastest element mode, `h ω_max` with the requested
@@ -377,21 +424,25 @@ impl Simulation {
             (omega2_normalised * self.material.youngs_modulus_pa / self.material.density_kg_m3).sqrt();
         let s = &self.settings;
         let trigger_h_omega = guard_trigger_h_omega(s.formulation, &self.material);
-        let (substeps, capped) = if s.stability_guard {
-            guarded_substeps(s.substeps, s.frames_per_second, omega_max_rad_s, trigger_h_omega, GUARD_H_OMEGA)
+        let implicit = s.method.is_implicit();
+        let requested = if implicit { s.steps_per_frame } else { s.substeps };
+        let guard = s.stability_guard && !implicit;
+        let (substeps, capped) = if guard {
+            guarded_substeps(requested, s.frames_per_second, omega_max_rad_s, trigger_h_omega, GUARD_H_OMEGA)
         } else {
-            (s.substeps, false)
+            (requested, false)
         };
         StabilityReport {
             omega_max_rad_s,
             block,
             element,
-            requested_h_omega: omega_max_rad_s * s.substep_dt_secs(),
+            requested_h_omega: omega_max_rad_s * (1.0 / (s.frames_per_second * requested as f64)),
             trigger_h_omega,
-            requested_substeps: s.substeps,
+            requested_substeps: requested,
             substeps,
-            guard: s.stability_guard,
+            guard,
             capped,
+            implicit,
         }
     }
 
@@ -417,8 +468,13 @@ impl Simulation {
 
     /// Recomputes the substeps per frame after a change of settings, material or masses.
     fn update_guard(&mut self) {
-        self.substeps_per_frame =
-            if self.settings.stability_guard { self.stability().substeps } else { self.settings.substeps };
+        self.substeps_per_frame = if self.settings.method.is_implicit() {
+            self.settings.steps_per_frame
+        } else if self.settings.stability_guard {
+            self.stability().substeps
+        } else {
+            self.settings.substeps
+        };
     }
 
     /// Advances one frame (`substeps` substeps, or more: the stability guard).
@@ -437,6 +493,7 @@ impl Simulation {
             return Err(e.clone());
         }
         let h = self.substep_dt_secs();
+        self.solver.begin_step(&self.velocities);
         self.time_secs += h;
         self.counters.substeps += 1;
         self.substeps_in_frame += 1;
@@ -462,12 +519,34 @@ impl Simulation {
             *x += v * h;
         }
         hook!(after_prediction);
-        self.lambdas.iter_mut().for_each(|l| l.fill(0.0));
-        for _ in 0..self.settings.iterations {
-            if let Err(bad) = self.project_elements(h) {
-                return Err(self.fail(bad));
-            }
-            hook!(after_projection);
+        let body_acceleration = self.body_acceleration_m_s2();
+        let mut hook_calls = 0;
+        let input = StepInput {
+            mesh: &self.mesh,
+            geometry: &self.geometry,
+            material: &self.material,
+            masses_kg: &self.masses_kg,
+            inv_mass: &self.inv_mass,
+            prev_positions: &self.prev_positions,
+            body_acceleration,
+            h,
+            settings: &self.settings,
+            model_version: self.model_version,
+        };
+        let mut hooks = Hooks {
+            effects: &mut self.effects,
+            velocities: &mut self.velocities,
+            prev_positions: &self.prev_positions,
+            rest: &self.mesh.rest_positions,
+            inv_mass: &self.inv_mass,
+            time_secs: self.time_secs,
+            h,
+            calls: &mut hook_calls,
+        };
+        let solved = self.solver.solve_step(&input, &mut self.positions, &mut hooks, &mut self.counters);
+        self.counters.effect_hook_calls += hook_calls;
+        if let Err(bad) = solved {
+            return Err(self.fail(bad));
         }
         let inv_h = 1.0 / h;
         for ((v, x), xp) in self.velocities.iter_mut().zip(&self.positions).zip(&self.prev_positions) {

@@ -27,7 +27,14 @@ impl Simulation {
     /// Builds the NaN guard's error, puts the state back to the last finite positions (the
     /// start of this substep, else the rest shape) at rest, and stops the simulation until reset.
     pub(super) fn fail(&mut self, bad: BadElement) -> SimError {
+        let method = self.solver.method();
         let err = SimError::NonFinite {
+            solver: method.name(),
+            step_word: if method.is_implicit() { "step" } else { "substep" },
+            remedy: match method {
+                super::Method::Xpbd => "more substeps, a softer material or stable Neo-Hookean",
+                _ => "more steps per frame, a softer material or stable Neo-Hookean",
+            },
             block: bad.block,
             element: bad.element,
             element_type: self
@@ -59,7 +66,7 @@ impl Simulation {
 /// An element the NaN guard names: block, index in the block, one of its non-finite nodes, and
 /// what went wrong.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct BadElement {
+pub(crate) struct BadElement {
     block: usize,
     element: usize,
     node: u32,
@@ -70,6 +77,10 @@ pub(super) struct BadElement {
 const ORIGIN_PROJECTION: &str = "the projection of";
 /// … when the element was handed a non-finite position (by an effect or the caller).
 const ORIGIN_INPUT: &str = "a non-finite position handed to";
+/// … when vertex block descent's update of a node came out non-finite.
+pub(super) const ORIGIN_VBD: &str = "the vertex block update of a node of";
+/// … when Newton's step came out non-finite.
+pub(super) const ORIGIN_NEWTON: &str = "the Newton step at a node of";
 /// … when the check after the substep finds a non-finite position or velocity.
 const ORIGIN_STATE: &str = "a non-finite position or velocity in";
 
@@ -85,6 +96,19 @@ impl BadElement {
     ) -> Self {
         let input_finite = nodes.iter().all(|&n| read(n as usize).iter().all(|c| c.is_finite()));
         Self { block, element, node, origin: if input_finite { ORIGIN_PROJECTION } else { ORIGIN_INPUT } }
+    }
+}
+
+impl BadElement {
+    /// A solver's update of `node` came out non-finite; names the first element holding it.
+    pub(super) fn at_node(mesh: &crate::mesh::Mesh, node: usize, origin: &'static str) -> Self {
+        let (block, element) = mesh
+            .blocks
+            .iter()
+            .enumerate()
+            .find_map(|(bi, b)| b.elements().position(|el| el.contains(&(node as u32))).map(|e| (bi, e)))
+            .unwrap_or((0, 0));
+        Self { block, element, node: node as u32, origin }
     }
 }
 

@@ -1,12 +1,17 @@
-//! What a run is asked to do: substeps, iterations, frame rate, formulation, quadrature degree,
-//! serial or parallel sweep, and the stability guard ([`SolverSettings`]).
+//! What a run is asked to do: the solver ([`Method`]), substeps, iterations, frame rate,
+//! formulation, quadrature degree, serial or parallel sweep, the stability guard, and the
+//! implicit solvers' own settings ([`VbdSettings`], [`NewtonSettings`]) ([`SolverSettings`]).
 
 use super::SimError;
+use super::method::Method;
 use crate::xpbd::constraint::Formulation;
 
 /// Time stepping and constraint settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverSettings {
+    /// The solver moving the free nodes within a step (XPBD by default, the paper's).
+    pub method: Method,
+    /// XPBD's substeps per frame (`substeps`, raised by the stability guard) and iterations.
     pub substeps: u32,
     pub iterations: u32,
     pub frames_per_second: f64,
@@ -24,6 +29,74 @@ pub struct SolverSettings {
     /// `h ω_max ≤` [`crate::solver::stability::GUARD_H_OMEGA`]. On by default; the paper's scenes are
     /// below the trigger and unaffected.
     pub stability_guard: bool,
+    /// The implicit solvers' (VBD, Newton) steps per frame; XPBD takes `substeps`.
+    pub steps_per_frame: u32,
+    pub vbd: VbdSettings,
+    pub newton: NewtonSettings,
+}
+
+/// Vertex block descent's settings ([`crate::solver::Method::Vbd`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VbdSettings {
+    /// Gauss–Seidel sweeps over the node colours per step.
+    pub iterations: u32,
+    /// Chebyshev semi-iterative acceleration's spectral radius estimate `ρ` (0: off).
+    pub chebyshev_rho: f64,
+    /// Where a step's iterations start.
+    pub init: VbdInit,
+}
+
+/// Where vertex block descent starts a step (Chen et al. 2024, §3.5).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum VbdInit {
+    /// `x⁰ = x_n + h v_n + h² ã`, the acceleration `ã` the body had along gravity, clamped to
+    /// `[0, |g|]` (the paper's adaptive initialisation): a body at rest starts at rest.
+    #[default]
+    Adaptive,
+    /// `x⁰ = y`, the inertial prediction.
+    Inertia,
+    /// `x⁰ = x_n`.
+    Previous,
+}
+
+impl VbdInit {
+    pub const ALL: [VbdInit; 3] = [VbdInit::Adaptive, VbdInit::Inertia, VbdInit::Previous];
+    pub fn name(self) -> &'static str {
+        match self {
+            VbdInit::Adaptive => "adaptive",
+            VbdInit::Inertia => "inertia",
+            VbdInit::Previous => "previous",
+        }
+    }
+    pub fn from_name(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == s)
+    }
+}
+
+impl Default for VbdSettings {
+    fn default() -> Self {
+        Self { iterations: 20, chebyshev_rho: 0.0, init: VbdInit::Adaptive }
+    }
+}
+
+/// Newton's settings ([`crate::solver::Method::Newton`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonSettings {
+    /// A step has converged when the free residual of its incremental potential is at most this
+    /// times the load (the body force, or the reactions if larger): the measure `hox static` uses.
+    pub tolerance: f64,
+    /// The most Newton iterations a step takes; a step that reaches it keeps its last iterate and
+    /// is counted as unconverged.
+    pub max_iterations: u32,
+    /// Refactor the stiffness at every iteration (pure Newton) instead of reusing the last
+    /// factorisation while it keeps converging fast.
+    pub refactor_every_iteration: bool,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        Self { tolerance: 1e-6, max_iterations: 30, refactor_every_iteration: false }
+    }
 }
 
 impl Default for SolverSettings {
@@ -36,6 +109,10 @@ impl Default for SolverSettings {
             quadrature_degree: None,
             parallel: false,
             stability_guard: true,
+            method: Method::Xpbd,
+            steps_per_frame: 1,
+            vbd: VbdSettings::default(),
+            newton: NewtonSettings::default(),
         }
     }
 }
@@ -51,6 +128,21 @@ impl SolverSettings {
         }
         if !(self.frames_per_second.is_finite() && self.frames_per_second > 0.0) {
             return bad(format!("frames per second must be a finite positive number, got {}", self.frames_per_second));
+        }
+        if self.steps_per_frame == 0 {
+            return bad("steps per frame must be at least 1, got 0".into());
+        }
+        if self.vbd.iterations == 0 {
+            return bad("VBD iterations must be at least 1, got 0".into());
+        }
+        if !(0.0..1.0).contains(&self.vbd.chebyshev_rho) {
+            return bad(format!("the Chebyshev ρ must be in [0, 1), got {}", self.vbd.chebyshev_rho));
+        }
+        if !(self.newton.tolerance > 0.0 && self.newton.tolerance < 1.0) {
+            return bad(format!("the Newton tolerance must be in (0, 1), got {}", self.newton.tolerance));
+        }
+        if self.newton.max_iterations == 0 {
+            return bad("Newton's iterations per step must be at least 1, got 0".into());
         }
         Ok(())
     }

@@ -190,6 +190,8 @@ pub struct StabilityReport {
     pub guard: bool,
     /// The guard wanted more than [`GUARD_MAX_SUBSTEPS`].
     pub capped: bool,
+    /// The solver is implicit (VBD, Newton): no substep guard; `substeps` are its steps per frame.
+    pub implicit: bool,
 }
 
 impl StabilityReport {
@@ -205,6 +207,12 @@ impl StabilityReport {
         } else {
             String::new()
         };
+        if self.implicit {
+            return format!(
+                "h·ω_max = {:.3} with {} implicit steps per frame (implicit solver: no substep guard)",
+                self.requested_h_omega, self.substeps
+            );
+        }
         if self.raised() {
             format!(
                 "stability guard: {} substeps per frame instead of {} (h·ω_max would be {:.3} > {}, now ≤ {GUARD_H_OMEGA}; ω_max = {:.4e} rad/s in element {} of block {}){cap}",

@@ -13,18 +13,16 @@
 //! - convergence when the free residual `|∇Π|` is at most `tolerance` times the force scale
 //!   (body force `Σ m_i |a|`, or the reaction forces at the Dirichlet nodes if larger).
 
+use super::sparse::{SparseError, SparsePattern};
 use crate::Vec3;
 use crate::effect::Prescribed;
-use crate::fem::energy::{element_grads, element_hessian, total_energy_and_gradient};
+use crate::fem::energy::total_energy_and_gradient;
 use crate::fem::geometry::{BlockGeometry, GeometryError, precompute};
 use crate::fem::mass::lumped_masses_kg;
 use crate::material::Material;
 use crate::mesh::Mesh;
-use faer::Side;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
-use nalgebra::DMatrix;
+
+pub use super::sparse::assemble_dense;
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StaticError {
@@ -76,16 +74,8 @@ pub fn solve(problem: &StaticProblem<'_>, progress: Progress<'_>) -> Result<Stat
             prescribed_node[node as usize] = true;
         }
     }
-    // free DOF numbering
-    let mut dof_of = vec![usize::MAX; 3 * n];
-    let mut free_dofs = 0;
-    for d in 0..3 * n {
-        if !prescribed_node[d / 3] {
-            dof_of[d] = free_dofs;
-            free_dofs += 1;
-        }
-    }
-    let pattern = SparsePattern::new(mesh, &dof_of, free_dofs)?;
+    let mut pattern = SparsePattern::new(mesh, |i| prescribed_node[i])?;
+    let free_dofs = pattern.free_dofs;
     let mut x = mesh.rest_positions.clone();
     let mut total_iterations = 0;
     let mut done = 0.0;
@@ -95,7 +85,7 @@ pub fn solve(problem: &StaticProblem<'_>, progress: Progress<'_>) -> Result<Stat
         let target = (done + increment).min(1.0);
         let mut trial = x.clone();
         apply_dirichlet(problem, target, &mut trial);
-        match newton(problem, &geo, &masses, &pattern, &dof_of, target, &mut trial, &mut total_iterations, progress) {
+        match newton(problem, &geo, &masses, &mut pattern, target, &mut trial, &mut total_iterations, progress) {
             Ok(residual) => {
                 x = trial;
                 done = target;
@@ -131,8 +121,7 @@ fn newton(
     problem: &StaticProblem<'_>,
     geo: &[BlockGeometry],
     masses: &[f64],
-    pattern: &SparsePattern,
-    dof_of: &[usize],
+    pattern: &mut SparsePattern,
     fraction: f64,
     x: &mut Vec<Vec3>,
     total_iterations: &mut usize,
@@ -151,8 +140,10 @@ fn newton(
         (pot, g)
     };
     let body_force: f64 = masses.iter().map(|m| m * a.norm()).sum();
+    let dof_of = pattern.dof_of.clone();
+    let free_dofs = pattern.free_dofs;
     let split = |g: &[Vec3]| -> (Vec<f64>, f64) {
-        let mut r = vec![0.0; pattern.free_dofs];
+        let mut r = vec![0.0; free_dofs];
         let mut reactions = 0.0;
         for (d, &k) in dof_of.iter().enumerate() {
             let v = g[d / 3][d % 3];
@@ -168,15 +159,17 @@ fn newton(
     let mut residual = f64::INFINITY;
     for _ in 0..50 {
         let (r, reactions) = split(&g);
-        let scale = body_force.max(reactions).max(f64::MIN_POSITIVE);
+        let scale = super::residual::load_scale(body_force, reactions);
         residual = norm(&r) / scale;
         progress(fraction, *total_iterations, residual);
         if residual <= problem.tolerance {
             return Ok(residual);
         }
         *total_iterations += 1;
-        let mut step = pattern.factor_and_solve(mesh, geo, &problem.material, x, dof_of, &r)?;
-        step.iter_mut().for_each(|s| *s = -*s);
+        let par = faer::get_global_parallelism();
+        pattern.assemble_and_factor(mesh, geo, &problem.material, x, &[], par)?;
+        let mut step: Vec<f64> = r.iter().map(|v| -v).collect();
+        pattern.solve_in_place(&mut step, par);
         let mut t = 1.0;
         let mut accepted = false;
         while t > 1e-8 {
@@ -208,120 +201,13 @@ fn norm(v: &[f64]) -> f64 {
     v.iter().map(|c| c * c).sum::<f64>().sqrt()
 }
 
-/// The sparsity pattern of the free-DOF stiffness (lower triangle), its value order and
-/// symbolic Cholesky factorisation, built once per solve.
-struct SparsePattern {
-    free_dofs: usize,
-    symbolic: SymbolicSparseColMat<usize>,
-    argsort: faer::sparse::Argsort<usize>,
-    llt: SymbolicLlt<usize>,
-}
-
-impl SparsePattern {
-    fn new(mesh: &Mesh, dof_of: &[usize], free_dofs: usize) -> Result<Self, StaticError> {
-        let mut pairs = Vec::new();
-        for_each_entry(mesh, dof_of, |row, col, _, _, _, _| pairs.push(Pair::new(row, col)));
-        let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(free_dofs, free_dofs, &pairs)
-            .map_err(|e| StaticError::Factorisation(format!("{e:?}")))?;
-        let llt = SymbolicLlt::try_new(symbolic.as_ref(), Side::Lower)
-            .map_err(|e| StaticError::Factorisation(format!("{e:?}")))?;
-        Ok(Self { free_dofs, symbolic, argsort, llt })
-    }
-
-    /// Assembles the stiffness at `x`, factors it and solves `K s = r`.
-    fn factor_and_solve(
-        &self,
-        mesh: &Mesh,
-        geo: &[BlockGeometry],
-        material: &Material,
-        x: &[Vec3],
-        dof_of: &[usize],
-        r: &[f64],
-    ) -> Result<Vec<f64>, StaticError> {
-        let hessians: Vec<Vec<DMatrix<f64>>> = mesh
-            .blocks
-            .iter()
-            .zip(geo)
-            .map(|(b, g)| {
-                b.elements().enumerate().map(|(e, nodes)| element_hessian_at(mesh, g, e, nodes, material, x)).collect()
-            })
-            .collect();
-        let mut values = Vec::with_capacity(self.argsort_len_hint());
-        for_each_entry(mesh, dof_of, |_, _, b, e, i, j| values.push(hessians[b][e][(i, j)]));
-        let k = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, &values)
-            .map_err(|e| StaticError::Factorisation(format!("{e:?}")))?;
-        let llt =
-            Llt::try_new_with_symbolic(self.llt.clone(), k.as_ref(), Side::Lower).map_err(|_| StaticError::Singular)?;
-        let mut rhs = faer::Mat::<f64>::from_fn(self.free_dofs, 1, |i, _| r[i]);
-        llt.solve_in_place(rhs.as_mut());
-        Ok((0..self.free_dofs).map(|i| rhs[(i, 0)]).collect())
-    }
-
-    fn argsort_len_hint(&self) -> usize {
-        self.symbolic.compute_nnz()
-    }
-}
-
-/// Visits every lower-triangle entry of every element Hessian that couples two free DOFs, in a
-/// fixed order: `(global row, global col, block, element, local row, local col)`.
-fn for_each_entry(mesh: &Mesh, dof_of: &[usize], mut visit: impl FnMut(usize, usize, usize, usize, usize, usize)) {
-    for (b, block) in mesh.blocks.iter().enumerate() {
-        for (e, nodes) in block.elements().enumerate() {
-            for (li, &ni) in nodes.iter().enumerate() {
-                for a in 0..3 {
-                    let row = dof_of[3 * ni as usize + a];
-                    if row == usize::MAX {
-                        continue;
-                    }
-                    for (lj, &nj) in nodes.iter().enumerate() {
-                        for c in 0..3 {
-                            let col = dof_of[3 * nj as usize + c];
-                            if col == usize::MAX || row < col {
-                                continue;
-                            }
-                            visit(row, col, b, e, 3 * li + a, 3 * lj + c);
-                        }
-                    }
-                }
-            }
+impl From<SparseError> for StaticError {
+    fn from(e: SparseError) -> Self {
+        match e {
+            SparseError::Pattern(what) => StaticError::Factorisation(what),
+            SparseError::NotPositiveDefinite => StaticError::Singular,
         }
     }
-}
-
-/// The dense Hessian of the total elastic energy at `x` (projected per quadrature point), for
-/// small problems such as modal analysis in tests.
-pub fn assemble_dense(mesh: &Mesh, geo: &[BlockGeometry], material: &Material, x: &[Vec3]) -> DMatrix<f64> {
-    let n = mesh.num_nodes();
-    let mut k = DMatrix::zeros(3 * n, 3 * n);
-    for (b, gb) in mesh.blocks.iter().zip(geo) {
-        for (e, nodes) in b.elements().enumerate() {
-            let he = element_hessian_at(mesh, gb, e, nodes, material, x);
-            for (li, &i) in nodes.iter().enumerate() {
-                for (lj, &j) in nodes.iter().enumerate() {
-                    for a in 0..3 {
-                        for c in 0..3 {
-                            k[(3 * i as usize + a, 3 * j as usize + c)] += he[(3 * li + a, 3 * lj + c)];
-                        }
-                    }
-                }
-            }
-        }
-    }
-    k
-}
-
-/// The PSD-projected Hessian of element `e` (nodes `nodes`) at positions `x`.
-fn element_hessian_at(
-    mesh: &Mesh,
-    g: &BlockGeometry,
-    e: usize,
-    nodes: &[u32],
-    material: &Material,
-    x: &[Vec3],
-) -> DMatrix<f64> {
-    let xl: Vec<Vec3> = nodes.iter().map(|&i| x[i as usize]).collect();
-    let rest: Vec<Vec3> = nodes.iter().map(|&i| mesh.rest_positions[i as usize]).collect();
-    element_hessian(&xl, &rest, element_grads(g, e), g.volumes(e), material, true)
 }
 
 /// Clamps as Dirichlet conditions: the nodes held at their rest positions.

@@ -1,31 +1,38 @@
-//! One Gauss–Seidel sweep over every element constraint of a [`Simulation`]: in element order,
+//! One Gauss–Seidel sweep of [`Xpbd`] over every element constraint: in element order,
 //! or colour by colour with the elements of a colour projected in parallel. The energy
 //! formulation goes through the specialised sweep ([`crate::xpbd::kernels`]); the split
 //! formulation (and any node count without a specialised sweep) through the generic kernels of
 //! [`crate::xpbd::constraint`], element by element: gather, project, check, scatter.
 
-use super::Simulation;
+use super::SolverCounters;
+use super::method::StepInput;
 use super::nan_guard::{BadElement, non_finite_node};
+use super::xpbd::Xpbd;
 use crate::Vec3;
 use crate::fem::energy::{element_grads, gather};
 use crate::fem::geometry::BlockGeometry;
 use crate::material::Material;
 use crate::xpbd::constraint::{Formulation, NodeScratch, project_energy_constraint, project_split_constraints};
 
-impl Simulation {
+impl Xpbd {
     /// One Gauss–Seidel sweep over every element constraint: in element order, or colour by
     /// colour with the elements of a colour projected in parallel.
     /// Stops at the first element whose corrections come out non-finite (not scattered) and
     /// returns it.
-    pub(super) fn project_elements(&mut self, h: f64) -> Result<(), BadElement> {
-        let inv_dt2 = 1.0 / (h * h);
-        if self.settings.parallel {
-            return self.project_elements_parallel(inv_dt2);
+    pub(super) fn project_elements(
+        &mut self,
+        s: &StepInput<'_>,
+        positions: &mut [Vec3],
+        counters: &mut SolverCounters,
+    ) -> Result<(), BadElement> {
+        let inv_dt2 = 1.0 / (s.h * s.h);
+        if s.settings.parallel {
+            return self.project_elements_parallel(s, positions, counters, inv_dt2);
         }
         for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
-            let block = &self.mesh.blocks[bi];
+            let block = &s.mesh.blocks[bi];
             let n = block.nodes_per_element();
-            if self.settings.formulation == Formulation::Energy {
+            if s.settings.formulation == Formulation::Energy {
                 use crate::xpbd::kernels::{Multipliers, Positions, energy_sweep};
                 let data = self.packed.serial[bi].data();
                 // SAFETY: one thread; the mesh was validated, so its node indices fit positions,
@@ -33,10 +40,10 @@ impl Simulation {
                 let fast = unsafe {
                     energy_sweep(
                         n,
-                        &self.material,
-                        Positions::new(&mut self.positions),
-                        &self.mesh.rest_positions,
-                        &self.inv_mass,
+                        s.material,
+                        Positions::new(positions),
+                        &s.mesh.rest_positions,
+                        s.inv_mass,
                         &data,
                         0..block.len(),
                         Multipliers::new(lambdas),
@@ -45,7 +52,7 @@ impl Simulation {
                 };
                 match fast {
                     Some(Ok(projected)) => {
-                        self.counters.element_projections += projected;
+                        counters.element_projections += projected;
                         continue;
                     }
                     Some(Err(bad)) => {
@@ -54,7 +61,7 @@ impl Simulation {
                             bad.element,
                             bad.node,
                             block.element(bad.element),
-                            |i| self.positions[i],
+                            |i| positions[i],
                         ));
                     }
                     None => {}
@@ -66,21 +73,21 @@ impl Simulation {
             for (e, nodes) in block.elements().enumerate() {
                 let lambda = &mut lambdas[e * per_element..(e + 1) * per_element];
                 let ctx = ProjectionContext {
-                    rest: &self.mesh.rest_positions,
-                    inv_mass: &self.inv_mass,
-                    material: &self.material,
-                    formulation: self.settings.formulation,
+                    rest: &s.mesh.rest_positions,
+                    inv_mass: s.inv_mass,
+                    material: s.material,
+                    formulation: s.settings.formulation,
                     inv_dt2,
                 };
-                let positions = &self.positions;
-                if ctx.project(|i| positions[i], &self.geometry[bi], e, nodes, lambda, x) {
+                let read = &*positions;
+                if ctx.project(|i| read[i], &s.geometry[bi], e, nodes, lambda, x) {
                     if let Some(node) = non_finite_node(x, nodes) {
-                        return Err(BadElement::projected(bi, e, node, nodes, |i| positions[i]));
+                        return Err(BadElement::projected(bi, e, node, nodes, |i| read[i]));
                     }
                     for (xi, &node) in x.iter().zip(nodes) {
-                        self.positions[node as usize] = *xi;
+                        positions[node as usize] = *xi;
                     }
-                    self.counters.element_projections += 1;
+                    counters.element_projections += 1;
                 }
             }
         }
@@ -91,14 +98,20 @@ impl Simulation {
     /// are projected concurrently and the result does not depend on the scheduling. On two or
     /// more threads, large blocks of the energy formulation are swept slab by slab
     /// ([`crate::xpbd::kernels::Partition`]), which depends on the thread count.
-    fn project_elements_parallel(&mut self, inv_dt2: f64) -> Result<(), BadElement> {
+    fn project_elements_parallel(
+        &mut self,
+        s: &StepInput<'_>,
+        positions: &mut [Vec3],
+        counters: &mut SolverCounters,
+        inv_dt2: f64,
+    ) -> Result<(), BadElement> {
         use rayon::prelude::*;
-        let positions = crate::xpbd::kernels::SharedMut::new(&mut self.positions);
+        let positions = crate::xpbd::kernels::SharedMut::new(positions);
         for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
-            let block = &self.mesh.blocks[bi];
+            let block = &s.mesh.blocks[bi];
             let n = block.nodes_per_element();
             let per_element = lambdas.len() / block.len().max(1);
-            if self.settings.formulation == Formulation::Energy {
+            if s.settings.formulation == Formulation::Energy {
                 // SAFETY of the aliasing: the specialised sweep writes positions through its own
                 // pointer, and nothing else touches them meanwhile.
                 let all = unsafe { positions.slice_mut(0, positions.len()) };
@@ -108,9 +121,9 @@ impl Simulation {
                     if self.partitions[bi].threads != threads {
                         self.partitions[bi] = crate::xpbd::kernels::Partition::new(
                             block,
-                            &self.geometry[bi],
+                            &s.geometry[bi],
                             &self.colours[bi],
-                            &self.mesh.rest_positions,
+                            &s.mesh.rest_positions,
                             threads,
                         );
                     }
@@ -120,10 +133,10 @@ impl Simulation {
                 };
                 let result = crate::xpbd::kernels::parallel_energy_block(
                     n,
-                    &self.material,
+                    s.material,
                     all,
-                    &self.mesh.rest_positions,
-                    &self.inv_mass,
+                    &s.mesh.rest_positions,
+                    s.inv_mass,
                     sweep,
                     lambdas,
                     inv_dt2,
@@ -131,7 +144,7 @@ impl Simulation {
                 );
                 match result {
                     Some(Ok(projected)) => {
-                        self.counters.element_projections += projected;
+                        counters.element_projections += projected;
                         continue;
                     }
                     Some(Err(bad)) => {
@@ -153,17 +166,17 @@ impl Simulation {
                         // each element owns its multipliers: concurrent writes are disjoint.
                         let lambda = unsafe { lambdas.slice_mut(e * per_element, per_element) };
                         let ctx = ProjectionContext {
-                            rest: &self.mesh.rest_positions,
-                            inv_mass: &self.inv_mass,
-                            material: &self.material,
-                            formulation: self.settings.formulation,
+                            rest: &s.mesh.rest_positions,
+                            inv_mass: s.inv_mass,
+                            material: s.material,
+                            formulation: s.settings.formulation,
                             inv_dt2,
                         };
                         let mut x = NodeScratch::new(Vec3::zeros(), n);
                         let x = x.as_mut_slice();
                         // SAFETY: reads only this element's nodes, which no other thread writes.
                         let read = |i: usize| unsafe { positions.read(i) };
-                        if !ctx.project(read, &self.geometry[bi], e, nodes, lambda, x) {
+                        if !ctx.project(read, &s.geometry[bi], e, nodes, lambda, x) {
                             return Ok(0);
                         }
                         if let Some(node) = non_finite_node(x, nodes) {
@@ -176,7 +189,7 @@ impl Simulation {
                         Ok(1)
                     })
                     .sum();
-                self.counters.element_projections += projected? as u64;
+                counters.element_projections += projected? as u64;
             }
         }
         Ok(())

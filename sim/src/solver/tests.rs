@@ -3,6 +3,7 @@ use crate::effect::{Clamp, Damping, Gravity};
 use crate::element::ElementType;
 use crate::material::MaterialModel;
 use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+use crate::xpbd::constraint::Formulation;
 use nalgebra::DMatrix;
 
 const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
@@ -79,6 +80,7 @@ fn settled_xpbd_error(
         quadrature_degree: None,
         parallel: false,
         stability_guard: false,
+        ..Default::default()
     };
     let effects: Vec<Box<dyn Effect>> = vec![
         Box::new(Gravity::new(G)),
@@ -329,7 +331,7 @@ fn slab_sweep_is_deterministic_for_a_thread_count() {
             for _ in 0..3 {
                 sim.step_frame().unwrap();
             }
-            let part = &sim.partitions[0];
+            let part = &sim.solver.as_xpbd().unwrap().partitions[0];
             assert_eq!((part.threads, part.slabs.len()), (2, 2));
             let counts: Vec<usize> = part.slabs.iter().map(|s| s.len()).collect();
             assert_eq!(counts.iter().sum::<usize>() + part.interface.len(), sim.mesh().num_elements());

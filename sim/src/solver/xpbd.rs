@@ -1,0 +1,106 @@
+//! The paper's solver: extended position-based dynamics (Macklin, Müller & Chentanez 2016) with
+//! small steps (Macklin et al. 2019), over the element constraints of Saillant et al.
+//! ([`crate::xpbd::constraint`]). Within a substep: every multiplier `λ ← 0`, then `iterations`
+//! Gauss–Seidel sweeps (`sweep.rs`), each followed by every effect's own projection.
+//!
+//! Its state: the multipliers, the element colouring, the element data packed for the sweeps and
+//! the parallel sweep's slabs.
+
+use super::SolverCounters;
+use super::method::{Hooks, Method, StepInput, StepSolver};
+use super::nan_guard::BadElement;
+use super::settings::SolverSettings;
+use crate::Vec3;
+use crate::fem::geometry::BlockGeometry;
+use crate::mesh::Mesh;
+use crate::xpbd::constraint::Formulation;
+
+pub(crate) struct Xpbd {
+    pub(super) lambdas: Vec<Vec<f64>>,
+    /// Per block, the elements grouped by colour (no two elements of a colour share a node).
+    pub(super) colours: Vec<Vec<Vec<u32>>>,
+    /// Per block, the element data packed for the sweeps (element order and colour order).
+    pub(super) packed: crate::xpbd::kernels::SolverData,
+    /// The colour sweep projects linear tetrahedra four at a time ([`crate::xpbd::kernels::p1x4`]).
+    pub(super) simd_batches: bool,
+    /// Per block, its cut into one slab per thread for the parallel sweep on two or more
+    /// threads (built for the current thread count on first use).
+    pub(super) partitions: Vec<crate::xpbd::kernels::Partition>,
+    /// Fewest elements per thread for which a block is partitioned.
+    pub(super) partition_min_per_thread: usize,
+}
+
+impl Xpbd {
+    pub fn new(mesh: &Mesh, geometry: &[BlockGeometry], settings: &SolverSettings) -> Self {
+        let colours =
+            mesh.blocks.iter().map(|b| crate::xpbd::colouring::colour_elements(b, mesh.num_nodes())).collect();
+        let mut xpbd = Self {
+            lambdas: Vec::new(),
+            colours,
+            packed: crate::xpbd::kernels::SolverData::default(),
+            simd_batches: true,
+            partitions: Vec::new(),
+            partition_min_per_thread: crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD,
+        };
+        xpbd.pack(mesh, geometry);
+        xpbd.lambdas = Self::multipliers(geometry, settings.formulation);
+        xpbd
+    }
+
+    fn pack(&mut self, mesh: &Mesh, geometry: &[BlockGeometry]) {
+        self.packed = crate::xpbd::kernels::SolverData::new(&mesh.blocks, geometry, &self.colours);
+        self.partitions = vec![crate::xpbd::kernels::Partition::default(); mesh.blocks.len()];
+    }
+
+    fn multipliers(geometry: &[BlockGeometry], formulation: Formulation) -> Vec<Vec<f64>> {
+        geometry
+            .iter()
+            .map(|g| vec![0.0; g.num_elements() * formulation.multipliers_per_element(g.points_per_element)])
+            .collect()
+    }
+
+    /// Number of element colours per block.
+    pub fn num_colours(&self) -> Vec<usize> {
+        self.colours.iter().map(Vec::len).collect()
+    }
+
+    /// Number of constraints per iteration.
+    pub fn num_constraints(&self) -> usize {
+        self.lambdas.iter().map(Vec::len).sum()
+    }
+}
+
+impl StepSolver for Xpbd {
+    fn method(&self) -> Method {
+        Method::Xpbd
+    }
+
+    fn solve_step(
+        &mut self,
+        input: &StepInput<'_>,
+        positions: &mut [Vec3],
+        hooks: &mut Hooks<'_>,
+        counters: &mut SolverCounters,
+    ) -> Result<(), BadElement> {
+        self.lambdas.iter_mut().for_each(|l| l.fill(0.0));
+        for _ in 0..input.settings.iterations {
+            self.project_elements(input, positions, counters)?;
+            hooks.after_projection(positions, None);
+        }
+        Ok(())
+    }
+
+    fn rebuild(&mut self, mesh: &Mesh, geometry: &[BlockGeometry], settings: &SolverSettings, geometry_changed: bool) {
+        if geometry_changed {
+            self.pack(mesh, geometry);
+        }
+        self.lambdas = Self::multipliers(geometry, settings.formulation);
+    }
+
+    fn as_xpbd(&self) -> Option<&Xpbd> {
+        Some(self)
+    }
+    fn as_xpbd_mut(&mut self) -> Option<&mut Xpbd> {
+        Some(self)
+    }
+}
