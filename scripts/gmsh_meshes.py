@@ -12,6 +12,8 @@ Files (all MSH 4.1 ASCII unless named otherwise):
   beam-tet4.msh      4-node tetrahedra (unstructured)
   beam-tet10.msh     10-node tetrahedra (same mesh, order 2), also as beam-tet10-v22.msh (MSH 2.2)
   beam-tet20.msh     20-node tetrahedra (coarser, order 3)
+  beam-tet10-fine.msh 10-node tetrahedra, size 0.125 (about 1,500 elements: the implicit solvers'
+                     acceptance mesh, where XPBD at the paper's settings does not settle)
   beam-hex8.msh      8-node hexahedra (transfinite 8x2x2, recombined), also as
                      beam-hex8-v22-binary.msh (MSH 2.2 binary)
   beam-hex27.msh     27-node hexahedra (same, order 2), MSH 4.1 binary
@@ -107,6 +109,9 @@ def main():
     unstructured_tets(0.5)
     gmsh.model.mesh.setOrder(3)
     write(out, "beam-tet20.msh")
+    unstructured_tets(0.125)
+    gmsh.model.mesh.setOrder(2)
+    write(out, "beam-tet10-fine.msh")
 
     # hexahedra of order 1 and 2
     transfinite_hexes(8, 2, 2)

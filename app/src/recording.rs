@@ -78,7 +78,12 @@ pub fn configuration_markdown(instance: &Instance) -> String {
 pub fn config_label(instance: &Instance) -> String {
     let mesh = instance.sim.mesh();
     let types: Vec<&str> = mesh.blocks.iter().map(|b| b.element_type.name()).collect();
-    format!("{} {}", types.join("+"), mesh.num_elements())
+    let label = format!("{} {}", types.join("+"), mesh.num_elements());
+    // XPBD, the paper's solver, is unnamed (the labels of earlier recordings stay as they were)
+    match instance.sim.method() {
+        hox_sim::solver::Method::Xpbd => label,
+        other => format!("{label} {other}"),
+    }
 }
 
 impl SimLogger {

@@ -218,3 +218,16 @@ fn a_refused_record_option_names_the_problem_without_an_empty_prefix() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.starts_with("error: --compare 'refine=7':"), "{err}");
 }
+
+#[test]
+fn an_implicit_solvers_recording_is_labelled_with_its_solver() {
+    let file = temp("newton.rrd");
+    let f = file.to_str().unwrap();
+    let summary =
+        ok_json(&["record", "--scene", "bending", "--seconds", "0.05", "--solver", "newton", "--out", f, "--json"]);
+    let entities: Vec<&str> =
+        summary["configurations"].as_array().unwrap().iter().map(|c| c["entity"].as_str().unwrap()).collect();
+    assert_eq!(entities, ["world/p2_160_newton"]);
+    let checked = ok_json(&["inspect", f, "--expect-frames", "4", "--json"]);
+    assert_eq!(checked["configurations"], serde_json::json!(["p2_160_newton"]));
+}

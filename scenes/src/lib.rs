@@ -12,7 +12,10 @@ pub mod scene;
 pub mod study;
 
 pub use params::{Params, SceneOverrides};
-pub use run::{RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_FRAMES, median, run, run_observed};
+pub use run::{
+    RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_EQUILIBRIUM_FRAMES, SETTLE_FRAMES, SETTLE_KINETIC_REL,
+    SETTLE_RESIDUAL_REL, median, run, run_observed,
+};
 pub use scene::{Drive, NodeSelector, Scene, SceneFile, SceneMesh};
 
 use hox_sim::measure::probe::Probe;

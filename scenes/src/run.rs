@@ -1,10 +1,17 @@
 //! Running a scene: for a given simulated time, or until it settles.
 //!
 //! **Settling** (`RunMode::Settle`): velocity damping `v ← v e^{−c h}` with the scene's
-//! `settle_damping_per_sec` is added, and the run stops once every node has moved less than
-//! `SETTLE_TOLERANCE_REL` × the body's bounding-box diagonal per frame for `SETTLE_FRAMES`
-//! consecutive frames, after all prescribed ramps and moving planes have stopped; or after
-//! `SETTLE_CAP_SECS` simulated seconds, reported as not settled.
+//! `settle_damping_per_sec` is added, and once all prescribed ramps and moving planes have
+//! stopped the run ends
+//! - **settled** (in equilibrium) once, for `SETTLE_EQUILIBRIUM_FRAMES` consecutive frames, the
+//!   static residual — the unbalanced force on the free nodes relative to the load
+//!   ([`hox_sim::solver::StaticResidual`]) — is at most `SETTLE_RESIDUAL_REL` and the kinetic
+//!   energy at most `SETTLE_KINETIC_REL` × the elastic energy;
+//! - **at rest but not in equilibrium** once every node has moved less than
+//!   `SETTLE_TOLERANCE_REL` × the body's bounding-box diagonal per frame for `SETTLE_FRAMES`
+//!   consecutive frames while the residual stays above that (XPBD's bias at few substeps; or a
+//!   contact scene, whose contact forces the residual does not count);
+//! - or after `SETTLE_CAP_SECS` simulated seconds, reported as neither.
 
 use crate::scene::EffectSpec;
 use crate::{Instance, SceneError};
@@ -17,6 +24,12 @@ pub const SETTLE_FRAMES: usize = 30;
 pub const SETTLE_TOLERANCE_REL: f64 = 1e-7;
 /// Simulated time after which settling gives up.
 pub const SETTLE_CAP_SECS: f64 = 120.0;
+/// Largest static residual (relative to the load) that counts as equilibrium.
+pub const SETTLE_RESIDUAL_REL: f64 = 1e-5;
+/// Largest kinetic energy, relative to the elastic energy, that counts as equilibrium.
+pub const SETTLE_KINETIC_REL: f64 = 1e-10;
+/// Consecutive frames in equilibrium that count as settled.
+pub const SETTLE_EQUILIBRIUM_FRAMES: usize = 3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RunMode {
@@ -44,9 +57,38 @@ pub struct RunReport {
     /// Median wall-clock time of one frame (stepping only), milliseconds; NaN (`null` in JSON)
     /// for a run of no frames.
     pub ms_per_frame: f64,
+    /// The run ended in equilibrium (`--settle`: residual and kinetic energy below their limits).
     pub settled: bool,
+    /// The run ended with the body at rest, in equilibrium or not (`--settle`).
+    pub at_rest: bool,
+    /// The static residual at the end: the unbalanced force on the free nodes relative to the
+    /// load (contact and attachment forces not counted).
+    pub residual_rel: f64,
+    /// Wall-clock time of the whole run (stepping and checks), seconds.
+    pub wall_secs: f64,
+    /// Implicit steps that reached their iteration limit (Newton).
+    pub unconverged_steps: u64,
     pub kinetic_energy_j: f64,
     pub elastic_energy_j: f64,
+    /// The solver that ran ("xpbd", "vbd", "newton").
+    pub solver: String,
+}
+
+impl RunReport {
+    /// How a settling run ended, in words: "settled (residual 3.1e-6)", "at rest but NOT in
+    /// equilibrium (residual 1.2e-2 of the load)", "NOT settled after 120 s (residual …)".
+    pub fn settle_summary(&self) -> String {
+        if self.settled {
+            format!("settled in equilibrium (residual {:.1e} of the load)", self.residual_rel)
+        } else if self.at_rest {
+            format!(
+                "at rest but NOT in equilibrium (residual {:.1e} of the load; the solver's bias, or forces the residual does not count such as contact)",
+                self.residual_rel
+            )
+        } else {
+            format!("NOT settled after {:.1} s (residual {:.1e} of the load)", self.sim_seconds, self.residual_rel)
+        }
+    }
 }
 
 /// Runs `instance` and reports. `progress(sim_seconds, fraction)` is called after every frame
@@ -71,7 +113,9 @@ pub fn run_observed(
     let source = instance.scene.source.clone();
     let fail =
         |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: source.clone(), message: e.to_string() };
+    let started = Instant::now();
     let mut settled = false;
+    let mut at_rest = false;
     let mut frame_ms: Vec<f64> = Vec::new();
     let window = (instance.scene.params().frames_per_second.round() as usize).max(1);
     let mut history: std::collections::VecDeque<Vec<(String, [f64; 3])>> =
@@ -109,17 +153,23 @@ pub fn run_observed(
                 if instance.sim.time_secs() > 0.0 { 0.0 } else { driven_until_secs(&instance.scene.file.effects) };
             let (lo, hi) = instance.sim.mesh().bounding_box();
             let tolerance_m = SETTLE_TOLERANCE_REL * (hi - lo).norm();
-            let mut quiet = 0;
+            let (mut quiet, mut balanced) = (0, 0);
             let mut before = instance.sim.positions.clone();
             let give_up_at = instance.sim.time_secs() + cap_secs;
             while instance.sim.time_secs() < give_up_at {
                 step(instance)?;
                 let moved = instance.sim.positions.iter().zip(&before).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
                 before.copy_from_slice(&instance.sim.positions);
-                quiet = if moved < tolerance_m && instance.sim.time_secs() >= driven_until { quiet + 1 } else { 0 };
+                let driving = instance.sim.time_secs() < driven_until;
+                quiet = if moved < tolerance_m && !driving { quiet + 1 } else { 0 };
+                balanced = if !driving && in_equilibrium(instance) { balanced + 1 } else { 0 };
                 progress(instance.sim.time_secs(), None);
+                if balanced >= SETTLE_EQUILIBRIUM_FRAMES {
+                    (settled, at_rest) = (true, true);
+                    break;
+                }
                 if quiet >= SETTLE_FRAMES {
-                    settled = true;
+                    at_rest = true;
                     break;
                 }
             }
@@ -142,9 +192,21 @@ pub fn run_observed(
         sim_seconds: instance.sim.time_secs(),
         ms_per_frame: median(&mut frame_ms),
         settled,
+        at_rest,
+        residual_rel: instance.sim.static_residual().relative,
+        wall_secs: started.elapsed().as_secs_f64(),
+        unconverged_steps: instance.sim.counters().unconverged_steps,
         kinetic_energy_j: instance.sim.kinetic_energy_j(),
         elastic_energy_j: instance.sim.elastic_energy_j(),
+        solver: instance.sim.method().name().to_string(),
     })
+}
+
+/// Whether the state is in equilibrium: static residual and kinetic energy below their limits.
+fn in_equilibrium(instance: &Instance) -> bool {
+    let kinetic = instance.sim.kinetic_energy_j();
+    kinetic <= SETTLE_KINETIC_REL * instance.sim.elastic_energy_j().max(f64::MIN_POSITIVE)
+        && instance.sim.static_residual().relative <= SETTLE_RESIDUAL_REL
 }
 
 pub use hox_sim::measure::median;

@@ -181,7 +181,7 @@ fn probes_of(instance: &Instance, positions: &[Vec3]) -> Vec<(String, Vec3)> {
 /// The settled probe displacements of a run, or, when it never settled (XPBD can keep a small
 /// oscillation going), their mean over the last simulated second.
 fn settled_probes(report: &crate::RunReport) -> Vec<(String, Vec3)> {
-    let source = if report.settled { &report.probes } else { &report.probes_last_second_mean };
+    let source = if report.settled || report.at_rest { &report.probes } else { &report.probes_last_second_mean };
     source.iter().map(|(n, u)| (n.clone(), Vec3::from(*u))).collect()
 }
 
@@ -271,7 +271,7 @@ pub fn study_one(
         substeps_for_1pct: substeps,
         ms_per_frame_1pct: ms_1pct,
         error_1pct_m,
-        settled: report.settled,
+        settled: report.settled || report.at_rest,
     })
 }
 

@@ -27,6 +27,7 @@ const MESHES: &[(&str, usize, &[(&str, usize)])] = &[
     ("beam-tet10.msh", 495, &[("p2", 218)]),
     ("beam-tet10-v22.msh", 495, &[("p2", 218)]),
     ("beam-tet20.msh", 548, &[("p3", 82)]),
+    ("beam-tet10-fine.msh", 2767, &[("p2", 1471)]),
     ("beam-hex8.msh", 81, &[("q1", 32)]),
     ("beam-hex8-v22-binary.msh", 81, &[("q1", 32)]),
     ("beam-hex27.msh", 425, &[("q2", 32)]),

@@ -61,17 +61,22 @@ pub fn simulate(
         println!("{out}");
     } else {
         println!(
-            "{}: {} frames, {:.3} s simulated, {}{}",
+            "{}: {} frames, {:.3} s simulated in {:.2} s, {}{}",
             instance.scene.name(),
             report.frames,
             report.sim_seconds,
+            report.wall_secs,
             // the median of no frame is NaN (JSON null): nothing was timed
             if report.frames > 0 {
                 format!("{:.2} ms per frame", report.ms_per_frame)
             } else {
                 "no frame timed".into()
             },
-            if settle { if report.settled { ", settled" } else { ", NOT settled (cap reached)" } } else { "" }
+            if settle {
+                format!(", {}, {}", report.solver, report.settle_summary())
+            } else {
+                format!(", {}", report.solver)
+            }
         );
         for (name, u) in &report.probes {
             println!("  probe {name}: u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
@@ -88,7 +93,13 @@ pub fn simulate(
         }
     }
     if settle && !report.settled {
-        eprintln!("warning: the run did not settle within {} s", hox_scenes::SETTLE_CAP_SECS);
+        eprintln!("warning: {}", report.settle_summary());
+    }
+    if report.unconverged_steps > 0 {
+        eprintln!(
+            "warning: {} Newton steps reached their iteration limit before the tolerance",
+            report.unconverged_steps
+        );
     }
     Ok(())
 }

@@ -60,7 +60,8 @@ pub struct Session {
     pub reference: Vec<(String, Vec3)>,
     /// Wall time of the last frames' stepping, exponentially averaged, milliseconds.
     pub ms_per_frame: f64,
-    /// Relative force residual |f_int + f_ext| / |f_ext| over free nodes at the last frame.
+    /// The static residual at the last frame: the unbalanced force on the free nodes relative to
+    /// the load ([`hox_sim::solver::StaticResidual`]).
     pub residual: f64,
     /// Why the simulation stopped (the NaN guard), until reset.
     pub failure: Option<String>,
@@ -246,27 +247,10 @@ impl Session {
 
     /// |f_int + f_ext| / |f_ext| over the free nodes (gravity as the external load); 0 at an
     /// equilibrium, about 1 far from it.
+    /// The static residual: the unbalanced force on the free nodes relative to the load, the
+    /// measure `hox static` converges on and `--settle` stops on.
     fn force_residual(&self) -> f64 {
-        let sim = &self.instance.sim;
-        let mesh = sim.mesh();
-        let mut grad = vec![Vec3::zeros(); mesh.num_nodes()];
-        hox_sim::fem::energy::total_energy_and_gradient(
-            mesh,
-            sim.geometry(),
-            sim.material(),
-            &sim.positions,
-            &mut grad,
-        );
-        let g = gravity(&self.instance.scene);
-        let (mut num, mut den) = (0.0, 0.0);
-        for (i, w) in sim.inv_mass().iter().enumerate() {
-            if *w > 0.0 {
-                let f_ext = g * sim.masses_kg()[i];
-                num += (f_ext - grad[i]).norm_squared();
-                den += f_ext.norm_squared() + grad[i].norm_squared();
-            }
-        }
-        if den > 0.0 { (num / den).sqrt() } else { 0.0 }
+        self.instance.sim.static_residual().relative
     }
 
     /// Largest probe error against the reference, metres (None for scenes without one).
@@ -282,18 +266,6 @@ impl Session {
             .collect();
         errors.into_iter().reduce(f64::max)
     }
-}
-
-fn gravity(scene: &Scene) -> Vec3 {
-    scene
-        .file
-        .effects
-        .iter()
-        .find_map(|e| match e {
-            hox_scenes::scene::EffectSpec::Gravity { acceleration_m_s2 } => Some(Vec3::from(*acceleration_m_s2)),
-            _ => None,
-        })
-        .unwrap_or_default()
 }
 
 #[cfg(test)]

@@ -26,13 +26,19 @@ impl HoxApp {
         ui.horizontal_wrapped(|ui| {
             for (k, s) in self.sessions.iter().enumerate() {
                 let sim = &s.instance.sim;
+                let solver = match sim.method() {
+                    hox_sim::solver::Method::Xpbd => format!("xpbd, {} constraints", sim.num_constraints()),
+                    hox_sim::solver::Method::Vbd => format!("vbd, {} sweeps", sim.settings().vbd.iterations),
+                    hox_sim::solver::Method::Newton => {
+                        format!("newton, {} factorisations", sim.counters().factorizations)
+                    }
+                };
                 let mut text = format!(
-                    "{}{}: {} nodes, {} elements, {} constraints, {:.2} ms/frame, residual {:.1e}, t = {:.2} s",
+                    "{}{}: {} nodes, {} elements, {solver}, {:.2} ms/frame, residual {:.1e}, t = {:.2} s",
                     if self.compare { ["A ", "B "][k] } else { "" },
                     s.label(),
                     sim.mesh().num_nodes(),
                     sim.mesh().num_elements(),
-                    sim.num_constraints(),
                     s.ms_per_frame,
                     s.residual,
                     sim.time_secs()

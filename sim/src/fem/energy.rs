@@ -110,8 +110,12 @@ pub fn element_node_gradient_and_block(
         let f = deformation_gradient(x, rest, g);
         let (_, p) = material.energy_density_and_pk1(&f);
         grad += (p * g[a]) * *v;
-        let c = if projected { material.dpdf_projected(&f) } else { material.dpdf(&f) };
         let ga = g[a];
+        if !projected {
+            block += material.node_block(&f, &ga) * *v;
+            continue;
+        }
+        let c = material.dpdf_projected(&f);
         for r in 0..3 {
             for k in 0..3 {
                 let mut sum = 0.0;

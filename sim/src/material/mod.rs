@@ -69,6 +69,22 @@ pub trait HyperelasticModel: Sync + Send + 'static {
     fn energy_density_and_pk1(&self, l: Lame, f: &Mat3) -> (f64, Mat3);
     /// dP/dF on column-major vec(F), exactly symmetric.
     fn dpdf(&self, l: Lame, f: &Mat3) -> Mat9;
+    /// One node's 3×3 block of an element Hessian at one quadrature point, per unit volume:
+    /// `B_{rk} = Σ_{c,d} ∂P_{rc}/∂F_{kd} g_c g_d` with `g = ∇_X N_a`, i.e. column `k` is
+    /// `dP[e_k ⊗ g] g` — three directional derivatives where [`HyperelasticModel::dpdf`] takes
+    /// nine (vertex block descent's per-node Hessian). Symmetric. Default: from `dpdf`.
+    fn node_block(&self, l: Lame, f: &Mat3, g: &Vector3<f64>) -> Mat3 {
+        let c = self.dpdf(l, f);
+        Mat3::from_fn(|r, k| {
+            let mut sum = 0.0;
+            for cc in 0..3 {
+                for d in 0..3 {
+                    sum += c[(r + 3 * cc, k + 3 * d)] * g[cc] * g[d];
+                }
+            }
+            sum
+        })
+    }
     /// The split constraints `[deviatoric, hydrostatic]` at F.
     fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2];
     /// Stiffness k_t (Pa) of each split term.
@@ -306,6 +322,11 @@ impl Material {
     /// semi-definite matrix: symmetric eigen-decomposition with negative
     /// eigenvalues clamped to 0. Returned unchanged when already PSD.
     /// Non-finite input is returned as is.
+    /// One node's 3×3 Hessian block per unit volume at `f` ([`HyperelasticModel::node_block`]).
+    pub fn node_block(&self, f: &Mat3, g: &Vector3<f64>) -> Mat3 {
+        self.model.law().node_block(self.lame(), f, g)
+    }
+
     pub fn dpdf_projected(&self, f: &Mat3) -> Mat9 {
         project_psd(&self.dpdf(f))
     }
@@ -376,6 +397,17 @@ fn first_invariant_minus_three(f: &Mat3) -> f64 {
 /// Assembles the 9×9 tangent from a directional derivative dP(F; dF) applied
 /// to the 9 unit matrices (column j ↔ vec index j = row + 3·col), and
 /// symmetrises it (the exact tangent is a Hessian, so this only removes rounding).
+/// [`HyperelasticModel::node_block`] from the directional derivative `dP[dF]`.
+fn node_block_from_directional(dp: impl Fn(&Mat3) -> Mat3, g: &Vector3<f64>) -> Mat3 {
+    let mut b = Mat3::zeros();
+    for k in 0..3 {
+        let mut df = Mat3::zeros();
+        df.set_row(k, &g.transpose());
+        b.set_column(k, &(dp(&df) * g));
+    }
+    (b + b.transpose()) * 0.5
+}
+
 fn dpdf_from_directional(dp: impl Fn(&Mat3) -> Mat3) -> Mat9 {
     let mut out = Mat9::zeros();
     for j in 0..9 {

@@ -41,7 +41,7 @@
 
 use super::{
     HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
-    dpdf_from_directional, first_invariant_minus_three,
+    dpdf_from_directional, first_invariant_minus_three, node_block_from_directional,
 };
 
 /// J below which ln J is continued linearly (see the module doc).
@@ -105,12 +105,11 @@ impl HyperelasticModel for NeoHookean {
     }
 
     fn dpdf(&self, l: Lame, f: &Mat3) -> Mat9 {
-        let log = log_j(f);
-        let cof = cofactor(f);
-        let a = l.lambda_pa * log.value - l.mu_pa;
-        let g = a * log.d1;
-        let dg = l.lambda_pa * log.d1 * log.d1 + a * log.d2;
-        dpdf_from_directional(|df| df * l.mu_pa + cof * (dg * cof.dot(df)) + cofactor_directional(f, df) * g)
+        dpdf_from_directional(linearisation(l, f))
+    }
+
+    fn node_block(&self, l: Lame, f: &Mat3, g: &nalgebra::Vector3<f64>) -> Mat3 {
+        node_block_from_directional(linearisation(l, f), g)
     }
 
     fn split_terms(&self, _l: Lame, f: &Mat3) -> [SplitTerm; 2] {
@@ -229,4 +228,14 @@ mod tests {
         assert_eq!(m.split_energy_offset(), 0.0);
         assert_eq!(NEO_HOOKEAN_J_FLOOR, 0.2);
     }
+}
+
+/// `dP[dF] = μ dF + g'(J) (cof F : dF) cof F + g(J) d(cof F)[dF]`, `g = (λ ln J − μ) (ln J)'`.
+fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
+    let log = log_j(f);
+    let cof = cofactor(f);
+    let a = l.lambda_pa * log.value - l.mu_pa;
+    let g = a * log.d1;
+    let dg = l.lambda_pa * log.d1 * log.d1 + a * log.d2;
+    move |df| df * l.mu_pa + cof * (dg * cof.dot(df)) + cofactor_directional(f, df) * g
 }

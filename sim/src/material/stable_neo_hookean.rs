@@ -28,7 +28,7 @@
 
 use super::{
     HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
-    dpdf_from_directional, first_invariant_minus_three,
+    dpdf_from_directional, first_invariant_minus_three, node_block_from_directional,
 };
 
 /// λ̂ = λ + μ and r = μ/λ̂ = α − 1.
@@ -68,10 +68,11 @@ impl HyperelasticModel for StableNeoHookean {
     }
 
     fn dpdf(&self, l: Lame, f: &Mat3) -> Mat9 {
-        let (lambda_hat, _) = lambda_hat_and_ratio(l);
-        let cof = cofactor(f);
-        let g = lambda_hat * det_minus_one(f) - l.mu_pa;
-        dpdf_from_directional(|df| df * l.mu_pa + cof * (lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g)
+        dpdf_from_directional(linearisation(l, f))
+    }
+
+    fn node_block(&self, l: Lame, f: &Mat3, g: &nalgebra::Vector3<f64>) -> Mat3 {
+        node_block_from_directional(linearisation(l, f), g)
     }
 
     fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2] {
@@ -152,4 +153,12 @@ mod tests {
         assert!((dev.value - 3f64.sqrt()).abs() < 1e-15);
         assert!((hyd.value + l.mu_pa / lambda_hat).abs() < 1e-15);
     }
+}
+
+/// `dP[dF] = μ dF + λ̂ (cof F : dF) cof F + (λ̂ (J − 1) − μ) d(cof F)[dF]`.
+fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
+    let (lambda_hat, _) = lambda_hat_and_ratio(l);
+    let cof = cofactor(f);
+    let g = lambda_hat * det_minus_one(f) - l.mu_pa;
+    move |df| df * l.mu_pa + cof * (lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g
 }

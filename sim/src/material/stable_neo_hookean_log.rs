@@ -49,7 +49,7 @@
 
 use super::{
     HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
-    dpdf_from_directional, first_invariant_minus_three,
+    dpdf_from_directional, first_invariant_minus_three, node_block_from_directional,
 };
 
 /// The re-parametrised constants of the model.
@@ -122,15 +122,11 @@ impl HyperelasticModel for StableNeoHookeanLog {
     }
 
     fn dpdf(&self, l: Lame, f: &Mat3) -> Mat9 {
-        let p = params(l);
-        let cof = cofactor(f);
-        let ic = f.norm_squared();
-        let a = p.mu_hat * (ic / (ic + 1.0));
-        let da = 2.0 * p.mu_hat / ((ic + 1.0) * (ic + 1.0));
-        let g = cofactor_coefficient(p, det_minus_one(f));
-        dpdf_from_directional(|df| {
-            df * a + f * (da * f.dot(df)) + cof * (p.lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g
-        })
+        dpdf_from_directional(linearisation(l, f))
+    }
+
+    fn node_block(&self, l: Lame, f: &Mat3, g: &nalgebra::Vector3<f64>) -> Mat3 {
+        node_block_from_directional(linearisation(l, f), g)
     }
 
     fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2] {
@@ -376,4 +372,15 @@ mod tests {
             Ok(())
         });
     }
+}
+
+/// `dP[dF] = a dF + a' (F : dF) F + λ̂ (cof F : dF) cof F + g d(cof F)[dF]`.
+fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
+    let p = params(l);
+    let cof = cofactor(f);
+    let ic = f.norm_squared();
+    let a = p.mu_hat * (ic / (ic + 1.0));
+    let da = 2.0 * p.mu_hat / ((ic + 1.0) * (ic + 1.0));
+    let g = cofactor_coefficient(p, det_minus_one(f));
+    move |df| df * a + f * (da * f.dot(df)) + cof * (p.lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g
 }

@@ -26,7 +26,7 @@
 //! (shear) stress as 2μE; a NaN or infinite entry of F otherwise propagates into ψ and P.
 
 use super::lane::{Lane, M3, Scalar, from_mat3, to_mat3, tr_mat_mul};
-use super::{HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, dpdf_from_directional};
+use super::{HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, dpdf_from_directional, node_block_from_directional};
 
 /// E = ½(H + Hᵀ + HᵀH), H = F − I (Green–Lagrange).
 #[inline(always)]
@@ -119,13 +119,11 @@ impl HyperelasticModel for StVenantKirchhoff {
     }
 
     fn dpdf(&self, l: Lame, f: &Mat3) -> Mat9 {
-        let s = stress(l, &strain(f));
-        let ft = f.transpose();
-        dpdf_from_directional(|df| {
-            let de = (df.transpose() * f + ft * df) * 0.5;
-            let ds = stress(l, &de);
-            df * s + f * ds
-        })
+        dpdf_from_directional(linearisation(l, f))
+    }
+
+    fn node_block(&self, l: Lame, f: &Mat3, g: &nalgebra::Vector3<f64>) -> Mat3 {
+        node_block_from_directional(linearisation(l, f), g)
     }
 
     fn split_terms(&self, _l: Lame, f: &Mat3) -> [SplitTerm; 2] {
@@ -212,5 +210,16 @@ mod tests {
         let p = m.dpdf_projected(&f);
         assert!(testing::min_eigenvalue(&p) >= -1e-9 * p.norm());
         assert!((p - h).norm() > 1e-3 * h.norm());
+    }
+}
+
+/// `dP[dF] = dF S + F S(dE)`, `dE = (dFᵀ F + Fᵀ dF)/2`.
+fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
+    let s = stress(l, &strain(f));
+    let ft = f.transpose();
+    move |df| {
+        let de = (df.transpose() * f + ft * df) * 0.5;
+        let ds = stress(l, &de);
+        df * s + f * ds
     }
 }

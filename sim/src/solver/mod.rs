@@ -576,4 +576,6 @@ impl Simulation {
 }
 
 #[cfg(test)]
+mod implicit_tests;
+#[cfg(test)]
 mod tests;

@@ -76,7 +76,7 @@ pub(crate) struct BadElement {
 /// The guard's wording when an element's projection turned finite positions into non-finite ones.
 const ORIGIN_PROJECTION: &str = "the projection of";
 /// … when the element was handed a non-finite position (by an effect or the caller).
-const ORIGIN_INPUT: &str = "a non-finite position handed to";
+pub(super) const ORIGIN_INPUT: &str = "a non-finite position handed to";
 /// … when vertex block descent's update of a node came out non-finite.
 pub(super) const ORIGIN_VBD: &str = "the vertex block update of a node of";
 /// … when Newton's step came out non-finite.
@@ -110,6 +110,11 @@ impl BadElement {
             .unwrap_or((0, 0));
         Self { block, element, node: node as u32, origin }
     }
+}
+
+/// The first non-finite position.
+pub(super) fn first_non_finite_position(x: &[Vec3]) -> Option<usize> {
+    x.iter().position(|p| !p.iter().all(|c| c.is_finite()))
 }
 
 /// The first node of an element whose gathered position `x` is not finite.

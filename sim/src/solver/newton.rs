@@ -9,8 +9,9 @@
 //! `M (v_{n+1} − v_n)/h = f(x_{n+1}) + M g`, `x_{n+1} = x_n + h v_{n+1}` (Martin et al. 2011,
 //! "Example-based elastic materials"; Gast et al. 2015, "Optimization integrator for large time
 //! steps"). Each iteration solves `K Δ = −∇E` with
-//! `K = M/h² + Σ_e Σ_q V_q Gᵀ ∂P/∂F|_projected G + Σ_k k_k I` (sparse Cholesky, the static
-//! solver's machinery: `sparse.rs`) and backtracks on `E`.
+//! `K = M/h² + Σ_e Σ_q V_q Gᵀ ∂P/∂F G + Σ_k k_k I` (sparse Cholesky, the static solver's
+//! machinery: `sparse.rs`; the exact Hessian where it is positive definite, else `∂P/∂F`
+//! projected to positive semi-definite per quadrature point) and backtracks on `E`.
 //!
 //! - **Start:** `x⁰ = x_n + h v_n` on free nodes (the prediction without the step's body
 //!   acceleration): a body at rest in equilibrium starts converged.
@@ -38,6 +39,9 @@ use crate::effect::NodeSpring;
 use crate::fem::energy::total_energy_and_gradient;
 use crate::fem::geometry::BlockGeometry;
 use crate::mesh::Mesh;
+
+/// The factorisation runs on one thread: results independent of the thread count.
+const SEQ: faer::Par = faer::Par::Seq;
 
 /// Residual decrease per iteration below which the kept factor is refreshed.
 const SLOW_RATIO: f64 = 0.25;
@@ -142,6 +146,9 @@ impl StepSolver for Newton {
         let n = positions.len();
         let settings = s.settings.newton;
         let bad = |node: usize| BadElement::at_node(s.mesh, node, ORIGIN_NEWTON);
+        if let Some(i) = super::nan_guard::first_non_finite_position(positions) {
+            return Err(BadElement::at_node(s.mesh, i, super::nan_guard::ORIGIN_INPUT));
+        }
         if self.pattern.is_none() || self.made_for != (s.model_version, s.h) {
             let pattern = SparsePattern::new(s.mesh, |i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?;
             self.pattern = Some(pattern);
@@ -196,9 +203,16 @@ impl StepSolver for Newton {
             }
             counters.solver_iterations += 1;
             if refactor {
-                pattern
-                    .assemble_and_factor(s.mesh, s.geometry, s.material, positions, &diagonal, faer::Par::Seq)
-                    .map_err(|_| bad(0))?;
+                // the exact Hessian where it is positive definite (quadratic convergence), else
+                // the one projected per quadrature point
+                let exact =
+                    pattern.assemble_and_factor(s.mesh, s.geometry, s.material, positions, &diagonal, false, SEQ);
+                if exact.is_err() {
+                    pattern
+                        .assemble_and_factor(s.mesh, s.geometry, s.material, positions, &diagonal, true, SEQ)
+                        .map_err(|_| bad(0))?;
+                    counters.factorizations += 1;
+                }
                 counters.factorizations += 1;
             }
             for (dof, &k) in pattern.dof_of.iter().enumerate() {
@@ -206,7 +220,7 @@ impl StepSolver for Newton {
                     step[k] = -self.grad[dof / 3][dof % 3];
                 }
             }
-            pattern.solve_in_place(&mut step, faer::Par::Seq);
+            pattern.solve_in_place(&mut step, SEQ);
             // backtracking on E: accept a decrease of E or, at its round-off floor, of the residual
             let mut t = 1.0;
             let mut accepted = false;

@@ -73,8 +73,12 @@ impl SparsePattern {
         Ok(Self { free_dofs, dof_of, symbolic, argsort, cholesky, factor, factored: false })
     }
 
-    /// Assembles `K` at `x` (element Hessians projected per quadrature point) plus `diagonal`
-    /// (one value per free DOF, or empty for none) and factors it with parallelism `par`.
+    /// Assembles `K` at `x` plus `diagonal` (one value per free DOF, or empty for none) and
+    /// factors it with parallelism `par`. With `projected`, `∂P/∂F` is projected to positive
+    /// semi-definite at each quadrature point (always factorisable where the body is held or
+    /// the diagonal positive); without, `K` is the exact Hessian (Newton's quadratic
+    /// convergence), which may not be positive definite.
+    #[allow(clippy::too_many_arguments)]
     pub fn assemble_and_factor(
         &mut self,
         mesh: &Mesh,
@@ -82,6 +86,7 @@ impl SparsePattern {
         material: &Material,
         x: &[Vec3],
         diagonal: &[f64],
+        projected: bool,
         par: Par,
     ) -> Result<(), SparseError> {
         use rayon::prelude::*;
@@ -94,7 +99,7 @@ impl SparsePattern {
                 .with_min_len(16)
                 .map(|e| {
                     let nodes = b.element(e);
-                    let he = element_hessian_at(mesh, g, e, nodes, material, x);
+                    let he = element_hessian_at(mesh, g, e, nodes, material, x, projected);
                     let mut v = Vec::new();
                     for_each_element_entry(dof_of, nodes, |_, _, i, j| v.push(he[(i, j)]));
                     v
@@ -168,7 +173,8 @@ fn for_each_element_entry(dof_of: &[usize], nodes: &[u32], mut visit: impl FnMut
     }
 }
 
-/// The PSD-projected Hessian of element `e` (nodes `nodes`) at positions `x`.
+/// The Hessian of element `e` (nodes `nodes`) at positions `x` (`projected`: PSD-projected per
+/// quadrature point).
 pub(crate) fn element_hessian_at(
     mesh: &Mesh,
     g: &BlockGeometry,
@@ -176,10 +182,11 @@ pub(crate) fn element_hessian_at(
     nodes: &[u32],
     material: &Material,
     x: &[Vec3],
+    projected: bool,
 ) -> DMatrix<f64> {
     let xl: Vec<Vec3> = nodes.iter().map(|&i| x[i as usize]).collect();
     let rest: Vec<Vec3> = nodes.iter().map(|&i| mesh.rest_positions[i as usize]).collect();
-    element_hessian(&xl, &rest, element_grads(g, e), g.volumes(e), material, true)
+    element_hessian(&xl, &rest, element_grads(g, e), g.volumes(e), material, projected)
 }
 
 /// The dense Hessian of the total elastic energy at `x` (projected per quadrature point), for
@@ -189,7 +196,7 @@ pub fn assemble_dense(mesh: &Mesh, geo: &[BlockGeometry], material: &Material, x
     let mut k = DMatrix::zeros(3 * n, 3 * n);
     for (b, gb) in mesh.blocks.iter().zip(geo) {
         for (e, nodes) in b.elements().enumerate() {
-            let he = element_hessian_at(mesh, gb, e, nodes, material, x);
+            let he = element_hessian_at(mesh, gb, e, nodes, material, x, true);
             for (li, &i) in nodes.iter().enumerate() {
                 for (lj, &j) in nodes.iter().enumerate() {
                     for a in 0..3 {

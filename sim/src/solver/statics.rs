@@ -167,7 +167,7 @@ fn newton(
         }
         *total_iterations += 1;
         let par = faer::get_global_parallelism();
-        pattern.assemble_and_factor(mesh, geo, &problem.material, x, &[], par)?;
+        pattern.assemble_and_factor(mesh, geo, &problem.material, x, &[], true, par)?;
         let mut step: Vec<f64> = r.iter().map(|v| -v).collect();
         pattern.solve_in_place(&mut step, par);
         let mut t = 1.0;

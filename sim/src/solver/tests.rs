@@ -6,14 +6,14 @@ use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 use crate::xpbd::constraint::Formulation;
 use nalgebra::DMatrix;
 
-const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
+pub(super) const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 
 fn cantilever(et: ElementType) -> Mesh {
     beam(et, [2, 1, 1])
 }
 
 /// The beam `[0, 1] × [0, 0.25]²` with `cells`, five tetrahedra per cell for P1–P3.
-fn beam(et: ElementType, cells: [usize; 3]) -> Mesh {
+pub(super) fn beam(et: ElementType, cells: [usize; 3]) -> Mesh {
     BoxMeshSpec {
         grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 0.25, 0.25), cells },
         element_type: et,
@@ -24,13 +24,18 @@ fn beam(et: ElementType, cells: [usize; 3]) -> Mesh {
     .unwrap()
 }
 
-fn clamped_at_x0(mesh: &Mesh) -> Vec<u32> {
+pub(super) fn clamped_at_x0(mesh: &Mesh) -> Vec<u32> {
     mesh.nodes_where(|p| p.x.abs() < 1e-12)
 }
 
 /// Static equilibrium `∇U(x) = M g` with clamped nodes, by Newton's method
 /// ([`crate::solver::statics`]): independent of XPBD.
-fn static_equilibrium(mesh: &Mesh, material: &Material, degree: Option<usize>, clamped: &[u32]) -> Vec<Vec3> {
+pub(super) fn static_equilibrium(
+    mesh: &Mesh,
+    material: &Material,
+    degree: Option<usize>,
+    clamped: &[u32],
+) -> Vec<Vec3> {
     let problem = crate::solver::statics::StaticProblem {
         mesh,
         material: *material,
@@ -45,7 +50,7 @@ fn static_equilibrium(mesh: &Mesh, material: &Material, degree: Option<usize>, c
 
 /// The circular frequencies (rad/s) of the clamped mesh's lowest and highest modes at `x`:
 /// square roots of the extreme eigenvalues of `M^{-1/2} K M^{-1/2}` on the free nodes.
-fn frequency_range(mesh: &Mesh, material: &Material, clamped: &[u32], x: &[Vec3]) -> (f64, f64) {
+pub(super) fn frequency_range(mesh: &Mesh, material: &Material, clamped: &[u32], x: &[Vec3]) -> (f64, f64) {
     let geo = precompute(mesh, None).unwrap();
     let masses = lumped_masses_kg(mesh, material.density_kg_m3).unwrap();
     let n = mesh.num_nodes();
@@ -141,7 +146,7 @@ fn settled_xpbd_converges_to_the_static_equilibrium_for_every_element_type_and_f
     }
 }
 
-fn one_cell_cantilever(et: ElementType) -> Mesh {
+pub(super) fn one_cell_cantilever(et: ElementType) -> Mesh {
     BoxMeshSpec {
         grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(0.5, 0.25, 0.25), cells: [1, 1, 1] },
         element_type: et,

@@ -24,7 +24,8 @@
 //!   exactly there: VBD's fixed point is the static equilibrium for any iteration count.
 //! - **Acceleration** (§3.7): Chebyshev semi-iteration with spectral radius estimate `ρ`,
 //!   `x⁽ᵏ⁾ = ω_k (x̄⁽ᵏ⁾ − x⁽ᵏ⁻²⁾) + x⁽ᵏ⁻²⁾`, `ω_1 = 1`, `ω_2 = 2/(2 − ρ²)`,
-//!   `ω_k = 4/(4 − ρ² ω_{k−1})`; off (`ρ = 0`) by default, as in the authors' code.
+//!   `ω_k = 4/(4 − ρ² ω_{k−1})`; `ρ = 0.9` by default (measured: half the sweeps to settle the
+//!   bending beam; the authors' code ships it off; 0.95 at 5 sweeps per step diverged).
 //! - Effects: contact's projection runs after every sweep; attachments are springs in `G`.
 
 use super::SolverCounters;
@@ -74,12 +75,6 @@ impl Vbd {
             prev_iter: Vec::new(),
             prev_prev: Vec::new(),
         }
-    }
-
-    /// Number of node colours.
-    #[cfg(test)]
-    pub fn num_colours(&self) -> usize {
-        self.colours.len()
     }
 }
 
@@ -171,6 +166,9 @@ impl StepSolver for Vbd {
         counters: &mut SolverCounters,
     ) -> Result<(), BadElement> {
         let h = s.h;
+        if let Some(i) = super::nan_guard::first_non_finite_position(positions) {
+            return Err(BadElement::at_node(s.mesh, i, super::nan_guard::ORIGIN_INPUT));
+        }
         self.y.clear();
         self.y.extend_from_slice(positions);
         // the initial guess

@@ -1,0 +1,298 @@
+//! Tests of the implicit solvers (VBD, Newton) against the static solution, each other and
+//! the effects they must honour or refuse.
+
+use super::tests::{G, beam, clamped_at_x0, frequency_range, one_cell_cantilever, static_equilibrium};
+use super::*;
+use crate::effect::{Attachment, Clamp, ContactPlane, Damping, EffectState, Gravity};
+use crate::element::ElementType;
+use crate::material::MaterialModel;
+
+fn implicit(method: Method, frames_per_second: f64) -> SolverSettings {
+    SolverSettings { method, frames_per_second, ..SolverSettings::default() }
+}
+
+fn max_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max)
+}
+
+fn cantilever_effects(clamped: &[u32], damping_per_sec: f64) -> Vec<Box<dyn Effect>> {
+    let mut effects: Vec<Box<dyn Effect>> =
+        vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.to_vec() })];
+    if damping_per_sec > 0.0 {
+        effects.push(Box::new(Damping { rate_per_sec: damping_per_sec }));
+    }
+    effects
+}
+
+fn materials() -> impl Iterator<Item = Material> {
+    [MaterialModel::StVenantKirchhoff, MaterialModel::StableNeoHookean]
+        .into_iter()
+        .map(|m| Material::new(m, 1.0e5, 0.3, 1000.0).unwrap())
+}
+
+/// Every element type × (StVK, stable Neo-Hookean) on the one-cell cantilever with its static
+/// equilibrium and largest displacement: `(type, material, mesh, clamped, equilibrium, u_max)`.
+fn cantilever_cases() -> impl Iterator<Item = (ElementType, Material, Mesh, Vec<u32>, Vec<Vec3>, f64)> {
+    ElementType::all().flat_map(|et| {
+        materials().map(move |material| {
+            let mesh = one_cell_cantilever(et);
+            let clamped = clamped_at_x0(&mesh);
+            let reference = static_equilibrium(&mesh, &material, None, &clamped);
+            let u_max = max_distance(&reference, &mesh.rest_positions);
+            (et, material, mesh, clamped, reference, u_max)
+        })
+    })
+}
+
+/// With a step of 1000 s the inertia term vanishes: one Newton step is the static solution.
+#[test]
+fn newton_with_a_huge_step_is_the_static_solver() {
+    for (et, material, mesh, clamped, reference, u_max) in cantilever_cases() {
+        let mut settings = implicit(Method::Newton, 1e-3);
+        settings.newton.tolerance = 1e-11;
+        let mut sim = Simulation::new(mesh, material, settings, cantilever_effects(&clamped, 0.0)).unwrap();
+        sim.step_frame().unwrap();
+        let err = max_distance(&sim.positions, &reference) / u_max;
+        // the static solution is itself converged to a residual of 1e-10 of the load
+        assert!(err < 1e-7, "{et} {:?}: {err:.2e} of u_max from the static solution", material.model);
+        assert_eq!(sim.counters().unconverged_steps, 0);
+    }
+}
+
+/// Pure Newton (a factorisation per iteration) converges quadratically near the solution.
+#[test]
+fn newton_converges_quadratically_near_the_solution() {
+    let mesh = beam(ElementType::from_name("p2").unwrap(), [4, 1, 1]);
+    let material = Material::new(MaterialModel::StableNeoHookean, 2.0e4, 0.3, 1000.0).unwrap();
+    let clamped = clamped_at_x0(&mesh);
+    let mut settings = implicit(Method::Newton, 20.0);
+    settings.newton = NewtonSettings { tolerance: 1e-13, max_iterations: 50, refactor_every_iteration: true };
+    let mut sim = Simulation::new(mesh, material, settings, cantilever_effects(&clamped, 0.0)).unwrap();
+    sim.step_frame().unwrap();
+    let r = sim.last_step_residuals().to_vec();
+    let r_text: Vec<String> = r.iter().map(|v| format!("{v:.2e}")).collect();
+    eprintln!("residuals {r_text:?}");
+    let pairs: Vec<(f64, f64)> = r.windows(2).map(|w| (w[0], w[1])).filter(|&(a, b)| a < 1e-2 && b > 1e-12).collect();
+    assert!(!pairs.is_empty(), "too few iterations near the solution to judge: {r_text:?}");
+    for (a, b) in pairs {
+        assert!(b <= 10.0 * a * a, "not quadratic: {a:.2e} → {b:.2e} in {r_text:?}");
+    }
+    assert!(*r.last().unwrap() <= 1e-13);
+}
+
+/// A body warm-started at its static equilibrium, at rest, stays there exactly: VBD's adaptive
+/// start makes the equilibrium its fixed point even at one sweep per step, and Newton starts
+/// converged.
+#[test]
+fn a_body_at_static_equilibrium_stays_there_under_vbd_and_newton() {
+    for (et, material, mesh, clamped, reference, u_max) in cantilever_cases() {
+        for method in [Method::Vbd, Method::Newton] {
+            let mut settings = implicit(method, 60.0);
+            settings.vbd.iterations = 1;
+            let mut sim = Simulation::new(mesh.clone(), material, settings, cantilever_effects(&clamped, 0.0)).unwrap();
+            sim.warm_start(&reference, 10.0);
+            for _ in 0..3 {
+                sim.step_frame().unwrap();
+            }
+            let moved = max_distance(&sim.positions, &reference) / u_max;
+            assert!(moved < 1e-9, "{et} {:?} {method}: moved {moved:.2e} of u_max", material.model);
+        }
+    }
+}
+
+/// Run with damping until settled, VBD (with and without Chebyshev) and Newton land on the
+/// static solution of the same mesh, for every element type.
+#[test]
+fn vbd_and_newton_settle_on_the_static_solution_for_every_element_type() {
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
+    for et in ElementType::all() {
+        let mesh = one_cell_cantilever(et);
+        let clamped = clamped_at_x0(&mesh);
+        let reference = static_equilibrium(&mesh, &material, None, &clamped);
+        let u_max = max_distance(&reference, &mesh.rest_positions);
+        let (omega_min, _) = frequency_range(&mesh, &material, &clamped, &reference);
+        let fps = 4.0 * omega_min;
+        let frames = (30.0 / omega_min * fps).ceil() as usize;
+        for (method, rho) in [(Method::Vbd, 0.0), (Method::Vbd, 0.8), (Method::Newton, 0.0)] {
+            let mut settings = implicit(method, fps);
+            settings.vbd.chebyshev_rho = rho;
+            let mut sim =
+                Simulation::new(mesh.clone(), material, settings, cantilever_effects(&clamped, omega_min)).unwrap();
+            for _ in 0..frames {
+                sim.step_frame().unwrap();
+            }
+            let err = max_distance(&sim.positions, &reference) / u_max;
+            assert!(err < 1e-4, "{et} {method} ρ = {rho}: settled {err:.2e} of u_max from the static solution");
+            let residual = sim.static_residual();
+            assert!(residual.relative < 1e-3, "{et} {method}: residual {residual:?}");
+        }
+    }
+}
+
+/// Node colours and a fixed summation order: serial, one thread and two threads give the same
+/// bits, for both implicit solvers.
+#[test]
+fn implicit_solvers_are_bitwise_identical_on_1_and_2_threads_and_serial() {
+    let mesh = beam(ElementType::from_name("p2").unwrap(), [4, 2, 2]);
+    let material = Material::new(MaterialModel::StableNeoHookean, 1.0e5, 0.3, 1000.0).unwrap();
+    let clamped = clamped_at_x0(&mesh);
+    for method in [Method::Vbd, Method::Newton] {
+        let run = |parallel: bool, threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let mut settings = implicit(method, 60.0);
+                settings.parallel = parallel;
+                settings.vbd.iterations = 5;
+                let mut sim =
+                    Simulation::new(mesh.clone(), material, settings, cantilever_effects(&clamped, 0.0)).unwrap();
+                for _ in 0..10 {
+                    sim.step_frame().unwrap();
+                }
+                sim.positions
+            })
+        };
+        let serial = run(false, 1);
+        assert!(max_distance(&serial, &mesh.rest_positions) > 1e-4, "{method}: the beam must move");
+        assert_eq!(run(true, 1), serial, "{method}: one thread");
+        assert_eq!(run(true, 2), serial, "{method}: two threads");
+    }
+}
+
+/// A free body under gravity alone falls exactly as backward Euler on the prediction: `x = y`.
+#[test]
+fn implicit_free_fall_is_backward_euler_on_the_prediction() {
+    let mesh = beam(ElementType::from_name("p1").unwrap(), [2, 1, 1]);
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e6, 0.35, 1000.0).unwrap();
+    for method in [Method::Vbd, Method::Newton] {
+        let mut sim =
+            Simulation::new(mesh.clone(), material, implicit(method, 60.0), vec![Box::new(Gravity::new(G))]).unwrap();
+        for _ in 0..30 {
+            sim.step_frame().unwrap();
+        }
+        // v_n = n h g, x_n = x_0 + h² g n(n + 1)/2 (velocity first, as symplectic Euler)
+        let (n, h) = (30.0, 1.0 / 60.0);
+        let want = G * (h * h * n * (n + 1.0) / 2.0);
+        for (x, x0) in sim.positions.iter().zip(&mesh.rest_positions) {
+            assert!((x - x0 - want).norm() < 1e-9, "{method}: {} vs {}", x - x0, want);
+        }
+    }
+}
+
+/// An effect no implicit solver can honour is refused by name, never ignored.
+#[test]
+fn contact_under_newton_and_an_effect_without_a_role_are_refused_naming_the_effect() {
+    struct Wind;
+    impl Effect for Wind {
+        fn name(&self) -> &'static str {
+            "wind"
+        }
+        fn before_prediction(&mut self, _s: &mut EffectState<'_>) {}
+    }
+    let mesh = one_cell_cantilever(ElementType::from_name("p1").unwrap());
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
+    let plane = || Box::new(ContactPlane::new(Vec3::zeros(), Vec3::z(), Vec3::zeros(), 0.0, 0.0)) as Box<dyn Effect>;
+    let err = Simulation::new(mesh.clone(), material, implicit(Method::Newton, 60.0), vec![plane()])
+        .err()
+        .unwrap()
+        .to_string();
+    assert_eq!(err, "the newton solver cannot honour the effect 'contact' (supported by: xpbd, vbd)");
+    assert!(Simulation::new(mesh.clone(), material, implicit(Method::Vbd, 60.0), vec![plane()]).is_ok());
+    for method in [Method::Vbd, Method::Newton] {
+        let err = Simulation::new(mesh.clone(), material, implicit(method, 60.0), vec![Box::new(Wind)])
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(err.contains("'wind'") && err.contains(method.name()) && err.contains("supported by: xpbd"), "{err}");
+    }
+    // switching a running XPBD simulation with contact to Newton is refused, and changes nothing
+    let mut sim = Simulation::new(mesh, material, SolverSettings::default(), vec![plane()]).unwrap();
+    assert!(sim.set_settings(implicit(Method::Newton, 60.0)).is_err());
+    assert_eq!(sim.method(), Method::Xpbd);
+    assert!(sim.set_settings(implicit(Method::Vbd, 60.0)).is_ok());
+    assert_eq!(sim.method(), Method::Vbd);
+}
+
+/// VBD runs contact's projection after every sweep: a body falling on a plane stays above it.
+#[test]
+fn vbd_keeps_nodes_above_a_contact_plane() {
+    let mesh = beam(ElementType::from_name("p1").unwrap(), [2, 1, 1]);
+    let material = Material::new(MaterialModel::StableNeoHookean, 1.0e5, 0.3, 1000.0).unwrap();
+    let floor = ContactPlane::new(Vec3::new(0.0, 0.0, -0.1), Vec3::z(), Vec3::zeros(), 0.0, 0.5);
+    let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(G)), Box::new(floor)];
+    let mut sim = Simulation::new(mesh, material, implicit(Method::Vbd, 60.0), effects).unwrap();
+    for _ in 0..60 {
+        sim.step_frame().unwrap();
+    }
+    let lowest = sim.positions.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    assert!(lowest > -0.1 - 1e-9 && lowest < -0.09, "lowest node at {lowest}");
+}
+
+/// Driven nodes follow their drive and a dragged node moves to its attachment, under every solver.
+#[test]
+fn drives_and_attachments_are_honoured_by_every_solver() {
+    let mesh = beam(ElementType::from_name("p2").unwrap(), [2, 1, 1]);
+    let material = Material::new(MaterialModel::StableNeoHookean, 1.0e5, 0.3, 1000.0).unwrap();
+    let clamped = clamped_at_x0(&mesh);
+    let tip = mesh.nodes_where(|p| (p - Vec3::new(1.0, 0.25, 0.25)).norm() < 1e-12)[0];
+    let target = mesh.rest_positions[tip as usize] + Vec3::new(0.0, 0.0, 0.05);
+    for method in Method::ALL {
+        let effects: Vec<Box<dyn Effect>> = vec![
+            Box::new(Clamp { nodes: clamped.clone() }),
+            Box::new(Damping { rate_per_sec: 20.0 }),
+            Box::new(Attachment::new(tip, target, 1e-7)),
+        ];
+        let mut sim = Simulation::new(mesh.clone(), material, implicit(method, 60.0), effects).unwrap();
+        for _ in 0..120 {
+            sim.step_frame().unwrap();
+        }
+        let gap = (sim.positions[tip as usize] - target).norm();
+        assert!(gap < 2e-3, "{method}: the dragged node is {gap} m from its target");
+        for &c in &clamped {
+            assert_eq!(sim.positions[c as usize], mesh.rest_positions[c as usize], "{method}: clamped node moved");
+        }
+    }
+}
+
+/// Damping takes the kinetic energy out under the implicit solvers too.
+#[test]
+fn damping_decays_kinetic_energy_under_every_solver() {
+    let mesh = beam(ElementType::from_name("p1").unwrap(), [4, 1, 1]);
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
+    let clamped = clamped_at_x0(&mesh);
+    for method in Method::ALL {
+        let mut sim =
+            Simulation::new(mesh.clone(), material, implicit(method, 60.0), cantilever_effects(&clamped, 5.0)).unwrap();
+        for _ in 0..30 {
+            sim.step_frame().unwrap();
+        }
+        let early = sim.kinetic_energy_j();
+        for _ in 0..300 {
+            sim.step_frame().unwrap();
+        }
+        let late = sim.kinetic_energy_j();
+        assert!(early > 0.0 && late < 1e-6 * early, "{method}: kinetic energy {early:.3e} → {late:.3e}");
+    }
+}
+
+/// A NaN under an implicit solver stops the run naming the solver, keeps the last finite state,
+/// and refuses to step until reset.
+#[test]
+fn an_implicit_blow_up_names_the_solver_and_keeps_the_last_finite_state() {
+    let mesh = beam(ElementType::from_name("p2").unwrap(), [2, 1, 1]);
+    let material = Material::new(MaterialModel::StableNeoHookean, 1.0e5, 0.3, 1000.0).unwrap();
+    let clamped = clamped_at_x0(&mesh);
+    for method in [Method::Vbd, Method::Newton] {
+        let mut sim =
+            Simulation::new(mesh.clone(), material, implicit(method, 60.0), cantilever_effects(&clamped, 0.0)).unwrap();
+        sim.step_frame().unwrap();
+        let node = mesh.num_nodes() - 1;
+        sim.positions[node].x = f64::NAN;
+        let err = sim.step_frame().unwrap_err().to_string();
+        assert!(err.starts_with(&format!("the {method} simulation blew up")), "{err}");
+        assert!(err.contains("step 1 of 1") && err.contains(&format!("node {node}")), "{err}");
+        assert!(sim.positions.iter().all(|p| p.iter().all(|c| c.is_finite())));
+        assert!(sim.step_frame().is_err());
+        sim.reset();
+        sim.step_frame().unwrap();
+    }
+}
