@@ -131,6 +131,16 @@ impl HyperelasticModel for NeoHookean {
     }
 }
 
+/// `dP[dF] = μ dF + g'(J) (cof F : dF) cof F + g(J) d(cof F)[dF]`, `g = (λ ln J − μ) (ln J)'`.
+fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
+    let log = log_j(f);
+    let cof = cofactor(f);
+    let a = l.lambda_pa * log.value - l.mu_pa;
+    let g = a * log.d1;
+    let dg = l.lambda_pa * log.d1 * log.d1 + a * log.d2;
+    move |df| df * l.mu_pa + cof * (dg * cof.dot(df)) + cofactor_directional(f, df) * g
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::testing;
@@ -228,14 +238,4 @@ mod tests {
         assert_eq!(m.split_energy_offset(), 0.0);
         assert_eq!(NEO_HOOKEAN_J_FLOOR, 0.2);
     }
-}
-
-/// `dP[dF] = μ dF + g'(J) (cof F : dF) cof F + g(J) d(cof F)[dF]`, `g = (λ ln J − μ) (ln J)'`.
-fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
-    let log = log_j(f);
-    let cof = cofactor(f);
-    let a = l.lambda_pa * log.value - l.mu_pa;
-    let g = a * log.d1;
-    let dg = l.lambda_pa * log.d1 * log.d1 + a * log.d2;
-    move |df| df * l.mu_pa + cof * (dg * cof.dot(df)) + cofactor_directional(f, df) * g
 }

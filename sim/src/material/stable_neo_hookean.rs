@@ -96,6 +96,14 @@ impl HyperelasticModel for StableNeoHookean {
     }
 }
 
+/// `dP[dF] = μ dF + λ̂ (cof F : dF) cof F + (λ̂ (J − 1) − μ) d(cof F)[dF]`.
+fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
+    let (lambda_hat, _) = lambda_hat_and_ratio(l);
+    let cof = cofactor(f);
+    let g = lambda_hat * det_minus_one(f) - l.mu_pa;
+    move |df| df * l.mu_pa + cof * (lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::testing;
@@ -153,12 +161,4 @@ mod tests {
         assert!((dev.value - 3f64.sqrt()).abs() < 1e-15);
         assert!((hyd.value + l.mu_pa / lambda_hat).abs() < 1e-15);
     }
-}
-
-/// `dP[dF] = μ dF + λ̂ (cof F : dF) cof F + (λ̂ (J − 1) − μ) d(cof F)[dF]`.
-fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
-    let (lambda_hat, _) = lambda_hat_and_ratio(l);
-    let cof = cofactor(f);
-    let g = lambda_hat * det_minus_one(f) - l.mu_pa;
-    move |df| df * l.mu_pa + cof * (lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g
 }

@@ -151,6 +151,17 @@ impl HyperelasticModel for StableNeoHookeanLog {
     }
 }
 
+/// `dP[dF] = a dF + a' (F : dF) F + λ̂ (cof F : dF) cof F + g d(cof F)[dF]`.
+fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
+    let p = params(l);
+    let cof = cofactor(f);
+    let ic = f.norm_squared();
+    let a = p.mu_hat * (ic / (ic + 1.0));
+    let da = 2.0 * p.mu_hat / ((ic + 1.0) * (ic + 1.0));
+    let g = cofactor_coefficient(p, det_minus_one(f));
+    move |df| df * a + f * (da * f.dot(df)) + cof * (p.lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::testing;
@@ -372,15 +383,4 @@ mod tests {
             Ok(())
         });
     }
-}
-
-/// `dP[dF] = a dF + a' (F : dF) F + λ̂ (cof F : dF) cof F + g d(cof F)[dF]`.
-fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
-    let p = params(l);
-    let cof = cofactor(f);
-    let ic = f.norm_squared();
-    let a = p.mu_hat * (ic / (ic + 1.0));
-    let da = 2.0 * p.mu_hat / ((ic + 1.0) * (ic + 1.0));
-    let g = cofactor_coefficient(p, det_minus_one(f));
-    move |df| df * a + f * (da * f.dot(df)) + cof * (p.lambda_hat * cof.dot(df)) + cofactor_directional(f, df) * g
 }

@@ -144,6 +144,17 @@ impl HyperelasticModel for StVenantKirchhoff {
     }
 }
 
+/// `dP[dF] = dF S + F S(dE)`, `dE = (dFᵀ F + Fᵀ dF)/2`.
+fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
+    let s = stress(l, &strain(f));
+    let ft = f.transpose();
+    move |df| {
+        let de = (df.transpose() * f + ft * df) * 0.5;
+        let ds = stress(l, &de);
+        df * s + f * ds
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::testing;
@@ -210,16 +221,5 @@ mod tests {
         let p = m.dpdf_projected(&f);
         assert!(testing::min_eigenvalue(&p) >= -1e-9 * p.norm());
         assert!((p - h).norm() > 1e-3 * h.norm());
-    }
-}
-
-/// `dP[dF] = dF S + F S(dE)`, `dE = (dFᵀ F + Fᵀ dF)/2`.
-fn linearisation(l: Lame, f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
-    let s = stress(l, &strain(f));
-    let ft = f.transpose();
-    move |df| {
-        let de = (df.transpose() * f + ft * df) * 0.5;
-        let ds = stress(l, &de);
-        df * s + f * ds
     }
 }

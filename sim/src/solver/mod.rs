@@ -66,15 +66,13 @@ pub enum SimError {
     #[error("node {node}: {reason}")]
     Mass { node: usize, reason: String },
     #[error(
-        "the {solver} simulation blew up at frame {frame}, {step_word} {substep_in_frame} of {substeps_per_frame} (t = {time_secs:.6} s): {origin} element {element} of block {block} ({element_type}), at its node {node}; the last finite state is kept — reset, or use {remedy}"
+        "the {solver} simulation blew up at frame {frame}, {} {substep_in_frame} of {substeps_per_frame} (t = {time_secs:.6} s): {origin} element {element} of block {block} ({element_type}), at its node {node}; the last finite state is kept — reset, or use {}",
+        nan_guard::step_word(solver),
+        nan_guard::remedy(solver)
     )]
     NonFinite {
         /// The solver that was running ("xpbd", "vbd", "newton").
         solver: &'static str,
-        /// "substep" (XPBD) or "step".
-        step_word: &'static str,
-        /// What to try instead.
-        remedy: &'static str,
         /// Element block and index within it.
         block: usize,
         element: usize,

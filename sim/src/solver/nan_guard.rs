@@ -30,11 +30,6 @@ impl Simulation {
         let method = self.solver.method();
         let err = SimError::NonFinite {
             solver: method.name(),
-            step_word: if method.is_implicit() { "step" } else { "substep" },
-            remedy: match method {
-                super::Method::Xpbd => "more substeps, a softer material or stable Neo-Hookean",
-                _ => "more steps per frame, a softer material or stable Neo-Hookean",
-            },
             block: bad.block,
             element: bad.element,
             element_type: self
@@ -109,6 +104,20 @@ impl BadElement {
             .find_map(|(bi, b)| b.elements().position(|el| el.contains(&(node as u32))).map(|e| (bi, e)))
             .unwrap_or((0, 0));
         Self { block, element, node: node as u32, origin }
+    }
+}
+
+/// What the NaN guard calls a solver's step: XPBD takes substeps, the implicit solvers steps.
+pub(super) fn step_word(solver: &str) -> &'static str {
+    if solver == super::Method::Xpbd.name() { "substep" } else { "step" }
+}
+
+/// What the NaN guard suggests after a blow-up under `solver`.
+pub(super) fn remedy(solver: &str) -> &'static str {
+    if solver == super::Method::Xpbd.name() {
+        "more substeps, a softer material or stable Neo-Hookean"
+    } else {
+        "more steps per frame, a softer material or stable Neo-Hookean"
     }
 }
 
