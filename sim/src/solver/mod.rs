@@ -123,7 +123,8 @@ pub struct Simulation {
     effects: Vec<Box<dyn Effect>>,
     /// The solver moving the free nodes within a step ([`Method`]).
     solver: Box<dyn StepSolver>,
-    /// Bumped whenever the pinned nodes, the masses or the material may have changed.
+    /// Bumped whenever the held nodes, the masses or the material change (not when an effect
+    /// that holds nothing comes or goes).
     model_version: u64,
     time_secs: f64,
     frames: u64,
@@ -283,14 +284,18 @@ impl Simulation {
     /// the solver cannot honour it.
     pub fn add_effect(&mut self, effect: Box<dyn Effect>) -> Result<(), SimError> {
         method::check_effects(self.solver.method(), [effect.as_ref()])?;
-        self.model_version += 1;
         for node in effect.pinned_nodes(&self.mesh) {
             let slot = self.inv_mass.get_mut(node as usize).ok_or(SimError::EffectNode {
                 effect: effect.name(),
                 node,
                 num_nodes: self.mesh.num_nodes(),
             })?;
-            *slot = 0.0;
+            // only a change of what is held invalidates the implicit solvers' stiffness pattern
+            // (a dragged node's attachment, replaced as the mouse moves, holds nothing)
+            if *slot != 0.0 {
+                *slot = 0.0;
+                self.model_version += 1;
+            }
         }
         self.effects.push(effect);
         Ok(())
@@ -300,7 +305,6 @@ impl Simulation {
     /// node is dragged); nodes they pinned get their mass back. Returns how many were removed.
     pub fn remove_effects_named(&mut self, name: &str) -> usize {
         let before = self.effects.len();
-        self.model_version += 1;
         let (removed, kept): (Vec<_>, Vec<_>) =
             std::mem::take(&mut self.effects).into_iter().partition(|e| e.name() == name);
         self.effects = kept;
@@ -308,8 +312,9 @@ impl Simulation {
             self.effects.iter().flat_map(|e| e.pinned_nodes(&self.mesh)).collect();
         for e in &removed {
             for node in e.pinned_nodes(&self.mesh) {
-                if !still_pinned.contains(&node) {
+                if !still_pinned.contains(&node) && self.inv_mass[node as usize] == 0.0 {
                     self.inv_mass[node as usize] = 1.0 / self.masses_kg[node as usize];
+                    self.model_version += 1;
                 }
             }
         }

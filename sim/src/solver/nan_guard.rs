@@ -14,14 +14,7 @@ impl Simulation {
             .iter()
             .zip(&self.velocities)
             .position(|(x, v)| !(x.iter().chain(v.iter()).all(|c| c.is_finite())))?;
-        let (block, element) = self
-            .mesh
-            .blocks
-            .iter()
-            .enumerate()
-            .find_map(|(bi, b)| b.elements().position(|el| el.contains(&(node as u32))).map(|e| (bi, e)))
-            .unwrap_or((0, 0));
-        Some(BadElement { block, element, node: node as u32, origin: ORIGIN_STATE })
+        Some(BadElement::at_node(&self.mesh, node, ORIGIN_STATE))
     }
 
     /// Builds the NaN guard's error, puts the state back to the last finite positions (the
@@ -95,7 +88,7 @@ impl BadElement {
 }
 
 impl BadElement {
-    /// A solver's update of `node` came out non-finite; names the first element holding it.
+    /// `node` went non-finite (`origin` says how); names the first element holding it.
     pub(super) fn at_node(mesh: &crate::mesh::Mesh, node: usize, origin: &'static str) -> Self {
         let (block, element) = mesh
             .blocks
