@@ -77,7 +77,8 @@ pub enum Command {
         out: PathBuf,
     },
     /// Time the XPBD loop on the paper's Table 1 beams and the other element types: ms per
-    /// frame against the paper's, ns per element per substep, GFLOP/s (docs/PERFORMANCE.md).
+    /// frame against the paper's, ns per element per substep, GFLOP/s (docs/PERFORMANCE.md);
+    /// --solver vbd|newton times an implicit solver on the same beams.
     Bench {
         /// Timed frames per configuration (the median is reported).
         #[arg(long, default_value_t = 20)]
@@ -89,9 +90,14 @@ pub enum Command {
         #[arg(long, default_value = "")]
         only: String,
         /// Also time the colour sweep on one thread (linear tetrahedra four per 256-bit
-        /// register; `--colour-on-one false`: the serial sweep only).
+        /// register; `--colour-on-one false`: the serial sweep only). XPBD only.
         #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
         colour_on_one: bool,
+        /// The solver timed: xpbd (the table above), vbd (µs per node update and per element
+        /// visit) or newton (ms per iteration and per factorisation); the thread counts run side
+        /// by side, with the speed-up over one thread.
+        #[arg(long, default_value = "xpbd")]
+        solver: String,
     },
     /// Run a scene (for --seconds, or until it --settle-s) and print the probe displacements.
     Simulate {
@@ -154,7 +160,9 @@ pub fn main(cli: Cli) -> Result<()> {
             simulate::simulate(&scene, &mesh, &physics, seconds, settle, &vtk, json)
         }
         Command::Study { quick, out } => study::study(quick, &out),
-        Command::Bench { frames, threads, only, colour_on_one } => bench::bench(frames, &threads, &only, colour_on_one),
+        Command::Bench { frames, threads, only, colour_on_one, solver } => {
+            bench::bench(frames, &threads, &only, colour_on_one, &solver)
+        }
         Command::Static { scene, mesh, physics, tolerance, load_steps, json } => {
             statics::static_command(&scene, &mesh, &physics, tolerance, load_steps, json)
         }

@@ -353,3 +353,29 @@ fn a_grid_too_large_for_memory_is_refused_naming_the_grid() {
     fails_with(&["mesh", "--scene", "bending", "--element", "p3", "--grid", "64x64x64"], "--grid");
     fails_with(&["mesh", "--scene", "bending", "--element", "p3", "--grid", "64x64x64"], "1,310,720 elements");
 }
+
+/// `hox bench --solver vbd` prints the implicit solver's table (a positive, finite µs per node
+/// update next to the counts); an unknown solver names the flag and the allowed values.
+#[test]
+fn bench_times_an_implicit_solver_and_refuses_an_unknown_one() {
+    let args = ["bench", "--solver", "vbd", "--frames", "2", "--threads", "1", "--only", "P2 8x2x2"];
+    let out = hox(&args);
+    assert!(out.status.success(), "hox {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    let table = String::from_utf8_lossy(&out.stdout);
+    let cells =
+        |line: &str| line.split('|').map(str::trim).filter(|c| !c.is_empty()).map(String::from).collect::<Vec<_>>();
+    let mut lines = table.lines();
+    let header = cells(lines.next().expect("a header"));
+    let row = cells(lines.find(|l| l.starts_with("| P2 8x2x2")).unwrap_or_else(|| panic!("no P2 row in:\n{table}")));
+    let column =
+        |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no '{name}' in {header:?}"));
+    assert_eq!(row[column("solver")], "vbd");
+    assert_eq!(row[column("threads")], "1");
+    assert_eq!(row[column("sweeps/frame")], "10", "the scene's 10 sweeps per step, 1 step per frame");
+    for name in ["ms/frame", "µs per node update", "µs per element visit"] {
+        let t: f64 = row[column(name)].parse().unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(t.is_finite() && t > 0.0, "{name} = {t}");
+    }
+    fails_with(&["bench", "--solver", "foo"], "--solver");
+    fails_with(&["bench", "--solver", "foo"], "xpbd, vbd, newton");
+}

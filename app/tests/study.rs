@@ -51,6 +51,35 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
         (missing("0.499", "P1 16x4x4 five"), missing("0.499", "P2 8x2x2 five"), missing("0.499", "P3 4x2x2 five"));
     assert!(p1 > 3.0 * p2 && p2 > 0.0 && p3 > 0.0 && p3 < p2, "locking at ν = 0.499: P1 {p1} %, P2 {p2} %, P3 {p3} %");
     assert!(p1 > missing("0.35", "P1 16x4x4 five") + 10.0, "P1 must stiffen as ν → 0.5");
+    // the solver axis: every solver on the quick meshes, the Pareto chart, the cheapest sentence
+    assert!(md.contains("## The solver axis"), "study.md lacks the solver axis");
+    assert!(md.contains("**bending**"), "study.md names no cheapest bending configuration");
+    let solvers = std::fs::read_to_string(out.join("solvers.csv")).unwrap();
+    let mut lines = solvers.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let value = |config: &str, solver: &str, column: &str| -> f64 {
+        let row = rows
+            .iter()
+            .find(|r| r[col("configuration")] == config && r[col("solver")] == solver)
+            .unwrap_or_else(|| panic!("no row {config} {solver}"));
+        row[col(column)].parse().unwrap_or_else(|_| panic!("{config} {solver} {column}: {}", row[col(column)]))
+    };
+    for solver in ["xpbd 50x1", "xpbd 25x2", "xpbd 10x5", "xpbd 100x1", "xpbd 50x2", "vbd", "newton"] {
+        let ms = value("P2 8x2x2 five", solver, "ms_per_frame_1_thread");
+        assert!(ms > 0.0 && ms.is_finite(), "{solver}: {ms} ms");
+        let period = value("P2 8x2x2 five", solver, "period_error_pct");
+        assert!(period.abs() < 20.0, "{solver}: period error {period} %");
+    }
+    // the converged solvers sit on the static solution; XPBD at the paper's settings does not
+    assert!(value("P2 8x2x2 five", "newton", "solver_error_pct") < 0.1);
+    assert!(value("P2 8x2x2 five", "vbd", "solver_error_pct") < 0.1);
+    assert!(value("P2 8x2x2 five", "xpbd 50x1", "solver_error_pct") > 1.0);
+    // implicit Euler damps the motion the reference (Newmark) keeps
+    assert!(value("P2 8x2x2 five", "newton", "amplitude_error_pct") < -5.0);
+    let pareto = std::fs::read_to_string(out.join("pareto-bending.svg")).unwrap();
+    assert!(pareto.contains("class=\"pareto\"") && pareto.trim_end().ends_with("</svg>"));
     std::fs::remove_dir_all(&out).ok();
 }
 

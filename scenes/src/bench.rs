@@ -14,6 +14,10 @@
 //!
 //! So `flops = Q (36 N + 174) + 16 N + 10`: 384 for P1. Achieved GFLOP/s = flops × elements ×
 //! substeps / time. The machine's peak is stated in [`PEAK_GFLOPS_PER_CORE`].
+//!
+//! The implicit solvers (VBD, Newton) on the same beams: [`solver`] (`hox bench --solver`).
+
+pub mod solver;
 
 use crate::params::SceneOverrides;
 use crate::{Instance, SceneError};
@@ -196,6 +200,22 @@ pub fn markdown(rows: &[BenchRow]) -> String {
     s
 }
 
+/// Untimed frames before the timed ones (the beam starts at rest and sags).
+pub const WARMUP_FRAMES: usize = 5;
+/// Timed work per configuration after which no more frames are timed (at least 3 are), seconds.
+pub const BUDGET_SECS: f64 = 10.0;
+
+/// The case labelled `filter`, or else every case whose label contains it, ignoring case (a whole
+/// label picks that case alone: "P1 16x4x4" is also part of its refinements' labels).
+pub fn matching_cases(filter: &str) -> Vec<&'static BenchCase> {
+    let filter = filter.to_uppercase();
+    let exact = CASES.iter().any(|c| c.label().to_uppercase() == filter);
+    CASES
+        .iter()
+        .filter(|c| if exact { c.label().to_uppercase() == filter } else { c.label().to_uppercase().contains(&filter) })
+        .collect()
+}
+
 /// Measures the case labelled `filter`, or else every case whose label contains it (ignoring
 /// case), on each of `threads`
 /// (1: the serial sweep; more: the parallel colour sweep; with `colour_on_one`, also the
@@ -209,18 +229,12 @@ pub fn run(
     frames: usize,
     progress: &mut dyn FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, SceneError> {
-    let filter = filter.to_uppercase();
-    // a whole label picks that case alone ("P1 16x4x4" is also part of its refinements' labels)
-    let exact = CASES.iter().any(|c| c.label().to_uppercase() == filter);
     let mut rows = Vec::new();
-    for case in CASES
-        .iter()
-        .filter(|c| if exact { c.label().to_uppercase() == filter } else { c.label().to_uppercase().contains(&filter) })
-    {
+    for case in matching_cases(filter) {
         for &t in threads {
             let sweeps: &[bool] = if t == 1 && colour_on_one { &[false, true] } else { &[t > 1] };
             for &parallel in sweeps {
-                let row = measure(case, t, parallel, 5, frames, 10.0)?;
+                let row = measure(case, t, parallel, WARMUP_FRAMES, frames, BUDGET_SECS)?;
                 progress(&row);
                 rows.push(row);
             }

@@ -1,16 +1,25 @@
-//! `hox bench`: time the XPBD loop on the paper's Table 1 beams and the other element types.
+//! `hox bench`: time the XPBD loop on the paper's Table 1 beams and the other element types, or
+//! (`--solver vbd|newton`) an implicit solver on the same beams.
 
 use anyhow::{Result, bail};
+use hox_sim::solver::Method;
 
-pub fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool) -> Result<()> {
+pub fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool, solver: &str) -> Result<()> {
+    let method = hox_scenes::bench::solver::parse_solver(solver)?;
     if frames == 0 || threads.contains(&0) {
         bail!("--frames and every --threads count must be at least 1");
     }
-    let rows =
-        hox_scenes::bench::run(only, threads, colour_on_one, frames, &mut |r| eprintln!("{}", r.progress_line()))?;
-    if rows.is_empty() {
+    if hox_scenes::bench::matching_cases(only).is_empty() {
         bail!("no configuration matches '{only}'");
     }
-    print!("{}", hox_scenes::bench::markdown(&rows));
+    if method == Method::Xpbd {
+        let rows =
+            hox_scenes::bench::run(only, threads, colour_on_one, frames, &mut |r| eprintln!("{}", r.progress_line()))?;
+        print!("{}", hox_scenes::bench::markdown(&rows));
+    } else {
+        let rows =
+            hox_scenes::bench::solver::run(only, method, threads, frames, &mut |r| eprintln!("{}", r.progress_line()))?;
+        print!("{}", hox_scenes::bench::solver::markdown(&rows));
+    }
     Ok(())
 }

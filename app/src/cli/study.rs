@@ -1,6 +1,8 @@
-//! `hox study`: the accuracy-versus-time study over the paper scenes, written to a folder.
+//! `hox study`: the accuracy-versus-time study over the paper scenes (the paper's settings, the
+//! locking table and the solver axis), written to a folder.
 
 use anyhow::{Context, Result};
+use hox_scenes::study::solver_axis;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::time::{Duration, Instant};
 
@@ -23,13 +25,26 @@ pub fn study(quick: bool, out: &std::path::Path) -> Result<()> {
     };
     let rows = hox_scenes::study::run_study(quick, &mut report)?;
     let locking = hox_scenes::study::locking(quick, &mut report)?;
+    let solvers = solver_axis::run_solver_axis(quick, &mut report)?;
     bar.finish_and_clear();
-    let files = [
-        ("study.md", hox_scenes::study::markdown(&rows, quick) + "\n" + &hox_scenes::study::locking_markdown(&locking)),
-        ("study.csv", hox_scenes::study::csv(&rows)),
-        ("locking.csv", hox_scenes::study::locking_csv(&locking)),
-        ("study.svg", hox_scenes::study::svg(&rows)),
+    let mut files = vec![
+        (
+            "study.md".to_string(),
+            hox_scenes::study::markdown(&rows, quick)
+                + "\n"
+                + &solver_axis::solver_markdown(&solvers)
+                + &hox_scenes::study::locking_markdown(&locking),
+        ),
+        ("study.csv".into(), hox_scenes::study::csv(&rows)),
+        ("solvers.csv".into(), solver_axis::solver_csv(&solvers)),
+        ("locking.csv".into(), hox_scenes::study::locking_csv(&locking)),
+        ("study.svg".into(), hox_scenes::study::svg(&rows)),
     ];
+    for scene in hox_scenes::PAPER_SCENES {
+        if solvers.iter().any(|r| r.scene == scene) {
+            files.push((format!("pareto-{scene}.svg"), solver_axis::pareto_svg(&solvers, scene)));
+        }
+    }
     for (name, text) in files {
         let path = out.join(name);
         std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;

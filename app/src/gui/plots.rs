@@ -47,6 +47,9 @@ pub fn decimate(t: &[f64], y: impl Fn(usize) -> f64, max_points: usize) -> Vec<e
     out
 }
 
+/// The legend of the reference motion's dashed curve.
+pub const REFERENCE_MOTION_LABEL: &str = "reference motion u_z (Newmark, Q2 16×4×4)";
+
 pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         ui.selectable_value(&mut app.bottom_tab, Tab::Probe, "Probe displacement").on_hover_text("The first probe's displacement components over simulated time, metres.");
@@ -84,6 +87,24 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                                 Line::new("reference u_z", PlotPoints::from(vec![[0.0, r.z], [t1, r.z]]))
                                     .style(egui_plot::LineStyle::dashed_loose()),
                             );
+                        }
+                        // the reference motion (the beam released from rest), dashed, as far as
+                        // the run has come
+                        if let Some(m) = s.reference_motion().filter(|_| k == 0 && probe == "tip") {
+                            let t1 = h.time_secs.last().copied().unwrap_or(0.0);
+                            let points: Vec<[f64; 2]> = m
+                                .tip_z_m
+                                .iter()
+                                .enumerate()
+                                .map(|(i, z)| [i as f64 * m.sample_secs, *z])
+                                .take_while(|p| p[0] <= t1 + 1e-9)
+                                .collect();
+                            if points.len() > 1 {
+                                plot.line(
+                                    Line::new(REFERENCE_MOTION_LABEL, PlotPoints::from(points))
+                                        .style(egui_plot::LineStyle::dashed_dense()),
+                                );
+                            }
                         }
                     }
                 });

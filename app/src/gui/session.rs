@@ -4,6 +4,7 @@
 //! A configuration change rebuilds only what it invalidates ([`Invalidates`]): a material or
 //! solver change keeps the current positions and velocities; a mesh change rebuilds from rest.
 
+use hox_scenes::study::motion::Motion;
 use super::config::{self, Config, Invalidates};
 use hox_scenes::{Instance, Scene};
 use hox_sim::Vec3;
@@ -253,6 +254,26 @@ impl Session {
         self.instance.sim.static_residual().relative
     }
 
+    /// The reference motion of the bending beam's tip released from rest (Newmark on Q2
+    /// 16×4×4, `assets/reference/bending-motion.json`), when it applies to this session: the
+    /// built-in bending scene with its own material, gravity and no added damping.
+    pub fn reference_motion(&self) -> Option<&'static Motion> {
+        static MOTION: std::sync::OnceLock<Option<Motion>> = std::sync::OnceLock::new();
+        let (now, base) = (self.instance.scene.params(), self.base.params());
+        let applies = self.base.name() == "bending"
+            && self.base.source == self.instance.scene.source
+            && now.material == base.material
+            && now.youngs_modulus_pa == base.youngs_modulus_pa
+            && now.poisson_ratio == base.poisson_ratio
+            && now.density_kg_m3 == base.density_kg_m3
+            && now.damping_per_sec == 0.0
+            && self.instance.scene.file.effects == self.base.file.effects;
+        if !applies {
+            return None;
+        }
+        MOTION.get_or_init(|| hox_scenes::study::motion::reference_motion().ok()).as_ref()
+    }
+
     /// Largest probe error against the reference, metres (None for scenes without one).
     pub fn probe_error_m(&self) -> Option<f64> {
         if self.reference.is_empty() {
@@ -293,6 +314,30 @@ mod tests {
         assert_eq!(s.apply(c), Ok(Invalidates::Mesh));
         assert_eq!(s.instance.sim.mesh().num_nodes(), 9 * 3 * 3);
         assert_eq!(s.instance.sim.time_secs(), 0.0);
+    }
+
+    /// The reference motion (issue #19) is offered for the bending beam as built, and withdrawn
+    /// once the material or the damping makes it another beam.
+    #[test]
+    fn the_reference_motion_is_offered_only_for_the_beam_it_was_computed_for() {
+        let mut s = bending();
+        let m = s.reference_motion().expect("bending has a reference motion");
+        assert!(m.tip_z_m.len() > 100 && m.tip_z_m[0] == 0.0);
+        let mut c = s.config.clone();
+        c.youngs_modulus_pa *= 2.0;
+        s.apply(c).unwrap();
+        assert!(s.reference_motion().is_none(), "a stiffer beam moves otherwise");
+        let mut other = bending();
+        let mut c = other.config.clone();
+        c.damping_per_sec = 1.0;
+        other.apply(c).unwrap();
+        assert!(other.reference_motion().is_none(), "a damped beam moves otherwise");
+        let element = bending();
+        let mut c = element.config.clone();
+        c.element = "q2".into();
+        let mut element = element;
+        element.apply(c).unwrap();
+        assert!(element.reference_motion().is_some(), "another mesh of the same beam is compared with it");
     }
 
     #[test]

@@ -27,6 +27,7 @@
 
 mod method;
 mod nan_guard;
+mod newmark;
 mod newton;
 mod residual;
 mod settings;
@@ -38,6 +39,7 @@ mod vbd;
 mod xpbd;
 
 pub use method::Method;
+pub use newmark::Newmark;
 pub use residual::StaticResidual;
 pub use settings::{NewtonSettings, SolverSettings, VbdInit, VbdSettings};
 

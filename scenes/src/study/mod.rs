@@ -14,6 +14,9 @@
 //! static on this mesh). Each error is the largest probe-displacement difference (m), and in % of
 //! the largest reference probe displacement.
 
+pub mod motion;
+pub mod solver_axis;
+
 use crate::{Instance, RunMode, SceneError, SceneOverrides, run};
 use hox_sim::Vec3;
 use hox_sim::element::{ElementType, ReferenceShape};
@@ -21,9 +24,9 @@ use hox_sim::mesh::structured::TetSplit;
 
 /// The reference (fine Q2 static solution) of each paper scene, as committed.
 pub const REFERENCES: [(&str, &str); 3] = [
-    ("bending", include_str!("../../assets/reference/bending-fine.json")),
-    ("tension", include_str!("../../assets/reference/tension-fine.json")),
-    ("torsion", include_str!("../../assets/reference/torsion-fine.json")),
+    ("bending", include_str!("../../../assets/reference/bending-fine.json")),
+    ("tension", include_str!("../../../assets/reference/tension-fine.json")),
+    ("torsion", include_str!("../../../assets/reference/torsion-fine.json")),
 ];
 
 /// The paper's Table 1 (bending): (label, elements, ms per frame, tip error in m).
