@@ -14,6 +14,7 @@ mod list;
 mod mesh;
 mod params;
 mod record;
+mod reference;
 mod simulate;
 mod statics;
 mod study;
@@ -63,6 +64,8 @@ pub enum Command {
         /// Initial number of load increments (halved automatically where Newton struggles).
         #[arg(long, default_value_t = 1)]
         load_steps: usize,
+        #[command(flatten)]
+        reference: reference::ReferenceArgs,
         #[arg(long)]
         json: bool,
     },
@@ -116,6 +119,8 @@ pub enum Command {
         settle: bool,
         #[command(flatten)]
         vtk: gmsh::VtkArgs,
+        #[command(flatten)]
+        reference: reference::ReferenceArgs,
         #[arg(long)]
         json: bool,
     },
@@ -156,15 +161,15 @@ pub fn main(cli: Cli) -> Result<()> {
         Command::Elements { json } => list::elements(json),
         Command::Scenes { json } => list::scenes(json),
         Command::Mesh { scene, mesh, json } => mesh::mesh_command(&scene, &mesh, json),
-        Command::Simulate { scene, mesh, physics, seconds, settle, vtk, json } => {
-            simulate::simulate(&scene, &mesh, &physics, seconds, settle, &vtk, json)
+        Command::Simulate { scene, mesh, physics, seconds, settle, vtk, reference, json } => {
+            simulate::simulate(&scene, &mesh, &physics, seconds, settle, &vtk, &reference, json)
         }
         Command::Study { quick, out } => study::study(quick, &out),
         Command::Bench { frames, threads, only, colour_on_one, solver } => {
             bench::bench(frames, &threads, &only, colour_on_one, &solver)
         }
-        Command::Static { scene, mesh, physics, tolerance, load_steps, json } => {
-            statics::static_command(&scene, &mesh, &physics, tolerance, load_steps, json)
+        Command::Static { scene, mesh, physics, tolerance, load_steps, reference, json } => {
+            statics::static_command(&scene, &mesh, &physics, tolerance, load_steps, &reference, json)
         }
         Command::Record(args) => record::record(&args),
         Command::Inspect(args) => inspect::inspect(&args),

@@ -379,3 +379,38 @@ fn bench_times_an_implicit_solver_and_refuses_an_unknown_one() {
     fails_with(&["bench", "--solver", "foo"], "--solver");
     fails_with(&["bench", "--solver", "foo"], "xpbd, vbd, newton");
 }
+
+/// Issue #20: `simulate --json` and `static --json` report the reference of the physics at hand
+/// and the error against it: the committed one for bending as built, one computed (and cached)
+/// for ν = 0.49; a swinging run is measured by its last-second mean, and says so.
+#[test]
+fn simulate_and_static_report_the_reference_of_the_physics_at_hand() {
+    let cache = std::env::temp_dir().join(format!("hox-reference-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&cache);
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_hox")).args(args).env("HOX_CACHE_DIR", &cache).output().unwrap();
+        assert!(out.status.success(), "hox {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let built = run(&["simulate", "--scene", "bending", "--seconds", "0.5", "--json"]);
+    assert_eq!(built["reference"]["origin"], "committed");
+    assert!(built["reference"]["label"].as_str().unwrap().contains("ν = 0.35"), "{}", built["reference"]);
+    assert!(built["error_of"].as_str().unwrap().contains("last-second mean"), "{}", built["error_of"]);
+    assert!(built["error_m"].as_f64().unwrap() > 0.0);
+    // another ν: a reference computed for it (small levels keep the debug test quick)
+    let args =
+        ["static", "--scene", "bending", "--element", "p2", "--poisson", "0.49", "--reference-cells", "64", "--json"];
+    let soft = run(&args);
+    let r = &soft["reference"];
+    assert_eq!((r["origin"].as_str(), r["poisson_ratio"].as_f64()), (Some("computed"), Some(0.49)), "{r}");
+    assert!(r["estimated_error_pct"].as_f64().is_some() && r["label"].as_str().unwrap().contains("ν = 0.49"), "{r}");
+    assert!(soft["error_of"].as_str().unwrap().contains("discretisation"));
+    let cached: Vec<_> = std::fs::read_dir(&cache).expect("the reference was cached").collect();
+    assert_eq!(cached.len(), 1);
+    // the second time it comes from the cache: the same reference
+    assert_eq!(run(&args)["reference"], *r);
+    let _ = std::fs::remove_dir_all(&cache);
+    fails_with(&["static", "--scene", "bending", "--reference-cells", "8"], "--reference-cells");
+    let none = json(&["simulate", "--scene", "bending", "--seconds", "0.1", "--no-reference", "--json"]);
+    assert!(none["reference"].is_null() && none["error_m"].is_null());
+}

@@ -43,12 +43,21 @@ fn motion(h_secs: f64, secs: f64) -> Result<(Motion, Vec<[f64; 3]>, f64, u64), B
         }
         tip_m.push(probe(&instance));
         if (k + 1) % 30 == 0 {
-            eprintln!("h = {h_secs:.3e} s: {:.2} s simulated, {:.0} s wall", newmark.time_secs(), started.elapsed().as_secs_f64());
+            eprintln!(
+                "h = {h_secs:.3e} s: {:.2} s simulated, {:.0} s wall",
+                newmark.time_secs(),
+                started.elapsed().as_secs_f64()
+            );
         }
     }
     let tip_z_m = tip_m.iter().map(|u| u.z).collect();
     let tip_xyz = tip_m.iter().map(|u| [u.x, u.y, u.z]).collect();
-    Ok((Motion { sample_secs: 1.0 / SAMPLE_HZ, tip_z_m }, tip_xyz, started.elapsed().as_secs_f64(), newmark.counters().solver_iterations))
+    Ok((
+        Motion { sample_secs: 1.0 / SAMPLE_HZ, tip_z_m },
+        tip_xyz,
+        started.elapsed().as_secs_f64(),
+        newmark.counters().solver_iterations,
+    ))
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -7,14 +7,16 @@
 
 pub mod bench;
 pub mod params;
+pub mod reference;
 pub mod run;
 pub mod scene;
 pub mod study;
 
 pub use params::{Params, SceneOverrides};
 pub use run::{
-    RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_EQUILIBRIUM_FRAMES, SETTLE_FRAMES, SETTLE_KINETIC_REL,
-    SETTLE_RESIDUAL_REL, median, run, run_observed,
+    RestWatch, RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_DAMPING_NAME, SETTLE_EQUILIBRIUM_FRAMES, SETTLE_FRAMES,
+    SETTLE_KINETIC_REL, SETTLE_RESIDUAL_REL, SettleState, Settler, driven_until_secs, in_equilibrium, median, run,
+    run_observed,
 };
 pub use scene::{Drive, NodeSelector, Scene, SceneFile, SceneMesh};
 

@@ -15,7 +15,7 @@
 
 use crate::scene::EffectSpec;
 use crate::{Instance, SceneError};
-use hox_sim::effect::Damping;
+use hox_sim::effect::{Damping, Effect};
 use std::time::Instant;
 
 /// Consecutive quiet frames that count as settled.
@@ -144,33 +144,21 @@ pub fn run_observed(
             }
         }
         RunMode::Settle { cap_secs } => {
-            let damping = instance.scene.params().settle_damping_per_sec;
-            if damping > 0.0 {
-                instance.sim.add_effect(Box::new(Damping { rate_per_sec: damping })).map_err(fail)?;
-            }
-            // a warm-started run (positions set by the caller) has its drives already applied
-            let driven_until =
-                if instance.sim.time_secs() > 0.0 { 0.0 } else { driven_until_secs(&instance.scene.file.effects) };
-            let (lo, hi) = instance.sim.mesh().bounding_box();
-            let tolerance_m = SETTLE_TOLERANCE_REL * (hi - lo).norm();
-            let (mut quiet, mut balanced) = (0, 0);
-            let mut before = instance.sim.positions.clone();
-            let give_up_at = instance.sim.time_secs() + cap_secs;
-            while instance.sim.time_secs() < give_up_at {
+            let mut settler = Settler::start(instance, cap_secs)?;
+            loop {
                 step(instance)?;
-                let moved = instance.sim.positions.iter().zip(&before).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-                before.copy_from_slice(&instance.sim.positions);
-                let driving = instance.sim.time_secs() < driven_until;
-                quiet = if moved < tolerance_m && !driving { quiet + 1 } else { 0 };
-                balanced = if !driving && in_equilibrium(instance) { balanced + 1 } else { 0 };
                 progress(instance.sim.time_secs(), None);
-                if balanced >= SETTLE_EQUILIBRIUM_FRAMES {
-                    (settled, at_rest) = (true, true);
-                    break;
-                }
-                if quiet >= SETTLE_FRAMES {
-                    at_rest = true;
-                    break;
+                match settler.check(instance) {
+                    SettleState::Running => {}
+                    SettleState::Settled => {
+                        (settled, at_rest) = (true, true);
+                        break;
+                    }
+                    SettleState::AtRest => {
+                        at_rest = true;
+                        break;
+                    }
+                    SettleState::GaveUp => break,
                 }
             }
         }
@@ -202,8 +190,135 @@ pub fn run_observed(
     })
 }
 
+/// How a settling run stands after a frame ([`Settler::check`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SettleState {
+    Running,
+    /// In equilibrium (residual and kinetic energy below their limits).
+    Settled,
+    /// At rest but not in equilibrium.
+    AtRest,
+    /// The cap was reached.
+    GaveUp,
+}
+
+/// Velocity damping added for settling only: a [`Damping`] under its own name, so that it can be
+/// removed again without touching a damping the scene lists.
+struct SettleDamping(Damping);
+
+/// The name of the settling damping effect.
+pub const SETTLE_DAMPING_NAME: &str = "settle damping";
+
+impl Effect for SettleDamping {
+    fn name(&self) -> &'static str {
+        SETTLE_DAMPING_NAME
+    }
+    fn implicit_role(&self) -> hox_sim::effect::ImplicitRole {
+        self.0.implicit_role()
+    }
+    fn after_velocity_update(&mut self, s: &mut hox_sim::effect::EffectState<'_>) {
+        self.0.after_velocity_update(s)
+    }
+}
+
+/// Counts quiet frames and frames in equilibrium (module docs), a frame at a time: what
+/// [`Settler`] stops on and what the app's readout calls settled.
+#[derive(Clone, Debug)]
+pub struct RestWatch {
+    /// Consecutive frames in which every node moved less than the tolerance.
+    pub quiet_frames: usize,
+    /// Consecutive frames in equilibrium ([`in_equilibrium`]).
+    pub balanced_frames: usize,
+    before: Vec<hox_sim::Vec3>,
+    tolerance_m: f64,
+}
+
+impl RestWatch {
+    pub fn new(instance: &Instance) -> RestWatch {
+        let (lo, hi) = instance.sim.mesh().bounding_box();
+        RestWatch {
+            quiet_frames: 0,
+            balanced_frames: 0,
+            before: instance.sim.positions.clone(),
+            tolerance_m: SETTLE_TOLERANCE_REL * (hi - lo).norm(),
+        }
+    }
+
+    /// After a frame; `driving`: a prescribed motion is still under way (nothing counts).
+    pub fn observe(&mut self, instance: &Instance, driving: bool) {
+        let positions = &instance.sim.positions;
+        if positions.len() != self.before.len() {
+            *self = RestWatch::new(instance);
+            return;
+        }
+        let moved = positions.iter().zip(&self.before).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        self.before.copy_from_slice(positions);
+        self.quiet_frames = if moved < self.tolerance_m && !driving { self.quiet_frames + 1 } else { 0 };
+        self.balanced_frames = if !driving && in_equilibrium(instance) { self.balanced_frames + 1 } else { 0 };
+    }
+
+    /// Settled in equilibrium ([`SETTLE_EQUILIBRIUM_FRAMES`] frames in equilibrium).
+    pub fn settled(&self) -> bool {
+        self.balanced_frames >= SETTLE_EQUILIBRIUM_FRAMES
+    }
+
+    /// At rest ([`SETTLE_FRAMES`] quiet frames), in equilibrium or not.
+    pub fn at_rest(&self) -> bool {
+        self.settled() || self.quiet_frames >= SETTLE_FRAMES
+    }
+}
+
+/// Settling a frame at a time (module docs): [`run`]'s `RunMode::Settle` and the app's *Settle*
+/// action. The caller steps frames and asks [`Settler::check`] after each.
+pub struct Settler {
+    watch: RestWatch,
+    give_up_at: f64,
+    driven_until: f64,
+}
+
+impl Settler {
+    /// Adds the scene's settle damping to `instance` and starts counting.
+    pub fn start(instance: &mut Instance, cap_secs: f64) -> Result<Settler, SceneError> {
+        let damping = instance.scene.params().settle_damping_per_sec;
+        if damping > 0.0 && !instance.sim.effects().iter().any(|e| e.name() == SETTLE_DAMPING_NAME) {
+            instance.sim.add_effect(Box::new(SettleDamping(Damping { rate_per_sec: damping }))).map_err(|e| {
+                SceneError::Simulation { source_name: instance.scene.source.clone(), message: e.to_string() }
+            })?;
+        }
+        // a warm-started run (positions set by the caller) has its drives already applied
+        let driven_until =
+            if instance.sim.time_secs() > 0.0 { 0.0 } else { driven_until_secs(&instance.scene.file.effects) };
+        Ok(Settler { watch: RestWatch::new(instance), give_up_at: instance.sim.time_secs() + cap_secs, driven_until })
+    }
+
+    /// After a frame: has the run settled, come to rest, or reached its cap?
+    pub fn check(&mut self, instance: &Instance) -> SettleState {
+        self.watch.observe(instance, instance.sim.time_secs() < self.driven_until);
+        if self.watch.settled() {
+            SettleState::Settled
+        } else if self.watch.at_rest() {
+            SettleState::AtRest
+        } else if instance.sim.time_secs() >= self.give_up_at {
+            SettleState::GaveUp
+        } else {
+            SettleState::Running
+        }
+    }
+
+    /// Simulated seconds left before the cap.
+    pub fn secs_left(&self, instance: &Instance) -> f64 {
+        (self.give_up_at - instance.sim.time_secs()).max(0.0)
+    }
+
+    /// Removes the settle damping [`Settler::start`] added (the app's settled state keeps
+    /// swinging freely when played on).
+    pub fn stop(self, instance: &mut Instance) {
+        instance.sim.remove_effects_named(SETTLE_DAMPING_NAME);
+    }
+}
+
 /// Whether the state is in equilibrium: static residual and kinetic energy below their limits.
-fn in_equilibrium(instance: &Instance) -> bool {
+pub fn in_equilibrium(instance: &Instance) -> bool {
     let kinetic = instance.sim.kinetic_energy_j();
     kinetic <= SETTLE_KINETIC_REL * instance.sim.elastic_energy_j().max(f64::MIN_POSITIVE)
         && instance.sim.static_residual().relative <= SETTLE_RESIDUAL_REL
@@ -212,7 +327,7 @@ fn in_equilibrium(instance: &Instance) -> bool {
 pub use hox_sim::measure::median;
 
 /// Time after which no listed effect drives motion any more (ramps done, planes stopped).
-fn driven_until_secs(effects: &[EffectSpec]) -> f64 {
+pub fn driven_until_secs(effects: &[EffectSpec]) -> f64 {
     effects
         .iter()
         .map(|e| match e {

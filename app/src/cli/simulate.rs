@@ -1,6 +1,6 @@
 //! `hox simulate`: run a scene for a time or until it settles and print the probe displacements.
 
-use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, gmsh, load_scene, note_stability, overrides};
+use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, gmsh, load_scene, note_stability, overrides, reference};
 use anyhow::{Result, bail};
 use hox_scenes::{Instance, RunMode};
 
@@ -11,8 +11,10 @@ pub fn simulate(
     seconds: Option<f64>,
     settle: bool,
     vtk: &gmsh::VtkArgs,
+    reference_args: &reference::ReferenceArgs,
     json: bool,
 ) -> Result<()> {
+    reference::check(reference_args)?;
     let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
     let mode = if settle {
         RunMode::SETTLE
@@ -48,6 +50,17 @@ pub fn simulate(
     bar.bar.finish_and_clear();
     let groups = instance.group_displacements();
     let vtk_index = vtk_writer.map(|w| w.finish(&instance)).transpose()?;
+    // the error of the state the run ended in when at rest, else of its last-second mean (an
+    // instantaneous value of a swinging body says little about its accuracy)
+    let found = reference::find(reference_args, &instance.scene);
+    let (compared, of) = if report.settled || report.at_rest {
+        (&report.probes, if report.settled { "settled state" } else { "state at rest" })
+    } else if settle {
+        (&report.probes_last_second_mean, "last-second mean (not settled)")
+    } else {
+        (&report.probes_last_second_mean, "last-second mean (still moving; --settle for the equilibrium)")
+    };
+    let compared: Vec<(String, [f64; 3])> = compared.iter().map(|(n, u)| (n.clone(), *u)).collect();
     if json {
         let mut out = serde_json::to_value(&report)?;
         if !groups.is_empty() {
@@ -58,6 +71,7 @@ pub fn simulate(
         }
         out["substeps_per_frame"] = stability.substeps.into();
         out["h_omega_max"] = stability.requested_h_omega.into();
+        reference::json(&mut out, found.as_ref(), &compared, of);
         println!("{out}");
     } else {
         println!(
@@ -88,6 +102,7 @@ pub fn simulate(
             "  kinetic energy {:.6e} J, elastic energy {:.6e} J",
             report.kinetic_energy_j, report.elastic_energy_j
         );
+        reference::print(found.as_ref(), &compared, of);
         if let Some(index) = &vtk_index {
             println!("  ParaView series: {}", index.display());
         }

@@ -1,6 +1,6 @@
 //! `hox static`: a scene's static equilibrium by Newton's method (the reference XPBD settles to).
 
-use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, load_scene, overrides};
+use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, load_scene, overrides, reference};
 use anyhow::{Result, bail};
 use std::time::Instant;
 
@@ -10,6 +10,7 @@ pub fn static_command(
     physics: &PhysicsArgs,
     tolerance: f64,
     load_steps: usize,
+    reference_args: &reference::ReferenceArgs,
     json: bool,
 ) -> Result<()> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
@@ -18,6 +19,7 @@ pub fn static_command(
     if load_steps == 0 {
         bail!("--load-steps must be at least 1");
     }
+    reference::check(reference_args)?;
     let scene = load_scene(scene)?.with_overrides(&overrides(mesh, Some(physics)))?;
     let m = scene.build_mesh()?;
     let started = Instant::now();
@@ -38,7 +40,11 @@ pub fn static_command(
         probes.insert(p.name.clone(), [u.x, u.y, u.z]);
     }
     let groups = scene.group_displacements(&solution.positions);
-    let out = serde_json::json!({
+    // a mesh file's reference would be this very solution: its error is the mesh's, unknown here
+    let found = if scene.is_box() { reference::find(reference_args, &scene) } else { None };
+    let compared: Vec<(String, [f64; 3])> = probes.iter().map(|(n, u)| (n.clone(), *u)).collect();
+    let of = "static solution (the mesh's discretisation error)";
+    let mut out = serde_json::json!({
         "probes": probes,
         "groups": groups,
         "newton_iterations": solution.newton_iterations,
@@ -46,6 +52,7 @@ pub fn static_command(
         "seconds": seconds,
         "dofs": dofs,
     });
+    reference::json(&mut out, found.as_ref(), &compared, of);
     if json {
         println!("{out}");
     } else {
@@ -61,6 +68,7 @@ pub fn static_command(
         for (name, u) in &groups {
             println!("  group {name}: mean u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
         }
+        reference::print(found.as_ref(), &compared, of);
     }
     Ok(())
 }

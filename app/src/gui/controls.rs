@@ -67,6 +67,7 @@ pub fn menu_bar_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         if ui.button("Reset").on_hover_text("Back to the rest shape at t = 0 (R).").clicked() {
             app.reset();
         }
+        settle_button_ui(app, ui);
         ui.label(format!("t = {:.2} s", app.sessions[0].instance.sim.time_secs()));
         if let Some(m) = &app.message {
             ui.separator();
@@ -337,6 +338,16 @@ fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
     }
 }
 
+/// *Settle* (E): run to rest with the settle damping, as `hox simulate --settle` does.
+fn settle_button_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    let settling = app.settling();
+    let text = if settling { "Settling…" } else { "Settle" };
+    let tip = "Run every configuration with the scene's settle damping, as fast as the machine allows, until it is at rest (E); then the readout shows the settled error against the reference, as `hox simulate --settle` does.";
+    if ui.add_enabled(!settling, egui::Button::new(text)).on_hover_text(tip).clicked() {
+        app.settle();
+    }
+}
+
 fn playback_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.heading("Playback");
     ui.horizontal(|ui| {
@@ -354,6 +365,7 @@ fn playback_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         if ui.button("Reset").on_hover_text("Rest shape, t = 0 (R).").clicked() {
             app.reset();
         }
+        settle_button_ui(app, ui);
     });
     ui.horizontal(|ui| {
         let l = label(ui, "Time scale", "Simulated seconds per real second (1 = real time; the simulation slows down by itself when a frame costs more than real time).");

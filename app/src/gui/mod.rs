@@ -7,7 +7,7 @@
 //! invalidates ([`config::Invalidates`]); a value the scene validation refuses leaves the
 //! running simulation untouched and shows the reason next to the control.
 //!
-//! Shortcuts: space play/pause, S single step, R reset. Settings persist across runs.
+//! Shortcuts: space play/pause, S single step, E settle, R reset. Settings persist across runs.
 //!
 //! Where to find things: [`HoxApp`] and its core (scene, compare mode, applying a change,
 //! stepping) here; the window's panels and frame bookkeeping in `window.rs`; opening the window
@@ -25,6 +25,7 @@ mod persist;
 mod playback;
 pub mod plots;
 pub mod raster;
+pub mod readout;
 mod rerun_link;
 mod run;
 pub mod session;
@@ -251,6 +252,21 @@ impl HoxApp {
     /// Something was rebuilt: Rerun loggers must log the new static data.
     fn rebuilt(&mut self) {
         self.generation += 1;
+    }
+
+    /// The *Settle* action (E): every configuration runs with its settle damping, as fast as
+    /// the machine allows, until at rest, then pauses ([`Session::start_settle`]).
+    pub fn settle(&mut self) {
+        self.join_background();
+        for s in &mut self.sessions {
+            s.start_settle();
+        }
+        self.playback.playing = true;
+    }
+
+    /// Whether a *Settle* is under way in any configuration.
+    pub fn settling(&self) -> bool {
+        self.sessions.iter().any(|s| s.settler.is_some())
     }
 
     pub fn reset(&mut self) {

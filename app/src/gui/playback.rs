@@ -15,11 +15,16 @@ pub struct Playback {
     pub(super) frame_budget_secs: f64,
     /// A frame has been shown (the first frame's clock step is not a real interval).
     pub(super) last_clock_frame: bool,
+    /// A *Settle* was under way at the last frame (it pauses when it ends).
+    pub(super) was_settling: bool,
 }
+
+/// Wall time of stepping per displayed frame while settling, ms.
+const SETTLE_STEP_BUDGET_MS: f64 = 50.0;
 
 impl Playback {
     pub(super) fn new(playing: bool, time_scale: f64) -> Playback {
-        Playback { playing, time_scale, frame_budget_secs: 0.0, last_clock_frame: false }
+        Playback { playing, time_scale, frame_budget_secs: 0.0, last_clock_frame: false, was_settling: false }
     }
 
     /// The frames of `frame_secs` due after `real_dt_secs` of real time (at most 4); the
@@ -78,8 +83,17 @@ impl HoxApp {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
-        let (space, s, r) =
-            ctx.input(|i| (i.key_pressed(egui::Key::Space), i.key_pressed(egui::Key::S), i.key_pressed(egui::Key::R)));
+        let (space, s, r, e) = ctx.input(|i| {
+            (
+                i.key_pressed(egui::Key::Space),
+                i.key_pressed(egui::Key::S),
+                i.key_pressed(egui::Key::R),
+                i.key_pressed(egui::Key::E),
+            )
+        });
+        if e {
+            self.settle();
+        }
         if space {
             self.playback.playing = !self.playback.playing;
         }
@@ -95,11 +109,24 @@ impl HoxApp {
     /// Steps as much simulated time as passed in real time × time scale (at most 4 frames per
     /// displayed frame, so a slow configuration slows down instead of freezing the window).
     pub(super) fn advance(&mut self, real_dt_secs: f64) {
+        self.playback.was_settling |= self.settling();
         if !self.playback.playing || self.sessions.iter().all(|s| s.failure.is_some()) {
             self.playback.frame_budget_secs = 0.0;
             return;
         }
         let frame_secs = 1.0 / self.sessions[0].config.frames_per_second;
+        if self.settling() {
+            // settling: as many frames as about 50 ms of stepping allows, whatever the time scale
+            let ms = self.sessions.iter().map(|s| s.ms_per_frame).fold(0.0, f64::max).max(0.05);
+            self.step_or_defer(((SETTLE_STEP_BUDGET_MS / ms) as usize).clamp(1, 400));
+            return;
+        }
+        if self.sessions.iter().any(|s| s.settle_outcome.is_some()) && self.playback.was_settling {
+            // the settle just ended: show the state it reached
+            self.playback.was_settling = false;
+            self.playback.playing = false;
+            return;
+        }
         if self.measure.is_some() {
             // measuring: one simulation frame per displayed frame
             self.step_or_defer(1);

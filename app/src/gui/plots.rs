@@ -2,6 +2,7 @@
 //! study's accuracy-versus-time chart with the running configuration(s) marked.
 
 use super::HoxApp;
+use super::readout::Readout;
 use super::study_chart::{StudyPoint, study_chart_ui};
 use eframe::egui;
 use egui_plot::{Legend, Line, Plot, PlotPoints};
@@ -79,12 +80,12 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                             plot.line(Line::new(name, points));
                         }
                         // the reference displacement, as a dashed level
-                        if let Some((_, r)) = s.reference.iter().find(|(n, _)| *n == probe)
+                        if let Some(r) = s.reference.reference().and_then(|r| r.probes.get(&probe))
                             && k == 0
                         {
                             let t1 = h.time_secs.last().copied().unwrap_or(1.0).max(1e-3);
                             plot.line(
-                                Line::new("reference u_z", PlotPoints::from(vec![[0.0, r.z], [t1, r.z]]))
+                                Line::new("reference u_z", PlotPoints::from(vec![[0.0, r[2]], [t1, r[2]]]))
                                     .style(egui_plot::LineStyle::dashed_loose()),
                             );
                         }
@@ -135,10 +136,17 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 .sessions
                 .iter()
                 .filter_map(|s| {
-                    s.probe_error_m().map(|e| StudyPoint {
-                        label: format!("now: {}", s.label()),
+                    // a settled state or the mean of the motion, never an instantaneous value
+                    let readout = s.readout();
+                    readout.error_with_uncertainty_m().map(|(error_m, uncertainty_m)| StudyPoint {
+                        label: format!(
+                            "now: {} ({})",
+                            s.label(),
+                            if matches!(readout, Readout::Settled { .. }) { "settled" } else { "mean of the motion" }
+                        ),
                         ms_per_frame: s.ms_per_frame,
-                        error_m: e,
+                        error_m,
+                        uncertainty_m,
                     })
                 })
                 .collect();

@@ -1,12 +1,15 @@
 //! One running configuration in the app: the simulation, its display surface, its history for
-//! the plots, and its error against the scene's reference solution.
+//! the plots, its reference solution and its readout against it ([`super::readout`]), and the
+//! *Settle* action.
 //!
 //! A configuration change rebuilds only what it invalidates ([`Invalidates`]): a material or
 //! solver change keeps the current positions and velocities; a mesh change rebuilds from rest.
 
-use hox_scenes::study::motion::Motion;
 use super::config::{self, Config, Invalidates};
+use super::readout::{Readout, ReferenceState, last_oscillation};
+use hox_scenes::study::motion::Motion;
 use hox_scenes::{Instance, Scene};
+use hox_scenes::{RestWatch, SettleState, Settler};
 use hox_sim::Vec3;
 use hox_sim::effect::Attachment;
 use hox_sim::measure::surface::{PointMap, Surface};
@@ -57,8 +60,16 @@ pub struct Session {
     pub instance: Instance,
     pub surface: Surface,
     pub history: History,
-    /// Reference displacement of each probe (the paper scenes'), metres.
-    pub reference: Vec<(String, Vec3)>,
+    /// The reference of the physics on screen (committed, computing or computed).
+    pub reference: ReferenceState,
+    /// Quiet frames and frames in equilibrium (what the readout calls settled).
+    pub rest: RestWatch,
+    /// The *Settle* action under way (settle damping added until at rest).
+    pub settler: Option<Settler>,
+    /// How the last *Settle* ended.
+    pub settle_outcome: Option<SettleState>,
+    /// Simulated time until which prescribed motion is under way (nothing counts as at rest).
+    driven_until_secs: f64,
     /// Wall time of the last frames' stepping, exponentially averaged, milliseconds.
     pub ms_per_frame: f64,
     /// The static residual at the last frame: the unbalanced force on the free nodes relative to
@@ -91,7 +102,9 @@ impl Session {
         let scene = config::resolve(&config, &base)?;
         let instance = Instance::new(scene).map_err(|e| e.to_string())?;
         let surface = Surface::new(instance.sim.mesh(), config.tessellation);
-        let reference = hox_scenes::study::reference(base.name()).unwrap_or_default();
+        let reference = ReferenceState::for_scene(&instance.scene);
+        let rest = RestWatch::new(&instance);
+        let driven_until_secs = hox_scenes::driven_until_secs(&instance.scene.file.effects);
         let mut s = Session {
             base,
             config,
@@ -99,6 +112,10 @@ impl Session {
             surface,
             history: History::default(),
             reference,
+            rest,
+            settler: None,
+            settle_outcome: None,
+            driven_until_secs,
             ms_per_frame: 0.0,
             residual: f64::NAN,
             failure: None,
@@ -133,6 +150,10 @@ impl Session {
                 self.failure = None;
                 self.drag = None;
                 self.attached = None;
+                self.settler = None;
+                self.settle_outcome = None;
+                self.rest = RestWatch::new(&self.instance);
+                self.driven_until_secs = hox_scenes::driven_until_secs(&self.instance.scene.file.effects);
                 self.mesh_changed();
                 self.residual = self.force_residual();
             }
@@ -152,6 +173,8 @@ impl Session {
             self.set_segments(new.tessellation);
         }
         self.config = new;
+        // another ν, E, ρ or model: another equilibrium, another reference
+        self.reference.follow(&self.instance.scene);
         Ok(what)
     }
 
@@ -197,9 +220,13 @@ impl Session {
     pub fn reset(&mut self) {
         self.instance.sim.reset();
         self.instance.sim.remove_effects_named("attachment");
+        self.instance.sim.remove_effects_named(hox_scenes::SETTLE_DAMPING_NAME);
         self.drag = None;
         self.attached = None;
         self.failure = None;
+        self.settler = None;
+        self.settle_outcome = None;
+        self.rest = RestWatch::new(&self.instance);
         self.history = History::default();
         self.record();
     }
@@ -217,11 +244,72 @@ impl Session {
             self.ms_per_frame = if self.ms_per_frame == 0.0 { ms } else { 0.9 * self.ms_per_frame + 0.1 * ms };
             if let Err(e) = result {
                 self.failure = Some(format!("{e} — press Reset (R)"));
+                self.settler = None;
                 break;
             }
             self.record();
+            let driving = self.instance.sim.time_secs() < self.driven_until_secs || self.drag.is_some();
+            self.rest.observe(&self.instance, driving);
+            if let Some(settler) = &mut self.settler {
+                let state = settler.check(&self.instance);
+                if state != SettleState::Running {
+                    if let Some(s) = self.settler.take() {
+                        s.stop(&mut self.instance);
+                    }
+                    self.settle_outcome = Some(state);
+                    break;
+                }
+            }
         }
         self.residual = self.force_residual();
+    }
+
+    /// Starts the *Settle* action: the scene's settle damping until the body is at rest (as
+    /// `hox simulate --settle`), then the damping is removed again.
+    pub fn start_settle(&mut self) {
+        if self.failure.is_some() || self.settler.is_some() {
+            return;
+        }
+        self.settle_outcome = None;
+        match Settler::start(&mut self.instance, hox_scenes::SETTLE_CAP_SECS) {
+            Ok(s) => self.settler = Some(s),
+            Err(e) => self.failure = Some(e.to_string()),
+        }
+    }
+
+    /// The probe readout against the reference: settled, or the mean and amplitude of the
+    /// motion ([`Readout`]).
+    pub fn readout(&self) -> Readout {
+        let Some(r) = self.reference.reference() else {
+            return Readout::NoReference(self.reference.status());
+        };
+        if self.rest.at_rest() {
+            let now = self.instance.probe_displacements();
+            return match (r.error_m(&now), r.error_pct(&now)) {
+                (Some(error_m), Some(error_pct)) => {
+                    Readout::Settled { error_m, error_pct, in_equilibrium: self.rest.settled() }
+                }
+                _ => Readout::NoReference("the reference has none of this scene's probes".into()),
+            };
+        }
+        let Some(first) = self.instance.probes.first() else {
+            return Readout::NoReference("the scene has no probes".into());
+        };
+        let h = &self.history;
+        let Some((mean, amplitude_m, period_secs, before)) = last_oscillation(&h.time_secs, &h.probe_m) else {
+            return Readout::Starting;
+        };
+        let one = |u: [f64; 3]| vec![(first.name.clone(), u)];
+        match (r.error_m(&one(mean)), r.error_pct(&one(mean))) {
+            (Some(error_m), Some(error_pct)) => Readout::Moving {
+                error_m,
+                error_pct,
+                amplitude_m,
+                period_secs,
+                drift_m: before.map(|b| (Vec3::from(mean) - Vec3::from(b)).norm()),
+            },
+            _ => Readout::NoReference(format!("the reference has no probe '{}'", first.name)),
+        }
     }
 
     /// Makes the simulation's mouse attachment match `drag`: replaced when the target moved,
@@ -272,20 +360,6 @@ impl Session {
             return None;
         }
         MOTION.get_or_init(|| hox_scenes::study::motion::reference_motion().ok()).as_ref()
-    }
-
-    /// Largest probe error against the reference, metres (None for scenes without one).
-    pub fn probe_error_m(&self) -> Option<f64> {
-        if self.reference.is_empty() {
-            return None;
-        }
-        let now = self.instance.probe_displacements();
-        let errors: Vec<f64> = self
-            .reference
-            .iter()
-            .filter_map(|(name, r)| now.iter().find(|(n, _)| n == name).map(|(_, u)| (Vec3::from(*u) - r).norm()))
-            .collect();
-        errors.into_iter().reduce(f64::max)
     }
 }
 

@@ -25,6 +25,8 @@ pub struct StudyPoint {
     pub label: String,
     pub ms_per_frame: f64,
     pub error_m: f64,
+    /// ± metres (0 for a settled state), drawn as a vertical bar.
+    pub uncertainty_m: f64,
 }
 
 /// The study's output, as committed.
@@ -277,7 +279,14 @@ pub fn study_chart_ui(ui: &mut egui::Ui, scene: &str, current: &[StudyPoint]) {
         labelled.push(Labelled {
             series: "now".into(),
             at: *p,
-            text: format!("{}\n{:.2} ms per frame, error {:.2e} m", c.label, c.ms_per_frame, c.error_m),
+            text: if c.uncertainty_m > 0.0 {
+                format!(
+                    "{}\n{:.2} ms per frame, error {:.2e} ± {:.1e} m",
+                    c.label, c.ms_per_frame, c.error_m, c.uncertainty_m
+                )
+            } else {
+                format!("{}\n{:.2} ms per frame, error {:.2e} m", c.label, c.ms_per_frame, c.error_m)
+            },
         });
     }
 
@@ -326,6 +335,18 @@ pub fn study_chart_ui(ui: &mut egui::Ui, scene: &str, current: &[StudyPoint]) {
                         .shape(MarkerShape::Diamond),
                 );
                 for (i, (c, p)) in now.iter().enumerate() {
+                    // the uncertainty of a time average, as a vertical bar (log axes: clipped
+                    // at a decade below the value)
+                    if c.uncertainty_m > 0.0 {
+                        let lo = (c.error_m - c.uncertainty_m).max(0.1 * c.error_m).log10();
+                        let hi = (c.error_m + c.uncertainty_m).log10();
+                        plot.line(
+                            egui_plot::Line::new("now", PlotPoints::from(vec![[p[0], lo], [p[0], hi]]))
+                                .id(("now bar", i))
+                                .color(highlight)
+                                .width(2.0),
+                        );
+                    }
                     // a little right of the marker: 0.04 decades
                     let text = egui::RichText::new(&c.label).color(highlight).strong();
                     plot.text(

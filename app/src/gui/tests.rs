@@ -5,6 +5,7 @@ use super::*;
 use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT, Queryable};
+use readout::Readout;
 
 fn harness(args: AppArgs) -> Harness<'static, HoxApp> {
     let app = HoxApp::new(&AppArgs { fresh: true, ..args }, None).expect("the app starts on bending");
@@ -228,4 +229,87 @@ fn a_stiff_material_at_one_substep_runs_under_the_stability_guard_shown_in_the_s
     assert!(!h.state().sessions[0].config.stability_guard);
     assert_eq!(h.state().sessions[0].instance.sim.substeps_per_frame(), 1);
     assert!(!status(&h).contains("(guard)"), "{}", status(&h));
+}
+
+/// Steps the harness until no configuration is settling (at most `max_steps` displayed frames).
+fn settle_all(h: &mut Harness<'_, HoxApp>, max_steps: usize) {
+    for _ in 0..max_steps {
+        h.run_steps(1);
+        if !h.state().settling() {
+            break;
+        }
+    }
+    assert!(!h.state().settling(), "still settling after {max_steps} displayed frames");
+    h.run_steps(2);
+}
+
+/// Issue #20: compare P1 (1,280) with P2 (160), press E (*Settle*): each readout is the settled
+/// error, within 5 % of what `hox simulate --settle` reports for the same configuration, and the
+/// app pauses on the settled state.
+#[test]
+fn settle_shows_the_settled_errors_that_simulate_settle_gives() {
+    let mut h = harness(AppArgs { compare: true, ..Default::default() });
+    h.run_steps(2);
+    h.key_press(egui::Key::E);
+    settle_all(&mut h, 3000);
+    assert!(!h.state().playback.playing, "the app pauses on the settled state");
+    for s in &h.state().sessions {
+        assert!(matches!(s.settle_outcome, Some(hox_scenes::SettleState::Settled | hox_scenes::SettleState::AtRest)));
+        let readout = s.readout();
+        let Readout::Settled { error_m, .. } = readout else { panic!("{}: {readout:?}", s.label()) };
+        // what the command line does: `hox simulate --settle` on the same configuration
+        let mut instance = hox_scenes::Instance::new(s.instance.scene.clone()).unwrap();
+        let report = hox_scenes::run(&mut instance, hox_scenes::RunMode::SETTLE, &mut |_, _| {}).unwrap();
+        let probes: Vec<(String, [f64; 3])> = report.probes.into_iter().collect();
+        let expected = s.reference.reference().unwrap().error_m(&probes).unwrap();
+        assert!(
+            (error_m - expected).abs() <= 0.05 * expected,
+            "{}: app {error_m:e} m, simulate {expected:e} m",
+            s.label()
+        );
+        assert!(!s.instance.sim.effects().iter().any(|e| e.name() == hox_scenes::SETTLE_DAMPING_NAME));
+    }
+    let (p1, p2) = (&h.state().sessions[0], &h.state().sessions[1]);
+    let e = |s: &Session| s.readout().error_with_uncertainty_m().unwrap().0;
+    // settled, P2 160 is far nearer the reference than P1 1,280 (about 1.3 mm against 5.4 cm)
+    assert!(e(p1) > 10.0 * e(p2), "P1 {} vs P2 {}", e(p1), e(p2));
+    assert_eq!(h.query_all_by_label_contains("settled error").count(), 2, "both status lines say settled");
+}
+
+/// Issue #20: a swinging beam's readout is the mean of its last oscillation, never the
+/// instantaneous distance, and says it is moving.
+#[test]
+fn a_swinging_beam_reads_out_the_mean_of_its_motion() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(1);
+    h.state_mut().step(150);
+    h.run_steps(1);
+    let s = &h.state().sessions[0];
+    let Readout::Moving { error_m, amplitude_m, period_secs, .. } = s.readout() else { panic!("{:?}", s.readout()) };
+    // the tip swings about 0.3 m around its sag; the mean is much nearer the reference than
+    // the swing (an instantaneous value would be off by up to the amplitude)
+    assert!(amplitude_m > 0.2 && error_m < 0.1 * amplitude_m, "error {error_m}, amplitude {amplitude_m}");
+    assert!((0.7..1.2).contains(&period_secs), "{period_secs}");
+    assert!(status(&h).contains("moving: mean error"), "{}", status(&h));
+}
+
+/// Issue #20: at ν = 0.49 the reference is computed for ν = 0.49 (in the background, with
+/// progress), not the committed ν = 0.35 one; back at ν = 0.35 the committed one returns.
+#[test]
+fn the_reference_follows_the_poisson_ratio() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    let committed = h.state().sessions[0].reference.reference().cloned().expect("bending's committed reference");
+    assert_eq!(committed.origin, hox_scenes::reference::Origin::Committed);
+    type_into(&mut h, "Poisson ratio ν", "0.49");
+    assert_eq!(h.state().sessions[0].instance.sim.material().poisson_ratio, 0.49);
+    assert!(h.state().sessions[0].reference.reference().is_none(), "the ν = 0.35 reference is withdrawn at once");
+    h.state_mut().sessions[0].reference.wait();
+    h.run_steps(2);
+    let r = h.state().sessions[0].reference.reference().cloned().expect("computed");
+    assert_eq!((r.origin, r.poisson_ratio), (hox_scenes::reference::Origin::Computed, 0.49));
+    assert!(r.probes["tip"][2] > committed.probes["tip"][2], "a nearly incompressible beam sags less");
+    assert!(r.estimated_error_m.is_some());
+    type_into(&mut h, "Poisson ratio ν", "0.35");
+    assert_eq!(h.state().sessions[0].reference.reference(), Some(&committed));
 }

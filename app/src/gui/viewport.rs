@@ -269,9 +269,7 @@ impl Viewport {
                 let top = Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z) + o;
                 if let Some(p) = self.screen_position(top) {
                     let mut text = s.label();
-                    if let Some(e) = s.probe_error_m() {
-                        text += &format!("\nprobe error {} m", crate::recording::format_metres(e));
-                    }
+                    text += &format!("\n{}", s.readout().text());
                     painter.text(
                         p - egui::vec2(0.0, 14.0),
                         egui::Align2::CENTER_BOTTOM,

@@ -43,8 +43,9 @@ impl HoxApp {
                     s.residual,
                     sim.time_secs()
                 );
-                if let Some(e) = s.probe_error_m() {
-                    text += &format!(", probe error {} m", crate::recording::format_metres(e));
+                text += &format!(", {}", s.readout().text());
+                if s.settler.is_some() {
+                    text += " (settling…)";
                 }
                 let raised = sim.substeps_per_frame() > s.config.substeps;
                 if raised {
@@ -78,6 +79,15 @@ impl HoxApp {
         let now = Instant::now();
         self.times.frame_started(now);
         self.join_background();
+        // a reference computed in the background arrives; until then its progress is shown
+        let mut computing = false;
+        for s in &mut self.sessions {
+            s.reference.poll();
+            computing |= matches!(s.reference, super::readout::ReferenceState::Computing { .. });
+        }
+        if computing {
+            ctx.request_repaint_after(std::time::Duration::from_millis(250));
+        }
         self.shortcuts(&ctx);
         // Simulated time follows egui's clock (the window's: wall time between frames; the
         // headless tests': exactly their step), never the wall clock read here, so a test plays

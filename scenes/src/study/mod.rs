@@ -147,23 +147,8 @@ pub fn reference(scene: &str) -> Result<Vec<(String, Vec3)>, SceneError> {
         name: scene.to_string(),
         available: "bending, tension, torsion".into(),
     })?;
-    let bad = |m: &str| SceneError::Parse {
-        source_name: format!("assets/reference/{scene}-fine.json"),
-        message: m.to_string(),
-    };
-    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(&e.to_string()))?;
-    let probes = v["probes"].as_object().ok_or_else(|| bad("no probes"))?;
-    probes
-        .iter()
-        .map(|(name, u)| {
-            let c: Vec<f64> =
-                u.as_array().ok_or_else(|| bad("probe is not an array"))?.iter().filter_map(|x| x.as_f64()).collect();
-            if c.len() != 3 {
-                return Err(bad("probe needs three components"));
-            }
-            Ok((name.clone(), Vec3::new(c[0], c[1], c[2])))
-        })
-        .collect()
+    let probes = crate::reference::parse_probes(text, &format!("assets/reference/{scene}-fine.json"))?;
+    Ok(probes.into_iter().map(|(name, u)| (name, Vec3::from(u))).collect())
 }
 
 /// Largest distance between two probe sets (matched by name).

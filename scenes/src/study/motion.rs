@@ -94,7 +94,9 @@ pub fn parse_motion(text: &str, source_name: &str) -> Result<Motion, SceneError>
         .as_array()
         .ok_or_else(|| bad("no tip_z_m array"))?
         .iter()
-        .map(|x| x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| bad("tip_z_m holds a value that is not a finite number")))
+        .map(|x| {
+            x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| bad("tip_z_m holds a value that is not a finite number"))
+        })
         .collect::<Result<_, _>>()?;
     if tip_z_m.len() < 3 {
         return Err(bad("tip_z_m needs at least three samples"));
@@ -186,6 +188,18 @@ mod tests {
         assert!(err.contains("m.json") && err.contains("finite"), "{err}");
         let err = parse_motion(r#"{"tip_z_m": [0, 1, 2]}"#, "m.json").unwrap_err().to_string();
         assert!(err.contains("sample_secs"), "{err}");
+    }
+
+    /// The summary figures the reference file states are those of its own trace (a rerun of
+    /// the example after a change of definition rewrites both).
+    #[test]
+    fn the_committed_reference_motion_states_the_metrics_of_its_own_trace() {
+        let v: serde_json::Value = serde_json::from_str(REFERENCE_MOTION_JSON).unwrap();
+        let m = reference_motion().unwrap().metrics();
+        let stated = |key: &str| v[key].as_f64().unwrap_or_else(|| panic!("no {key}"));
+        assert!((stated("period_secs") - m.period_secs.unwrap()).abs() < 1e-12, "{m:?}");
+        assert!((stated("amplitude_m") - m.amplitude_m.unwrap()).abs() < 1e-12, "{m:?}");
+        assert_eq!(stated("amplitude_at_secs"), AMPLITUDE_AT_SECS);
     }
 
     #[test]

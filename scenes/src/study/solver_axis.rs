@@ -180,9 +180,9 @@ fn config_rows(
     progress(&format!("solvers: {scene_name} {label}: static solution"));
     let instance = Instance::new(scene.clone())?;
     let mesh = instance.sim.mesh();
-    let statics = pool.install(|| crate::solve_static(&scene, mesh, 1e-8, 1, &mut |_, _, _| {})).map_err(|e| {
-        SceneError::Simulation { source_name: format!("{scene_name} {label}"), message: e.to_string() }
-    })?;
+    let statics = pool
+        .install(|| crate::solve_static(&scene, mesh, 1e-8, 1, &mut |_, _, _| {}))
+        .map_err(|e| SceneError::Simulation { source_name: format!("{scene_name} {label}"), message: e.to_string() })?;
     let static_probes = probes_of(&instance, &statics.positions);
     let static_size = static_probes.iter().map(|(_, u)| u.norm()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
     let discretisation_pct = 100.0 * probe_distance(&static_probes, &reference) / reference_size;
@@ -221,7 +221,8 @@ fn config_rows(
             Ok(())
         };
         let cap_secs = settle_cap_secs(config.heavy);
-        let settle = pool.install(|| run_observed(&mut settling, RunMode::Settle { cap_secs }, &mut |_, _| {}, &mut on_frame));
+        let settle =
+            pool.install(|| run_observed(&mut settling, RunMode::Settle { cap_secs }, &mut |_, _| {}, &mut on_frame));
         let report = match settle {
             Ok(r) => r,
             Err(e) => {
@@ -384,7 +385,10 @@ pub fn cheapest_sentence(rows: &[SolverRow], scene: &str) -> String {
             let budget = if r.ms_per_frame <= REAL_TIME_MS {
                 format!("within the {REAL_TIME_MS:.1} ms of 60 frames per second on one thread")
             } else {
-                format!("{:.1}× the {REAL_TIME_MS:.1} ms of 60 frames per second on one thread", r.ms_per_frame / REAL_TIME_MS)
+                format!(
+                    "{:.1}× the {REAL_TIME_MS:.1} ms of 60 frames per second on one thread",
+                    r.ms_per_frame / REAL_TIME_MS
+                )
             };
             format!(
                 "**{scene}**: the cheapest configuration within {TARGET_ERROR_PCT} % of the reference is **{} with {}** ({} elements): {:.2} % total error ({:.2} % of it the mesh's), {:.2} ms per frame — {budget}; from rest it is within 1 % of its static solution after {} s of wall time.",
@@ -437,9 +441,20 @@ pub fn solver_csv(rows: &[SolverRow]) -> String {
 /// The marker of a solver in the chart: XPBD circles, VBD squares, Newton triangles.
 fn marker(r: &SolverRow, x: f64, y: f64, fill: &str, title: &str) -> String {
     if r.solver.starts_with("vbd") {
-        format!(r#"<rect x="{}" y="{}" width="10" height="10" fill="{fill}"><title>{title}</title></rect>"#, x - 5.0, y - 5.0)
+        format!(
+            r#"<rect x="{}" y="{}" width="10" height="10" fill="{fill}"><title>{title}</title></rect>"#,
+            x - 5.0,
+            y - 5.0
+        )
     } else if r.solver.starts_with("newton") {
-        format!(r#"<path d="M{x} {} L{} {} L{} {} Z" fill="{fill}"><title>{title}</title></path>"#, y - 6.0, x + 6.0, y + 5.0, x - 6.0, y + 5.0)
+        format!(
+            r#"<path d="M{x} {} L{} {} L{} {} Z" fill="{fill}"><title>{title}</title></path>"#,
+            y - 6.0,
+            x + 6.0,
+            y + 5.0,
+            x - 6.0,
+            y + 5.0
+        )
     } else {
         format!(r#"<circle cx="{x}" cy="{y}" r="4.5" fill="{fill}"><title>{title}</title></circle>"#)
     }
@@ -526,7 +541,10 @@ pub fn pareto_svg(rows: &[SolverRow], scene: &str) -> String {
         ));
     }
     for r in &points {
-        let title = format!("{} {}: {:.2} ms, {:.3} % ({} % the mesh's)", r.config, r.solver, r.ms_per_frame, r.error_pct, format!("{:.2}", r.discretisation_pct));
+        let title = format!(
+            "{} {}: {:.2} ms, {:.3} % ({:.2} % the mesh's)",
+            r.config, r.solver, r.ms_per_frame, r.error_pct, r.discretisation_pct
+        );
         s.push_str(&marker(r, px(r.ms_per_frame), py(r.error_pct), &colour(&r.element), &title));
         s.push('\n');
     }
@@ -642,7 +660,11 @@ mod tests {
 
     #[test]
     fn the_chart_draws_every_solver_marker_and_the_frontier() {
-        let rows = vec![row("a", "xpbd 50x1", 2.0, 1.5, 1.8), row("b", "vbd", 4.0, 0.4, 0.2), row("c", "newton", 9.0, 0.1, 0.05)];
+        let rows = vec![
+            row("a", "xpbd 50x1", 2.0, 1.5, 1.8),
+            row("b", "vbd", 4.0, 0.4, 0.2),
+            row("c", "newton", 9.0, 0.1, 0.05),
+        ];
         let svg = pareto_svg(&rows, "bending");
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         assert!(svg.contains("class=\"pareto\"") && svg.contains("<rect x=") && svg.contains(" Z\""));

@@ -196,7 +196,10 @@ mod tests {
                 drift = drift.max((total_energy_j(&sim) - e0).abs());
             }
             assert!(peak_kinetic > 0.0, "{et}: the cantilever must move");
-            assert!(drift < 1e-3 * peak_kinetic, "{et}: energy drift {drift:.2e} J against a peak KE {peak_kinetic:.2e} J");
+            assert!(
+                drift < 1e-3 * peak_kinetic,
+                "{et}: energy drift {drift:.2e} J against a peak KE {peak_kinetic:.2e} J"
+            );
         }
     }
 

@@ -1,0 +1,76 @@
+//! The reference a run's error is measured against ([`hox_scenes::reference`]): committed for
+//! a paper scene as built, computed (and cached) for other physics, the static solution of the
+//! mesh itself for a mesh file. `simulate` and `static` report it and the error against it.
+
+use super::DelayedBar;
+use clap::Args;
+use hox_scenes::Scene;
+use hox_scenes::reference::{Origin, Reference};
+
+#[derive(Args, Clone, Debug)]
+pub struct ReferenceArgs {
+    /// Report no reference and no error. Otherwise the error is measured against the committed
+    /// reference when the physics are a paper scene's as built, or against one computed with
+    /// hox's static solver on three Q2 levels (seconds to minutes the first time; cached in
+    /// ~/.cache/hox/references, or HOX_CACHE_DIR), or for a mesh file against its own static
+    /// solution.
+    #[arg(long)]
+    pub no_reference: bool,
+    /// Cells of the finest Q2 level of a computed reference (the coarser two have a half and a
+    /// quarter as many per direction): more, a better reference at more cost.
+    #[arg(long, default_value_t = hox_scenes::reference::FINEST_CELLS)]
+    pub reference_cells: usize,
+}
+
+/// Refuses bad reference options before anything runs.
+pub fn check(args: &ReferenceArgs) -> anyhow::Result<()> {
+    if args.reference_cells < 64 {
+        anyhow::bail!("--reference-cells must be at least 64 (four cells per direction), got {}", args.reference_cells);
+    }
+    Ok(())
+}
+
+/// The reference of `scene`, or None (skipped, unavailable or failed: said on stderr).
+pub fn find(args: &ReferenceArgs, scene: &Scene) -> Option<Reference> {
+    if args.no_reference {
+        return None;
+    }
+    if let Some(why) = hox_scenes::reference::unavailable(scene) {
+        eprintln!("note: no reference: {why}");
+        return None;
+    }
+    let mut bar = DelayedBar::new();
+    let lookup = hox_scenes::reference::Lookup { finest_cells: args.reference_cells, ..Default::default() };
+    let found = lookup.for_scene(scene, &mut |what, fraction| {
+        bar.reveal("{spinner} {bar:30} {msg} [{elapsed}]");
+        bar.bar.set_position((1000.0 * fraction) as u64);
+        bar.bar.set_message(what.to_string());
+    });
+    bar.bar.finish_and_clear();
+    match found {
+        Ok(r) => Some(r),
+        Err(e) => {
+            eprintln!("warning: no reference: {e}");
+            None
+        }
+    }
+}
+
+/// `"reference"`, `"error_m"`, `"error_pct"` and `"error_of"` for `--json` (nulls without a
+/// reference).
+pub fn json(out: &mut serde_json::Value, reference: Option<&Reference>, probes: &[(String, [f64; 3])], of: &str) {
+    out["reference"] = reference.map(Reference::to_json).unwrap_or(serde_json::Value::Null);
+    out["error_m"] = reference.and_then(|r| r.error_m(probes)).into();
+    out["error_pct"] = reference.and_then(|r| r.error_pct(probes)).into();
+    out["error_of"] = if reference.is_some() { of.into() } else { serde_json::Value::Null };
+}
+
+/// The human-readable lines: the reference and the error of `of`.
+pub fn print(reference: Option<&Reference>, probes: &[(String, [f64; 3])], of: &str) {
+    let Some(r) = reference else { return };
+    if let (Some(m), Some(pct)) = (r.error_m(probes), r.error_pct(probes)) {
+        let what = if r.origin == Origin::OwnMesh { "solver error" } else { "error" };
+        println!("  {what} of the {of}: {m:.3e} m ({pct:.3} %)");
+    }
+    println!("  reference: {}", r.label());
+}

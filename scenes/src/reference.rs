@@ -1,0 +1,544 @@
+//! What an error is measured against: the reference solution of the configuration at hand.
+//!
+//! A reference is the static equilibrium (probe displacements) of a scene's *physics* — its
+//! geometry, material, loads, boundary conditions and probes; not its mesh, solver, quadrature
+//! or damping, which do not change the exact equilibrium ([`physics_key`]). Three origins:
+//!
+//! - **committed**: the physics of a paper scene as built. The fine Q2 solution in
+//!   `assets/reference/SCENE-fine.json`, its mesh error estimated from the committed coarse and
+//!   medium levels as below.
+//! - **computed**: any other physics on a box mesh (another ν, E, ρ or model, a scene file's own
+//!   loads). hox's static solver ([`crate::solve_static`]) on triquadratic hexahedra (Q2) at
+//!   four levels: the finest ([`levels`]; bending 32×8×8) and a quarter, a half and three
+//!   quarters as many cells per direction. The reference is the finest level extrapolated
+//!   (below) with the order the three finest levels show; its uncertainty is its distance from
+//!   the extrapolation by the halving levels (¼, ½, 1) — two independent estimates of the limit.
+//! - **own mesh**: a scene on a mesh file. The static solution of that same mesh: it measures
+//!   what the solver costs, not what the mesh costs, and is labelled so.
+//!
+//! **Mesh error of a reference** (Richardson extrapolation; Roache, "Perspective: a method for
+//! uniform reporting of grid refinement studies", J. Fluids Eng. 116, 1994): with the
+//! largest probe differences `d₁ = |u₁ − u₂|` and `d₂ = |u₂ − u₃|` between levels of cell sizes
+//! `h₁ > h₂ > h₃`, the observed order `p` solves `d₁/d₂ = (h₁ᵖ − h₂ᵖ)/(h₂ᵖ − h₃ᵖ)` (for a
+//! ratio `r` each time, `p = log_r(d₁/d₂)`), and the finest level's error is
+//! `e₃ ≈ d₂ h₃ᵖ/(h₂ᵖ − h₃ᵖ)` (`d₂/(rᵖ − 1)`); the extrapolated limit is
+//! `u₃ + (u₃ − u₂) h₃ᵖ/(h₂ᵖ − h₃ᵖ)`. When the levels do not converge monotonically
+//! (`d₁ ≤ d₂`) the estimate falls back to `d₂`, the finest level is the reference, and the
+//! estimate says so.
+//!
+//! Computed references are cached by their physics key, in memory and on disk (`HOX_CACHE_DIR`,
+//! else `$XDG_CACHE_HOME/hox` or `~/.cache/hox`, folder `references/`), so a configuration is
+//! solved once per machine.
+
+use crate::scene::EffectSpec;
+use crate::{Scene, SceneError, SceneOverrides};
+use hox_sim::Vec3;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Probe displacements by probe name, metres.
+pub type Probes = BTreeMap<String, [f64; 3]>;
+
+/// Where a reference comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Origin {
+    /// A committed fine solution (`assets/reference/`).
+    Committed,
+    /// Computed on a fine Q2 mesh of the same box, for the physics at hand.
+    Computed,
+    /// The static solution of the scene's own mesh (a mesh file): solver error only.
+    OwnMesh,
+}
+
+/// A reference solution and how good it is.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Reference {
+    pub origin: Origin,
+    /// The probes' displacements, metres.
+    pub probes: Probes,
+    /// The mesh it was solved on, e.g. "Q2 32×8×8".
+    pub mesh: String,
+    /// Estimated mesh error of the reference itself (None for the own-mesh case, whose mesh
+    /// error is not what it measures), metres.
+    pub estimated_error_m: Option<f64>,
+    /// How the estimate was made, e.g. "from three levels, observed order 1.56".
+    pub estimate: String,
+    /// The Poisson ratio it was solved with (shown in the label).
+    pub poisson_ratio: f64,
+}
+
+impl Reference {
+    /// The largest reference probe displacement, metres: what percentages are relative to.
+    pub fn size_m(&self) -> f64 {
+        self.probes.values().map(|u| Vec3::from(*u).norm()).fold(0.0, f64::max)
+    }
+
+    /// The estimated mesh error in % of [`Reference::size_m`].
+    pub fn estimated_error_pct(&self) -> Option<f64> {
+        self.estimated_error_m.map(|e| 100.0 * e / self.size_m().max(f64::MIN_POSITIVE))
+    }
+
+    /// The largest distance between `probes` and the reference's (matched by name; a probe the
+    /// reference lacks is ignored), metres; None when no probe matches.
+    pub fn error_m(&self, probes: &[(String, [f64; 3])]) -> Option<f64> {
+        probes
+            .iter()
+            .filter_map(|(name, u)| self.probes.get(name).map(|r| (Vec3::from(*u) - Vec3::from(*r)).norm()))
+            .reduce(f64::max)
+    }
+
+    /// [`Reference::error_m`] in % of the reference's size.
+    pub fn error_pct(&self, probes: &[(String, [f64; 3])]) -> Option<f64> {
+        self.error_m(probes).map(|e| 100.0 * e / self.size_m().max(f64::MIN_POSITIVE))
+    }
+
+    /// One line for a user: "static, Q2 32×8×8, ν = 0.49, ± 0.31 % (from three levels, observed order 1.6)".
+    pub fn label(&self) -> String {
+        let what = match self.origin {
+            Origin::Committed => "static (committed)",
+            Origin::Computed => "static, computed",
+            Origin::OwnMesh => "static solution of this mesh",
+        };
+        let estimate = match self.estimated_error_pct() {
+            Some(pct) => format!(", ± {pct:.2} % ({})", self.estimate),
+            None => format!(" ({})", self.estimate),
+        };
+        format!("{what}, {}, ν = {}{estimate}", self.mesh, self.poisson_ratio)
+    }
+
+    /// The JSON `simulate --json` and `static --json` report under "reference".
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "origin": self.origin,
+            "label": self.label(),
+            "mesh": self.mesh,
+            "poisson_ratio": self.poisson_ratio,
+            "probes": self.probes,
+            "estimated_error_m": self.estimated_error_m,
+            "estimated_error_pct": self.estimated_error_pct(),
+            "estimate": self.estimate,
+        })
+    }
+}
+
+/// Everything that determines a scene's exact static equilibrium, as canonical text: the box
+/// (or the mesh file's path and size), the material, every effect but damping, and the probes.
+/// The mesh resolution, element, solver, quadrature, damping and display do not enter.
+pub fn physics_key(scene: &Scene) -> String {
+    let p = scene.params();
+    let geometry = match &scene.mesh {
+        crate::SceneMesh::Box(_) => format!("box {:?} {:?}", p.box_min_m, p.box_max_m),
+        crate::SceneMesh::File { path, imported } => {
+            format!("file {} ({} nodes)", path.display(), imported.mesh.num_nodes())
+        }
+    };
+    let effects: Vec<String> = scene
+        .file
+        .effects
+        .iter()
+        .filter(|e| !matches!(e, EffectSpec::Damping { .. }))
+        .map(|e| format!("{e:?}"))
+        .collect();
+    let probes: Vec<String> = scene.file.probes.iter().map(|q| format!("{}@{:?}", q.name, q.point_m)).collect();
+    format!(
+        "{geometry}; material {} E={:e} nu={:e} rho={:e}; effects [{}]; probes [{}]",
+        p.material,
+        p.youngs_modulus_pa,
+        p.poisson_ratio,
+        p.density_kg_m3,
+        effects.join(", "),
+        probes.join(", ")
+    )
+}
+
+/// The committed levels of the paper scenes: (scene, [(grid, JSON text)] coarse to fine).
+const COMMITTED: [(&str, [([usize; 3], &str); 3]); 3] = [
+    (
+        "bending",
+        [
+            ([8, 2, 2], include_str!("../../assets/reference/bending-coarse.json")),
+            ([16, 4, 4], include_str!("../../assets/reference/bending-medium.json")),
+            ([32, 8, 8], include_str!("../../assets/reference/bending-fine.json")),
+        ],
+    ),
+    (
+        "tension",
+        [
+            ([4, 2, 2], include_str!("../../assets/reference/tension-coarse.json")),
+            ([12, 6, 6], include_str!("../../assets/reference/tension-medium.json")),
+            ([24, 12, 12], include_str!("../../assets/reference/tension-fine.json")),
+        ],
+    ),
+    (
+        "torsion",
+        [
+            ([4, 2, 2], include_str!("../../assets/reference/torsion-coarse.json")),
+            ([12, 6, 6], include_str!("../../assets/reference/torsion-medium.json")),
+            ([24, 12, 12], include_str!("../../assets/reference/torsion-fine.json")),
+        ],
+    ),
+];
+
+pub(crate) fn parse_probes(text: &str, source_name: &str) -> Result<Probes, SceneError> {
+    let bad = |m: &str| SceneError::Parse { source_name: source_name.to_string(), message: m.to_string() };
+    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(&e.to_string()))?;
+    let probes = v["probes"].as_object().ok_or_else(|| bad("no probes"))?;
+    probes
+        .iter()
+        .map(|(name, u)| {
+            let c: Vec<f64> =
+                u.as_array().ok_or_else(|| bad("probe is not an array"))?.iter().filter_map(|x| x.as_f64()).collect();
+            match c[..] {
+                [x, y, z] if c.iter().all(|v| v.is_finite()) => Ok((name.clone(), [x, y, z])),
+                _ => Err(bad("a probe needs three finite components")),
+            }
+        })
+        .collect()
+}
+
+/// The committed reference of `scene`, if its physics are a paper scene's as built.
+pub fn committed(scene: &Scene) -> Result<Option<Reference>, SceneError> {
+    let Some((name, levels)) = COMMITTED.iter().find(|(n, _)| *n == scene.name()) else {
+        return Ok(None);
+    };
+    if !scene.is_box() || physics_key(scene) != physics_key(&crate::by_name(name)?) {
+        return Ok(None);
+    }
+    let mut solved = Vec::new();
+    for (k, (grid, text)) in levels.iter().enumerate() {
+        let level = ["coarse", "medium", "fine"][k];
+        let probes = parse_probes(text, &format!("assets/reference/{name}-{level}.json"))?;
+        solved.push((cell_size(scene, *grid), probes));
+    }
+    let (error_m, estimate) = mesh_error(&solved);
+    let fine = levels[2].0;
+    Ok(Some(Reference {
+        origin: Origin::Committed,
+        probes: solved.pop().map(|(_, p)| p).unwrap_or_default(),
+        mesh: format!("Q2 {}×{}×{}", fine[0], fine[1], fine[2]),
+        estimated_error_m: Some(error_m),
+        estimate,
+        poisson_ratio: scene.params().poisson_ratio,
+    }))
+}
+
+/// Representative cell size of a grid on the scene's box: the largest cell extent, metres.
+fn cell_size(scene: &Scene, grid: [usize; 3]) -> f64 {
+    let p = scene.params();
+    (0..3).map(|d| (p.box_max_m[d] - p.box_min_m[d]) / grid[d] as f64).fold(0.0, f64::max)
+}
+
+/// The largest number of Q2 cells of a computed reference's finest level (the committed
+/// bending reference's 32×8×8).
+pub const FINEST_CELLS: usize = 2048;
+
+/// The three Q2 grids of a computed reference on a box, coarse to fine: the finest has cells as
+/// near cubic as a multiple of four per direction allows and about `finest_cells` cells (at
+/// least four per direction); the others have a half and a quarter as many per direction (bending with [`FINEST_CELLS`]: 8×2×2, 16×4×4, 32×8×8).
+pub fn levels(box_min_m: [f64; 3], box_max_m: [f64; 3], finest_cells: usize) -> [[usize; 3]; 3] {
+    let extent: Vec<f64> = (0..3).map(|d| (box_max_m[d] - box_min_m[d]).abs()).collect();
+    let volume: f64 = extent.iter().product();
+    // cells per metre for `finest_cells` cubic cells
+    let per_m = (finest_cells as f64 / volume.max(f64::MIN_POSITIVE)).cbrt();
+    let mut fine = [0usize; 3];
+    for d in 0..3 {
+        fine[d] = 4 * ((per_m * extent[d] / 4.0).round() as usize).clamp(1, 16);
+    }
+    let coarse = fine.map(|n| n / 4);
+    let medium = fine.map(|n| n / 2);
+    [coarse, medium, fine]
+}
+
+/// Largest probe distance between two solutions, metres.
+fn distance(a: &Probes, b: &Probes) -> f64 {
+    a.iter().filter_map(|(n, u)| b.get(n).map(|v| (Vec3::from(*u) - Vec3::from(*v)).norm())).fold(0.0, f64::max)
+}
+
+/// The observed order of convergence of three levels `(cell size, probes)`, coarse to fine
+/// (module docs); None when they do not converge monotonically or the finest two agree.
+pub fn observed_order(levels: &[(f64, Probes); 3]) -> Option<f64> {
+    let [(h1, u1), (h2, u2), (h3, u3)] = levels;
+    let (d1, d2) = (distance(u1, u2), distance(u2, u3));
+    if d2 == 0.0 || d1 <= d2 {
+        return None;
+    }
+    // d1/d2 = (h1^p − h2^p)/(h2^p − h3^p) grows with p: bisection
+    let ratio = |p: f64| (h1.powf(p) - h2.powf(p)) / (h2.powf(p) - h3.powf(p));
+    let (mut lo, mut hi) = (1e-3, 12.0);
+    if ratio(hi) < d1 / d2 {
+        lo = hi;
+    } else if ratio(lo) > d1 / d2 {
+        hi = lo;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if ratio(mid) < d1 / d2 { lo = mid } else { hi = mid }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// Richardson's extrapolation of two levels with order `p`:
+/// `u₃ + (u₃ − u₂) h₃ᵖ/(h₂ᵖ − h₃ᵖ)` per probe component.
+pub fn extrapolate((h2, u2): &(f64, Probes), (h3, u3): &(f64, Probes), p: f64) -> Probes {
+    let w = h3.powf(p) / (h2.powf(p) - h3.powf(p));
+    u3.iter()
+        .map(|(n, f)| {
+            let m = u2.get(n).copied().unwrap_or(*f);
+            (n.clone(), [0, 1, 2].map(|d| f[d] + (f[d] - m[d]) * w))
+        })
+        .collect()
+}
+
+/// The mesh error of the finest of three levels `(cell size, probes)`, coarse to fine, and how
+/// it was estimated (module docs).
+pub fn mesh_error(levels: &[(f64, Probes)]) -> (f64, String) {
+    let [a, b, c] = levels else {
+        return (f64::NAN, "needs three levels".into());
+    };
+    let d2 = distance(&b.1, &c.1);
+    if d2 == 0.0 {
+        return (0.0, "the two finest levels agree exactly".into());
+    }
+    match observed_order(&[a.clone(), b.clone(), c.clone()]) {
+        Some(p) => (distance(&extrapolate(b, c, p), &c.1), format!("from three levels, observed order {p:.2}")),
+        None => (d2, "the difference of the two finest levels; they do not yet converge monotonically".into()),
+    }
+}
+
+/// Progress of a computation: (what is being done, overall fraction 0–1).
+pub type Progress<'p> = &'p mut dyn FnMut(&str, f64);
+
+/// Static tolerance and load steps of a computed reference (as the committed ones).
+const TOLERANCE: f64 = 1e-10;
+const LOAD_STEPS: usize = 10;
+
+/// Computes the reference of a box scene's physics on three Q2 levels ([`levels`] with
+/// [`FINEST_CELLS`]).
+pub fn compute(scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
+    compute_with(scene, FINEST_CELLS, progress)
+}
+
+/// [`compute`] with a finest level of about `finest_cells` cells.
+pub fn compute_with(scene: &Scene, finest_cells: usize, progress: Progress<'_>) -> Result<Reference, SceneError> {
+    let p = scene.params();
+    let [coarse, medium, fine] = levels(p.box_min_m, p.box_max_m, finest_cells);
+    let grids = [coarse, medium, fine.map(|n| 3 * n / 4), fine];
+    let cells: Vec<f64> = grids.iter().map(|g| (g[0] * g[1] * g[2]) as f64).collect();
+    let total: f64 = cells.iter().sum();
+    let mut done = 0.0;
+    let mut solved = Vec::new();
+    for (k, grid) in grids.iter().enumerate() {
+        let o = SceneOverrides {
+            element: Some("q2".into()),
+            grid: Some(*grid),
+            quadrature_degree: Some(None),
+            ..Default::default()
+        };
+        let level = scene.with_overrides(&o)?;
+        let mesh = level.build_mesh()?;
+        let what = format!("reference: static Q2 {}×{}×{} ({} of 4)", grid[0], grid[1], grid[2], k + 1);
+        let solution = crate::solve_static(&level, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
+            progress(&what, (done + fraction * cells[k]) / total)
+        })?;
+        done += cells[k];
+        solved.push((cell_size(scene, *grid), probes_at(&level, &mesh, &solution.positions)?));
+    }
+    let name = format!("Q2 {}×{}×{}", fine[0], fine[1], fine[2]);
+    let triplet = |i: usize, j: usize, k: usize| [solved[i].clone(), solved[j].clone(), solved[k].clone()];
+    // two extrapolations of the finest level, from the halving triplet and from the finest
+    // triplet: the second is the reference, their distance its uncertainty
+    let reference = match (observed_order(&triplet(0, 1, 3)), observed_order(&triplet(1, 2, 3))) {
+        (Some(p_halving), Some(p_finest)) => {
+            let by_halving = extrapolate(&solved[1], &solved[3], p_halving);
+            let by_finest = extrapolate(&solved[2], &solved[3], p_finest);
+            Reference {
+                origin: Origin::Computed,
+                estimated_error_m: Some(distance(&by_halving, &by_finest)),
+                probes: by_finest,
+                mesh: format!("{name} extrapolated"),
+                estimate: format!("Richardson from four levels, order {p_finest:.2}; {p_halving:.2} by halving"),
+                poisson_ratio: p.poisson_ratio,
+            }
+        }
+        _ => {
+            let (error_m, estimate) = mesh_error(&triplet(0, 1, 3));
+            Reference {
+                origin: Origin::Computed,
+                probes: solved[3].1.clone(),
+                mesh: name,
+                estimated_error_m: Some(error_m),
+                estimate,
+                poisson_ratio: p.poisson_ratio,
+            }
+        }
+    };
+    Ok(reference)
+}
+
+/// The displacement of every probe of `scene` at `positions` on `mesh`.
+fn probes_at(scene: &Scene, mesh: &hox_sim::mesh::Mesh, positions: &[Vec3]) -> Result<Probes, SceneError> {
+    scene
+        .file
+        .probes
+        .iter()
+        .map(|q| {
+            let probe = hox_sim::measure::probe::Probe::locate(mesh, &q.name, Vec3::from(q.point_m))
+                .map_err(|e| SceneError::Probe { source_name: scene.source.clone(), message: e.to_string() })?;
+            let u = probe.displacement(positions, &mesh.rest_positions);
+            Ok((q.name.clone(), [u.x, u.y, u.z]))
+        })
+        .collect()
+}
+
+/// The static solution of the scene's own mesh (a mesh file's scene).
+pub fn own_mesh(scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
+    let mesh = scene.build_mesh()?;
+    let solution = crate::solve_static(scene, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
+        progress("reference: static solution of this mesh", fraction)
+    })?;
+    let probes = probes_at(scene, &mesh, &solution.positions)?;
+    Ok(Reference {
+        origin: Origin::OwnMesh,
+        probes,
+        mesh: format!("{} ({} elements)", scene.mesh.element_names(), mesh.num_elements()),
+        estimated_error_m: None,
+        estimate: "measures the solver's error only, not the mesh's".into(),
+        poisson_ratio: scene.params().poisson_ratio,
+    })
+}
+
+/// Why a scene has no reference, if it has none: no probes, or contact (no static counterpart).
+pub fn unavailable(scene: &Scene) -> Option<String> {
+    if scene.file.probes.is_empty() {
+        return Some("the scene has no probes".into());
+    }
+    if scene.file.effects.iter().any(|e| matches!(e, EffectSpec::Contact { .. })) {
+        return Some("contact has no static reference".into());
+    }
+    None
+}
+
+/// The folder computed references are cached in (module docs); None without a home.
+pub fn cache_dir() -> Option<PathBuf> {
+    let base = std::env::var_os("HOX_CACHE_DIR").map(PathBuf::from).or_else(|| {
+        std::env::var_os("XDG_CACHE_HOME")
+            .map(|d| PathBuf::from(d).join("hox"))
+            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache").join("hox")))
+    })?;
+    Some(base.join("references"))
+}
+
+/// FNV-1a, 64 bits: the cache file's name from the physics key (the key itself is stored in
+/// the file and compared on reading).
+fn fnv1a(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
+}
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Cached {
+    key: String,
+    reference: Reference,
+}
+
+fn memory() -> &'static std::sync::Mutex<BTreeMap<String, Reference>> {
+    static MEMORY: std::sync::OnceLock<std::sync::Mutex<BTreeMap<String, Reference>>> = std::sync::OnceLock::new();
+    MEMORY.get_or_init(Default::default)
+}
+
+/// How references are looked up and computed: the finest level's size and the cache folder
+/// (None: no disk cache).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lookup {
+    pub finest_cells: usize,
+    pub cache_dir: Option<PathBuf>,
+}
+
+impl Default for Lookup {
+    /// [`FINEST_CELLS`] and [`cache_dir`].
+    fn default() -> Lookup {
+        Lookup { finest_cells: FINEST_CELLS, cache_dir: cache_dir() }
+    }
+}
+
+impl Lookup {
+    /// The cache key: the physics and, for a box, the levels solved.
+    fn key(&self, scene: &Scene) -> String {
+        if scene.is_box() {
+            format!("{}; Q2 levels up to {} cells", physics_key(scene), self.finest_cells)
+        } else {
+            physics_key(scene)
+        }
+    }
+
+    fn cache_file(&self, key: &str) -> Option<PathBuf> {
+        self.cache_dir.as_ref().map(|d| d.join(format!("{:016x}.json", fnv1a(key))))
+    }
+
+    /// The reference of `scene` if it is known without solving: committed, or computed before
+    /// (in memory, or for a box in the disk cache). Ok(None): it must be computed
+    /// ([`Lookup::for_scene`]).
+    pub fn known(&self, scene: &Scene) -> Result<Option<Reference>, SceneError> {
+        if let Some(r) = committed(scene)? {
+            return Ok(Some(r));
+        }
+        let key = self.key(scene);
+        if let Some(r) = memory().lock().ok().and_then(|m| m.get(&key).cloned()) {
+            return Ok(Some(r));
+        }
+        let Some(path) = self.cache_file(&key).filter(|_| scene.is_box()) else { return Ok(None) };
+        // an unreadable or foreign cache file is recomputed, never trusted
+        let cached = std::fs::read_to_string(&path).ok().and_then(|t| serde_json::from_str::<Cached>(&t).ok());
+        match cached {
+            Some(c) if c.key == key => {
+                if let Ok(mut m) = memory().lock() {
+                    m.insert(key, c.reference.clone());
+                }
+                Ok(Some(c.reference))
+            }
+            _ => Ok(None),
+        }
+    }
+
+    /// The reference of `scene`: committed, cached, or computed now (and cached). Err when the
+    /// scene has none ([`unavailable`]) or the static solve fails.
+    pub fn for_scene(&self, scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
+        if let Some(why) = unavailable(scene) {
+            return Err(SceneError::Simulation {
+                source_name: scene.source.clone(),
+                message: format!("no reference: {why}"),
+            });
+        }
+        if let Some(r) = self.known(scene)? {
+            return Ok(r);
+        }
+        let key = self.key(scene);
+        let reference =
+            if scene.is_box() { compute_with(scene, self.finest_cells, progress)? } else { own_mesh(scene, progress)? };
+        if let Ok(mut m) = memory().lock() {
+            m.insert(key.clone(), reference.clone());
+        }
+        if let Some(path) = self.cache_file(&key).filter(|_| scene.is_box()) {
+            // the cache is an optimisation: failing to write it loses nothing
+            let text = serde_json::to_string_pretty(&Cached { key, reference: reference.clone() }).unwrap_or_default();
+            let tmp = path.with_extension("json.tmp");
+            let _ = std::fs::create_dir_all(path.parent().unwrap_or(&path))
+                .and_then(|_| std::fs::write(&tmp, text))
+                .and_then(|_| std::fs::rename(&tmp, &path));
+        }
+        Ok(reference)
+    }
+}
+
+/// [`Lookup::known`] with the default lookup.
+pub fn known(scene: &Scene) -> Result<Option<Reference>, SceneError> {
+    Lookup::default().known(scene)
+}
+
+/// [`Lookup::for_scene`] with the default lookup.
+pub fn for_scene(scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
+    Lookup::default().for_scene(scene, progress)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,147 @@
+use super::*;
+use crate::by_name;
+
+fn with(scene: &Scene, o: SceneOverrides) -> Scene {
+    scene.with_overrides(&o).unwrap()
+}
+
+#[test]
+fn the_physics_key_ignores_mesh_solver_and_damping_but_not_the_material() {
+    let b = by_name("bending").unwrap();
+    let key = physics_key(&b);
+    let same = [
+        SceneOverrides { element: Some("q1".into()), grid: Some([4, 1, 1]), ..Default::default() },
+        SceneOverrides { method: Some("newton".into()), substeps: Some(7), ..Default::default() },
+        SceneOverrides { damping_per_sec: Some(3.0), quadrature_degree: Some(Some(2)), ..Default::default() },
+    ];
+    for o in same {
+        assert_eq!(physics_key(&with(&b, o.clone())), key, "{o:?}");
+    }
+    let other = [
+        SceneOverrides { poisson_ratio: Some(0.49), ..Default::default() },
+        SceneOverrides { youngs_modulus_pa: Some(1e6), ..Default::default() },
+        SceneOverrides { density_kg_m3: Some(500.0), ..Default::default() },
+        SceneOverrides { material: Some("snh".into()), ..Default::default() },
+    ];
+    for o in other {
+        assert_ne!(physics_key(&with(&b, o.clone())), key, "{o:?}");
+    }
+}
+
+/// Issue #20: the reference follows ν (and any other physics), not the scene's name.
+#[test]
+fn the_committed_reference_is_offered_only_for_the_physics_it_was_solved_for() {
+    let b = by_name("bending").unwrap();
+    let r = committed(&b).unwrap().expect("the bending scene as built has its committed reference");
+    assert_eq!((r.origin, r.mesh.as_str()), (Origin::Committed, "Q2 32×8×8"));
+    assert!((r.probes["tip"][2] + 0.3199).abs() < 1e-3, "{:?}", r.probes);
+    // another mesh or solver of the same beam: the same reference
+    let p1 = with(&b, SceneOverrides { element: Some("p1".into()), grid: Some([16, 4, 4]), ..Default::default() });
+    assert_eq!(committed(&p1).unwrap(), Some(r.clone()));
+    let nu = with(&b, SceneOverrides { poisson_ratio: Some(0.49), ..Default::default() });
+    assert_eq!(committed(&nu).unwrap(), None);
+    assert_eq!(known(&with(&nu, SceneOverrides { poisson_ratio: Some(0.4999), ..Default::default() })).unwrap(), None);
+    // a scene with no committed reference at all
+    assert_eq!(committed(&by_name("squash").unwrap()).unwrap(), None);
+}
+
+/// The committed estimates are those assets/reference/README.md derives by hand (bending:
+/// 5.0e-4 m, 0.16 %, observed order 1.56).
+#[test]
+fn the_committed_references_carry_their_richardson_estimates() {
+    let r = committed(&by_name("bending").unwrap()).unwrap().unwrap();
+    let e = r.estimated_error_m.unwrap();
+    assert!((4.5e-4..5.5e-4).contains(&e), "{e:e} ({})", r.estimate);
+    assert!(r.estimate.contains("1.5"), "{}", r.estimate);
+    let pct = r.estimated_error_pct().unwrap();
+    assert!((0.14..0.18).contains(&pct), "{pct}");
+    assert!(r.label().contains("± 0.16 %") && r.label().contains("ν = 0.35"), "{}", r.label());
+    for scene in ["tension", "torsion"] {
+        let r = committed(&by_name(scene).unwrap()).unwrap().unwrap();
+        let pct = r.estimated_error_pct().unwrap();
+        assert!(pct < 0.05, "{scene}: {pct} %");
+    }
+}
+
+#[test]
+fn richardson_recovers_the_order_and_error_of_a_power_law() {
+    for (p, ratio) in [(1.5, 2.0), (2.0, 2.0), (3.0, 1.5)] {
+        let exact = -0.3;
+        let at = |h: f64| -> Probes { [("tip".to_string(), [0.0, 0.0, exact + 0.2 * h.powf(p)])].into() };
+        let hs = [0.4, 0.4 / ratio, 0.4 / ratio / ratio];
+        let levels = hs.map(|h| (h, at(h)));
+        let (e, how) = mesh_error(&levels);
+        let truth = 0.2 * hs[2].powf(p);
+        assert!((e - truth).abs() < 1e-9 * truth.max(1e-12), "p {p}: {e} vs {truth}");
+        assert!(how.contains(&format!("{p:.2}")), "{how}");
+        let found = observed_order(&levels).unwrap();
+        assert!((found - p).abs() < 1e-9, "{found}");
+        let limit = extrapolate(&levels[1], &levels[2], found);
+        assert!((limit["tip"][2] - exact).abs() < 1e-9, "{limit:?}");
+    }
+    // levels that do not converge monotonically fall back to the finest difference, saying so
+    let flat: [(f64, Probes); 3] =
+        [0.4f64, 0.2, 0.1].map(|h: f64| (h, [("tip".to_string(), [0.0, 0.0, 0.1 * (h * 40.0).sin()])].into()));
+    let (e, how) = mesh_error(&flat);
+    assert!(e > 0.0 && how.contains("monotonically"), "{e} {how}");
+}
+
+#[test]
+fn the_levels_halve_the_cells_and_follow_the_box() {
+    assert_eq!(levels([0.0; 3], [2.0, 0.5, 0.5], FINEST_CELLS), [[8, 2, 2], [16, 4, 4], [32, 8, 8]]);
+    let [c, m, f] = levels([0.0; 3], [1.0, 0.5, 0.5], FINEST_CELLS);
+    assert_eq!((m, c), (f.map(|n| n / 2), f.map(|n| n / 4)));
+    assert!(f.iter().all(|n| n % 4 == 0) && f[0] > f[1] && f[1] == f[2], "{f:?}");
+    let cells = f.iter().product::<usize>();
+    assert!((1500..=3500).contains(&cells), "{cells}");
+    // a small budget still has four cells per direction
+    assert_eq!(levels([0.0; 3], [1.0, 1.0, 1.0], 8)[2], [4, 4, 4]);
+}
+
+/// A computed reference on small levels: it solves the scene at four Q2 levels, extrapolates,
+/// and states an uncertainty.
+#[test]
+fn a_computed_reference_solves_three_levels_and_estimates_its_own_error() {
+    let b = by_name("bending").unwrap();
+    let soft = with(&b, SceneOverrides { poisson_ratio: Some(0.3), ..Default::default() });
+    let mut calls = 0;
+    let mut last = 0.0;
+    let r = compute_with(&soft, 64, &mut |what, fraction| {
+        assert!(what.contains("Q2") && fraction >= last - 1e-12 && fraction <= 1.0 + 1e-12, "{what} {fraction}");
+        last = fraction;
+        calls += 1;
+    })
+    .unwrap();
+    assert!(calls > 3 && last > 0.99, "{calls} calls, last {last}");
+    assert_eq!((r.origin, r.mesh.as_str(), r.poisson_ratio), (Origin::Computed, "Q2 12×4×4 extrapolated", 0.3));
+    let tip = r.probes["tip"][2];
+    assert!((-0.34..-0.30).contains(&tip), "{tip}");
+    let e = r.estimated_error_m.unwrap();
+    assert!(e > 0.0 && e < 0.01, "{e} ({})", r.estimate);
+    assert!(r.label().starts_with("static, computed, Q2 12×4×4 extrapolated, ν = 0.3, ± "), "{}", r.label());
+    let json = r.to_json();
+    assert_eq!(json["origin"], "computed");
+    assert!(json["estimated_error_pct"].as_f64().is_some());
+}
+
+#[test]
+fn a_scene_with_contact_or_without_probes_has_no_reference() {
+    let drop = by_name("drop").unwrap();
+    if drop.file.effects.iter().any(|e| matches!(e, EffectSpec::Contact { .. })) {
+        assert!(unavailable(&drop).unwrap().contains("contact"));
+        let err = for_scene(&drop, &mut |_, _| {}).unwrap_err().to_string();
+        assert!(err.contains("no reference") && err.contains("contact"), "{err}");
+    }
+    let mut bare = by_name("bending").unwrap();
+    bare.file.probes.clear();
+    assert!(unavailable(&bare).unwrap().contains("probes"));
+}
+
+/// The disk cache is keyed by the physics and never trusted blindly: a file whose key differs
+/// (a hash collision, or a hand edit) is recomputed.
+#[test]
+fn the_cache_file_names_its_key() {
+    let a = fnv1a("box [0,0,0]; nu=0.49");
+    assert_ne!(a, fnv1a("box [0,0,0]; nu=0.35"));
+    assert_eq!(a, fnv1a("box [0,0,0]; nu=0.49"));
+}
