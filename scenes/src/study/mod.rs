@@ -488,14 +488,38 @@ pub fn element_colour(element: &str) -> [u8; 3] {
         .map_or([0x7f; 3], |i| PALETTE[i % PALETTE.len()])
 }
 
+/// An element type's chart colour as `#rrggbb`.
+pub(crate) fn element_hex(element: &str) -> String {
+    let [r, g, b] = element_colour(element);
+    format!("#{r:02x}{g:02x}{b:02x}")
+}
+
+/// The element-colour legend of a chart: a dot and the name of each of `elements` from
+/// (`lx`, `ly`) down, 18 px apart; returns the y below the last entry.
+pub(crate) fn svg_element_legend<'e>(
+    s: &mut String,
+    elements: impl IntoIterator<Item = &'e str>,
+    lx: f64,
+    mut ly: f64,
+) -> f64 {
+    for e in elements {
+        s.push_str(&format!(
+            "<circle cx=\"{lx}\" cy=\"{ly}\" r=\"5\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
+            element_hex(e),
+            lx + 10.0,
+            ly + 4.0,
+            e.to_uppercase()
+        ));
+        ly += 18.0;
+    }
+    ly
+}
+
 /// `study.svg`: bending tip error versus ms per frame, log–log, one colour per element type;
 /// filled circles at the paper's settings, rings at the 1 %-solver-error settings, and the
 /// paper's Table 1 points as crosses.
 pub fn svg(rows: &[StudyRow]) -> String {
-    let colour = |element: &str| {
-        let [r, g, b] = element_colour(element);
-        format!("#{r:02x}{g:02x}{b:02x}")
-    };
+    let colour = element_hex;
     let bending: Vec<&StudyRow> = rows.iter().filter(|r| r.scene == "bending").collect();
     let mut xs: Vec<f64> = bending.iter().flat_map(|r| [r.ms_per_frame, r.ms_per_frame_1pct]).collect();
     let mut ys: Vec<f64> = bending.iter().flat_map(|r| [r.error_m, r.error_1pct_m]).collect();
@@ -568,18 +592,7 @@ pub fn svg(rows: &[StudyRow]) -> String {
     }
     // legend
     let lx = w - right + 15.0;
-    let mut ly = top + 10.0;
-    for e in ElementType::all().map(|e| e.name()) {
-        s.push_str(&format!(
-            r#"<circle cx="{lx}" cy="{ly}" r="5" fill="{}"/><text x="{}" y="{}">{}</text>
-"#,
-            colour(e),
-            lx + 10.0,
-            ly + 4.0,
-            e.to_uppercase()
-        ));
-        ly += 18.0;
-    }
+    let mut ly = svg_element_legend(&mut s, ElementType::all().map(|e| e.name()), lx, top + 10.0);
     ly += 8.0;
     s.push_str(&format!(r##"<circle cx="{lx}" cy="{ly}" r="5" fill="#555"/><text x="{}" y="{}">50 substeps</text>
 <circle cx="{lx}" cy="{}" r="5" fill="white" stroke="#555" stroke-width="2"/><text x="{}" y="{}">solver error &lt; 1 %</text>

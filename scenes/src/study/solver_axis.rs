@@ -464,10 +464,7 @@ fn marker(r: &SolverRow, x: f64, y: f64, fill: &str, title: &str) -> String {
 /// log–log, every element type (colour) and solver (marker), the Pareto frontier drawn, the
 /// 1 % target and the 16.7 ms frame budget as dashed lines.
 pub fn pareto_svg(rows: &[SolverRow], scene: &str) -> String {
-    let colour = |element: &str| {
-        let [r, g, b] = super::element_colour(element);
-        format!("#{r:02x}{g:02x}{b:02x}")
-    };
+    let colour = super::element_hex;
     let points: Vec<&SolverRow> = rows
         .iter()
         .filter(|r| r.scene == scene && r.failure.is_none() && r.ms_per_frame > 0.0 && r.error_pct > 0.0)
@@ -550,24 +547,13 @@ pub fn pareto_svg(rows: &[SolverRow], scene: &str) -> String {
     }
     // legend: element colours, then solver markers
     let lx = w - right + 15.0;
-    let mut ly = top + 10.0;
     let mut seen: Vec<&str> = Vec::new();
     for r in &points {
         if !seen.contains(&r.element.as_str()) {
             seen.push(&r.element);
         }
     }
-    for e in seen {
-        s.push_str(&format!(
-            "<circle cx=\"{lx}\" cy=\"{ly}\" r=\"5\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
-            colour(e),
-            lx + 10.0,
-            ly + 4.0,
-            e.to_uppercase()
-        ));
-        ly += 18.0;
-    }
-    ly += 8.0;
+    let mut ly = super::svg_element_legend(&mut s, seen, lx, top + 10.0) + 8.0;
     for (name, probe) in [("XPBD (substeps × iterations)", "xpbd"), ("VBD", "vbd"), ("Newton", "newton")] {
         let fake = SolverRow { solver: probe.into(), ..dummy_row() };
         s.push_str(&marker(&fake, lx, ly, "#555", name));
