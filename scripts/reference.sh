@@ -17,7 +17,7 @@ levels="${1:-all}"
 run() { # scene level grid
     local scene=$1 level=$2 grid=$3
     echo "reference: $scene $level (q2 $grid)" >&2
-    "$hox" static --scene "$scene" --element q2 --grid "$grid" --tolerance 1e-10 --no-reference --json \
+    "$hox" static --scene "$scene" --element q2 --grid "$grid" --tolerance 1e-10 --reference none --json \
         | python3 -c "import json,sys; d=json.load(sys.stdin); d.update(scene='$scene', level='$level', element='q2', grid='$grid'); print(json.dumps(d))" \
         > "$out/$scene-$level.json"
 }

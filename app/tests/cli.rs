@@ -397,6 +397,9 @@ fn simulate_and_static_report_the_reference_of_the_physics_at_hand() {
     assert!(built["reference"]["label"].as_str().unwrap().contains("ν = 0.35"), "{}", built["reference"]);
     assert!(built["error_of"].as_str().unwrap().contains("last-second mean"), "{}", built["error_of"]);
     assert!(built["error_m"].as_f64().unwrap() > 0.0);
+    // a timed run does not start a computation of minutes unasked: it uses known references only
+    let timed = run(&["simulate", "--scene", "bending", "--poisson", "0.3", "--seconds", "0.1", "--json"]);
+    assert!(timed["reference"].is_null() && timed["error_m"].is_null(), "{}", timed["reference"]);
     // another ν: a reference computed for it (small levels keep the debug test quick)
     let args =
         ["static", "--scene", "bending", "--element", "p2", "--poisson", "0.49", "--reference-cells", "64", "--json"];
@@ -411,6 +414,6 @@ fn simulate_and_static_report_the_reference_of_the_physics_at_hand() {
     assert_eq!(run(&args)["reference"], *r);
     let _ = std::fs::remove_dir_all(&cache);
     fails_with(&["static", "--scene", "bending", "--reference-cells", "8"], "--reference-cells");
-    let none = json(&["simulate", "--scene", "bending", "--seconds", "0.1", "--no-reference", "--json"]);
+    let none = json(&["simulate", "--scene", "bending", "--seconds", "0.1", "--reference", "none", "--json"]);
     assert!(none["reference"].is_null() && none["error_m"].is_null());
 }

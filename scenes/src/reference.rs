@@ -309,8 +309,10 @@ pub fn mesh_error(levels: &[(f64, Probes)]) -> (f64, String) {
 /// Progress of a computation: (what is being done, overall fraction 0–1).
 pub type Progress<'p> = &'p mut dyn FnMut(&str, f64);
 
-/// Static tolerance and load steps of a computed reference (as the committed ones).
-const TOLERANCE: f64 = 1e-10;
+/// Static tolerance and load steps of a computed reference: a residual of 1e-9 of the load is
+/// far below the mesh error (the committed ones went to 1e-10, which the twist scene's large
+/// rotation cannot always reach).
+const TOLERANCE: f64 = 1e-9;
 const LOAD_STEPS: usize = 10;
 
 /// Computes the reference of a box scene's physics on three Q2 levels ([`levels`] with

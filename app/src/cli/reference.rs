@@ -7,17 +7,29 @@ use clap::Args;
 use hox_scenes::Scene;
 use hox_scenes::reference::{Origin, Reference};
 
+/// When a reference is computed (`--reference`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum When {
+    /// Committed or cached references always; a new one is computed for `static` and `--settle`
+    /// runs (whose error compares equilibria), not for a timed run.
+    Auto,
+    /// Also compute one for a timed run.
+    Compute,
+    /// No reference and no error.
+    None,
+}
+
 #[derive(Args, Clone, Debug)]
 pub struct ReferenceArgs {
-    /// Report no reference and no error. Otherwise the error is measured against the committed
-    /// reference when the physics are a paper scene's as built, or against one computed with
-    /// hox's static solver on three Q2 levels (seconds to minutes the first time; cached in
-    /// ~/.cache/hox/references, or HOX_CACHE_DIR), or for a mesh file against its own static
-    /// solution.
-    #[arg(long)]
-    pub no_reference: bool,
-    /// Cells of the finest Q2 level of a computed reference (the coarser two have a half and a
-    /// quarter as many per direction): more, a better reference at more cost.
+    /// The error is measured against the committed reference when the physics are a paper
+    /// scene's as built; otherwise against one computed with hox's static solver on four Q2
+    /// levels and extrapolated (a minute or more the first time, then cached in
+    /// ~/.cache/hox/references or HOX_CACHE_DIR), or, for a mesh file, its own static solution.
+    #[arg(long, value_enum, default_value_t = When::Auto)]
+    pub reference: When,
+    /// Cells of the finest Q2 level of a computed reference (the three coarser levels have a
+    /// quarter, a half and three quarters as many per direction): more, a better reference at
+    /// more cost.
     #[arg(long, default_value_t = hox_scenes::reference::FINEST_CELLS)]
     pub reference_cells: usize,
 }
@@ -31,16 +43,33 @@ pub fn check(args: &ReferenceArgs) -> anyhow::Result<()> {
 }
 
 /// The reference of `scene`, or None (skipped, unavailable or failed: said on stderr).
-pub fn find(args: &ReferenceArgs, scene: &Scene) -> Option<Reference> {
-    if args.no_reference {
+/// `equilibrium`: the run compares an equilibrium (`static`, `--settle`), which `--reference
+/// auto` computes a reference for.
+pub fn find(args: &ReferenceArgs, scene: &Scene, equilibrium: bool) -> Option<Reference> {
+    if args.reference == When::None {
         return None;
     }
     if let Some(why) = hox_scenes::reference::unavailable(scene) {
         eprintln!("note: no reference: {why}");
         return None;
     }
-    let mut bar = DelayedBar::new();
     let lookup = hox_scenes::reference::Lookup { finest_cells: args.reference_cells, ..Default::default() };
+    if args.reference == When::Auto && !equilibrium {
+        return match lookup.known(scene) {
+            Ok(Some(r)) => Some(r),
+            Ok(None) => {
+                eprintln!(
+                    "note: no reference for these physics yet; a timed run does not compute one (--reference compute, or --settle)"
+                );
+                None
+            }
+            Err(e) => {
+                eprintln!("warning: no reference: {e}");
+                None
+            }
+        };
+    }
+    let mut bar = DelayedBar::new();
     let found = lookup.for_scene(scene, &mut |what, fraction| {
         bar.reveal("{spinner} {bar:30} {msg} [{elapsed}]");
         bar.bar.set_position((1000.0 * fraction) as u64);

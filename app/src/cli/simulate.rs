@@ -52,7 +52,7 @@ pub fn simulate(
     let vtk_index = vtk_writer.map(|w| w.finish(&instance)).transpose()?;
     // the error of the state the run ended in when at rest, else of its last-second mean (an
     // instantaneous value of a swinging body says little about its accuracy)
-    let found = reference::find(reference_args, &instance.scene);
+    let found = reference::find(reference_args, &instance.scene, settle);
     let (compared, of) = if report.settled || report.at_rest {
         (&report.probes, if report.settled { "settled state" } else { "state at rest" })
     } else if settle {

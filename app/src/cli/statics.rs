@@ -41,7 +41,7 @@ pub fn static_command(
     }
     let groups = scene.group_displacements(&solution.positions);
     // a mesh file's reference would be this very solution: its error is the mesh's, unknown here
-    let found = if scene.is_box() { reference::find(reference_args, &scene) } else { None };
+    let found = if scene.is_box() { reference::find(reference_args, &scene, true) } else { None };
     let compared: Vec<(String, [f64; 3])> = probes.iter().map(|(n, u)| (n.clone(), *u)).collect();
     let of = "static solution (the mesh's discretisation error)";
     let mut out = serde_json::json!({
