@@ -68,11 +68,17 @@ pub const CASES: [BenchCase; 9] = [
 /// The paper's bending beam for `case`, at rest: the `bending` scene with the case's element
 /// type, grid and refinement; `parallel` selects the colour sweep.
 pub fn bending_beam(case: &BenchCase, parallel: bool) -> Result<Simulation, SceneError> {
+    beam(case, parallel, None)
+}
+
+/// [`bending_beam`], solved by `method` if given (else the scene's own solver).
+fn beam(case: &BenchCase, parallel: bool, method: Option<hox_sim::solver::Method>) -> Result<Simulation, SceneError> {
     let overrides = SceneOverrides {
         element: Some(case.element.to_string()),
         grid: Some(case.grid),
         refine: Some(case.refine),
         parallel: Some(parallel),
+        method: method.map(|m| m.name().to_string()),
         ..SceneOverrides::default()
     };
     Ok(Instance::new(crate::by_name("bending")?.with_overrides(&overrides)?)?.sim)

@@ -464,12 +464,14 @@ impl Default for Lookup {
 }
 
 impl Lookup {
-    /// The cache key: the physics and, for a box, the levels solved.
-    fn key(&self, scene: &Scene) -> String {
+    /// What determines the reference, as its cache key: the physics and, for a box, the levels
+    /// solved; for a mesh file (whose reference is the static solution of that mesh) also the
+    /// quadrature it is integrated with.
+    pub fn key(&self, scene: &Scene) -> String {
         if scene.is_box() {
             format!("{}; Q2 levels up to {} cells", physics_key(scene), self.finest_cells)
         } else {
-            physics_key(scene)
+            format!("{}; own mesh, quadrature {:?}", physics_key(scene), scene.params().quadrature_degree)
         }
     }
 

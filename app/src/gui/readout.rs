@@ -51,8 +51,8 @@ impl ReferenceState {
         if let Some(why) = hox_scenes::reference::unavailable(scene) {
             return ReferenceState::Unavailable(why);
         }
-        let key = hox_scenes::reference::physics_key(scene);
         let lookup = lookup();
+        let key = lookup.key(scene);
         match lookup.known(scene) {
             Ok(Some(r)) => return ReferenceState::Ready { key, reference: Arc::new(r) },
             Ok(None) => {}
@@ -80,9 +80,10 @@ impl ReferenceState {
         }
     }
 
-    /// Follows `scene`'s physics: a new reference when they changed, the same one otherwise.
+    /// Follows `scene`'s physics (and, for a mesh file, its quadrature): a new reference when
+    /// they changed, the same one otherwise.
     pub fn follow(&mut self, scene: &Scene) {
-        let key = hox_scenes::reference::physics_key(scene);
+        let key = lookup().key(scene);
         let unavailable = hox_scenes::reference::unavailable(scene);
         if self.key() != Some(key.as_str()) || unavailable.is_some() {
             // a computation no longer wanted finishes in the background (and fills the cache)
@@ -90,11 +91,11 @@ impl ReferenceState {
         }
     }
 
-    /// Takes a finished background computation in (non-blocking).
-    pub fn poll(&mut self) {
-        let ReferenceState::Computing { key, handle, .. } = self else { return };
+    /// Takes a finished background computation in (non-blocking); whether it did.
+    pub fn poll(&mut self) -> bool {
+        let ReferenceState::Computing { key, handle, .. } = self else { return false };
         if !handle.as_ref().is_some_and(|h| h.is_finished()) {
-            return;
+            return false;
         }
         let key = key.clone();
         *self = match handle.take().map(|h| h.join()) {
@@ -102,6 +103,7 @@ impl ReferenceState {
             Some(Ok(Err(message))) => ReferenceState::Failed { key, message },
             _ => ReferenceState::Failed { key, message: "the reference computation stopped unexpectedly".into() },
         };
+        true
     }
 
     /// Waits for a background computation (tests).
@@ -114,7 +116,7 @@ impl ReferenceState {
                 std::thread::sleep(std::time::Duration::from_millis(20));
             }
         }
-        self.poll();
+        let _ = self.poll();
     }
 
     pub fn reference(&self) -> Option<&Reference> {

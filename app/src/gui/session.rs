@@ -7,6 +7,7 @@
 
 use super::config::{self, Config, Invalidates};
 use super::readout::{Readout, ReferenceState, last_oscillation};
+use hox_scenes::reference::physics_key;
 use hox_scenes::study::motion::Motion;
 use hox_scenes::{Instance, Scene};
 use hox_scenes::{RestWatch, SettleState, Settler};
@@ -70,6 +71,9 @@ pub struct Session {
     pub settle_outcome: Option<SettleState>,
     /// Simulated time until which prescribed motion is under way (nothing counts as at rest).
     driven_until_secs: f64,
+    /// The readout as of the last change (step, reset, configuration, reference): the UI reads
+    /// it several times a frame, the history scan it needs runs once.
+    readout: Readout,
     /// Wall time of the last frames' stepping, exponentially averaged, milliseconds.
     pub ms_per_frame: f64,
     /// The static residual at the last frame: the unbalanced force on the free nodes relative to
@@ -116,6 +120,7 @@ impl Session {
             settler: None,
             settle_outcome: None,
             driven_until_secs,
+            readout: Readout::Starting,
             ms_per_frame: 0.0,
             residual: f64::NAN,
             failure: None,
@@ -129,6 +134,7 @@ impl Session {
         };
         s.mesh_changed();
         s.residual = s.force_residual();
+        s.refresh_readout();
         Ok(s)
     }
 
@@ -175,6 +181,7 @@ impl Session {
         self.config = new;
         // another ν, E, ρ or model: another equilibrium, another reference
         self.reference.follow(&self.instance.scene);
+        self.refresh_readout();
         Ok(what)
     }
 
@@ -229,6 +236,7 @@ impl Session {
         self.rest = RestWatch::new(&self.instance);
         self.history = History::default();
         self.record();
+        self.refresh_readout();
     }
 
     /// Steps `frames` frames (stopping at a failure).
@@ -262,6 +270,14 @@ impl Session {
             }
         }
         self.residual = self.force_residual();
+        self.refresh_readout();
+    }
+
+    /// Takes a reference computed in the background in (non-blocking), and with it the readout.
+    pub fn poll_reference(&mut self) {
+        if self.reference.poll() {
+            self.refresh_readout();
+        }
     }
 
     /// Starts the *Settle* action: the scene's settle damping until the body is at rest (as
@@ -278,8 +294,21 @@ impl Session {
     }
 
     /// The probe readout against the reference: settled, or the mean and amplitude of the
-    /// motion ([`Readout`]).
+    /// motion ([`Readout`]); while the reference is being computed, its progress.
     pub fn readout(&self) -> Readout {
+        match (&self.readout, self.reference.reference()) {
+            (_, None) => Readout::NoReference(self.reference.status()),
+            // taken in since the last refresh (a test waiting on the computation)
+            (Readout::NoReference(_), Some(_)) => self.measure_readout(),
+            (r, Some(_)) => r.clone(),
+        }
+    }
+
+    fn refresh_readout(&mut self) {
+        self.readout = self.measure_readout();
+    }
+
+    fn measure_readout(&self) -> Readout {
         let Some(r) = self.reference.reference() else {
             return Readout::NoReference(self.reference.status());
         };
@@ -347,15 +376,13 @@ impl Session {
     /// built-in bending scene with its own material, gravity and no added damping.
     pub fn reference_motion(&self) -> Option<&'static Motion> {
         static MOTION: std::sync::OnceLock<Option<Motion>> = std::sync::OnceLock::new();
-        let (now, base) = (self.instance.scene.params(), self.base.params());
-        let applies = self.base.name() == "bending"
-            && self.base.source == self.instance.scene.source
-            && now.material == base.material
-            && now.youngs_modulus_pa == base.youngs_modulus_pa
-            && now.poisson_ratio == base.poisson_ratio
-            && now.density_kg_m3 == base.density_kg_m3
-            && now.damping_per_sec == 0.0
-            && self.instance.scene.file.effects == self.base.file.effects;
+        static BENDING: std::sync::OnceLock<Option<String>> = std::sync::OnceLock::new();
+        let bending = BENDING.get_or_init(|| hox_scenes::by_name("bending").ok().map(|b| physics_key(&b)));
+        // the same physics as the built-in beam (whatever its mesh or solver), and no damping
+        let scene = &self.instance.scene;
+        let applies = bending.as_deref() == Some(physics_key(scene).as_str())
+            && scene.params().damping_per_sec == 0.0
+            && !scene.file.effects.iter().any(|e| matches!(e, hox_scenes::scene::EffectSpec::Damping { .. }));
         if !applies {
             return None;
         }

@@ -82,7 +82,7 @@ impl HoxApp {
         // a reference computed in the background arrives; until then its progress is shown
         let mut computing = false;
         for s in &mut self.sessions {
-            s.reference.poll();
+            s.poll_reference();
             computing |= matches!(s.reference, super::readout::ReferenceState::Computing { .. });
         }
         if computing {

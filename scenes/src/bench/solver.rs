@@ -23,8 +23,8 @@
 //!   factorisation, an upper bound of one factorisation's cost); iterations per step.
 
 use super::{BenchCase, matching_cases};
-use crate::params::SceneOverrides;
-use crate::{Instance, SceneError};
+use crate::SceneError;
+use crate::study::solver_axis::opt;
 use hox_sim::measure::median;
 use hox_sim::solver::{Method, SimError, Simulation, SolverCounters};
 use std::time::Instant;
@@ -46,15 +46,7 @@ pub fn parse_solver(name: &str) -> Result<Method, SceneError> {
 /// The benchmark beam of `case` ([`super::bending_beam`]) solved by `method`; `parallel` selects
 /// the colour sweep (VBD's parallel node sweep).
 pub fn bending_beam_solved_by(case: &BenchCase, method: Method, parallel: bool) -> Result<Simulation, SceneError> {
-    let overrides = SceneOverrides {
-        element: Some(case.element.to_string()),
-        grid: Some(case.grid),
-        refine: Some(case.refine),
-        parallel: Some(parallel),
-        method: Some(method.name().to_string()),
-        ..SceneOverrides::default()
-    };
-    Ok(Instance::new(crate::by_name("bending")?.with_overrides(&overrides)?)?.sim)
+    super::beam(case, parallel, Some(method))
 }
 
 /// One measured row: a case, a solver and a thread count.
@@ -257,10 +249,6 @@ pub fn run(
         }
     }
     Ok(rows)
-}
-
-fn opt(x: Option<f64>, digits: usize) -> String {
-    x.map_or("—".into(), |x| format!("{x:.digits$}"))
 }
 
 fn speedup(r: &SolverBenchRow) -> String {

@@ -22,13 +22,6 @@ use hox_sim::Vec3;
 use hox_sim::element::{ElementType, ReferenceShape};
 use hox_sim::mesh::structured::TetSplit;
 
-/// The reference (fine Q2 static solution) of each paper scene, as committed.
-pub const REFERENCES: [(&str, &str); 3] = [
-    ("bending", include_str!("../../../assets/reference/bending-fine.json")),
-    ("tension", include_str!("../../../assets/reference/tension-fine.json")),
-    ("torsion", include_str!("../../../assets/reference/torsion-fine.json")),
-];
-
 /// The paper's Table 1 (bending): (label, elements, ms per frame, tip error in m).
 pub const PAPER_TABLE_1: [(&str, usize, f64, f64); 5] = [
     ("P1", 1_280, 43.6, 1.5e-1),
@@ -141,14 +134,12 @@ pub struct StudyRow {
     pub settled: bool,
 }
 
-/// Probe displacements of a reference file.
+/// Probe displacements of a paper scene's committed reference ([`crate::reference::committed`]).
 pub fn reference(scene: &str) -> Result<Vec<(String, Vec3)>, SceneError> {
-    let text = REFERENCES.iter().find(|(s, _)| *s == scene).map(|(_, t)| *t).ok_or_else(|| SceneError::Unknown {
-        name: scene.to_string(),
-        available: "bending, tension, torsion".into(),
-    })?;
-    let probes = crate::reference::parse_probes(text, &format!("assets/reference/{scene}-fine.json"))?;
-    Ok(probes.into_iter().map(|(name, u)| (name, Vec3::from(u))).collect())
+    let unknown = || SceneError::Unknown { name: scene.to_string(), available: "bending, tension, torsion".into() };
+    let built = crate::by_name(scene).map_err(|_| unknown())?;
+    let committed = crate::reference::committed(&built)?.ok_or_else(unknown)?;
+    Ok(committed.probes.into_iter().map(|(name, u)| (name, Vec3::from(u))).collect())
 }
 
 /// Largest distance between two probe sets (matched by name).

@@ -235,8 +235,7 @@ fn config_rows(
         let frames = report.frames.max(1) as f64;
         row.sweeps_per_frame = match choice {
             SolverChoice::Xpbd { iterations, .. } => (settling.sim.substeps_per_frame() * iterations) as f64,
-            SolverChoice::Vbd => counters.solver_iterations as f64 / frames,
-            SolverChoice::Newton => counters.solver_iterations as f64 / frames,
+            SolverChoice::Vbd | SolverChoice::Newton => counters.solver_iterations as f64 / frames,
         };
         if let SolverChoice::Xpbd { substeps, iterations } = choice
             && settling.sim.substeps_per_frame() != substeps
@@ -319,7 +318,8 @@ pub fn pareto_frontier<'a>(rows: &'a [SolverRow], scene: &str) -> Vec<&'a Solver
         .collect()
 }
 
-fn opt(v: Option<f64>, digits: usize) -> String {
+/// A number with `digits` decimals, or "—".
+pub(crate) fn opt(v: Option<f64>, digits: usize) -> String {
     v.map_or_else(|| "—".into(), |v| format!("{v:.digits$}"))
 }
 
