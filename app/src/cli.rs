@@ -18,7 +18,8 @@ mod reference;
 mod simulate;
 mod statics;
 mod study;
-pub use params::{MeshArgs, PhysicsArgs, overrides};
+pub use params::{DisplayArgs, MeshArgs, PhysicsArgs, overrides};
+pub use record::parse_compare;
 
 #[derive(Parser)]
 #[command(name = "hox", version, about = "hox: see, measure and teach high-order finite elements in XPBD")]
@@ -131,7 +132,7 @@ pub enum Command {
     /// Read a Rerun recording back and list its entities, components and frame counts.
     Inspect(inspect::InspectArgs),
     /// Open the interactive app (the default when no command is given).
-    App(crate::gui::AppArgs),
+    App(Box<crate::gui::AppArgs>),
 }
 
 #[derive(Args)]
@@ -157,7 +158,7 @@ pub fn note_stability(instance: &mut Instance) -> hox_sim::solver::stability::St
 }
 
 pub fn main(cli: Cli) -> Result<()> {
-    match cli.command.unwrap_or(Command::App(crate::gui::AppArgs::default())) {
+    match cli.command.unwrap_or(Command::App(Box::default())) {
         Command::Elements { json } => list::elements(json),
         Command::Scenes { json } => list::scenes(json),
         Command::Mesh { scene, mesh, json } => mesh::mesh_command(&scene, &mesh, json),
@@ -173,7 +174,7 @@ pub fn main(cli: Cli) -> Result<()> {
         }
         Command::Record(args) => record::record(&args),
         Command::Inspect(args) => inspect::inspect(&args),
-        Command::App(args) => crate::gui::run(args),
+        Command::App(args) => crate::gui::run(*args),
     }
 }
 

@@ -1,57 +1,91 @@
-//! Rerun logging of running simulations, shared by `hox record` and the app.
+//! Rerun logging of running simulations, shared by `hox record` and the app, with the layout a
+//! recording opens in (its blueprint).
 //!
 //! Entity layout (one recording may hold several configurations side by side):
 //! - `world/<config>`: a static `Transform3D` offsetting the configuration in space;
-//! - `world/<config>/surface`: the deformed boundary surface (`Mesh3D`), curved faces tessellated
-//!   ([`hox_sim::measure::surface`]), coloured by displacement magnitude on a fixed range (viridis);
+//! - `world/<config>/surface/<field>`: the deformed boundary surface (`Mesh3D`), curved faces
+//!   tessellated ([`hox_sim::measure::surface`]), coloured by one field ([`crate::display`]) on
+//!   a range every configuration shares — one mesh per recorded field;
 //! - `world/<config>/edges`: element edges (`LineStrips3D`, curved for high-order elements);
+//!   `world/<config>/clamped`, `world/<config>/driven`: the edges of clamped and driven faces;
 //! - `world/<config>/rest_edges`: the rest shape's edges, static, as a ghost;
 //! - `world/<config>/probes`, `world/<config>/quadrature_points` (on request): `Points3D`;
-//! - `world/<config>/legend`: the colour bar beside the body with tick labels, and
-//!   `legend/<config>`: the same legend as text;
+//! - `legend/<field>/bar`, `legend/<field>/ticks`: each field's colour bar (an image) with its
+//!   tick labels in the field's unit (relabelled as an automatic range grows; a fixed range's
+//!   top and bottom labels say how much of the surface is saturated); `legend/text`: the
+//!   legend and every configuration's parameters as one text;
 //! - `plots/<quantity>/<config>`: `Scalars` — every probe displacement component (m), kinetic and
-//!   elastic energy (J), milliseconds per frame and the smallest det F over all quadrature points.
+//!   elastic energy (J), milliseconds per frame and the smallest det F over all quadrature points;
+//!   `plots/probe_<probe>_u_<axis>_m/reference_static`: the reference's value, where one is known.
 //!
-//! Timelines: `frame` (sequence) and `sim_time` (seconds). Topology, labels, the legend and the
-//! rest shape are logged once as static data; a frame logs only what moves.
+//! The blueprint ([`Recorder::blueprint`]): the first field's 3D view large on the left (a
+//! further field's view below it), the legend text and colour bars beside it, and one
+//! time-series chart per quantity with every configuration overlaid on the right, the probes'
+//! u_z first with their reference.
+//!
+//! Timelines: `frame` (sequence) and `sim_time` (seconds). Topology, labels and the rest shape
+//! are logged once as static data; a frame logs only what moves.
 
-use crate::colour::ColourRange;
-use crate::display::{SurfaceFrame, f32s};
+use crate::colour::{ColourRange, FieldScale};
+use crate::display::{FieldSource, SurfaceFrame, f32s};
 use hox_scenes::Instance;
+use hox_scenes::reference::Reference;
 use hox_sim::Vec3;
+use hox_sim::measure::field::Field;
 use hox_sim::measure::surface::{PointMap, Surface};
 use rerun::RecordingStream;
+use rerun::blueprint as bp;
 
 /// What to log besides the always-present surface, edges, probes and time series.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LogSettings {
     /// Pieces per edge of curved or quadrilateral faces.
     pub segments: usize,
-    /// The displacement colour range ([`crate::display::colour_range`]): configurations
-    /// recorded side by side share the first one's, as the viewport shows them.
-    pub colours: ColourRange,
     /// Also log the quadrature points.
     pub quadrature_points: bool,
 }
 
 impl LogSettings {
-    /// The display parameters of a configuration (`[display]` of the parameter table), drawn on
-    /// the shared colour range `colours`.
-    pub fn new(params: &hox_scenes::Params, colours: ColourRange) -> LogSettings {
-        LogSettings { segments: params.tessellation, colours, quadrature_points: params.quadrature_points }
+    /// The display parameters of a configuration (`[display]` of the parameter table).
+    pub fn new(params: &hox_scenes::Params) -> LogSettings {
+        LogSettings { segments: params.tessellation, quadrature_points: params.quadrature_points }
     }
 }
 
-/// Logs one simulation (one configuration) frame after frame.
-pub struct SimLogger {
+/// One configuration to record: its entity name, instance, place and reference (if known).
+pub struct Configuration<'a> {
+    pub name: String,
+    pub instance: &'a Instance,
+    pub offset_m: Vec3,
+    pub reference: Option<&'a Reference>,
+}
+
+/// Logs one configuration frame after frame.
+struct SimLogger {
     name: String,
+    label: String,
     surface: Surface,
     quadrature: Option<PointMap>,
-    colours: ColourRange,
     /// What is drawn this frame (the viewport's display frame).
     frame: SurfaceFrame,
+    /// One source per recorded field, with this frame's values.
+    sources: Vec<(FieldSource, Vec<f64>)>,
     /// Quadrature points this frame, reused.
     points: Vec<Vec3>,
+    clamped_edges: Vec<usize>,
+    driven_edges: Vec<usize>,
+    /// The reference's probe displacements, metres.
+    reference: Option<hox_scenes::reference::Probes>,
+}
+
+/// Logs several configurations side by side on shared colour ranges, with the recording's
+/// blueprint.
+pub struct Recorder {
+    loggers: Vec<SimLogger>,
+    fields: Vec<Field>,
+    /// One colour scale per field, shared by every configuration.
+    scales: Vec<FieldScale>,
+    probe_names: Vec<String>,
 }
 
 /// A name usable as one entity path part: lowercase letters, digits and `_`.
@@ -62,7 +96,6 @@ pub fn entity_name(label: &str) -> String {
     if s.is_empty() { "sim".to_string() } else { s }
 }
 
-/// A short label for an instance, e.g. `p2 160` (element type and count).
 /// What the recording states about a configuration: every parameter of the table
 /// ([`hox_scenes::params`]) by its scene-file key, with its unit.
 pub fn configuration_markdown(instance: &Instance) -> String {
@@ -75,6 +108,7 @@ pub fn configuration_markdown(instance: &Instance) -> String {
     text
 }
 
+/// A short label for an instance, e.g. `p2 160` (element type and count).
 pub fn config_label(instance: &Instance) -> String {
     let mesh = instance.sim.mesh();
     let types: Vec<&str> = mesh.blocks.iter().map(|b| b.element_type.name()).collect();
@@ -86,30 +120,44 @@ pub fn config_label(instance: &Instance) -> String {
     }
 }
 
+/// Line colours of the configurations in the charts, in order (Tableau 10).
+const SERIES: [[u8; 3]; 6] =
+    [[78, 121, 167], [242, 142, 43], [89, 161, 79], [225, 87, 89], [176, 122, 161], [118, 183, 178]];
+/// The clamped and driven face edges (as the viewport draws them).
+const CLAMPED: [u8; 3] = [70, 120, 255];
+const DRIVEN: [u8; 3] = [230, 70, 230];
+/// Pixel size of a colour-bar image (its tick labels sit to its right, [`log_ticks`]).
+const BAR_PX: [u32; 2] = [20, 200];
+
+/// The entity of the chart of probe `probe`'s component `axis` (0–2).
+fn probe_plot(probe: &str, axis: usize) -> String {
+    format!("plots/probe_{}_{}_m", entity_name(probe), ["u_x", "u_y", "u_z"][axis])
+}
+
 impl SimLogger {
-    /// Logs the static data of `instance` under `world/<name>` offset by `offset_m`.
-    pub fn new(
+    /// Logs the static data of one configuration (`index`-th) under `world/<name>`.
+    fn new(
         rec: &RecordingStream,
-        name: &str,
-        instance: &Instance,
-        offset_m: Vec3,
+        index: usize,
+        config: &Configuration<'_>,
         settings: &LogSettings,
+        fields: &[Field],
     ) -> Result<SimLogger, rerun::RecordingStreamError> {
-        let name = entity_name(name);
+        let (name, instance) = (entity_name(&config.name), config.instance);
         let mesh = instance.sim.mesh();
         let surface = Surface::new(mesh, settings.segments);
         let quadrature = settings
             .quadrature_points
             .then(|| hox_sim::measure::surface::quadrature_points(mesh, instance.sim.geometry()));
-        let (lo, hi) = mesh.bounding_box();
-        let colours = settings.colours;
         let root = format!("world/{name}");
-        rec.log_static(root.as_str(), &rerun::Transform3D::from_translation(f32s(&offset_m)))?;
-        rec.log_static(
-            format!("{root}/surface"),
-            &rerun::Mesh3D::update_fields()
-                .with_triangle_indices(surface.triangles.iter().map(|t| rerun::TriangleIndices::from(*t))),
-        )?;
+        rec.log_static(root.as_str(), &rerun::Transform3D::from_translation(f32s(&config.offset_m)))?;
+        for field in fields {
+            rec.log_static(
+                format!("{root}/surface/{}", field.name()),
+                &rerun::Mesh3D::update_fields()
+                    .with_triangle_indices(surface.triangles.iter().map(|t| rerun::TriangleIndices::from(*t))),
+            )?;
+        }
         // the rest shape's edges, a faint ghost
         let mut rest = Vec::new();
         surface.vertices.eval_into(&mesh.rest_positions, &mut rest);
@@ -135,6 +183,20 @@ impl SimLogger {
                 .with_colors([rerun::Color::from_rgb(20, 20, 20)])
                 .with_radii([rerun::Radius::new_ui_points(0.75)]),
         )?;
+        let (clamped, driven) = crate::display::held_nodes(instance);
+        let n = mesh.num_nodes();
+        let clamped_edges = surface.edges_between(&crate::display::node_flags(&clamped, n));
+        let driven_edges = surface.edges_between(&crate::display::node_flags(&driven, n));
+        for (part, edges, c) in [("clamped", &clamped_edges, CLAMPED), ("driven", &driven_edges, DRIVEN)] {
+            if !edges.is_empty() {
+                rec.log_static(
+                    format!("{root}/{part}"),
+                    &rerun::LineStrips3D::update_fields()
+                        .with_colors([rerun::Color::from_rgb(c[0], c[1], c[2])])
+                        .with_radii([rerun::Radius::new_ui_points(2.5)]),
+                )?;
+            }
+        }
         if quadrature.is_some() {
             rec.log_static(
                 format!("{root}/quadrature_points"),
@@ -143,103 +205,105 @@ impl SimLogger {
                     .with_radii([rerun::Radius::new_ui_points(2.5)]),
             )?;
         }
-        Self::log_legend(rec, &name, &root, &colours, lo, hi, &configuration_markdown(instance))?;
-        Ok(SimLogger { name, surface, quadrature, colours, frame: SurfaceFrame::default(), points: Vec::new() })
-    }
-
-    /// A vertical colour bar beside the body (its lower end at the body's rest bottom, height the
-    /// body's height) with labelled ticks, plus the legend as text.
-    fn log_legend(
-        rec: &RecordingStream,
-        name: &str,
-        root: &str,
-        colours: &ColourRange,
-        lo: Vec3,
-        hi: Vec3,
-        configuration: &str,
-    ) -> Result<(), rerun::RecordingStreamError> {
-        let extent = hi - lo;
-        let height = extent.z.max(0.25 * extent.max());
-        let width = 0.08 * height;
-        let x0 = hi.x + 0.15 * extent.max();
-        let y = 0.5 * (lo.y + hi.y);
-        let steps = 32;
-        let mut positions = Vec::new();
-        let mut vertex_colours = Vec::new();
-        let mut triangles = Vec::new();
-        for i in 0..=steps {
-            let f = i as f64 / steps as f64;
-            let z = lo.z + f * height;
-            let c = colours.colour(f * colours.max_m);
-            for x in [x0, x0 + width] {
-                positions.push([x as f32, y as f32, z as f32]);
-                vertex_colours.push(rerun::Color::from_rgb(c[0], c[1], c[2]));
-            }
-            if i < steps {
-                let k = 2 * i as u32;
-                triangles.push([k, k + 1, k + 3]);
-                triangles.push([k, k + 3, k + 2]);
-                // both sides visible
-                triangles.push([k, k + 3, k + 1]);
-                triangles.push([k, k + 2, k + 3]);
+        // the charts' line of this configuration: its label and colour in every chart
+        let label = config_label(instance);
+        let c = SERIES[index % SERIES.len()];
+        let mut series: Vec<String> = ["kinetic_energy_j", "elastic_energy_j", "ms_per_frame", "min_det_f"]
+            .iter()
+            .map(|q| format!("plots/{q}/{name}"))
+            .collect();
+        for p in &probe_names {
+            series.extend((0..3).map(|axis| format!("{}/{name}", probe_plot(p, axis))));
+        }
+        for path in series {
+            rec.log_static(
+                path,
+                &rerun::SeriesLines::new()
+                    .with_names([format!("{}: {label}", ["a", "b", "c", "d", "e", "f"][index.min(5)])])
+                    .with_colors([rerun::Color::from_rgb(c[0], c[1], c[2])])
+                    .with_widths([2.0]),
+            )?;
+        }
+        let reference = config.reference.map(|r| r.probes.clone());
+        if reference.is_some() {
+            for p in &probe_names {
+                for axis in 0..3 {
+                    rec.log_static(
+                        format!("{}/reference_static", probe_plot(p, axis)),
+                        &rerun::SeriesLines::new()
+                            .with_names(["reference (static)"])
+                            .with_colors([rerun::Color::from_rgb(150, 150, 150)])
+                            .with_widths([1.0]),
+                    )?;
+                }
             }
         }
-        rec.log_static(
-            format!("{root}/legend/bar"),
-            &rerun::Mesh3D::new(positions).with_vertex_colors(vertex_colours).with_triangle_indices(triangles),
-        )?;
-        let ticks = colours.ticks_m();
-        let tick_positions: Vec<[f32; 3]> = ticks
-            .iter()
-            .map(|t| [(x0 + 1.5 * width) as f32, y as f32, (lo.z + t / colours.max_m * height) as f32])
-            .collect();
-        let labels: Vec<String> = ticks.iter().map(|t| format!("{} m", format_metres(*t))).collect();
-        rec.log_static(
-            format!("{root}/legend/ticks"),
-            &rerun::Points3D::new(tick_positions)
-                .with_labels(labels)
-                .with_radii([rerun::Radius::new_ui_points(2.0)])
-                .with_colors([rerun::Color::from_rgb(220, 220, 220)]),
-        )?;
-        rec.log_static(
-            format!("legend/{name}"),
-            &rerun::TextDocument::from_markdown(format!(
-                "**{name}**: surface colour = displacement magnitude |u| in metres, viridis, fixed range 0 m (dark purple) to {} m (yellow); larger values are clamped.\n\n{}",
-                format_metres(colours.max_m),
-                configuration
-            )),
-        )
+        let mut sources: Vec<(FieldSource, Vec<f64>)> =
+            fields.iter().map(|&f| (FieldSource::new(f), Vec::new())).collect();
+        for (source, _) in &mut sources {
+            source.set_reference(&surface, mesh, config.reference.and_then(|r| r.field.as_ref()));
+        }
+        Ok(SimLogger {
+            name,
+            label,
+            surface,
+            quadrature,
+            frame: SurfaceFrame::default(),
+            sources,
+            points: Vec::new(),
+            clamped_edges,
+            driven_edges,
+            reference,
+        })
     }
 
-    /// Logs the current state of `instance` at its frame and time. `ms_per_frame` is the wall
-    /// time of the last step.
-    pub fn log_frame(
+    /// This frame's geometry and field values (before the shared ranges are known).
+    fn measure(&mut self, instance: &Instance) {
+        self.frame.update(&self.surface, &instance.sim);
+        for (source, values) in &mut self.sources {
+            source.values_into(&self.surface, &instance.sim, &self.frame, values);
+        }
+    }
+
+    /// Logs the frame measured last, coloured on `ranges` (one per field). `ms_per_frame` is
+    /// the wall time of the last step.
+    fn log(
         &mut self,
         rec: &RecordingStream,
         instance: &Instance,
+        ranges: &[ColourRange],
         ms_per_frame: f64,
     ) -> Result<(), rerun::RecordingStreamError> {
         let sim = &instance.sim;
-        let mesh = sim.mesh();
-        rec.set_time_sequence("frame", sim.frames() as i64);
-        rec.set_duration_secs("sim_time", sim.time_secs());
         let root = format!("world/{}", self.name);
-        self.frame.update(&self.surface, sim, &self.colours);
         let frame = &self.frame;
-        rec.log(
-            format!("{root}/surface"),
-            &rerun::Mesh3D::update_fields()
-                .with_vertex_positions(frame.positions_m.iter().map(f32s))
-                .with_vertex_normals(frame.normals.iter().map(f32s))
-                .with_vertex_colors(frame.colours.iter().map(|c| rerun::Color::from_rgb(c[0], c[1], c[2]))),
-        )?;
-        let x = &frame.positions_m;
+        let positions: Vec<[f32; 3]> = frame.positions_m.iter().map(f32s).collect();
+        let normals: Vec<[f32; 3]> = frame.normals.iter().map(f32s).collect();
+        for ((source, values), range) in self.sources.iter().zip(ranges) {
+            rec.log(
+                format!("{root}/surface/{}", source.field.name()),
+                &rerun::Mesh3D::update_fields()
+                    .with_vertex_positions(positions.iter().copied())
+                    .with_vertex_normals(normals.iter().copied())
+                    .with_vertex_colors(values.iter().map(|&v| {
+                        let c = range.colour(v);
+                        rerun::Color::from_rgb(c[0], c[1], c[2])
+                    })),
+            )?;
+        }
+        let strips = |edges: &mut dyn Iterator<Item = &Vec<u32>>| -> Vec<Vec<[f32; 3]>> {
+            edges.map(|e| e.iter().map(|&i| positions[i as usize]).collect()).collect()
+        };
         rec.log(
             format!("{root}/edges"),
-            &rerun::LineStrips3D::update_fields().with_strips(
-                self.surface.edges.iter().map(|e| e.iter().map(|&i| f32s(&x[i as usize])).collect::<Vec<_>>()),
-            ),
+            &rerun::LineStrips3D::update_fields().with_strips(strips(&mut self.surface.edges.iter())),
         )?;
+        for (part, edges) in [("clamped", &self.clamped_edges), ("driven", &self.driven_edges)] {
+            if !edges.is_empty() {
+                let mut it = edges.iter().map(|&k| &self.surface.edges[k]);
+                rec.log(format!("{root}/{part}"), &rerun::LineStrips3D::update_fields().with_strips(strips(&mut it)))?;
+            }
+        }
         let probe_positions: Vec<[f32; 3]> =
             instance.probes.iter().map(|p| f32s(&p.position(&sim.positions))).collect();
         rec.log(format!("{root}/probes"), &rerun::Points3D::update_fields().with_positions(probe_positions))?;
@@ -251,15 +315,15 @@ impl SimLogger {
             )?;
         }
         for (name, u) in instance.probe_displacements() {
-            for (axis, value) in ["u_x_m", "u_y_m", "u_z_m"].iter().zip(u) {
-                rec.log(
-                    format!("plots/probe_{}_{axis}/{}", entity_name(&name), self.name),
-                    &rerun::Scalars::single(value),
-                )?;
+            for (axis, value) in u.iter().enumerate() {
+                rec.log(format!("{}/{}", probe_plot(&name, axis), self.name), &rerun::Scalars::single(*value))?;
+                if let Some(r) = self.reference.as_ref().and_then(|r| r.get(&name)) {
+                    rec.log(format!("{}/reference_static", probe_plot(&name, axis)), &rerun::Scalars::single(r[axis]))?;
+                }
             }
         }
         let min_det_f =
-            hox_sim::measure::min_det_f(mesh, sim.geometry(), &sim.positions).map_or(f64::INFINITY, |m| m.det_f);
+            hox_sim::measure::min_det_f(sim.mesh(), sim.geometry(), &sim.positions).map_or(f64::INFINITY, |m| m.det_f);
         for (quantity, value) in [
             ("kinetic_energy_j", sim.kinetic_energy_j()),
             ("elastic_energy_j", sim.elastic_energy_j()),
@@ -270,22 +334,236 @@ impl SimLogger {
         }
         Ok(())
     }
+}
 
-    pub fn name(&self) -> &str {
-        &self.name
+impl Recorder {
+    /// Logs the static data of `configs` (side by side at their offsets), recording `fields`
+    /// (at least one; the first is the large view) on the colour scales of the first
+    /// configuration's display parameters, and sends the blueprint.
+    pub fn new(
+        rec: &RecordingStream,
+        configs: &[Configuration<'_>],
+        settings: &LogSettings,
+        fields: &[Field],
+    ) -> Result<Recorder, rerun::RecordingStreamError> {
+        let fields: Vec<Field> = if fields.is_empty() { vec![Field::Displacement] } else { fields.to_vec() };
+        let first = configs.first().map(|c| c.instance);
+        let scales = match first {
+            Some(i) => {
+                fields.iter().map(|&f| crate::display::field_scale(Some(i.sim.mesh()), i.scene.params(), f)).collect()
+            }
+            None => Vec::new(),
+        };
+        // z up, as the scenes are built (gravity along −z)
+        rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        let mut loggers = Vec::new();
+        for (k, c) in configs.iter().enumerate() {
+            loggers.push(SimLogger::new(rec, k, c, settings, &fields)?);
+        }
+        let probe_names = first.map(|i| i.probes.iter().map(|p| p.name.clone()).collect()).unwrap_or_default();
+        let recorder = Recorder { loggers, fields, scales, probe_names };
+        for field in &recorder.fields {
+            rec.log_static(format!("legend/{}/bar", field.name()), &colour_bar_image())?;
+        }
+        rec.log_static("legend/text", &rerun::TextDocument::from_markdown(recorder.legend_markdown(configs)))?;
+        recorder.blueprint().send(rec, bp::BlueprintActivation { make_active: true, make_default: true })?;
+        Ok(recorder)
     }
+
+    /// The entity names of the configurations, in order.
+    pub fn names(&self) -> Vec<&str> {
+        self.loggers.iter().map(|l| l.name.as_str()).collect()
+    }
+
+    /// Logs the current state of `instances` (in the order given to [`Recorder::new`]) at the
+    /// first one's frame and time; `ms_per_frame` is each one's wall time of its last step.
+    pub fn log_frame(
+        &mut self,
+        rec: &RecordingStream,
+        instances: &[&Instance],
+        ms_per_frame: &[f64],
+    ) -> Result<(), rerun::RecordingStreamError> {
+        let Some(first) = instances.first() else { return Ok(()) };
+        rec.set_time_sequence("frame", first.sim.frames() as i64);
+        rec.set_duration_secs("sim_time", first.sim.time_secs());
+        for (logger, instance) in self.loggers.iter_mut().zip(instances) {
+            logger.measure(instance);
+            for ((_, values), scale) in logger.sources.iter().zip(&mut self.scales) {
+                scale.observe(values);
+            }
+        }
+        let ranges: Vec<ColourRange> = self.scales.iter().map(FieldScale::range).collect();
+        for (j, range) in ranges.iter().enumerate() {
+            let values: Vec<f64> = self.loggers.iter().flat_map(|l| l.sources[j].1.iter().copied()).collect();
+            log_ticks(rec, range, &values)?;
+        }
+        for ((logger, instance), ms) in self.loggers.iter_mut().zip(instances).zip(ms_per_frame) {
+            logger.log(rec, instance, &ranges, *ms)?;
+        }
+        Ok(())
+    }
+
+    /// The legend as one text: what the colours, lines and marks mean, then every
+    /// configuration's parameters.
+    fn legend_markdown(&self, configs: &[Configuration<'_>]) -> String {
+        let mut text = String::from("## Legend\n\n");
+        let mut automatic = false;
+        for (field, scale) in self.fields.iter().zip(&self.scales) {
+            let range = scale.range();
+            automatic |= range.automatic;
+            let how = if range.automatic {
+                "automatic range".to_string()
+            } else {
+                format!(
+                    "fixed range {} to {}, beyond it pink (above){}",
+                    range.format(range.min),
+                    range.format(range.max),
+                    if field.two_sided() { " and light blue (below)" } else { "" }
+                )
+            };
+            text += &format!("- **{}** view: {} — {how}.\n", field.name(), field.description());
+        }
+        if automatic {
+            text += &format!(
+                "- An automatic range grows to hold {:.0} % of each frame's values (a stress peak at a clamped edge would otherwise leave the rest one colour); the few beyond are drawn pink, their share on the colour bar.\n",
+                100.0 * crate::colour::AUTOMATIC_PERCENTILE
+            );
+        }
+        text += "- Blue thick edges: clamped faces; magenta: driven faces; red points: probes; grey lines: the rest shape.\n";
+        text += "- Charts: one line per configuration, the same colour in every chart; grey: the static reference where one is known.\n\n";
+        for (k, (c, logger)) in configs.iter().zip(&self.loggers).enumerate() {
+            text += &format!(
+                "### {}: {} (`world/{}`)\n\n",
+                ["a", "b", "c", "d", "e", "f"][k.min(5)],
+                logger.label,
+                logger.name
+            );
+            if let Some(r) = c.reference {
+                text += &format!("Reference: {}\n\n", r.label());
+            }
+            text += &configuration_markdown(c.instance);
+            text += "\n";
+        }
+        text
+    }
+
+    /// The layout the recording opens in: the 3D views (first field large) on the left, the
+    /// legend and colour bars in a narrow column, the charts on the right.
+    pub fn blueprint(&self) -> bp::Blueprint {
+        let names: Vec<&str> = self.names();
+        let views_3d: Vec<bp::ContainerLike> = self
+            .fields
+            .iter()
+            .map(|field| {
+                let mut contents = vec!["+ world/**".to_string()];
+                for n in &names {
+                    contents.push(format!("- world/{n}/surface/**"));
+                    contents.push(format!("+ world/{n}/surface/{}", field.name()));
+                }
+                bp::Spatial3DView::new(format!("3D: {}", field.title()))
+                    .with_origin("world")
+                    .with_contents(contents)
+                    .into()
+            })
+            .collect();
+        let mut shares_3d = vec![1.0f32; views_3d.len()];
+        if let Some(s) = shares_3d.first_mut() {
+            *s = 2.0;
+        }
+        let mut legend: Vec<bp::ContainerLike> = vec![
+            bp::TextDocumentView::new("Legend").with_origin("legend/text").with_contents(["+ legend/text"]).into(),
+        ];
+        for (field, scale) in self.fields.iter().zip(&self.scales) {
+            legend.push(
+                bp::Spatial2DView::new(format!("colours: {}", scale.range().heading()))
+                    .with_origin(format!("legend/{}", field.name()))
+                    .with_contents([format!("+ legend/{}/**", field.name())])
+                    .into(),
+            );
+        }
+        let legend_shares: Vec<f32> = std::iter::once(1.2).chain(self.fields.iter().map(|_| 1.0)).collect();
+        let chart = |title: String, path: String| -> bp::ContainerLike {
+            bp::TimeSeriesView::new(title).with_origin(path.as_str()).with_contents([format!("+ {path}/**")]).into()
+        };
+        let mut charts: Vec<bp::ContainerLike> =
+            self.probe_names.iter().map(|p| chart(format!("probe {p}: u_z (m)"), probe_plot(p, 2))).collect();
+        let mut probe_rows = vec![2.0f32; charts.len()];
+        charts.push(chart("kinetic energy (J)".into(), "plots/kinetic_energy_j".into()));
+        charts.push(chart("elastic energy (J)".into(), "plots/elastic_energy_j".into()));
+        let mut more: Vec<bp::ContainerLike> = Vec::new();
+        for p in &self.probe_names {
+            more.push(chart(format!("probe {p}: u_x (m)"), probe_plot(p, 0)));
+            more.push(chart(format!("probe {p}: u_y (m)"), probe_plot(p, 1)));
+        }
+        more.push(chart("ms per frame".into(), "plots/ms_per_frame".into()));
+        more.push(chart("smallest det F".into(), "plots/min_det_f".into()));
+        charts.push(bp::Tabs::new(more).into());
+        probe_rows.extend([1.0, 1.0, 1.5]);
+        let root = bp::Horizontal::new([
+            bp::Vertical::new(views_3d).with_row_shares(shares_3d).into(),
+            bp::Vertical::new(legend).with_row_shares(legend_shares).into(),
+            bp::Vertical::new(charts).with_row_shares(probe_rows).into(),
+        ])
+        .with_column_shares([0.54, 0.18, 0.28]);
+        // the side panels folded away: the views get the window
+        bp::Blueprint::new(root)
+            .with_auto_views(false)
+            .with_auto_layout(false)
+            .with_blueprint_panel(bp::BlueprintPanel::from_state(bp::components::PanelState::Collapsed))
+            .with_selection_panel(bp::SelectionPanel::from_state(bp::components::PanelState::Collapsed))
+            .with_time_panel(
+                bp::TimePanel::new().with_state(bp::components::PanelState::Collapsed).with_timeline("sim_time"),
+            )
+    }
+}
+
+/// A vertical viridis bar, bottom to top, as an RGB image.
+fn colour_bar_image() -> rerun::Image {
+    let [w, h] = BAR_PX;
+    let mut bytes = Vec::with_capacity((w * h * 3) as usize);
+    for row in 0..h {
+        let c = crate::colour::viridis(1.0 - (row as f64 + 0.5) / h as f64);
+        for _ in 0..w {
+            bytes.extend_from_slice(&c);
+        }
+    }
+    rerun::Image::from_rgb24(bytes, BAR_PX)
+}
+
+/// The tick labels of `range` beside its colour bar: five, a quarter of the bar apart, centred
+/// right of it (labels are drawn centred on their points, so a label never covers the bar or
+/// its neighbour at the view sizes of the blueprint); a fixed range's end labels say how much of
+/// the surface is saturated. An invisible corner point keeps the labels inside the view.
+fn log_ticks(rec: &RecordingStream, range: &ColourRange, values: &[f64]) -> Result<(), rerun::RecordingStreamError> {
+    let [w, h] = BAR_PX.map(|v| v as f32);
+    let (over, under) = range.saturation(values);
+    let ticks = range.ticks();
+    let label_x = w + 48.0;
+    let mut positions: Vec<[f32; 2]> =
+        ticks.iter().enumerate().map(|(i, _)| [label_x, h * (1.0 - i as f32 / 4.0)]).collect();
+    let mut labels: Vec<String> = ticks.iter().map(|&t| range.format(t)).collect();
+    if over > 0.0 || !range.automatic {
+        labels[4] = format!("{} ({:.0} % above)", labels[4], 100.0 * over);
+    }
+    if range.field.two_sided() && (under > 0.0 || !range.automatic) {
+        labels[0] = format!("{} ({:.0} % below)", labels[0], 100.0 * under);
+    }
+    let mut colours = vec![rerun::Color::from_rgb(230, 230, 230); 5];
+    positions.push([label_x + 70.0, -10.0]);
+    labels.push(String::new());
+    colours.push(rerun::Color::from_unmultiplied_rgba(0, 0, 0, 0));
+    rec.log(
+        format!("legend/{}/ticks", range.field.name()),
+        &rerun::Points2D::new(positions)
+            .with_labels(labels)
+            .with_colors(colours)
+            .with_radii([rerun::Radius::new_ui_points(1.5)]),
+    )
 }
 
 /// `0.125`, `0.3`, `1.5e-4`: a compact metre value for labels.
 pub fn format_metres(v: f64) -> String {
-    if v == 0.0 {
-        "0".into()
-    } else if v.abs() >= 1e-3 && v.abs() < 1e4 {
-        let s = format!("{v:.4}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        format!("{v:.2e}")
-    }
+    crate::colour::format_value(v, "")
 }
 
 #[cfg(test)]

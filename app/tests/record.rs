@@ -37,7 +37,7 @@ fn paper_scenes_record_and_read_back() {
         assert_eq!(configs.len(), 1);
         let c = configs[0].as_str().unwrap();
         let e = &checked["entities"];
-        let surface = &e[format!("world/{c}/surface")];
+        let surface = &e[format!("world/{c}/surface/displacement")];
         assert!(surface["static_components"].as_array().unwrap().iter().any(|v| v == "Mesh3D:triangle_indices"));
         for component in ["Mesh3D:vertex_positions", "Mesh3D:vertex_colors", "Mesh3D:vertex_normals"] {
             assert_eq!(
@@ -69,16 +69,69 @@ fn paper_scenes_record_and_read_back() {
             assert_eq!(series.as_array().map(Vec::len), Some(16), "{scene}: plots/{quantity}/{c}");
         }
         assert!(
-            e[format!("world/{c}/legend/bar")]["static_components"]
-                .as_array()
-                .unwrap()
+            e["legend/displacement/bar"]["static_components"].as_array().unwrap().iter().any(|v| v == "Image:buffer"),
+            "{scene}: the colour bar is an image"
+        );
+        assert!(e["legend/text"]["static_components"].as_array().unwrap().iter().any(|v| v == "TextDocument:text"));
+        // the clamped face is marked
+        assert!(e[format!("world/{c}/clamped")]["frames_per_component"]["LineStrips3D:strips"].is_array(), "{scene}");
+        // the layout it opens in: a 3D view, the legend, and a chart per quantity
+        let views = checked["blueprint"]["views"].as_array().unwrap();
+        let named = |class: &str, name: &str| {
+            views
                 .iter()
-                .any(|v| v == "Mesh3D:vertex_colors")
-        );
-        assert!(
-            e[format!("legend/{c}")]["static_components"].as_array().unwrap().iter().any(|v| v == "TextDocument:text")
-        );
+                .any(|v| v[0].as_str().unwrap_or_default() == class && v[1].as_str().unwrap_or_default().contains(name))
+        };
+        assert!(named("3D", "3D: displacement"), "{scene}: {views:?}");
+        assert!(named("TextDocument", "Legend"), "{scene}: {views:?}");
+        assert!(named("TimeSeries", "u_z (m)") && named("TimeSeries", "kinetic energy"), "{scene}: {views:?}");
+        assert_eq!(checked["fields"], serde_json::json!(["displacement"]));
     }
+}
+
+/// `--field` records several fields, each on its own surface and in its own 3D view, on ranges
+/// shared by the configurations; `hox inspect` lists them. The committed bending reference
+/// appears beside the probe's u_z.
+#[test]
+fn several_fields_are_recorded_each_in_its_own_view() {
+    let file = temp("fields.rrd");
+    let f = file.to_str().unwrap();
+    let summary = ok_json(&[
+        "record",
+        "--scene",
+        "bending",
+        "--seconds",
+        "0.05",
+        "--out",
+        f,
+        "--field",
+        "von-mises,strain",
+        "--field",
+        "det-f",
+        "--colour-max",
+        "2e5",
+        "--json",
+    ]);
+    assert_eq!(summary["fields"], serde_json::json!(["von-mises", "strain", "det-f"]));
+    let checked = ok_json(&["inspect", f, "--expect-frames", "4", "--json"]);
+    assert_eq!(checked["fields"], serde_json::json!(["det-f", "strain", "von-mises"]));
+    let e = &checked["entities"];
+    for field in ["von-mises", "strain", "det-f"] {
+        assert!(e[format!("world/p2_160/surface/{field}")]["frames_per_component"]["Mesh3D:vertex_colors"].is_array());
+        assert!(e[format!("legend/{field}/ticks")]["frames_per_component"]["Points2D:labels"].is_array(), "{field}");
+    }
+    assert!(e["plots/probe_tip_u_z_m/reference_static"]["frames_per_component"]["Scalars:scalars"].is_array());
+    let views = checked["blueprint"]["views"].as_array().unwrap();
+    let n3d = views.iter().filter(|v| v[0] == "3D").count();
+    assert_eq!(n3d, 3, "{views:?}");
+    // the text listing names them with what they mean
+    let out = hox(&["inspect", f]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("fields: det-f, strain, von-mises") && text.contains("von Mises stress"), "{text}");
+    // an unknown field is refused with the list
+    let out = hox(&["record", "--scene", "bending", "--out", f, "--field", "stress"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("von-mises") && err.contains("field"), "{err}");
 }
 
 #[test]
@@ -189,7 +242,10 @@ fn ctrl_c_leaves_a_playable_file_up_to_the_last_frame() {
     assert_eq!(out.status.code(), Some(130));
     assert!(String::from_utf8_lossy(&out.stderr).contains("interrupted"));
     let e = entities(&file);
-    let frames = e["world/p2_160/surface"]["frames_per_component"]["Mesh3D:vertex_positions"].as_array().unwrap().len();
+    let frames = e["world/p2_160/surface/displacement"]["frames_per_component"]["Mesh3D:vertex_positions"]
+        .as_array()
+        .unwrap()
+        .len();
     assert!(frames >= 2, "{frames}");
     // every entity holds the same, complete frames
     ok_json(&["inspect", file.to_str().unwrap(), "--expect-frames", &frames.to_string(), "--json"]);

@@ -92,6 +92,8 @@ pub const FILE_ONLY: Surfaces = Surfaces { cli: false, app: false };
 pub enum Kind {
     /// One of named options: `(name, description)`.
     Choice(fn() -> Vec<(&'static str, String)>),
+    /// One or more of named options, comma-separated in order (`von-mises,strain`).
+    Choices(fn() -> Vec<(&'static str, String)>),
     /// A whole number in `min..=max`; `soft_max` bounds the app's slider only.
     Whole { min: u64, max: u64, soft_max: u64 },
     /// A finite number in `min..max` (ends inclusive or not); `soft` bounds the app's slider (if
@@ -185,6 +187,10 @@ impl Kind {
                 let names: Vec<&str> = options().into_iter().map(|(n, _)| n).collect();
                 format!("one of {}", names.join(", "))
             }
+            Kind::Choices(options) => {
+                let names: Vec<&str> = options().into_iter().map(|(n, _)| n).collect();
+                format!("one or more of {}, comma-separated", names.join(", "))
+            }
             Kind::Whole { min, max, .. } => format!("a whole number from {min} to {max}"),
             Kind::Number { min, min_inclusive, max, max_inclusive, .. } => {
                 let lo = if *min == f64::NEG_INFINITY {
@@ -214,6 +220,9 @@ impl Kind {
         let bad = || format!("'{t}' is not {}", self.expected());
         match self {
             Kind::Choice(_) => Ok(Value::Text(t.to_ascii_lowercase())),
+            Kind::Choices(_) => {
+                Ok(Value::Text(t.split(',').map(|n| n.trim().to_ascii_lowercase()).collect::<Vec<_>>().join(",")))
+            }
             Kind::Whole { .. } => t.parse::<u64>().map(Value::Whole).map_err(|_| bad()),
             Kind::Number { .. } => t.parse::<f64>().map(Value::Number).map_err(|_| bad()),
             Kind::Flag => match t.to_ascii_lowercase().as_str() {
@@ -255,6 +264,16 @@ impl Kind {
         let bad = || format!("expected {}", self.expected());
         match self {
             Kind::Choice(_) => v.as_str().map(|s| Value::Text(s.to_string())).ok_or_else(bad),
+            // a string ("von-mises,strain") or an array of strings
+            Kind::Choices(_) => match v {
+                toml::Value::Array(a) => a
+                    .iter()
+                    .map(|x| x.as_str().map(str::to_string))
+                    .collect::<Option<Vec<_>>>()
+                    .map(|names| Value::Text(names.join(",")))
+                    .ok_or_else(bad),
+                _ => v.as_str().map(|s| Value::Text(s.to_string())).ok_or_else(bad),
+            },
             Kind::Whole { .. } => toml_whole(v).and_then(|n| u64::try_from(n).ok()).map(Value::Whole).ok_or_else(bad),
             Kind::Number { .. } => toml_number(v).map(Value::Number).ok_or_else(bad),
             Kind::Flag => v.as_bool().map(Value::Flag).ok_or_else(bad),
@@ -284,6 +303,10 @@ impl Kind {
     pub fn check(&self, v: &Value) -> Result<(), String> {
         let ok = match (self, v) {
             (Kind::Choice(options), Value::Text(s)) => options().iter().any(|(n, _)| n == s),
+            (Kind::Choices(options), Value::Text(s)) => {
+                let known = options();
+                !s.is_empty() && s.split(',').all(|part| known.iter().any(|(n, _)| *n == part))
+            }
             (Kind::Whole { min, max, .. }, Value::Whole(n)) => (min..=max).contains(&n),
             (Kind::Number { min, min_inclusive, max, max_inclusive, .. }, Value::Number(x)) => {
                 x.is_finite()
@@ -485,6 +508,10 @@ fn material_options() -> Vec<(&'static str, String)> {
 }
 fn formulation_options() -> Vec<(&'static str, String)> {
     Formulation::ALL.iter().map(|f| (f.name(), f.name().to_string())).collect()
+}
+
+fn field_options() -> Vec<(&'static str, String)> {
+    hox_sim::measure::field::Field::ALL.iter().map(|f| (f.name(), f.description().to_string())).collect()
 }
 
 fn method_options() -> Vec<(&'static str, String)> {
@@ -771,10 +798,24 @@ params! {
         help: "Pieces per edge when drawing curved (high-order) and quadrilateral faces: more shows the curvature of P2, P3 and Q2 elements more smoothly, at more drawing cost.",
         kind: Kind::Whole { min: 1, max: 16, soft_max: 12 }, invalidates: Invalidates::Nothing, ..BASE
     }
-    /// Top of the displacement colour range, metres (0: a fifth of the body's largest extent).
+    /// The fields the surface is coloured by, comma-separated; the first is drawn
+    /// ([`hox_sim::measure::field::Field`]).
+    field: String = "displacement".into() => {
+        key: "field", group: Group::Display, file_key: "field", label: "Colour by",
+        help: "What the surface is coloured by: displacement (|u|, m), von-mises (stress, Pa), strain (equivalent Green–Lagrange strain), det-f (volume ratio), energy-density (J/m³) or error (|u − u_ref| against the reference field, m), evaluated at each element's own points. `hox record` records every field listed (comma-separated or --field repeated), each in its own 3D view; the app draws the first.",
+        kind: Kind::Choices(field_options), invalidates: Invalidates::Nothing, ..BASE
+    }
+    /// Top of the colour range of the metre fields (|u|, error), metres (0: automatic).
     colour_max_m: f64 = 0.0 => {
-        key: "colour-max-m", group: Group::Display, file_key: "colour_max_m", label: "Colour range top", unit: "m",
-        help: "Displacement magnitude shown yellow (the top of the fixed viridis range from 0 m), metres; 0: a fifth of the body's largest extent. Compared configurations share the first one's range.",
+        key: "colour-max-m", group: Group::Display, file_key: "colour_max_m", label: "Colour top (m)", unit: "m",
+        help: "Top of a fixed colour range for displacement and error, metres (larger values are drawn pink, marked saturated); 0: automatic, growing to the largest value seen so nothing saturates. Compared configurations share the first one's range.",
+        kind: Kind::Number { min: 0.0, min_inclusive: true, max: f64::INFINITY, max_inclusive: false, soft: None },
+        invalidates: Invalidates::Nothing, ..BASE
+    }
+    /// Top of the colour range of the first other field listed, in its unit (0: automatic).
+    colour_max: f64 = 0.0 => {
+        key: "colour-max", group: Group::Display, file_key: "colour_max", label: "Colour top (field unit)",
+        help: "Top of a fixed colour range for the first field listed other than displacement and error, in its unit (Pa for von-mises, J/m³ for energy-density, none for strain and det-f, whose range is then symmetric about 1); larger values are drawn pink, smaller than the bottom light blue. 0: automatic.",
         kind: Kind::Number { min: 0.0, min_inclusive: true, max: f64::INFINITY, max_inclusive: false, soft: None },
         invalidates: Invalidates::Nothing, ..BASE
     }

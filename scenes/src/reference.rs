@@ -30,6 +30,10 @@
 //! else `$XDG_CACHE_HOME/hox` or `~/.cache/hox`, folder `references/`), so a configuration is
 //! solved once per machine.
 
+pub mod field;
+
+pub use field::ReferenceField;
+
 use crate::scene::EffectSpec;
 use crate::{Scene, SceneError, SceneOverrides};
 use hox_sim::Vec3;
@@ -66,6 +70,10 @@ pub struct Reference {
     pub estimate: String,
     /// The Poisson ratio it was solved with (shown in the label).
     pub poisson_ratio: f64,
+    /// The displacement field of its finest solution, for the error field (None for the
+    /// committed references, which hold probes only, until [`Lookup::with_field`] solves it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub field: Option<ReferenceField>,
 }
 
 impl Reference {
@@ -220,6 +228,7 @@ pub fn committed(scene: &Scene) -> Result<Option<Reference>, SceneError> {
         estimated_error_m: Some(error_m),
         estimate,
         poisson_ratio: scene.params().poisson_ratio,
+        field: None,
     }))
 }
 
@@ -330,6 +339,7 @@ pub fn compute_with(scene: &Scene, finest_cells: usize, progress: Progress<'_>) 
     let total: f64 = cells.iter().sum();
     let mut done = 0.0;
     let mut solved = Vec::new();
+    let mut finest_field = None;
     for (k, grid) in grids.iter().enumerate() {
         let o = SceneOverrides {
             element: Some("q2".into()),
@@ -345,6 +355,9 @@ pub fn compute_with(scene: &Scene, finest_cells: usize, progress: Progress<'_>) 
         })?;
         done += cells[k];
         solved.push((cell_size(scene, *grid), probes_at(&level, &mesh, &solution.positions)?));
+        if k == grids.len() - 1 {
+            finest_field = ReferenceField::lattice(&mesh, &solution.positions, p.box_min_m, p.box_max_m, *grid);
+        }
     }
     let name = format!("Q2 {}×{}×{}", fine[0], fine[1], fine[2]);
     let triplet = |i: usize, j: usize, k: usize| [solved[i].clone(), solved[j].clone(), solved[k].clone()];
@@ -361,6 +374,7 @@ pub fn compute_with(scene: &Scene, finest_cells: usize, progress: Progress<'_>) 
                 mesh: format!("{name} extrapolated"),
                 estimate: format!("Richardson from four levels, order {p_finest:.2}; {p_halving:.2} by halving"),
                 poisson_ratio: p.poisson_ratio,
+                field: finest_field,
             }
         }
         _ => {
@@ -372,6 +386,7 @@ pub fn compute_with(scene: &Scene, finest_cells: usize, progress: Progress<'_>) 
                 estimated_error_m: Some(error_m),
                 estimate,
                 poisson_ratio: p.poisson_ratio,
+                field: finest_field,
             }
         }
     };
@@ -407,6 +422,9 @@ pub fn own_mesh(scene: &Scene, progress: Progress<'_>) -> Result<Reference, Scen
         estimated_error_m: None,
         estimate: "measures the solver's error only, not the mesh's".into(),
         poisson_ratio: scene.params().poisson_ratio,
+        field: Some(ReferenceField::Nodes {
+            displacements_m: solution.positions.iter().zip(&mesh.rest_positions).map(|(x, r)| (x - r).into()).collect(),
+        }),
     })
 }
 
@@ -486,21 +504,38 @@ impl Lookup {
         if let Some(r) = committed(scene)? {
             return Ok(Some(r));
         }
-        let key = self.key(scene);
-        if let Some(r) = memory().lock().ok().and_then(|m| m.get(&key).cloned()) {
-            return Ok(Some(r));
+        Ok(self.load(&self.key(scene), scene.is_box()))
+    }
+
+    /// A reference stored under `key`: in memory, or (`disk`) in the cache folder.
+    fn load(&self, key: &str, disk: bool) -> Option<Reference> {
+        if let Some(r) = memory().lock().ok().and_then(|m| m.get(key).cloned()) {
+            return Some(r);
         }
-        let Some(path) = self.cache_file(&key).filter(|_| scene.is_box()) else { return Ok(None) };
+        let path = self.cache_file(key).filter(|_| disk)?;
         // an unreadable or foreign cache file is recomputed, never trusted
-        let cached = std::fs::read_to_string(&path).ok().and_then(|t| serde_json::from_str::<Cached>(&t).ok());
-        match cached {
-            Some(c) if c.key == key => {
-                if let Ok(mut m) = memory().lock() {
-                    m.insert(key, c.reference.clone());
-                }
-                Ok(Some(c.reference))
+        let cached = std::fs::read_to_string(&path).ok().and_then(|t| serde_json::from_str::<Cached>(&t).ok())?;
+        (cached.key == key).then(|| {
+            if let Ok(mut m) = memory().lock() {
+                m.insert(key.to_string(), cached.reference.clone());
             }
-            _ => Ok(None),
+            cached.reference
+        })
+    }
+
+    /// Keeps `reference` under `key` in memory and (`disk`) in the cache folder.
+    fn store(&self, key: &str, reference: &Reference, disk: bool) {
+        if let Ok(mut m) = memory().lock() {
+            m.insert(key.to_string(), reference.clone());
+        }
+        if let Some(path) = self.cache_file(key).filter(|_| disk) {
+            // the cache is an optimisation: failing to write it loses nothing
+            let cached = Cached { key: key.to_string(), reference: reference.clone() };
+            let text = serde_json::to_string(&cached).unwrap_or_default();
+            let tmp = path.with_extension("json.tmp");
+            let _ = std::fs::create_dir_all(path.parent().unwrap_or(&path))
+                .and_then(|_| std::fs::write(&tmp, text))
+                .and_then(|_| std::fs::rename(&tmp, &path));
         }
     }
 
@@ -519,18 +554,43 @@ impl Lookup {
         let key = self.key(scene);
         let reference =
             if scene.is_box() { compute_with(scene, self.finest_cells, progress)? } else { own_mesh(scene, progress)? };
-        if let Ok(mut m) = memory().lock() {
-            m.insert(key.clone(), reference.clone());
-        }
-        if let Some(path) = self.cache_file(&key).filter(|_| scene.is_box()) {
-            // the cache is an optimisation: failing to write it loses nothing
-            let text = serde_json::to_string_pretty(&Cached { key, reference: reference.clone() }).unwrap_or_default();
-            let tmp = path.with_extension("json.tmp");
-            let _ = std::fs::create_dir_all(path.parent().unwrap_or(&path))
-                .and_then(|_| std::fs::write(&tmp, text))
-                .and_then(|_| std::fs::rename(&tmp, &path));
-        }
+        self.store(&key, &reference, scene.is_box());
         Ok(reference)
+    }
+
+    /// The key of [`Lookup::with_field`]'s result.
+    pub fn field_key(&self, scene: &Scene) -> String {
+        format!("{}; with its displacement field", self.key(scene))
+    }
+
+    /// [`Lookup::for_scene`] with its displacement field: a committed reference (probes only)
+    /// gets the field of one static Q2 solve on the finest level ([`levels`]), cached.
+    pub fn with_field(&self, scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
+        let reference = self.for_scene(scene, progress)?;
+        if reference.field.is_some() || !scene.is_box() {
+            return Ok(reference);
+        }
+        let key = self.field_key(scene);
+        if let Some(r) = self.load(&key, true) {
+            return Ok(r);
+        }
+        let p = scene.params();
+        let grid = levels(p.box_min_m, p.box_max_m, self.finest_cells)[2];
+        let o = SceneOverrides {
+            element: Some("q2".into()),
+            grid: Some(grid),
+            quadrature_degree: Some(None),
+            ..Default::default()
+        };
+        let level = scene.with_overrides(&o)?;
+        let mesh = level.build_mesh()?;
+        let what = format!("reference field: static Q2 {}×{}×{}", grid[0], grid[1], grid[2]);
+        let solution =
+            crate::solve_static(&level, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| progress(&what, fraction))?;
+        let field = ReferenceField::lattice(&mesh, &solution.positions, p.box_min_m, p.box_max_m, grid);
+        let with = Reference { field, ..reference };
+        self.store(&key, &with, true);
+        Ok(with)
     }
 }
 

@@ -34,6 +34,7 @@ fn on_cli(groups: &'static [Group]) -> impl Iterator<Item = &'static Param> {
 fn value_name(p: &Param) -> &'static str {
     match p.kind {
         Kind::Choice(_) => "NAME",
+        Kind::Choices(_) => "NAME[,NAME…]",
         Kind::Whole { .. } => "N",
         Kind::Number { .. } => "X",
         Kind::Flag => "on|off",
@@ -48,6 +49,13 @@ pub fn arg(p: &'static Param) -> Arg {
     let unit = if p.unit.is_empty() { String::new() } else { format!(", {}", p.unit) };
     match p.switch {
         Some((name, _)) => Arg::new(p.key).long(name).action(ArgAction::SetTrue).help(p.help),
+        // a list may be given as one comma-separated value or by repeating the flag
+        None if matches!(p.kind, Kind::Choices(_)) => Arg::new(p.key)
+            .long(p.key)
+            .value_name(value_name(p))
+            .help(format!("{} [{}]", p.help, p.kind.expected()))
+            .action(ArgAction::Append)
+            .value_parser(move |s: &str| p.kind.parse(s)),
         None => Arg::new(p.key)
             .long(p.key)
             .value_name(value_name(p))
@@ -72,6 +80,12 @@ fn read(m: &ArgMatches, groups: &'static [Group]) -> SceneOverrides {
             Some((_, sets)) => {
                 if m.get_flag(p.key) {
                     (p.set_override)(&mut o, Value::Flag(sets));
+                }
+            }
+            None if matches!(p.kind, Kind::Choices(_)) => {
+                if let Some(values) = m.get_many::<Value>(p.key) {
+                    let names: Vec<String> = values.map(|v| v.to_string()).collect();
+                    (p.set_override)(&mut o, Value::Text(names.join(",")));
                 }
             }
             None => {

@@ -3,7 +3,7 @@
 
 use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, load_scene, overrides};
 use crate::output::check_writable;
-use crate::recording::{LogSettings, SimLogger, config_label, entity_name};
+use crate::recording::{Configuration, LogSettings, Recorder, config_label, entity_name};
 use anyhow::{Context, Result, bail};
 use hox_scenes::{Instance, SceneOverrides};
 use std::collections::{BTreeMap, BTreeSet};
@@ -45,6 +45,8 @@ pub struct RecordArgs {
     pub display: super::params::DisplayArgs,
     #[command(flatten)]
     pub vtk: super::gmsh::VtkArgs,
+    #[command(flatten)]
+    pub reference: super::reference::ReferenceArgs,
     /// Print a JSON summary on stdout.
     #[arg(long)]
     pub json: bool,
@@ -95,30 +97,46 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     }
     check_writable(&args.out)?;
 
+    // the fields to record: the first configuration's list (`--field`, several allowed)
+    let fields = crate::display::fields(instances[0].scene.params());
+    let with_field = fields.contains(&hox_sim::measure::field::Field::Error);
+    if with_field && args.reference.reference == super::reference::When::None {
+        bail!("--field error draws the distance from the reference solution, but --reference none turns it off");
+    }
+    super::reference::check(&args.reference)?;
+    let references: Vec<Option<hox_scenes::reference::Reference>> =
+        instances.iter().map(|i| super::reference::find_for_record(&args.reference, &i.scene, with_field)).collect();
+    if with_field && references.iter().any(|r| r.as_ref().is_none_or(|r| r.field.is_none())) {
+        bail!("--field error: no reference displacement field for {} (see the notes above)", instances[0].scene.name());
+    }
+
     let rec = rerun::RecordingStreamBuilder::new("hox")
         .recording_name(format!("hox record {}", instances[0].scene.name()))
         .save(&args.out)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
-    // one layout and one colour range for every configuration, as the app's viewport draws them
+    // one layout and one colour range per field for every configuration, as the app's
+    // viewport draws them
     let first_mesh = instances[0].sim.mesh();
-    let offsets = crate::display::side_by_side_offsets(first_mesh, instances.len());
-    let colours = crate::display::colour_range(Some(first_mesh), instances[0].scene.params().colour_max_m);
+    let offsets = crate::display::side_by_side_offsets(first_mesh, instances.len(), crate::display::LayoutAxis::X);
     let mut names = BTreeSet::new();
-    let mut loggers = Vec::new();
+    let mut configs = Vec::new();
     for (k, inst) in instances.iter().enumerate() {
         let mut name = entity_name(&config_label(inst));
         if !names.insert(name.clone()) {
             name = format!("{name}_{}", k + 1);
             names.insert(name.clone());
         }
-        let settings = LogSettings::new(inst.scene.params(), colours);
-        loggers.push(SimLogger::new(&rec, &name, inst, offsets[k], &settings)?);
+        configs.push(Configuration { name, instance: inst, offset_m: offsets[k], reference: references[k].as_ref() });
     }
+    let settings = LogSettings::new(instances[0].scene.params());
+    let mut recorder = Recorder::new(&rec, &configs, &settings, &fields)?;
+    let logger_names: Vec<String> = recorder.names().iter().map(|s| s.to_string()).collect();
+    drop(configs);
 
     // VTK series beside the recording (one folder per configuration when comparing)
     let mut vtk_writers = Vec::new();
-    for (inst, logger) in instances.iter().zip(&loggers) {
-        let dir = args.vtk.vtk.as_ref().map(|d| if instances.len() > 1 { d.join(logger.name()) } else { d.clone() });
+    for (inst, name) in instances.iter().zip(&logger_names) {
+        let dir = args.vtk.vtk.as_ref().map(|d| if instances.len() > 1 { d.join(name) } else { d.clone() });
         vtk_writers.push(super::gmsh::VtkWriter::create(
             &super::gmsh::VtkArgs { vtk: dir, vtk_every: args.vtk.vtk_every },
             inst,
@@ -135,30 +153,30 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     let mut log_ms = Vec::new();
     let mut bar = DelayedBar::new();
     let started = Instant::now();
-    for (inst, logger) in instances.iter().zip(loggers.iter_mut()) {
-        logger.log_frame(&rec, inst, 0.0)?;
-    }
+    recorder.log_frame(&rec, &instances.iter().collect::<Vec<_>>(), &vec![0.0; instances.len()])?;
     let mut failure = None;
     let mut done = 0;
     'frames: for frame in 1..=frames {
         if interrupted.load(Ordering::SeqCst) {
             break;
         }
-        for (k, (inst, logger)) in instances.iter_mut().zip(loggers.iter_mut()).enumerate() {
+        let mut ms_now = vec![0.0; instances.len()];
+        for (k, (inst, name)) in instances.iter_mut().zip(&logger_names).enumerate() {
             let t0 = Instant::now();
             if let Err(e) = inst.sim.step_frame() {
-                failure = Some(anyhow::anyhow!("{}: configuration {}: {e}", inst.scene.source, logger.name()));
+                failure = Some(anyhow::anyhow!("{}: configuration {name}: {e}", inst.scene.source));
                 break 'frames;
             }
-            let ms = t0.elapsed().as_secs_f64() * 1e3;
-            step_ms[k].push(ms);
-            let t1 = Instant::now();
-            logger.log_frame(&rec, inst, ms)?;
-            log_ms.push(t1.elapsed().as_secs_f64() * 1e3);
+            ms_now[k] = t0.elapsed().as_secs_f64() * 1e3;
+            step_ms[k].push(ms_now[k]);
             if let Some(w) = &mut vtk_writers[k] {
                 w.frame(inst)?;
             }
         }
+        // every configuration stepped: log them together, on ranges they share
+        let t1 = Instant::now();
+        recorder.log_frame(&rec, &instances.iter().collect::<Vec<_>>(), &ms_now)?;
+        log_ms.push(t1.elapsed().as_secs_f64() * 1e3 / instances.len() as f64);
         done = frame;
         bar.reveal("{spinner} {bar:40} {percent}% {msg} (eta {eta})");
         bar.bar.set_position(1000 * frame / frames.max(1));
@@ -184,11 +202,11 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     }
     let configs: Vec<serde_json::Value> = instances
         .iter()
-        .zip(&loggers)
+        .zip(&logger_names)
         .zip(step_ms.iter_mut())
-        .map(|((inst, logger), ms)| {
+        .map(|((inst, name), ms)| {
             serde_json::json!({
-                "entity": format!("world/{}", logger.name()),
+                "entity": format!("world/{name}"),
                 "elements": inst.sim.mesh().num_elements(),
                 "nodes": inst.sim.mesh().num_nodes(),
                 "probes": inst.probe_displacements().into_iter().collect::<BTreeMap<_, _>>(),
@@ -204,6 +222,7 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         "log_ms_per_frame": hox_scenes::median(&mut log_ms),
         "wall_seconds": started.elapsed().as_secs_f64(),
         "configurations": configs,
+        "fields": fields.iter().map(|f| f.name()).collect::<Vec<_>>(),
         "vtk": vtk_indexes,
     });
     if args.json {

@@ -69,20 +69,36 @@ pub fn find(args: &ReferenceArgs, scene: &Scene, equilibrium: bool) -> Option<Re
             }
         };
     }
+    with_progress(|progress| lookup.for_scene(scene, progress))
+}
+
+/// Runs a reference computation with a progress bar (shown if it lasts); None with a warning
+/// when it fails.
+fn with_progress(
+    compute: impl FnOnce(hox_scenes::reference::Progress<'_>) -> Result<Reference, hox_scenes::SceneError>,
+) -> Option<Reference> {
     let mut bar = DelayedBar::new();
-    let found = lookup.for_scene(scene, &mut |what, fraction| {
+    let found = compute(&mut |what, fraction| {
         bar.reveal("{spinner} {bar:30} {msg} [{elapsed}]");
         bar.bar.set_position((1000.0 * fraction) as u64);
         bar.bar.set_message(what.to_string());
     });
     bar.bar.finish_and_clear();
-    match found {
-        Ok(r) => Some(r),
-        Err(e) => {
-            eprintln!("warning: no reference: {e}");
-            None
-        }
+    found.map_err(|e| eprintln!("warning: no reference: {e}")).ok()
+}
+
+/// The reference a recording shows: as [`find`] for a timed run, and with its displacement
+/// field (computed when missing, with progress) when `with_field` (`--field error`).
+pub fn find_for_record(args: &ReferenceArgs, scene: &Scene, with_field: bool) -> Option<Reference> {
+    if !with_field {
+        return find(args, scene, false);
     }
+    if let Some(why) = hox_scenes::reference::unavailable(scene) {
+        eprintln!("note: no reference: {why}");
+        return None;
+    }
+    let lookup = hox_scenes::reference::Lookup { finest_cells: args.reference_cells, ..Default::default() };
+    with_progress(|progress| lookup.with_field(scene, progress))
 }
 
 /// `"reference"`, `"error_m"`, `"error_pct"` and `"error_of"` for `--json` (nulls without a

@@ -2,6 +2,13 @@
 
 use std::path::PathBuf;
 
+/// What the central view shows at start (`--view`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum StartView {
+    Model,
+    ReferenceElement,
+}
+
 /// Command-line options of the app.
 #[derive(Clone, Debug, Default, clap::Args)]
 pub struct AppArgs {
@@ -17,9 +24,24 @@ pub struct AppArgs {
     /// Start playing at once.
     #[arg(long)]
     pub play: bool,
-    /// Start in compare mode (P1 refined once against P2 on the paper scenes).
-    #[arg(long)]
-    pub compare: bool,
+    /// Start in compare mode: alone, P1 refined once against P2 on the paper scenes; given twice
+    /// with values, these two configurations, as `hox record --compare` takes them (e.g.
+    /// `--compare element=p1,refine=1 --compare element=p2`), on top of the other options.
+    #[arg(long, value_name = "OPTION=VALUE,...", num_args = 0..=1, default_missing_value = "")]
+    pub compare: Vec<String>,
+    #[command(flatten)]
+    pub mesh: crate::cli::MeshArgs,
+    #[command(flatten)]
+    pub physics: crate::cli::PhysicsArgs,
+    #[command(flatten)]
+    pub display: crate::cli::DisplayArgs,
+    /// What the central view shows at start: the model, or the reference element's shape
+    /// functions and quadrature points.
+    #[arg(long, value_enum)]
+    pub view: Option<StartView>,
+    /// The camera preset at start (keys 1–4 in the app).
+    #[arg(long, value_enum)]
+    pub camera: Option<super::viewport::ViewPreset>,
     /// Save a PNG of the window after --after-secs and quit (for docs and tests).
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
@@ -35,4 +57,17 @@ pub struct AppArgs {
     /// Do not wait for the display's vertical sync (frame-rate measurements).
     #[arg(long)]
     pub no_vsync: bool,
+}
+
+/// The app's options from command-line words (the UI tests start the app as a teacher would).
+#[cfg(test)]
+pub fn parse_for_test(words: &[&str]) -> AppArgs {
+    use clap::Parser;
+    #[derive(clap::Parser)]
+    struct Line {
+        #[command(flatten)]
+        app: AppArgs,
+    }
+    let all = std::iter::once("hox").chain(words.iter().copied());
+    Line::try_parse_from(all).unwrap_or_else(|e| panic!("{words:?}: {e}")).app
 }

@@ -54,6 +54,19 @@ pub fn menu_bar_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 app.viewport.reset_camera(&app.sessions, &offsets);
                 ui.close();
             }
+            ui.separator();
+            for (k, preset) in super::viewport::ViewPreset::ALL.into_iter().enumerate() {
+                let mut name = format!("{} view", preset.name());
+                name[..1].make_ascii_uppercase();
+                if ui
+                    .selectable_label(app.viewport.preset == preset, name)
+                    .on_hover_text(format!("Key {}.", k + 1))
+                    .clicked()
+                {
+                    app.set_camera(preset);
+                    ui.close();
+                }
+            }
         });
         ui.separator();
         let play = if app.playback.playing { "Pause" } else { "Play" };
@@ -267,7 +280,9 @@ fn params_ui(app: &mut HoxApp, ui: &mut egui::Ui, group: Group) {
 /// Empty for a parameter that is not a choice.
 pub fn choice_menu(p: &Param) -> Vec<(String, String)> {
     match p.kind {
-        Kind::Choice(options) => options().into_iter().map(|(n, d)| (n.to_string(), d)).collect(),
+        Kind::Choice(options) | Kind::Choices(options) => {
+            options().into_iter().map(|(n, d)| (n.to_string(), d)).collect()
+        }
         _ => Vec::new(),
     }
 }
@@ -293,8 +308,12 @@ fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
     };
     match p.kind {
         Kind::Number { soft: None, .. } => number_ui(app, ui, p),
-        Kind::Choice(_) => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
+        // a list (the fields) is shown and chosen by its first entry: the app draws that one
+        Kind::Choice(_) | Kind::Choices(_) => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
             let Value::Text(name) = v else { return ui.label("?") };
+            if let Some((first, _)) = name.split_once(',') {
+                *name = first.to_string();
+            }
             let entries = choice_menu(p);
             let shown = choice_shown(&entries, name);
             ui.add_enabled_ui(enabled, |ui| combo(ui, (p.key, k), name, shown, entries)).inner
@@ -385,6 +404,30 @@ fn view_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
             .on_hover_text("Clamped nodes blue, nodes with prescribed motion magenta.");
         ui.checkbox(&mut v.ghost, "rest shape").on_hover_text("The undeformed shape's edges as a faint ghost.");
         ui.checkbox(&mut v.probes, "probes").on_hover_text("The probe points the study measures (red).");
+    });
+    camera_ui(app, ui);
+}
+
+/// The camera presets (keys 1–4): compared configurations are laid apart across the line of
+/// sight, so neither hides the other.
+pub fn camera_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.horizontal(|ui| {
+        ui.label("Camera");
+        for (k, preset) in super::viewport::ViewPreset::ALL.into_iter().enumerate() {
+            let help = match preset {
+                super::viewport::ViewPreset::Iso => "Three-quarter view from the front, above",
+                super::viewport::ViewPreset::Front => "Looking at the x–z plane: the bending of a beam",
+                super::viewport::ViewPreset::Side => "Looking along the beam at the y–z plane: twist and sideways bend",
+                super::viewport::ViewPreset::Top => {
+                    "Looking down at the x–y plane: a sideways bend (the tet split's bias)"
+                }
+            };
+            let selected = app.viewport.preset == preset;
+            if ui.selectable_label(selected, preset.name()).on_hover_text(format!("{help} (key {}).", k + 1)).clicked()
+            {
+                app.set_camera(preset);
+            }
+        }
     });
 }
 

@@ -65,6 +65,8 @@ pub struct HoxApp {
     pub show_reference_element: bool,
     pub reference_element: teach::ReferenceElementView,
     pub bottom_tab: plots::Tab,
+    /// The probe plot's components (None: u_z alone when comparing, else all three).
+    pub probe_axes: Option<[bool; 3]>,
     pub rerun_url: String,
     pub rerun_file: String,
     rerun: Option<RerunLink>,
@@ -118,6 +120,7 @@ impl HoxApp {
             show_reference_element: saved.as_ref().is_some_and(|s| s.show_reference_element),
             reference_element: teach::ReferenceElementView::default(),
             bottom_tab: plots::Tab::default(),
+            probe_axes: None,
             rerun_url: saved
                 .as_ref()
                 .map_or_else(|| "rerun+http://127.0.0.1:9876/proxy".into(), |s| s.rerun_url.clone()),
@@ -136,13 +139,59 @@ impl HoxApp {
         };
         let configs = saved.filter(|_| same_scene).map(|s| (s.configs, s.compare));
         app.load_scene(scene, configs)?;
-        if args.compare && !app.compare {
-            app.set_compare(true);
+        app.start_configurations(args)?;
+        if let Some(v) = args.view {
+            app.show_reference_element = v == args::StartView::ReferenceElement;
+        }
+        if let Some(preset) = args.camera {
+            app.set_camera(preset);
         }
         if app.measure.is_some() {
             app.playback.playing = true;
         }
         Ok(app)
+    }
+
+    /// The configurations the command line asks for: its overrides on the scene's own
+    /// configuration, and `--compare` (alone: the default pair; with values: exactly two
+    /// configurations). Nothing given keeps the saved ones. Errors name the option.
+    fn start_configurations(&mut self, args: &AppArgs) -> Result<(), String> {
+        let o = crate::cli::overrides(&args.mesh, Some(&args.physics)).merged(&args.display.overrides);
+        let specs: Vec<&String> = args.compare.iter().filter(|s| !s.trim().is_empty()).collect();
+        let wants_pair = !args.compare.is_empty();
+        if o.iter().next().is_none() && specs.is_empty() {
+            if wants_pair && !self.compare {
+                self.set_compare(true);
+            }
+            return Ok(());
+        }
+        let overrides = match specs.len() {
+            0 => vec![o],
+            2 => specs
+                .iter()
+                .map(|s| crate::cli::parse_compare(s, &o).map_err(|e| format!("{e:#}")))
+                .collect::<Result<Vec<_>, _>>()?,
+            n => return Err(format!("--compare with values needs exactly two configurations for the app, got {n}")),
+        };
+        let base = self.sessions[0].base.clone();
+        let mut sessions = Vec::new();
+        for (k, o) in overrides.iter().enumerate() {
+            let scene = base.with_overrides(o).map_err(|e| match specs.get(k) {
+                Some(spec) => format!("--compare '{spec}': {e}"),
+                None => e.to_string(),
+            })?;
+            sessions.push(Session::new(base.clone(), scene.params().clone())?);
+        }
+        self.sessions = sessions;
+        self.compare = self.sessions.len() > 1;
+        self.active = 0;
+        self.rebuilt();
+        if wants_pair && !self.compare {
+            self.set_compare(true);
+        }
+        let offsets = self.offsets();
+        self.viewport.reset_camera(&self.sessions, &offsets);
+        Ok(())
     }
 
     /// Switches to `source`, with saved configurations if given (falling back to the scene's).
@@ -206,10 +255,42 @@ impl HoxApp {
         self.viewport.reset_camera(&self.sessions, &self.offsets());
     }
 
-    /// World offsets of the sessions (side by side along y, [`crate::display`]).
+    /// World offsets of the sessions: side by side across the camera preset's line of sight
+    /// ([`crate::display`], [`viewport::ViewPreset::layout_axis`]).
     pub fn offsets(&self) -> Vec<Vec3> {
         let Some(first) = self.sessions.first() else { return Vec::new() };
-        crate::display::side_by_side_offsets(first.instance.sim.mesh(), self.sessions.len())
+        let axis = self.viewport.preset.layout_axis();
+        crate::display::side_by_side_offsets(first.instance.sim.mesh(), self.sessions.len(), axis)
+    }
+
+    /// Colours by `field` (every session: colours compare only on one field).
+    pub fn set_field(&mut self, field: hox_sim::measure::field::Field) {
+        for k in 0..self.sessions.len() {
+            let mut c = self.sessions[k].config.clone();
+            c.field = field.name().to_string();
+            if let Err(e) = self.sessions[k].apply(c) {
+                self.refusal = Some(("field".into(), e));
+            }
+        }
+        self.generation += 1;
+    }
+
+    /// The field after the one drawn (key F).
+    pub fn next_field(&mut self) {
+        use hox_sim::measure::field::Field;
+        let Some(first) = self.sessions.first() else { return };
+        let now = crate::display::fields(&first.config)[0];
+        let k = Field::ALL.iter().position(|f| *f == now).unwrap_or(0);
+        self.set_field(Field::ALL[(k + 1) % Field::ALL.len()]);
+    }
+
+    /// Looks from `preset`: the configurations laid apart across its line of sight, framed.
+    pub fn set_camera(&mut self, preset: viewport::ViewPreset) {
+        self.viewport.preset = preset;
+        let offsets = self.offsets();
+        self.viewport.reset_camera(&self.sessions, &offsets);
+        // the layout changed: recordings log it again
+        self.generation += 1;
     }
 
     /// Applies `new` to the active session and, in compare mode, the linked fields to the

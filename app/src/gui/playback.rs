@@ -91,6 +91,15 @@ impl HoxApp {
                 i.key_pressed(egui::Key::E),
             )
         });
+        // camera presets 1–4, and F for the next field
+        let keys = [egui::Key::Num1, egui::Key::Num2, egui::Key::Num3, egui::Key::Num4];
+        let preset = keys.iter().position(|k| ctx.input(|i| i.key_pressed(*k)));
+        if let Some(k) = preset {
+            self.set_camera(super::viewport::ViewPreset::ALL[k]);
+        }
+        if ctx.input(|i| i.key_pressed(egui::Key::F)) {
+            self.next_field();
+        }
         if e {
             self.settle();
         }

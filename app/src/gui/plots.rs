@@ -5,7 +5,7 @@ use super::HoxApp;
 use super::readout::Readout;
 use super::study_chart::{StudyPoint, study_chart_ui};
 use eframe::egui;
-use egui_plot::{Legend, Line, Plot, PlotPoints};
+use egui_plot::{Line, Plot, PlotPoints};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Tab {
@@ -51,25 +51,91 @@ pub fn decimate(t: &[f64], y: impl Fn(usize) -> f64, max_points: usize) -> Vec<e
 /// The legend of the reference motion's dashed curve.
 pub const REFERENCE_MOTION_LABEL: &str = "reference motion u_z (Newmark, Q2 16×4×4)";
 
+/// Line colours: per configuration (A, B) a hue, per displacement component a shade
+/// (u_x lightest, u_z full); the references grey and pink.
+fn line_colour(config: usize, shade: usize) -> egui::Color32 {
+    const HUES: [[[u8; 3]; 3]; 2] =
+        [[[160, 200, 240], [110, 160, 220], [60, 130, 230]], [[250, 200, 150], [245, 160, 90], [240, 120, 30]]];
+    let c = HUES[config.min(1)][shade.min(2)];
+    egui::Color32::from_rgb(c[0], c[1], c[2])
+}
+const REFERENCE_COLOUR: egui::Color32 = egui::Color32::from_rgb(235, 90, 200);
+const MOTION_COLOUR: egui::Color32 = egui::Color32::from_rgb(170, 170, 170);
+
+/// The plot's legend as a row of coloured entries above it, so it never covers the data.
+fn legend_row_ui(ui: &mut egui::Ui, entries: &[(String, egui::Color32, bool)]) {
+    ui.horizontal_wrapped(|ui| {
+        for (name, colour, dashed) in entries {
+            let (rect, _) = ui.allocate_exact_size(egui::vec2(22.0, 10.0), egui::Sense::hover());
+            let y = rect.center().y;
+            let stroke = egui::Stroke::new(2.5, *colour);
+            if *dashed {
+                for k in 0..3 {
+                    let x = rect.min.x + 8.0 * k as f32;
+                    ui.painter().line_segment([egui::pos2(x, y), egui::pos2(x + 5.0, y)], stroke);
+                }
+            } else {
+                ui.painter().line_segment([egui::pos2(rect.min.x, y), egui::pos2(rect.max.x, y)], stroke);
+            }
+            ui.label(egui::RichText::new(name).small());
+            ui.add_space(8.0);
+        }
+    });
+}
+
+/// Which displacement components the probe plot shows: the user's choice, else all three for
+/// one configuration and u_z alone when comparing (six lines would bury each other).
+pub fn probe_axes(app: &HoxApp) -> [bool; 3] {
+    app.probe_axes.unwrap_or(if app.compare { [false, false, true] } else { [true, true, true] })
+}
+
 pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         ui.selectable_value(&mut app.bottom_tab, Tab::Probe, "Probe displacement").on_hover_text("The first probe's displacement components over simulated time, metres.");
         ui.selectable_value(&mut app.bottom_tab, Tab::Energy, "Energies").on_hover_text("Kinetic and elastic energy over simulated time, joules.");
         ui.selectable_value(&mut app.bottom_tab, Tab::Study, "Accuracy vs time").on_hover_text("The study's probe error against the reference solution versus milliseconds per frame; the running configurations are marked.");
+        if app.bottom_tab == Tab::Probe {
+            ui.separator();
+            let mut axes = probe_axes(app);
+            for (k, name) in ["u_x", "u_y", "u_z"].iter().enumerate() {
+                ui.checkbox(&mut axes[k], *name);
+            }
+            if axes != probe_axes(app) {
+                app.probe_axes = Some(axes);
+            }
+        }
     });
     let names = ["A", "B"];
     match app.bottom_tab {
         Tab::Probe => {
             let probe = app.sessions[0].instance.probes.first().map_or("probe".to_string(), |p| p.name.clone());
+            let axes = probe_axes(app);
+            let mut entries = Vec::new();
+            for (k, s) in app.sessions.iter().enumerate() {
+                for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate().filter(|(a, _)| axes[*a]) {
+                    let name =
+                        if app.compare { format!("{} {} {label}", names[k], s.label()) } else { label.to_string() };
+                    entries.push((name, line_colour(k, axis), false));
+                }
+            }
+            let first = &app.sessions[0];
+            let reference = first.reference.reference().and_then(|r| r.probes.get(&probe)).copied();
+            if reference.is_some() && axes[2] {
+                entries.push(("reference u_z (static)".to_string(), REFERENCE_COLOUR, true));
+            }
+            let motion = first.reference_motion().filter(|_| probe == "tip" && axes[2]);
+            if motion.is_some() {
+                entries.push((REFERENCE_MOTION_LABEL.to_string(), MOTION_COLOUR, true));
+            }
+            legend_row_ui(ui, &entries);
             Plot::new("probe")
                 .show_background(false)
-                .legend(Legend::default())
                 .x_axis_label("t (s)")
                 .y_axis_label(format!("{probe} u (m)"))
                 .show(ui, |plot| {
                     for (k, s) in app.sessions.iter().enumerate() {
                         let h = &s.history;
-                        for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate() {
+                        for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate().filter(|(a, _)| axes[*a]) {
                             let points =
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.probe_m[i][axis], MAX_PLOT_POINTS));
                             let name = if app.compare {
@@ -77,59 +143,71 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                             } else {
                                 label.to_string()
                             };
-                            plot.line(Line::new(name, points));
+                            plot.line(Line::new(name, points).color(line_colour(k, axis)));
                         }
-                        // the reference displacement, as a dashed level
-                        if let Some(r) = s.reference.reference().and_then(|r| r.probes.get(&probe))
-                            && k == 0
-                        {
-                            let t1 = h.time_secs.last().copied().unwrap_or(1.0).max(1e-3);
+                    }
+                    let h = &first.history;
+                    // the reference displacement, as a dashed level
+                    if let Some(r) = reference.filter(|_| axes[2]) {
+                        let t1 = h.time_secs.last().copied().unwrap_or(1.0).max(1e-3);
+                        plot.line(
+                            Line::new("reference u_z (static)", PlotPoints::from(vec![[0.0, r[2]], [t1, r[2]]]))
+                                .color(REFERENCE_COLOUR)
+                                .style(egui_plot::LineStyle::dashed_loose()),
+                        );
+                    }
+                    // the reference motion (the beam released from rest), dashed, as far as the
+                    // run has come
+                    if let Some(m) = motion {
+                        let t1 = h.time_secs.last().copied().unwrap_or(0.0);
+                        let points: Vec<[f64; 2]> = m
+                            .tip_z_m
+                            .iter()
+                            .enumerate()
+                            .map(|(i, z)| [i as f64 * m.sample_secs, *z])
+                            .take_while(|p| p[0] <= t1 + 1e-9)
+                            .collect();
+                        if points.len() > 1 {
                             plot.line(
-                                Line::new("reference u_z", PlotPoints::from(vec![[0.0, r[2]], [t1, r[2]]]))
-                                    .style(egui_plot::LineStyle::dashed_loose()),
+                                Line::new(REFERENCE_MOTION_LABEL, PlotPoints::from(points))
+                                    .color(MOTION_COLOUR)
+                                    .style(egui_plot::LineStyle::dashed_dense()),
                             );
-                        }
-                        // the reference motion (the beam released from rest), dashed, as far as
-                        // the run has come
-                        if let Some(m) = s.reference_motion().filter(|_| k == 0 && probe == "tip") {
-                            let t1 = h.time_secs.last().copied().unwrap_or(0.0);
-                            let points: Vec<[f64; 2]> = m
-                                .tip_z_m
-                                .iter()
-                                .enumerate()
-                                .map(|(i, z)| [i as f64 * m.sample_secs, *z])
-                                .take_while(|p| p[0] <= t1 + 1e-9)
-                                .collect();
-                            if points.len() > 1 {
-                                plot.line(
-                                    Line::new(REFERENCE_MOTION_LABEL, PlotPoints::from(points))
-                                        .style(egui_plot::LineStyle::dashed_dense()),
-                                );
-                            }
                         }
                     }
                 });
         }
         Tab::Energy => {
-            Plot::new("energy")
-                .show_background(false)
-                .legend(Legend::default())
-                .x_axis_label("t (s)")
-                .y_axis_label("energy (J)")
-                .show(ui, |plot| {
+            let mut entries = Vec::new();
+            for k in 0..app.sessions.len() {
+                let prefix = if app.compare { format!("{} ", names[k]) } else { String::new() };
+                entries.push((format!("{prefix}kinetic"), line_colour(k, 0), false));
+                entries.push((format!("{prefix}elastic"), line_colour(k, 2), false));
+            }
+            legend_row_ui(ui, &entries);
+            Plot::new("energy").show_background(false).x_axis_label("t (s)").y_axis_label("energy (J)").show(
+                ui,
+                |plot| {
                     for (k, s) in app.sessions.iter().enumerate() {
                         let h = &s.history;
                         let prefix = if app.compare { format!("{} ", names[k]) } else { String::new() };
-                        plot.line(Line::new(
-                            format!("{prefix}kinetic"),
-                            PlotPoints::Owned(decimate(&h.time_secs, |i| h.kinetic_j[i], MAX_PLOT_POINTS)),
-                        ));
-                        plot.line(Line::new(
-                            format!("{prefix}elastic"),
-                            PlotPoints::Owned(decimate(&h.time_secs, |i| h.elastic_j[i], MAX_PLOT_POINTS)),
-                        ));
+                        plot.line(
+                            Line::new(
+                                format!("{prefix}kinetic"),
+                                PlotPoints::Owned(decimate(&h.time_secs, |i| h.kinetic_j[i], MAX_PLOT_POINTS)),
+                            )
+                            .color(line_colour(k, 0)),
+                        );
+                        plot.line(
+                            Line::new(
+                                format!("{prefix}elastic"),
+                                PlotPoints::Owned(decimate(&h.time_secs, |i| h.elastic_j[i], MAX_PLOT_POINTS)),
+                            )
+                            .color(line_colour(k, 2)),
+                        );
                     }
-                });
+                },
+            );
         }
         Tab::Study => {
             let current: Vec<StudyPoint> = app

@@ -30,14 +30,36 @@ pub struct Camera {
 impl Camera {
     /// A three-quarter view that frames the box `[lo, hi]`.
     pub fn framing(lo: [f32; 3], hi: [f32; 3]) -> Camera {
+        Camera::framing_from(lo, hi, -1.2, 0.45)
+    }
+
+    /// A view from the direction `(yaw, pitch)` that frames the box `[lo, hi]`: its extent
+    /// across the line of sight fills about 80 % of a view 1.6 times as wide as high.
+    pub fn framing_from(lo: [f32; 3], hi: [f32; 3], yaw: f32, pitch: f32) -> Camera {
         let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
-        let radius = 0.5 * (hi - lo).length().max(1e-6);
+        let centre = 0.5 * (lo + hi);
+        let dir = Vec3::new(pitch.cos() * yaw.cos(), pitch.cos() * yaw.sin(), pitch.sin());
+        let right = Vec3::Z.cross(dir).try_normalize().unwrap_or(Vec3::X);
+        let up = dir.cross(right);
+        let (mut half_w, mut half_h, mut half_d) = (0f32, 0f32, 0f32);
+        for k in 0..8 {
+            let corner = Vec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            ) - centre;
+            half_w = half_w.max(corner.dot(right).abs());
+            half_h = half_h.max(corner.dot(up).abs());
+            half_d = half_d.max(corner.dot(dir).abs());
+        }
+        let radius = (half_w / 1.6).max(half_h).max(1e-6) / 0.8;
         let fov_y = 35f32.to_radians();
         Camera {
             target: (0.5 * (lo + hi)).into(),
-            distance: 1.15 * radius / (0.5 * fov_y).sin(),
-            yaw: -0.9,
-            pitch: 0.45,
+            // the near side of the box is half its depth closer than the target
+            distance: radius / (0.5 * fov_y).tan() + half_d,
+            yaw,
+            pitch,
             fov_y,
         }
     }

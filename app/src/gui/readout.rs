@@ -45,17 +45,26 @@ pub enum ReferenceState {
     },
 }
 
+/// The key of what is wanted: the reference, or (`with_field`, for the error field) the
+/// reference with its displacement field.
+fn wanted_key(lookup: &Lookup, scene: &Scene, with_field: bool) -> String {
+    if with_field { lookup.field_key(scene) } else { lookup.key(scene) }
+}
+
 impl ReferenceState {
-    /// The reference of `scene`: known at once, or computing in the background.
-    pub fn for_scene(scene: &Scene) -> ReferenceState {
+    /// The reference of `scene` (`with_field`: with its displacement field, for the error
+    /// field): known at once, or computing in the background.
+    pub fn for_scene(scene: &Scene, with_field: bool) -> ReferenceState {
         if let Some(why) = hox_scenes::reference::unavailable(scene) {
             return ReferenceState::Unavailable(why);
         }
         let lookup = lookup();
-        let key = lookup.key(scene);
+        let key = wanted_key(&lookup, scene, with_field);
         match lookup.known(scene) {
-            Ok(Some(r)) => return ReferenceState::Ready { key, reference: Arc::new(r) },
-            Ok(None) => {}
+            Ok(Some(r)) if !with_field || r.field.is_some() || !scene.is_box() => {
+                return ReferenceState::Ready { key, reference: Arc::new(r) };
+            }
+            Ok(_) => {}
             Err(e) => return ReferenceState::Failed { key, message: e.to_string() },
         }
         let progress = Arc::new(Mutex::new(("reference: starting".to_string(), 0.0)));
@@ -66,7 +75,8 @@ impl ReferenceState {
                     *p = (what.to_string(), fraction);
                 }
             };
-            lookup.for_scene(&scene, &mut report).map_err(|e| e.to_string())
+            if with_field { lookup.with_field(&scene, &mut report) } else { lookup.for_scene(&scene, &mut report) }
+                .map_err(|e| e.to_string())
         });
         ReferenceState::Computing { key, progress, handle: Some(handle) }
     }
@@ -80,14 +90,18 @@ impl ReferenceState {
         }
     }
 
-    /// Follows `scene`'s physics (and, for a mesh file, its quadrature): a new reference when
-    /// they changed, the same one otherwise.
-    pub fn follow(&mut self, scene: &Scene) {
-        let key = lookup().key(scene);
+    /// Follows `scene`'s physics (and, for a mesh file, its quadrature) and whether its field
+    /// is wanted: a new reference when they changed, the same one otherwise (a reference with
+    /// its field serves where none is wanted too).
+    pub fn follow(&mut self, scene: &Scene, with_field: bool) {
+        let lookup = lookup();
         let unavailable = hox_scenes::reference::unavailable(scene);
-        if self.key() != Some(key.as_str()) || unavailable.is_some() {
+        let key = self.key().map(str::to_string);
+        let fits = key.as_deref() == Some(wanted_key(&lookup, scene, with_field).as_str())
+            || (!with_field && key.as_deref() == Some(lookup.field_key(scene).as_str()));
+        if !fits || unavailable.is_some() {
             // a computation no longer wanted finishes in the background (and fills the cache)
-            *self = ReferenceState::for_scene(scene);
+            *self = ReferenceState::for_scene(scene, with_field);
         }
     }
 
@@ -162,6 +176,30 @@ impl Readout {
             Readout::Settled { error_m, .. } => Some((error_m, 0.0)),
             Readout::Moving { error_m, amplitude_m, drift_m, .. } => Some((error_m, drift_m.unwrap_or(amplitude_m))),
             _ => None,
+        }
+    }
+
+    /// The error alone, for the status line.
+    pub fn error_text(&self) -> String {
+        let m = |v: f64| crate::colour::format_value(v, "m");
+        match *self {
+            Readout::NoReference(_) => "no reference".into(),
+            Readout::Settled { error_m, error_pct, .. } => format!("settled error {} ({error_pct:.2} %)", m(error_m)),
+            Readout::Moving { error_m, error_pct, .. } => format!("mean error {} ({error_pct:.2} %)", m(error_m)),
+            Readout::Starting => "moving".into(),
+        }
+    }
+
+    /// A few words for the label above a body in the viewport.
+    pub fn short_text(&self) -> String {
+        let m = |v: f64| crate::colour::format_value(v, "m");
+        match *self {
+            Readout::NoReference(_) => "no reference".into(),
+            Readout::Settled { error_m, error_pct, .. } => format!("settled: error {} ({error_pct:.2} %)", m(error_m)),
+            Readout::Moving { error_m, error_pct, amplitude_m, .. } => {
+                format!("mean error {} ({error_pct:.2} %), swinging ± {}", m(error_m), m(amplitude_m))
+            }
+            Readout::Starting => "moving".into(),
         }
     }
 

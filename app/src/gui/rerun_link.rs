@@ -3,15 +3,14 @@
 
 use super::HoxApp;
 use super::session::Session;
-use super::viewport::Viewport;
-use crate::recording::{LogSettings, SimLogger};
+use crate::recording::{Configuration, LogSettings, Recorder};
 use hox_sim::Vec3;
 use std::path::PathBuf;
 
 /// Live Rerun output through the shared logging module.
 pub(super) struct RerunLink {
     rec: rerun::RecordingStream,
-    loggers: Vec<SimLogger>,
+    recorder: Option<Recorder>,
     generation: u64,
     target: String,
 }
@@ -31,7 +30,7 @@ impl RerunLink {
             (builder.connect_grpc_opts(url.to_string()), format!("streaming to {url}"))
         };
         match rec {
-            Ok(rec) => Ok(RerunLink { rec, loggers: Vec::new(), generation: u64::MAX, target }),
+            Ok(rec) => Ok(RerunLink { rec, recorder: None, generation: u64::MAX, target }),
             Err(e) => Err(format!("Rerun: {e}")),
         }
     }
@@ -50,19 +49,28 @@ impl RerunLink {
         offsets: &[Vec3],
         generation: u64,
     ) -> Result<(), rerun::RecordingStreamError> {
-        if self.generation != generation {
-            // the viewport's colour range, shared by the configurations
-            let colours = Viewport::colour_range(sessions);
-            self.loggers.clear();
-            for (k, (s, o)) in sessions.iter().zip(offsets).enumerate() {
-                let name = format!("{}_{}", ["a", "b"][k.min(1)], s.label());
-                let settings = LogSettings::new(&s.config, colours);
-                self.loggers.push(SimLogger::new(&self.rec, &name, &s.instance, *o, &settings)?);
-            }
+        if self.generation != generation || self.recorder.is_none() {
+            let configs: Vec<Configuration<'_>> = sessions
+                .iter()
+                .zip(offsets)
+                .enumerate()
+                .map(|(k, (s, o))| Configuration {
+                    name: format!("{}_{}", ["a", "b"][k.min(1)], s.label()),
+                    instance: &s.instance,
+                    offset_m: *o,
+                    reference: s.reference.reference(),
+                })
+                .collect();
+            let Some(first) = sessions.first() else { return Ok(()) };
+            let settings = LogSettings::new(&first.config);
+            let fields = crate::display::fields(&first.config);
+            self.recorder = Some(Recorder::new(&self.rec, &configs, &settings, &fields)?);
             self.generation = generation;
         }
-        for (s, l) in sessions.iter().zip(&mut self.loggers) {
-            l.log_frame(&self.rec, &s.instance, s.ms_per_frame)?;
+        let instances: Vec<&hox_scenes::Instance> = sessions.iter().map(|s| &s.instance).collect();
+        let ms: Vec<f64> = sessions.iter().map(|s| s.ms_per_frame).collect();
+        if let Some(r) = &mut self.recorder {
+            r.log_frame(&self.rec, &instances, &ms)?;
         }
         Ok(())
     }

@@ -7,12 +7,14 @@
 
 use super::config::{self, Config, Invalidates};
 use super::readout::{Readout, ReferenceState, last_oscillation};
+use crate::display::FieldSource;
 use hox_scenes::reference::physics_key;
 use hox_scenes::study::motion::Motion;
 use hox_scenes::{Instance, Scene};
 use hox_scenes::{RestWatch, SettleState, Settler};
 use hox_sim::Vec3;
 use hox_sim::effect::Attachment;
+use hox_sim::measure::field::Field;
 use hox_sim::measure::surface::{PointMap, Surface};
 use std::time::Instant;
 
@@ -91,6 +93,11 @@ pub struct Session {
     /// Nodes held by clamps and moved by prescribed motions (for display).
     pub clamped: Vec<u32>,
     pub driven: Vec<u32>,
+    /// The surface's element edges on clamped and on driven faces ([`Surface::edges_between`]).
+    pub clamped_edges: Vec<usize>,
+    pub driven_edges: Vec<usize>,
+    /// What the surface is coloured by ([`crate::display::FieldSource`]).
+    pub field_source: FieldSource,
     quadrature: std::cell::OnceCell<PointMap>,
 }
 
@@ -106,7 +113,8 @@ impl Session {
         let scene = config::resolve(&config, &base)?;
         let instance = Instance::new(scene).map_err(|e| e.to_string())?;
         let surface = Surface::new(instance.sim.mesh(), config.tessellation);
-        let reference = ReferenceState::for_scene(&instance.scene);
+        let field = crate::display::fields(&config)[0];
+        let reference = ReferenceState::for_scene(&instance.scene, field == Field::Error);
         let rest = RestWatch::new(&instance);
         let driven_until_secs = hox_scenes::driven_until_secs(&instance.scene.file.effects);
         let mut s = Session {
@@ -130,6 +138,9 @@ impl Session {
             corner_nodes: Vec::new(),
             clamped: Vec::new(),
             driven: Vec::new(),
+            clamped_edges: Vec::new(),
+            driven_edges: Vec::new(),
+            field_source: FieldSource::new(field),
             quadrature: std::cell::OnceCell::new(),
         };
         s.mesh_changed();
@@ -180,34 +191,38 @@ impl Session {
         }
         self.config = new;
         // another ν, E, ρ or model: another equilibrium, another reference
-        self.reference.follow(&self.instance.scene);
+        let field = crate::display::fields(&self.config)[0];
+        self.field_source.field = field;
+        self.reference.follow(&self.instance.scene, field == Field::Error);
+        self.sync_reference_field();
         self.refresh_readout();
         Ok(what)
     }
 
     /// After a (re)build: the boundary-condition node sets, the first history sample.
     fn mesh_changed(&mut self) {
-        let scene = &self.instance.scene;
-        let mesh = self.instance.sim.mesh();
-        self.clamped.clear();
-        self.driven.clear();
-        for (k, e) in scene.file.effects.iter().enumerate() {
-            let (hox_scenes::scene::EffectSpec::Clamp { nodes }
-            | hox_scenes::scene::EffectSpec::Prescribed { nodes, .. }) = e
-            else {
-                continue;
-            };
-            let set = scene.selected_nodes(mesh, k, nodes).unwrap_or_default();
-            if matches!(e, hox_scenes::scene::EffectSpec::Clamp { .. }) {
-                self.clamped.extend(set);
-            } else {
-                self.driven.extend(set);
-            }
-        }
+        (self.clamped, self.driven) = crate::display::held_nodes(&self.instance);
         self.quadrature = std::cell::OnceCell::new();
-        self.corner_nodes = mesh.vertex_nodes();
-        self.surface.vertices.eval_into(&mesh.rest_positions, &mut self.rest_vertices);
+        self.corner_nodes = self.instance.sim.mesh().vertex_nodes();
+        self.surface_changed();
         self.record();
+    }
+
+    /// After the surface was rebuilt: its rest vertices, held edges and field data.
+    fn surface_changed(&mut self) {
+        let mesh = self.instance.sim.mesh();
+        self.surface.vertices.eval_into(&mesh.rest_positions, &mut self.rest_vertices);
+        let n = mesh.num_nodes();
+        self.clamped_edges = self.surface.edges_between(&crate::display::node_flags(&self.clamped, n));
+        self.driven_edges = self.surface.edges_between(&crate::display::node_flags(&self.driven, n));
+        self.field_source.surface_changed();
+        self.sync_reference_field();
+    }
+
+    /// Gives the field source the reference's displacement field, when there is one.
+    fn sync_reference_field(&mut self) {
+        let field = self.reference.reference().and_then(|r| r.field.as_ref());
+        self.field_source.set_reference(&self.surface, self.instance.sim.mesh(), field);
     }
 
     /// Every quadrature point as a material point (computed on first use).
@@ -220,7 +235,7 @@ impl Session {
     /// Changes the display tessellation.
     fn set_segments(&mut self, segments: usize) {
         self.surface = Surface::new(self.instance.sim.mesh(), segments);
-        self.surface.vertices.eval_into(&self.instance.sim.mesh().rest_positions, &mut self.rest_vertices);
+        self.surface_changed();
     }
 
     /// Back to the rest state at t = 0.
@@ -275,7 +290,10 @@ impl Session {
 
     /// Takes a reference computed in the background in (non-blocking), and with it the readout.
     pub fn poll_reference(&mut self) {
-        if self.reference.poll() {
+        let field_waiting =
+            !self.field_source.has_reference() && self.reference.reference().is_some_and(|r| r.field.is_some());
+        if self.reference.poll() || field_waiting {
+            self.sync_reference_field();
             self.refresh_readout();
         }
     }

@@ -1,6 +1,8 @@
 //! The 3D viewport: the deformed surfaces of the running sessions (side by side in compare
-//! mode), coloured by displacement magnitude with a legend in metres, element edges, nodes,
-//! quadrature points, clamped and driven nodes, the rest shape as a ghost; orbit (drag), pan
+//! mode), coloured by a field (|u|, von Mises stress, strain, det F, energy density, error;
+//! [`crate::display`]) on one range with a legend in the field's unit that shows saturation,
+//! element edges, nodes, quadrature points, clamped and driven nodes and the edges of their
+//! faces, the rest shape as a ghost; camera presets ([`ViewPreset`]); orbit (drag), pan
 //! (right or middle drag, or shift-drag), zoom (scroll), reset (double-click); dragging a node
 //! pulls it with an attachment that exists only while the mouse button is held.
 //!
@@ -10,11 +12,12 @@
 use super::gl_view::{GlScene, GlState, paint_callback};
 use super::raster::{BACKGROUND, Camera, Image, Overlay, TriangleLayer, shade};
 use super::session::{Drag, Session};
-use crate::colour::ColourRange;
+use crate::colour::{ColourRange, FieldScale};
 use crate::display::SurfaceFrame;
 pub use crate::display::f32s;
 use eframe::egui;
 use hox_sim::Vec3;
+use hox_sim::measure::field::Field;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -31,6 +34,54 @@ pub struct ViewOptions {
 impl Default for ViewOptions {
     fn default() -> Self {
         Self { edges: true, nodes: false, boundary_conditions: true, ghost: true, probes: true }
+    }
+}
+
+/// A camera preset: where the view looks from, and the axis compared configurations are laid
+/// apart along so neither hides the other from there.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+pub enum ViewPreset {
+    /// Three-quarter view from the front, above.
+    #[default]
+    Iso,
+    /// Looking along +y at the x–z plane: a beam's bending.
+    Front,
+    /// Looking along −x at the y–z plane: a beam's cross-section, its twist and sideways bend.
+    Side,
+    /// Looking down −z at the x–y plane: a sideways bend (the tet split's bias).
+    Top,
+}
+
+impl ViewPreset {
+    pub const ALL: [ViewPreset; 4] = [ViewPreset::Iso, ViewPreset::Front, ViewPreset::Side, ViewPreset::Top];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ViewPreset::Iso => "iso",
+            ViewPreset::Front => "front",
+            ViewPreset::Side => "side",
+            ViewPreset::Top => "top",
+        }
+    }
+
+    /// The camera's (yaw, pitch), radians ([`Camera`]): the eye's direction from the target.
+    pub fn yaw_pitch(self) -> (f32, f32) {
+        use std::f32::consts::FRAC_PI_2;
+        match self {
+            ViewPreset::Iso => (-1.2, 0.45),
+            ViewPreset::Front => (-FRAC_PI_2, 0.0),
+            ViewPreset::Side => (0.0, 0.0),
+            // straight down, x to the right
+            ViewPreset::Top => (-FRAC_PI_2, FRAC_PI_2 - 1e-3),
+        }
+    }
+
+    /// The axis across the line of sight that configurations are laid apart along.
+    pub fn layout_axis(self) -> crate::display::LayoutAxis {
+        match self {
+            ViewPreset::Side => crate::display::LayoutAxis::Y,
+            _ => crate::display::LayoutAxis::X,
+        }
     }
 }
 
@@ -59,6 +110,13 @@ pub struct Viewport {
     gl_state: GlState,
     /// Where the view was last drawn, in points.
     last_rect: egui::Rect,
+    /// The colour scale all sessions share (automatic ranges grow with what was seen).
+    scale: Option<FieldScale>,
+    /// Each session's frame count when last drawn: a smaller one is a new run (the automatic
+    /// range starts again).
+    last_frames: Vec<u64>,
+    /// The camera preset last chosen (a double-click frames the bodies from it again).
+    pub preset: ViewPreset,
 }
 
 impl Viewport {
@@ -74,10 +132,13 @@ impl Viewport {
             dragging: None,
             gl_state: GlState::default(),
             last_rect: egui::Rect::NOTHING,
+            scale: None,
+            last_frames: Vec::new(),
+            preset: ViewPreset::default(),
         }
     }
 
-    /// Frames the sessions' bodies again.
+    /// Frames the sessions' bodies again from the preset's direction.
     pub fn reset_camera(&mut self, sessions: &[Session], offsets: &[Vec3]) {
         let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
         for (s, o) in sessions.iter().zip(offsets) {
@@ -86,15 +147,49 @@ impl Viewport {
             hi = hi.sup(&(b + o));
         }
         if lo.x.is_finite() {
-            self.camera = Camera::framing(f32s(&lo), f32s(&hi));
+            let (yaw, pitch) = self.preset.yaw_pitch();
+            self.camera = Camera::framing_from(f32s(&lo), f32s(&hi), yaw, pitch);
         }
         self.fitted = true;
     }
 
-    /// The colour range of the first session (shared by all, so colours compare).
-    pub fn colour_range(sessions: &[Session]) -> ColourRange {
-        let first = sessions.first();
-        crate::display::colour_range(first.map(|s| s.instance.sim.mesh()), first.map_or(0.0, |s| s.config.colour_max_m))
+    /// The colour range drawn last (shared by every session, so colours compare); the UI
+    /// tests read it.
+    #[cfg(test)]
+    pub fn colour_range(&self) -> Option<ColourRange> {
+        self.scale.as_ref().map(FieldScale::range)
+    }
+
+    /// Takes this frame's field values of every session into the shared scale: the first
+    /// session's field and range settings for all, started again when a run restarts or they
+    /// change.
+    fn update_fields(&mut self, sessions: &mut [Session]) -> ColourRange {
+        let Some(first) = sessions.first() else { return ColourRange::metres(1.0) };
+        let field = crate::display::fields(&first.config)[0];
+        let want = crate::display::field_scale(Some(first.instance.sim.mesh()), &first.config, field);
+        let frames: Vec<u64> = sessions.iter().map(|s| s.instance.sim.frames()).collect();
+        let restarted = frames.len() != self.last_frames.len()
+            || frames.iter().zip(&self.last_frames).any(|(now, before)| now < before);
+        self.last_frames = frames;
+        let scale = match &mut self.scale {
+            Some(s) if s.field == want.field && s.fixed_max == want.fixed_max && s.floor == want.floor => s,
+            slot => slot.insert(want),
+        };
+        if restarted {
+            scale.reset();
+        }
+        self.frames.resize_with(sessions.len(), SurfaceFrame::default);
+        for (s, frame) in sessions.iter_mut().zip(&mut self.frames) {
+            s.field_source.field = field;
+            frame.update(&s.surface, &s.instance.sim);
+            frame.update_field(&s.surface, &s.instance.sim, &mut s.field_source);
+            scale.observe(&frame.values);
+        }
+        let range = scale.range();
+        for frame in &mut self.frames {
+            frame.paint(&range);
+        }
+        range
     }
 
     /// Shows the view; `gl` says whether the frame has an OpenGL context to draw it with (else,
@@ -166,14 +261,12 @@ impl Viewport {
 
         // --- scene
         let started = Instant::now();
-        let colours = Self::colour_range(sessions);
+        let colours = self.update_fields(sessions);
         self.layers.resize_with(sessions.len(), TriangleLayer::default);
-        self.frames.resize_with(sessions.len(), SurfaceFrame::default);
         let mut overlay = Overlay::default();
         let mut x = Vec::new();
-        for (((s, layer), frame), o) in sessions.iter().zip(&mut self.layers).zip(&mut self.frames).zip(offsets) {
+        for (((s, layer), frame), o) in sessions.iter().zip(&mut self.layers).zip(&self.frames).zip(offsets) {
             let sim = &s.instance.sim;
-            frame.update(&s.surface, sim, &colours);
             layer.positions = frame.positions_m.iter().map(|p| f32s(&(p + o))).collect();
             layer.normals = frame.normals.iter().map(f32s).collect();
             layer.colours.clone_from(&frame.colours);
@@ -208,6 +301,17 @@ impl Viewport {
                 }
             }
             if opts.boundary_conditions {
+                for (edges, colour) in [(&s.clamped_edges, CLAMPED), (&s.driven_edges, DRIVEN)] {
+                    for &k in edges {
+                        for pair in s.surface.edges[k].windows(2) {
+                            overlay.lines.push((
+                                layer.positions[pair[0] as usize],
+                                layer.positions[pair[1] as usize],
+                                colour,
+                            ));
+                        }
+                    }
+                }
                 for &n in &s.clamped {
                     overlay.points.push((f32s(&(sim.positions[n as usize] + o)), 2.0, CLAMPED));
                 }
@@ -269,7 +373,7 @@ impl Viewport {
                 let top = Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z) + o;
                 if let Some(p) = self.screen_position(top) {
                     let mut text = s.label();
-                    text += &format!("\n{}", s.readout().text());
+                    text += &format!("\n{}", s.readout().short_text());
                     painter.text(
                         p - egui::vec2(0.0, 14.0),
                         egui::Align2::CENTER_BOTTOM,
@@ -280,7 +384,16 @@ impl Viewport {
                 }
             }
         }
-        legend_ui(&painter, rect, &colours);
+        let values: Vec<f64> = self.frames.iter().flat_map(|f| f.values.iter().copied()).collect();
+        let note = sessions.first().and_then(|s| {
+            (colours.field == Field::Error && !s.field_source.has_reference())
+                .then(|| format!("no reference field: {}", s.reference.status()))
+        });
+        let held = (
+            opts.boundary_conditions && sessions.iter().any(|s| !s.clamped_edges.is_empty()),
+            opts.boundary_conditions && sessions.iter().any(|s| !s.driven_edges.is_empty()),
+        );
+        legend_ui(&painter, rect, &colours, &values, note.as_deref(), held);
     }
 
     /// Draws the view with the CPU rasteriser and shows it as a texture.
@@ -362,35 +475,85 @@ impl Viewport {
     }
 }
 
-/// The colour bar (metres) in the viewport's top-right corner.
-fn legend_ui(painter: &egui::Painter, rect: egui::Rect, colours: &ColourRange) {
-    let bar = egui::Rect::from_min_size(rect.right_top() + egui::vec2(-70.0, 30.0), egui::vec2(16.0, 160.0));
+/// The legend in the viewport's top-right corner, on a dark panel: the field and its unit,
+/// whether the range is automatic or fixed, the colour bar with ticks in the unit, the share of
+/// the surface beyond a fixed range (drawn in the saturation colours), why a field has no value
+/// (`note`), and what the coloured face edges mean (`held`: clamped, driven).
+fn legend_ui(
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    colours: &ColourRange,
+    values: &[f64],
+    note: Option<&str>,
+    held: (bool, bool),
+) {
+    let font = egui::FontId::proportional(12.0);
+    let mono = egui::FontId::monospace(11.0);
+    let white = egui::Color32::WHITE;
+    let (over, under) = colours.saturation(values);
+    let panel = egui::Rect::from_min_size(rect.right_top() + egui::vec2(-166.0, 6.0), egui::vec2(160.0, 236.0));
+    painter.rect_filled(panel, 4.0, egui::Color32::from_rgba_unmultiplied(0, 0, 0, 150));
+    painter.text(
+        panel.left_top() + egui::vec2(6.0, 4.0),
+        egui::Align2::LEFT_TOP,
+        colours.field.title(),
+        font.clone(),
+        white,
+    );
+    let unit = colours.field.unit();
+    let mode = format!(
+        "{}{}",
+        if unit.is_empty() { String::new() } else { format!("{unit}, ") },
+        if colours.automatic { "automatic range" } else { "fixed range" }
+    );
+    painter.text(panel.left_top() + egui::vec2(6.0, 20.0), egui::Align2::LEFT_TOP, mode, mono.clone(), white);
+    let bar = egui::Rect::from_min_size(panel.left_top() + egui::vec2(10.0, 52.0), egui::vec2(16.0, 130.0));
+    let swatch = |y: f32, c: [u8; 3], text: String| {
+        let r = egui::Rect::from_min_size(egui::pos2(bar.min.x, y), egui::vec2(bar.width(), 10.0));
+        painter.rect_filled(r, 0.0, egui::Color32::from_rgb(c[0], c[1], c[2]));
+        painter.text(egui::pos2(bar.max.x + 4.0, y + 5.0), egui::Align2::LEFT_CENTER, text, mono.clone(), white);
+    };
+    if !colours.automatic {
+        swatch(bar.min.y - 14.0, crate::colour::OVER, format!("above: {:.0} %", 100.0 * over));
+    }
     let steps = 40;
     for i in 0..steps {
         let f0 = i as f32 / steps as f32;
         let f1 = (i + 1) as f32 / steps as f32;
-        let c = colours.colour(colours.max_m * (f0 as f64 + 0.5 / steps as f64));
+        let c = crate::colour::viridis((f0 as f64 + 0.5 / steps as f64).clamp(0.0, 1.0));
         let r = egui::Rect::from_min_max(
             egui::pos2(bar.min.x, bar.max.y - f1 * bar.height()),
             egui::pos2(bar.max.x, bar.max.y - f0 * bar.height()),
         );
         painter.rect_filled(r, 0.0, egui::Color32::from_rgb(c[0], c[1], c[2]));
     }
-    for t in colours.ticks_m() {
-        let y = bar.max.y - (t / colours.max_m) as f32 * bar.height();
-        painter.text(
-            egui::pos2(bar.max.x + 4.0, y),
-            egui::Align2::LEFT_CENTER,
-            crate::recording::format_metres(t),
-            egui::FontId::monospace(11.0),
-            egui::Color32::WHITE,
-        );
+    for t in colours.ticks() {
+        let y = bar.max.y - colours.fraction(t) as f32 * bar.height();
+        painter.text(egui::pos2(bar.max.x + 4.0, y), egui::Align2::LEFT_CENTER, colours.format(t), mono.clone(), white);
     }
-    painter.text(
-        bar.center_top() - egui::vec2(0.0, 6.0),
-        egui::Align2::CENTER_BOTTOM,
-        "|u| (m)",
-        egui::FontId::proportional(12.0),
-        egui::Color32::WHITE,
-    );
+    let mut y = bar.max.y + 6.0;
+    if !colours.automatic && colours.field.two_sided() {
+        swatch(y, crate::colour::UNDER, format!("below: {:.0} %", 100.0 * under));
+        y += 14.0;
+    }
+    let mut line = |text: &str, colour: Option<[u8; 4]>| {
+        if let Some(c) = colour {
+            let a = egui::pos2(bar.min.x, y + 6.0);
+            painter.line_segment(
+                [a, a + egui::vec2(16.0, 0.0)],
+                egui::Stroke::new(3.0, egui::Color32::from_rgb(c[0], c[1], c[2])),
+            );
+        }
+        painter.text(egui::pos2(bar.max.x + 4.0, y + 6.0), egui::Align2::LEFT_CENTER, text, mono.clone(), white);
+        y += 14.0;
+    };
+    if held.0 {
+        line("clamped face", Some(CLAMPED));
+    }
+    if held.1 {
+        line("driven face", Some(DRIVEN));
+    }
+    if let Some(n) = note {
+        line(n, None);
+    }
 }

@@ -33,17 +33,16 @@ impl HoxApp {
                         format!("newton, {} factorisations", sim.counters().factorizations)
                     }
                 };
+                // one short line per configuration; the details on hover
                 let mut text = format!(
-                    "{}{}: {} nodes, {} elements, {solver}, {:.2} ms/frame, residual {:.1e}, t = {:.2} s",
+                    "{}{}: {} nodes, {} el, {:.1} ms/frame, {}",
                     if self.compare { ["A ", "B "][k] } else { "" },
                     s.label(),
                     sim.mesh().num_nodes(),
                     sim.mesh().num_elements(),
                     s.ms_per_frame,
-                    s.residual,
-                    sim.time_secs()
+                    s.readout().error_text()
                 );
-                text += &format!(", {}", s.readout().text());
                 if s.settler.is_some() {
                     text += " (settling…)";
                 }
@@ -51,7 +50,15 @@ impl HoxApp {
                 if raised {
                     text += &format!(", {} substeps (guard)", sim.substeps_per_frame());
                 }
-                let label = ui.label(egui::RichText::new(text).monospace());
+                let details = format!(
+                    "{} nodes, {} elements, {solver}, residual {:.1e}, t = {:.2} s\n{}",
+                    sim.mesh().num_nodes(),
+                    sim.mesh().num_elements(),
+                    s.residual,
+                    sim.time_secs(),
+                    s.readout().text()
+                );
+                let label = ui.label(egui::RichText::new(text).monospace()).on_hover_text(details);
                 if raised {
                     label.on_hover_text(format!(
                         "The stability guard takes {} substeps per frame instead of {}: the stiffest element's fastest mode needs h·ω_max ≤ {} (docs/STABILITY.md). Switch it off under Solver to see the instability.",
@@ -65,8 +72,8 @@ impl HoxApp {
                 }
                 ui.separator();
             }
-            ui.label(egui::RichText::new(format!("display {:.0} fps, view {:.1} ms, app {:.1} ms", 1000.0 / self.times.ui_frame_ms.max(1e-3), self.viewport.render_ms, self.times.app_ms)).monospace())
-                .on_hover_text(format!("Displayed frames per second; CPU milliseconds of the 3D view's preparation and of the app's whole frame. Renderer: {}.", self.renderer.as_deref().unwrap_or("none (no OpenGL: CPU rasteriser)")));
+            ui.label(egui::RichText::new(format!("{:.0} fps", 1000.0 / self.times.ui_frame_ms.max(1e-3))).monospace())
+                .on_hover_text(format!("Displayed frames per second; view {:.1} ms and app {:.1} ms of CPU per frame (the 3D view's preparation and the app's whole frame). Renderer: {}.", self.viewport.render_ms, self.times.app_ms, self.renderer.as_deref().unwrap_or("none (no OpenGL: CPU rasteriser)")));
             if let Some(e) = self.viewport.gl_error() {
                 ui.colored_label(egui::Color32::from_rgb(255, 170, 60), format!("OpenGL view unavailable, drawn on the CPU: {e}"));
             }

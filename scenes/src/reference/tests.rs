@@ -122,6 +122,27 @@ fn a_computed_reference_solves_three_levels_and_estimates_its_own_error() {
     let json = r.to_json();
     assert_eq!(json["origin"], "computed");
     assert!(json["estimated_error_pct"].as_f64().is_some());
+    assert!(json.get("field").is_none(), "the field stays out of the JSON report");
+    // the finest level's displacement field comes with it: at the tip it is that level's
+    // probe, within the extrapolation's correction of the reference
+    let field = r.field.as_ref().expect("a computed reference carries its field");
+    let at_tip = field.lattice_at(&hox_sim::Vec3::from(b.file.probes[0].point_m));
+    assert!((at_tip.z - tip).abs() < 0.01 && at_tip.z < -0.25, "{at_tip} vs {tip}");
+}
+
+/// A committed reference holds probes only; asking for its field solves the finest level once
+/// and keeps the committed probes.
+#[test]
+fn a_committed_reference_gets_its_field_on_request() {
+    let b = by_name("bending").unwrap();
+    let lookup = Lookup { finest_cells: 64, cache_dir: None };
+    let plain = lookup.for_scene(&b, &mut |_, _| {}).unwrap();
+    assert_eq!((plain.origin, plain.field.is_none()), (Origin::Committed, true));
+    let with = lookup.with_field(&b, &mut |what, _| assert!(what.contains("reference field"), "{what}")).unwrap();
+    assert_eq!(with.probes, plain.probes);
+    let field = with.field.expect("solved");
+    let tip = field.lattice_at(&hox_sim::Vec3::from(b.file.probes[0].point_m)).z;
+    assert!((tip / plain.probes["tip"][2] - 1.0).abs() < 0.05, "{tip} vs {:?}", plain.probes["tip"]);
 }
 
 #[test]

@@ -200,10 +200,7 @@ pub fn von_mises_stress_pa(
         let (mut sum, mut volume) = (0.0, 0.0);
         for (q, &v) in el.volumes().iter().enumerate() {
             let f = deformation_gradient(el.x, el.rest, el.geometry.gradients(el.element, q));
-            let j = f.determinant();
-            let sigma = material.pk1(&f) * f.transpose() / j;
-            let dev = sigma - nalgebra::Matrix3::identity() * (sigma.trace() / 3.0);
-            let vm = (1.5 * dev.norm_squared()).sqrt();
+            let vm = crate::measure::field::von_mises_pa(material, &f);
             if vm.is_finite() {
                 sum += vm * v;
                 volume += v;

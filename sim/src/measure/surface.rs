@@ -131,6 +131,10 @@ pub struct Surface {
     pub node_kind: Vec<Option<NodeKind>>,
     /// Pieces per face edge for curved and quadrilateral faces.
     pub segments: usize,
+    /// Every element face a vertex lies on, as the material point `(block, element, r)` it is
+    /// in that element (one per element, in the order the faces were met): the points a field
+    /// that depends on `F` is evaluated at ([`crate::measure::field`]).
+    pub samples: Vec<Vec<(u32, u32, [f64; 3])>>,
 }
 
 /// The kind of mesh node a display vertex coincides with.
@@ -156,6 +160,7 @@ impl Surface {
         });
         let mut vertices = PointMap { offsets: vec![0], ..Default::default() };
         let mut node_kind = Vec::new();
+        let mut samples: Vec<Vec<(u32, u32, [f64; 3])>> = Vec::new();
         let mut index: HashMap<SampleKey, u32> = HashMap::new();
         let mut triangles = Vec::new();
         let mut edges = Vec::new();
@@ -210,7 +215,7 @@ impl Surface {
             };
             let mut vertex = |i: usize, j: usize| -> u32 {
                 let (key, r) = sample(i, j);
-                *index.entry(key).or_insert_with(|| {
+                let v = *index.entry(key).or_insert_with(|| {
                     vertices.push(element, nodes, &r, &mut scratch);
                     let v = vertices.len() - 1;
                     let a = vertices.offsets[v] as usize;
@@ -219,7 +224,15 @@ impl Surface {
                     });
                     node_kind.push(kind);
                     v as u32
-                })
+                });
+                let (b32, e32) = (b as u32, e as u32);
+                if samples.len() <= v as usize {
+                    samples.resize(v as usize + 1, Vec::new());
+                }
+                if !samples[v as usize].iter().any(|&(sb, se, _)| sb == b32 && se == e32) {
+                    samples[v as usize].push((b32, e32, r));
+                }
+                v
             };
             let grid: Vec<Vec<u32>> = match face.shape {
                 FaceShape::Triangle => (0..=l).map(|i| (0..=l - i).map(|j| vertex(i, j)).collect()).collect(),
@@ -265,11 +278,23 @@ impl Surface {
                 edges.push(line);
             }
         }
-        Surface { vertices, triangles, edges, node_kind, segments: segments_wanted }
+        Surface { vertices, triangles, edges, node_kind, segments: segments_wanted, samples }
     }
 
     pub fn num_vertices(&self) -> usize {
         self.vertices.len()
+    }
+
+    /// The element edges (indices into [`Surface::edges`]) whose two end nodes are both in
+    /// `nodes` (flags by node): the edges of faces a clamp holds or a drive moves.
+    pub fn edges_between(&self, nodes: &[bool]) -> Vec<usize> {
+        let held = |v: u32| self.vertices.single_node(v as usize).is_some_and(|n| nodes.get(n as usize) == Some(&true));
+        (0..self.edges.len())
+            .filter(|&k| {
+                let e = &self.edges[k];
+                e.len() >= 2 && held(e[0]) && held(e[e.len() - 1])
+            })
+            .collect()
     }
 
     /// Area-weighted vertex normals of the surface at `vertex_positions` (unit length).
