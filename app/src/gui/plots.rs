@@ -51,9 +51,14 @@ pub fn decimate(t: &[f64], y: impl Fn(usize) -> f64, max_points: usize) -> Vec<e
 /// The legend of the reference motion's dashed curve.
 pub const REFERENCE_MOTION_LABEL: &str = "reference motion u_z (Newmark, Q2 16×4×4)";
 
-/// Line colours: per configuration (A, B) a hue, per displacement component a shade
-/// (u_x lightest, u_z full); the references grey and pink.
-fn line_colour(config: usize, shade: usize) -> egui::Color32 {
+/// Line colours: one configuration's components in three hues (u_x red, u_y green, u_z blue);
+/// when comparing, per configuration (A, B) a hue and per component a shade (u_x lightest, u_z
+/// full); the references grey and pink.
+fn line_colour(compare: bool, config: usize, shade: usize) -> egui::Color32 {
+    if !compare {
+        let c = [[230, 100, 90], [110, 200, 110], [80, 150, 240]][shade.min(2)];
+        return egui::Color32::from_rgb(c[0], c[1], c[2]);
+    }
     const HUES: [[[u8; 3]; 3]; 2] =
         [[[160, 200, 240], [110, 160, 220], [60, 130, 230]], [[250, 200, 150], [245, 160, 90], [240, 120, 30]]];
     let c = HUES[config.min(1)][shade.min(2)];
@@ -115,7 +120,7 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate().filter(|(a, _)| axes[*a]) {
                     let name =
                         if app.compare { format!("{} {} {label}", names[k], s.label()) } else { label.to_string() };
-                    entries.push((name, line_colour(k, axis), false));
+                    entries.push((name, line_colour(app.compare, k, axis), false));
                 }
             }
             let first = &app.sessions[0];
@@ -143,7 +148,7 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                             } else {
                                 label.to_string()
                             };
-                            plot.line(Line::new(name, points).color(line_colour(k, axis)));
+                            plot.line(Line::new(name, points).color(line_colour(app.compare, k, axis)));
                         }
                     }
                     let h = &first.history;
@@ -181,8 +186,8 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
             let mut entries = Vec::new();
             for k in 0..app.sessions.len() {
                 let prefix = if app.compare { format!("{} ", names[k]) } else { String::new() };
-                entries.push((format!("{prefix}kinetic"), line_colour(k, 0), false));
-                entries.push((format!("{prefix}elastic"), line_colour(k, 2), false));
+                entries.push((format!("{prefix}kinetic"), line_colour(app.compare, k, 0), false));
+                entries.push((format!("{prefix}elastic"), line_colour(app.compare, k, 2), false));
             }
             legend_row_ui(ui, &entries);
             Plot::new("energy").show_background(false).x_axis_label("t (s)").y_axis_label("energy (J)").show(
@@ -196,14 +201,14 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                                 format!("{prefix}kinetic"),
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.kinetic_j[i], MAX_PLOT_POINTS)),
                             )
-                            .color(line_colour(k, 0)),
+                            .color(line_colour(app.compare, k, 0)),
                         );
                         plot.line(
                             Line::new(
                                 format!("{prefix}elastic"),
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.elastic_j[i], MAX_PLOT_POINTS)),
                             )
-                            .color(line_colour(k, 2)),
+                            .color(line_colour(app.compare, k, 2)),
                         );
                     }
                 },

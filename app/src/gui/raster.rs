@@ -27,15 +27,19 @@ pub struct Camera {
     pub fov_y: f32,
 }
 
+/// The view's width over its height assumed before it is first drawn.
+pub const DEFAULT_ASPECT: f32 = 1.3;
+
 impl Camera {
     /// A three-quarter view that frames the box `[lo, hi]`.
     pub fn framing(lo: [f32; 3], hi: [f32; 3]) -> Camera {
-        Camera::framing_from(lo, hi, -1.2, 0.45)
+        Camera::framing_from(lo, hi, -1.2, 0.45, DEFAULT_ASPECT)
     }
 
     /// A view from the direction `(yaw, pitch)` that frames the box `[lo, hi]`: its extent
-    /// across the line of sight fills about 80 % of a view 1.6 times as wide as high.
-    pub fn framing_from(lo: [f32; 3], hi: [f32; 3], yaw: f32, pitch: f32) -> Camera {
+    /// across the line of sight fills about 60 % of a view `aspect` times as wide as high (room
+    /// for a beam to bend and swing).
+    pub fn framing_from(lo: [f32; 3], hi: [f32; 3], yaw: f32, pitch: f32, aspect: f32) -> Camera {
         let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
         let centre = 0.5 * (lo + hi);
         let dir = Vec3::new(pitch.cos() * yaw.cos(), pitch.cos() * yaw.sin(), pitch.sin());
@@ -52,7 +56,7 @@ impl Camera {
             half_h = half_h.max(corner.dot(up).abs());
             half_d = half_d.max(corner.dot(dir).abs());
         }
-        let radius = (half_w / 1.6).max(half_h).max(1e-6) / 0.8;
+        let radius = (half_w / aspect.max(0.2)).max(half_h).max(1e-6) / 0.6;
         let fov_y = 35f32.to_radians();
         Camera {
             target: (0.5 * (lo + hi)).into(),

@@ -117,6 +117,9 @@ pub struct Viewport {
     last_frames: Vec<u64>,
     /// The camera preset last chosen (a double-click frames the bodies from it again).
     pub preset: ViewPreset,
+    /// The camera was framed before the view had a size (at start): framed again on the first
+    /// frame drawn, for the view's real proportions.
+    framed_blind: bool,
 }
 
 impl Viewport {
@@ -135,6 +138,7 @@ impl Viewport {
             scale: None,
             last_frames: Vec::new(),
             preset: ViewPreset::default(),
+            framed_blind: false,
         }
     }
 
@@ -148,7 +152,10 @@ impl Viewport {
         }
         if lo.x.is_finite() {
             let (yaw, pitch) = self.preset.yaw_pitch();
-            self.camera = Camera::framing_from(f32s(&lo), f32s(&hi), yaw, pitch);
+            let r = self.last_rect;
+            let aspect = if r.is_positive() { r.width() / r.height() } else { super::raster::DEFAULT_ASPECT };
+            self.camera = Camera::framing_from(f32s(&lo), f32s(&hi), yaw, pitch, aspect);
+            self.framed_blind = !r.is_positive();
         }
         self.fitted = true;
     }
@@ -202,6 +209,9 @@ impl Viewport {
         let (rect, response) =
             ui.allocate_exact_size(ui.available_size().max(egui::vec2(64.0, 64.0)), egui::Sense::click_and_drag());
         self.last_rect = rect;
+        if self.framed_blind {
+            self.reset_camera(sessions, offsets);
+        }
         let ppp = ui.ctx().pixels_per_point();
         let scale = (1600.0 / (rect.width() * ppp)).min(1000.0 / (rect.height() * ppp)).min(1.0);
         let (w, h) =
