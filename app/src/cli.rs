@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 mod bench;
 mod gmsh;
 mod inspect;
+pub mod lesson;
 mod list;
 mod mesh;
 mod params;
@@ -131,6 +132,14 @@ pub enum Command {
     Record(Box<record::RecordArgs>),
     /// Read a Rerun recording back and list its entities, components and frame counts.
     Inspect(inspect::InspectArgs),
+    /// List the built-in lessons: guided classroom demonstrations (`hox app --lesson NAME`).
+    Lessons {
+        #[arg(long)]
+        json: bool,
+    },
+    /// Run a lesson headlessly, step by step, printing each step's measurement; `--record`
+    /// writes it as a Rerun file a student plays in the stock viewer.
+    Lesson(Box<lesson::LessonArgs>),
     /// Open the interactive app (the default when no command is given).
     App(Box<crate::gui::AppArgs>),
 }
@@ -174,6 +183,8 @@ pub fn main(cli: Cli) -> Result<()> {
         }
         Command::Record(args) => record::record(&args),
         Command::Inspect(args) => inspect::inspect(&args),
+        Command::Lessons { json } => lesson::lessons(json),
+        Command::Lesson(args) => lesson::lesson(&args),
         Command::App(args) => crate::gui::run(*args),
     }
 }

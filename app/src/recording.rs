@@ -43,12 +43,43 @@ pub struct LogSettings {
     pub segments: usize,
     /// Also log the quadrature points.
     pub quadrature_points: bool,
+    /// Log the fixed data (topology, rest shape, labels) as static — for a whole recording —
+    /// or at the current time, for one segment of a longer one (a lesson's step, whose
+    /// entities are cleared when it ends).
+    pub static_data: bool,
+    /// Send the recording's blueprint (a lesson sends its own).
+    pub blueprint: bool,
+    /// Added to every frame's `frame` and `sim_time` (a lesson's step starts where the last
+    /// one ended).
+    pub time_offset: (i64, f64),
 }
 
 impl LogSettings {
     /// The display parameters of a configuration (`[display]` of the parameter table).
     pub fn new(params: &hox_scenes::Params) -> LogSettings {
-        LogSettings { segments: params.tessellation, quadrature_points: params.quadrature_points }
+        LogSettings {
+            segments: params.tessellation,
+            quadrature_points: params.quadrature_points,
+            static_data: true,
+            blueprint: true,
+            time_offset: (0, 0.0),
+        }
+    }
+}
+
+/// Logs fixed data as static, or at the current time ([`LogSettings::static_data`]).
+struct Fixed<'a> {
+    rec: &'a RecordingStream,
+    statics: bool,
+}
+
+impl Fixed<'_> {
+    fn log<A: ?Sized + rerun::AsComponents>(
+        &self,
+        path: impl Into<rerun::EntityPath>,
+        archetype: &A,
+    ) -> Result<(), rerun::RecordingStreamError> {
+        self.rec.log_with_static(path, self.statics, archetype)
     }
 }
 
@@ -86,6 +117,8 @@ pub struct Recorder {
     /// One colour scale per field, shared by every configuration.
     scales: Vec<FieldScale>,
     probe_names: Vec<String>,
+    /// Added to the frame and time of every frame logged.
+    time_offset: (i64, f64),
 }
 
 /// A name usable as one entity path part: lowercase letters, digits and `_`.
@@ -150,9 +183,10 @@ impl SimLogger {
             .quadrature_points
             .then(|| hox_sim::measure::surface::quadrature_points(mesh, instance.sim.geometry()));
         let root = format!("world/{name}");
-        rec.log_static(root.as_str(), &rerun::Transform3D::from_translation(f32s(&config.offset_m)))?;
+        let fixed = Fixed { rec, statics: settings.static_data };
+        fixed.log(root.as_str(), &rerun::Transform3D::from_translation(f32s(&config.offset_m)))?;
         for field in fields {
-            rec.log_static(
+            fixed.log(
                 format!("{root}/surface/{}", field.name()),
                 &rerun::Mesh3D::update_fields()
                     .with_triangle_indices(surface.triangles.iter().map(|t| rerun::TriangleIndices::from(*t))),
@@ -163,21 +197,21 @@ impl SimLogger {
         surface.vertices.eval_into(&mesh.rest_positions, &mut rest);
         let strips: Vec<Vec<[f32; 3]>> =
             surface.edges.iter().map(|e| e.iter().map(|&i| f32s(&rest[i as usize])).collect()).collect();
-        rec.log_static(
+        fixed.log(
             format!("{root}/rest_edges"),
             &rerun::LineStrips3D::new(strips)
                 .with_colors([rerun::Color::from_unmultiplied_rgba(160, 160, 160, 90)])
                 .with_radii([rerun::Radius::new_ui_points(0.5)]),
         )?;
         let probe_names: Vec<String> = instance.probes.iter().map(|p| p.name.clone()).collect();
-        rec.log_static(
+        fixed.log(
             format!("{root}/probes"),
             &rerun::Points3D::update_fields()
                 .with_labels(probe_names.iter().map(String::as_str))
                 .with_colors([rerun::Color::from_rgb(230, 60, 40)])
                 .with_radii([rerun::Radius::new_ui_points(6.0)]),
         )?;
-        rec.log_static(
+        fixed.log(
             format!("{root}/edges"),
             &rerun::LineStrips3D::update_fields()
                 .with_colors([rerun::Color::from_rgb(20, 20, 20)])
@@ -189,7 +223,7 @@ impl SimLogger {
         let driven_edges = surface.edges_between(&crate::display::node_flags(&driven, n));
         for (part, edges, c) in [("clamped", &clamped_edges, CLAMPED), ("driven", &driven_edges, DRIVEN)] {
             if !edges.is_empty() {
-                rec.log_static(
+                fixed.log(
                     format!("{root}/{part}"),
                     &rerun::LineStrips3D::update_fields()
                         .with_colors([rerun::Color::from_rgb(c[0], c[1], c[2])])
@@ -198,7 +232,7 @@ impl SimLogger {
             }
         }
         if quadrature.is_some() {
-            rec.log_static(
+            fixed.log(
                 format!("{root}/quadrature_points"),
                 &rerun::Points3D::update_fields()
                     .with_colors([rerun::Color::from_rgb(255, 140, 0)])
@@ -216,7 +250,7 @@ impl SimLogger {
             series.extend((0..3).map(|axis| format!("{}/{name}", probe_plot(p, axis))));
         }
         for path in series {
-            rec.log_static(
+            fixed.log(
                 path,
                 &rerun::SeriesLines::new()
                     .with_names([format!("{}: {label}", ["a", "b", "c", "d", "e", "f"][index.min(5)])])
@@ -228,7 +262,7 @@ impl SimLogger {
         if reference.is_some() {
             for p in &probe_names {
                 for axis in 0..3 {
-                    rec.log_static(
+                    fixed.log(
                         format!("{}/reference_static", probe_plot(p, axis)),
                         &rerun::SeriesLines::new()
                             .with_names(["reference (static)"])
@@ -356,18 +390,29 @@ impl Recorder {
         };
         // z up, as the scenes are built (gravity along −z)
         rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        let fixed = Fixed { rec, statics: settings.static_data };
         let mut loggers = Vec::new();
         for (k, c) in configs.iter().enumerate() {
             loggers.push(SimLogger::new(rec, k, c, settings, &fields)?);
         }
         let probe_names = first.map(|i| i.probes.iter().map(|p| p.name.clone()).collect()).unwrap_or_default();
-        let recorder = Recorder { loggers, fields, scales, probe_names };
+        let recorder = Recorder { loggers, fields, scales, probe_names, time_offset: settings.time_offset };
         for field in &recorder.fields {
             rec.log_static(format!("legend/{}/bar", field.name()), &colour_bar_image())?;
         }
-        rec.log_static("legend/text", &rerun::TextDocument::from_markdown(recorder.legend_markdown(configs)))?;
-        recorder.blueprint().send(rec, bp::BlueprintActivation { make_active: true, make_default: true })?;
+        fixed.log("legend/text", &rerun::TextDocument::from_markdown(recorder.legend_markdown(configs)))?;
+        if settings.blueprint {
+            recorder.blueprint().send(rec, bp::BlueprintActivation { make_active: true, make_default: true })?;
+        }
         Ok(recorder)
+    }
+
+    /// Clears every configuration's entities at the current time (the end of a lesson's step).
+    pub fn clear(&self, rec: &RecordingStream) -> Result<(), rerun::RecordingStreamError> {
+        for l in &self.loggers {
+            rec.log(format!("world/{}", l.name), &rerun::Clear::recursive())?;
+        }
+        Ok(())
     }
 
     /// The entity names of the configurations, in order.
@@ -384,8 +429,8 @@ impl Recorder {
         ms_per_frame: &[f64],
     ) -> Result<(), rerun::RecordingStreamError> {
         let Some(first) = instances.first() else { return Ok(()) };
-        rec.set_time_sequence("frame", first.sim.frames() as i64);
-        rec.set_duration_secs("sim_time", first.sim.time_secs());
+        rec.set_time_sequence("frame", self.time_offset.0 + first.sim.frames() as i64);
+        rec.set_duration_secs("sim_time", self.time_offset.1 + first.sim.time_secs());
         for (logger, instance) in self.loggers.iter_mut().zip(instances) {
             logger.measure(instance);
             for ((_, values), scale) in logger.sources.iter().zip(&mut self.scales) {

@@ -287,3 +287,39 @@ fn an_implicit_solvers_recording_is_labelled_with_its_solver() {
     let checked = ok_json(&["inspect", f, "--expect-frames", "4", "--json"]);
     assert_eq!(checked["configurations"], serde_json::json!(["p2_160_newton"]));
 }
+
+/// Issue #21: `hox lessons --json` lists at least eight lessons; every one records headlessly
+/// (`hox lesson NAME --record`) as one file carrying its blueprint (a 3D view, the step text,
+/// the measurement), each step's text (its question, then its answer) and its measurements.
+#[test]
+fn every_lesson_records_with_its_blueprint_and_step_texts() {
+    let list = ok_json(&["lessons", "--json"]);
+    let lessons = list.as_array().unwrap();
+    assert!(lessons.len() >= 8, "{}", lessons.len());
+    for l in lessons {
+        let name = l["name"].as_str().unwrap();
+        let steps = l["steps"].as_array().unwrap().len();
+        let file = temp(&format!("lesson-{name}.rrd"));
+        let f = file.to_str().unwrap();
+        let report = ok_json(&["lesson", name, "--record", f, "--json"]);
+        assert_eq!(report["steps"].as_array().unwrap().len(), steps, "{name}");
+        let checked = ok_json(&["inspect", f, "--json"]);
+        let views = checked["blueprint"]["views"].as_array().unwrap();
+        let has = |class: &str, title: &str| views.iter().any(|v| v[0] == class && v[1] == title);
+        assert!(
+            has("3D", "3D") && has("TextDocument", "Step") && has("TimeSeries", "Measurement (A, B per step)"),
+            "{name}: {views:?}"
+        );
+        // the step text changes twice per step: the question, then the answer with the numbers
+        let texts = checked["entities"]["lesson/step"]["frames_per_component"]["TextDocument:text"].as_array().unwrap();
+        assert_eq!(texts.len(), 2 * steps, "{name}");
+        assert!(
+            checked["entities"].as_object().unwrap().keys().any(|k| k.starts_with("lesson/measure/step_1/")),
+            "{name}: no measurement series"
+        );
+    }
+    // an unknown lesson is named
+    let out = hox(&["lesson", "nope"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("no such lesson") && err.contains("locking"), "{err}");
+}

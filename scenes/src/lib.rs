@@ -6,6 +6,7 @@
 //! [`bench`] times the bending scene's beam (`hox bench`).
 
 pub mod bench;
+pub mod lesson;
 pub mod params;
 pub mod reference;
 pub mod run;

@@ -42,6 +42,15 @@ pub struct AppArgs {
     /// The camera preset at start (keys 1–4 in the app).
     #[arg(long, value_enum)]
     pub camera: Option<super::viewport::ViewPreset>,
+    /// Open on a built-in lesson (`hox lessons` lists them).
+    #[arg(long, conflicts_with = "lesson_file")]
+    pub lesson: Option<String>,
+    /// Open on a lesson file of your own (TOML, docs/LESSONS.md).
+    #[arg(long)]
+    pub lesson_file: Option<PathBuf>,
+    /// Presenter mode: a larger interface for a projector, the 3D view filling the window (P).
+    #[arg(long)]
+    pub presenter: bool,
     /// Save a PNG of the window after --after-secs and quit (for docs and tests).
     #[arg(long)]
     pub screenshot: Option<PathBuf>,

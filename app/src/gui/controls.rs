@@ -42,6 +42,7 @@ pub fn menu_bar_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 ui.close();
             }
         });
+        super::lesson::lessons_menu_ui(app, ui);
         ui.menu_button("View", |ui| {
             ui.checkbox(&mut app.show_reference_element, "Reference element")
                 .on_hover_text("Shape functions of a reference element as colour fields, with its quadrature points.");

@@ -19,6 +19,7 @@ mod args;
 pub mod config;
 pub mod controls;
 pub mod gl_view;
+pub mod lesson;
 mod links;
 mod measure;
 mod persist;
@@ -85,6 +86,14 @@ pub struct HoxApp {
     deferred_frames: usize,
     /// Sessions being stepped in the background, and how many frames.
     background: Option<(std::thread::JoinHandle<Vec<Session>>, usize)>,
+    /// The lesson under way, if any ([`lesson`]).
+    pub lesson: Option<lesson::LessonState>,
+    /// Presenter mode: a larger interface, the 3D view filling the window.
+    pub presenter: bool,
+    /// An interface scale to apply at the next frame.
+    zoom_wanted: Option<f32>,
+    /// The first start offers the lessons.
+    pub offer_lessons: bool,
 }
 
 /// Whether a change from `old` to `new` changes how a configuration is drawn (a `[display]`
@@ -136,6 +145,16 @@ impl HoxApp {
             renderer: None,
             deferred_frames: 0,
             background: None,
+            lesson: None,
+            presenter: false,
+            zoom_wanted: None,
+            // the very first start (no saved settings) offers the lessons
+            offer_lessons: saved.is_none()
+                && !args.fresh
+                && args.lesson.is_none()
+                && args.lesson_file.is_none()
+                && args.screenshot.is_none()
+                && args.measure_secs.is_none(),
         };
         let configs = saved.filter(|_| same_scene).map(|s| (s.configs, s.compare));
         app.load_scene(scene, configs)?;
@@ -145,6 +164,14 @@ impl HoxApp {
         }
         if let Some(preset) = args.camera {
             app.set_camera(preset);
+        }
+        if args.lesson.is_some() || args.lesson_file.is_some() {
+            let lesson = crate::cli::lesson::load(args.lesson.as_deref(), args.lesson_file.as_deref())
+                .map_err(|e| format!("{e:#}"))?;
+            app.open_lesson(lesson);
+        }
+        if args.presenter {
+            app.set_presenter(true);
         }
         if app.measure.is_some() {
             app.playback.playing = true;

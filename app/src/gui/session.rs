@@ -298,6 +298,20 @@ impl Session {
         }
     }
 
+    /// Shows the static equilibrium of the configuration (hox's static solver), at rest: what
+    /// settling tends to, at once (a lesson's `"static"` step).
+    pub fn show_static_equilibrium(&mut self) -> Result<(), String> {
+        let mesh = self.instance.sim.mesh().clone();
+        let solution = hox_scenes::solve_static(&self.instance.scene, &mesh, 1e-9, 10, &mut |_, _, _| {})
+            .map_err(|e| e.to_string())?;
+        self.instance.sim.warm_start(&solution.positions, 0.0);
+        self.history = History::default();
+        self.record();
+        self.residual = self.force_residual();
+        self.refresh_readout();
+        Ok(())
+    }
+
     /// Starts the *Settle* action: the scene's settle damping until the body is at rest (as
     /// `hox simulate --settle`), then the damping is removed again.
     pub fn start_settle(&mut self) {

@@ -447,3 +447,66 @@ fn a_prepared_comparison_starts_from_flags_and_reads_cleanly() {
         .unwrap_or_default();
     assert!(err.contains("--compare 'refine=9'"), "{err}");
 }
+
+/// Issue #21: `--lesson` opens a lesson on its first step — configurations, camera, text,
+/// question and the live measurement beside them; A reveals the answer, → goes on, ← back; P is
+/// presenter mode (the interface scaled up, the panels away, the caption over the view).
+#[test]
+fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
+    use super::viewport::ViewPreset;
+    let mut h = harness(args::parse_for_test(&["--lesson", "mesh-bias"]));
+    h.run_steps(3);
+    h.get_by_label_contains("Step 1 of 2: Five against six");
+    h.get_by_label_contains("Question: Does either tip move sideways");
+    let labels: Vec<String> = h.state().sessions.iter().map(|s| s.label()).collect();
+    assert_eq!(labels, ["P1 8×2×2 five", "P1 8×2×2 six"]);
+    assert_eq!(h.state().viewport.preset, ViewPreset::Top);
+    // the static step shows the equilibrium at once: the six-split tip sits 2.7 cm sideways
+    let six = text(&h, "B P1 8×2×2 six: 0.0");
+    assert!(six.contains("0.027"), "{six}");
+    assert!(h.query_by_label_contains("Answer:").is_none(), "the answer waits");
+    h.key_press(egui::Key::A);
+    h.run_steps(2);
+    h.get_by_label_contains("Answer: B does");
+    h.key_press(egui::Key::ArrowRight);
+    h.run_steps(3);
+    h.get_by_label_contains("Step 2 of 2: Does high order help?");
+    assert!(h.state().sessions.iter().all(|s| s.config.element == "p2"));
+    assert!(h.query_by_label_contains("Answer:").is_none(), "a new step hides its answer");
+    h.key_press(egui::Key::ArrowLeft);
+    h.run_steps(3);
+    h.get_by_label_contains("Step 1 of 2");
+    // presenter mode: no side panels; the caption carries the numbers
+    h.key_press(egui::Key::P);
+    h.run_steps(3);
+    assert!(h.state().presenter);
+    assert!(h.query_by_label_contains("Young's modulus").is_none(), "the controls are hidden");
+    h.get_by_label_contains("Mesh bias — Five against six");
+    h.get_by_label_contains("B: 0.027");
+}
+
+/// Issue #21: a lesson that plays for some seconds pauses at its end; the Lessons menu lists
+/// every lesson; the very first start offers them; a bad lesson file names the file and key.
+#[test]
+fn lessons_play_their_seconds_are_listed_and_offered_at_first_start() {
+    let mut h = harness(args::parse_for_test(&["--lesson", "why-high-order"]));
+    h.run_steps(2);
+    assert!(h.state().playback.playing);
+    // the first step plays 0.45 s (27 frames) and pauses there
+    h.state_mut().step(27);
+    h.run_steps(3);
+    assert!(!h.state().playback.playing, "paused at the bottom of the swing");
+    h.get_by_role_and_label(egui::accesskit::Role::Button, "Lessons").click();
+    h.run_steps(2);
+    // every lesson is in the menu (the open one's title is also the panel's heading)
+    for l in hox_scenes::lesson::registry().unwrap() {
+        assert!(h.query_all_by_label(&l.title).count() >= 1, "{}", l.title);
+    }
+    assert!(HoxApp::new(&AppArgs::default(), None).unwrap().offer_lessons, "the first start offers the lessons");
+    assert!(!HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap().offer_lessons);
+    let bad = std::env::temp_dir().join(format!("hox-bad-lesson-{}.toml", std::process::id()));
+    std::fs::write(&bad, "title = \"t\"\ngoal = \"g\"\n[[steps]]\ntitle = \"s\"\nscene = \"bending\"\nmeasure = \"tip-uz\"\ntext = \"x\"\nquestion = \"q\"\nanswer = \"a\"\na = { poisson = 0.7 }\n").unwrap();
+    let err =
+        HoxApp::new(&args::parse_for_test(&["--lesson-file", bad.to_str().unwrap()]), None).err().unwrap_or_default();
+    assert!(err.contains("hox-bad-lesson") && err.contains("a.poisson"), "{err}");
+}

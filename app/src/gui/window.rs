@@ -96,11 +96,16 @@ impl HoxApp {
             ctx.request_repaint_after(std::time::Duration::from_millis(250));
         }
         self.shortcuts(&ctx);
+        self.lesson_shortcuts(&ctx);
+        if let Some(z) = self.zoom_wanted.take() {
+            ctx.set_zoom_factor(z);
+        }
         // Simulated time follows egui's clock (the window's: wall time between frames; the
         // headless tests': exactly their step), never the wall clock read here, so a test plays
         // the same frames in a slow debug build and a fast release one.
         let clock_dt = f64::from(ctx.input(|i| i.unstable_dt));
         self.advance(if self.playback.last_clock_frame { clock_dt } else { 0.0 });
+        self.lesson_after_advance();
         self.playback.last_clock_frame = true;
 
         // The panels are not filled: the window is cleared to the panel colour (`clear_color`), and
@@ -108,14 +113,23 @@ impl HoxApp {
         let frame = egui::Frame::side_top_panel(ui.style()).fill(egui::Color32::TRANSPARENT);
         egui::Panel::top("menu").frame(frame).show(ui, |ui| controls::menu_bar_ui(self, ui));
         egui::Panel::bottom("status").frame(frame).show(ui, |ui| self.status_line_ui(ui));
-        egui::Panel::bottom("plots")
-            .frame(frame)
-            .resizable(true)
-            .default_size(230.0)
-            .show(ui, |ui| plots::plots_ui(self, ui));
-        egui::Panel::left("controls").frame(frame).resizable(true).default_size(330.0).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| controls::controls_ui(self, ui));
-        });
+        // presenter mode: the 3D view fills the window, the lesson's caption over it
+        if !self.presenter {
+            egui::Panel::bottom("plots")
+                .frame(frame)
+                .resizable(true)
+                .default_size(230.0)
+                .show(ui, |ui| plots::plots_ui(self, ui));
+            if self.lesson.is_some() {
+                egui::Panel::right("lesson").frame(frame).resizable(true).default_size(380.0).show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| super::lesson::lesson_panel_ui(self, ui));
+                });
+            }
+            egui::Panel::left("controls").frame(frame).resizable(true).default_size(330.0).show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| controls::controls_ui(self, ui));
+            });
+        }
+        super::lesson::welcome_ui(self, &ctx);
         if self.show_reference_element {
             let mut open = true;
             egui::Window::new("Reference element")
@@ -129,6 +143,9 @@ impl HoxApp {
             let offsets = self.offsets();
             self.viewport.ui(ui, &mut self.sessions, &offsets, &self.view, self.gl_available);
         });
+        if self.presenter {
+            super::lesson::caption_ui(self, &ctx);
+        }
         if self.playback.playing || self.sessions.iter().any(|s| s.drag.is_some()) {
             ctx.request_repaint();
         }

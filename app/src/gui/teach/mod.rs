@@ -164,7 +164,7 @@ impl ReferenceElementView {
     }
 
     /// Switches to `element`, keeping the node index and degree in range and reframing.
-    fn set_element(&mut self, element: ElementType) {
+    pub fn set_element(&mut self, element: ElementType) {
         self.element = element;
         self.node = self.node.min(element.num_nodes().saturating_sub(1));
         if let Some(d) = self.quadrature_degree {

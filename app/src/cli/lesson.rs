@@ -1,0 +1,272 @@
+//! `hox lessons` and `hox lesson NAME [--record FILE.rrd]`: the built-in lessons
+//! ([`hox_scenes::lesson`]), run headlessly step by step with each step's measurement, and
+//! recorded as one Rerun file a student plays in the stock viewer — every step a segment of
+//! the timeline, its text (title, what to look at, the question, then the answer and the
+//! numbers) a text document, the measurement a time series, laid out by the lesson's
+//! blueprint.
+
+use super::DelayedBar;
+use crate::output::check_writable;
+use crate::recording::{Configuration, LogSettings, Recorder, config_label, entity_name};
+use anyhow::{Context, Result};
+use hox_scenes::lesson::{Lesson, Measured, Step, StepRunner};
+use rerun::blueprint as bp;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct LessonArgs {
+    /// A built-in lesson (`hox lessons` lists them).
+    #[arg(required_unless_present = "lesson_file", conflicts_with = "lesson_file")]
+    pub name: Option<String>,
+    /// A lesson file of your own (TOML, see docs/LESSONS.md).
+    #[arg(long)]
+    pub lesson_file: Option<PathBuf>,
+    /// Record the lesson to this Rerun file (.rrd): every step a segment of the timeline.
+    #[arg(long)]
+    pub record: Option<PathBuf>,
+    /// Print the measurements as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The lesson `args` names.
+pub fn load(name: Option<&str>, file: Option<&std::path::Path>) -> Result<Lesson> {
+    Ok(match (name, file) {
+        (_, Some(path)) => hox_scenes::lesson::from_file(path)?,
+        (Some(n), None) => hox_scenes::lesson::by_name(n)?,
+        (None, None) => anyhow::bail!("name a lesson (hox lessons lists them) or give --lesson-file"),
+    })
+}
+
+/// `hox lessons`: every built-in lesson, its goal and steps.
+pub fn lessons(json: bool) -> Result<()> {
+    let all = hox_scenes::lesson::registry()?;
+    if json {
+        println!("{}", serde_json::Value::Array(all.iter().map(Lesson::summary_json).collect()));
+        return Ok(());
+    }
+    for l in &all {
+        println!("{:<18} {} — {} steps", l.name, l.title, l.steps.len());
+        println!("{:<18} {}", "", l.goal);
+    }
+    println!("run one: hox app --lesson NAME (in class), hox lesson NAME --record FILE.rrd (to take home)");
+    Ok(())
+}
+
+/// The markdown of a step: its title, text and question; with `outcome`, the answer and every
+/// configuration's measurement.
+pub fn step_markdown(lesson: &Lesson, k: usize, outcome: Option<&[Measured]>) -> String {
+    let step = &lesson.steps[k];
+    let mut text = format!(
+        "# {}\n\n## Step {} of {}: {}\n\n{}\n\n**Question:** {}\n\n",
+        lesson.title,
+        k + 1,
+        lesson.steps.len(),
+        step.title,
+        step.text,
+        step.question
+    );
+    for (j, scene) in step.configurations.iter().enumerate() {
+        let what = match outcome.and_then(|o| o.get(j)) {
+            Some(m) => m.text.clone(),
+            None => "…".into(),
+        };
+        text += &format!("- **{}** {}: {} = {what}\n", ["A", "B"][j.min(1)], scene_label(scene), step.measure.title());
+    }
+    if outcome.is_some() {
+        text += &format!("\n**Answer:** {}\n", step.answer);
+    }
+    text
+}
+
+/// "P1 8×2×2 five r1, ν = 0.49": what distinguishes a configuration.
+fn scene_label(scene: &hox_scenes::Scene) -> String {
+    let p = scene.params();
+    let mut label = if scene.is_box() {
+        format!("{} {}×{}×{}", p.element.to_uppercase(), p.grid[0], p.grid[1], p.grid[2])
+    } else {
+        scene.mesh.element_names()
+    };
+    if p.refine > 0 {
+        label += &format!(" r{}", p.refine);
+    }
+    label += &format!(", {}, ν = {}, {}", p.material, p.poisson_ratio, p.method);
+    label
+}
+
+/// `hox lesson`: runs every step headlessly, prints the measurements, and records if asked.
+pub fn lesson(args: &LessonArgs) -> Result<()> {
+    let lesson = load(args.name.as_deref(), args.lesson_file.as_deref())?;
+    if let Some(out) = &args.record {
+        check_writable(out)?;
+    }
+    let rec = match &args.record {
+        Some(out) => Some(
+            rerun::RecordingStreamBuilder::new("hox")
+                .recording_name(format!("hox lesson {}", lesson.name))
+                .save(out)
+                .with_context(|| format!("cannot write {}", out.display()))?,
+        ),
+        None => None,
+    };
+    if let Some(rec) = &rec {
+        blueprint().send(rec, bp::BlueprintActivation { make_active: true, make_default: true })?;
+        rec.log_static(
+            "lesson/goal",
+            &rerun::TextDocument::from_markdown(format!("# {}\n\n{}", lesson.title, lesson.goal)),
+        )?;
+    }
+    let mut offset = (0i64, 0.0f64);
+    let mut report = Vec::new();
+    for (k, step) in lesson.steps.iter().enumerate() {
+        let mut bar = DelayedBar::new();
+        let mut progress = |what: &str, fraction: f64| {
+            bar.reveal("{spinner} {bar:30} {msg} [{elapsed}]");
+            bar.bar.set_position((1000.0 * fraction.clamp(0.0, 1.0)) as u64);
+            bar.bar.set_message(format!("step {}: {what}", k + 1));
+        };
+        let mut runner = StepRunner::start(step, &mut progress)?;
+        let measured = match &rec {
+            Some(rec) => record_step(rec, &lesson, k, step, &mut runner, &mut offset, &mut progress)?,
+            None => {
+                runner.finish(&mut progress);
+                runner.measured()
+            }
+        };
+        bar.bar.finish_and_clear();
+        if !args.json {
+            println!("step {} — {}: {}", k + 1, step.title, step.measure.title());
+            for (j, m) in measured.iter().enumerate() {
+                println!("  {} {}: {}", ["A", "B"][j.min(1)], scene_label(&step.configurations[j]), m.text);
+            }
+        }
+        report.push(serde_json::json!({
+            "step": k + 1,
+            "title": step.title,
+            "measure": step.measure.name(),
+            "unit": step.measure.unit(),
+            "values": measured.iter().map(|m| m.value).collect::<Vec<_>>(),
+            "texts": measured.iter().map(|m| m.text.clone()).collect::<Vec<_>>(),
+        }));
+    }
+    if let Some(rec) = rec {
+        rec.flush_blocking().context("cannot finish the recording")?;
+    }
+    if args.json {
+        println!(
+            "{}",
+            serde_json::json!({ "lesson": lesson.name, "title": lesson.title, "steps": report, "file": args.record })
+        );
+    } else if let Some(out) = &args.record {
+        println!("{}: the lesson's {} steps, one after the other on the timeline", out.display(), lesson.steps.len());
+        println!("play it with the stock Rerun viewer 0.36.3: scripts/rerun.sh {}", out.display());
+    }
+    Ok(())
+}
+
+/// Logs step `k` as a segment starting at `offset` (advanced past it): its configurations side
+/// by side frame by frame, its text (question first, the answer and the numbers at the end), and
+/// its measurement as a time series; its bodies are cleared when it ends.
+fn record_step(
+    rec: &rerun::RecordingStream,
+    lesson: &Lesson,
+    k: usize,
+    step: &Step,
+    runner: &mut StepRunner,
+    offset: &mut (i64, f64),
+    progress: &mut dyn FnMut(&str, f64),
+) -> Result<Vec<Measured>> {
+    rec.set_time_sequence("frame", offset.0);
+    rec.set_duration_secs("sim_time", offset.1);
+    rec.log("lesson/step", &rerun::TextDocument::from_markdown(step_markdown(lesson, k, None)))?;
+    let first_mesh = runner.instances[0].sim.mesh().clone();
+    let offsets =
+        crate::display::side_by_side_offsets(&first_mesh, runner.instances.len(), crate::display::LayoutAxis::X);
+    let names: Vec<String> = runner
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(j, i)| format!("s{}_{}_{}", k + 1, ["a", "b"][j.min(1)], entity_name(&config_label(i))))
+        .collect();
+    let configs: Vec<Configuration<'_>> = runner
+        .instances
+        .iter()
+        .zip(&names)
+        .zip(&offsets)
+        .map(|((i, name), o)| Configuration { name: name.clone(), instance: i, offset_m: *o, reference: None })
+        .collect();
+    let mut settings = LogSettings::new(runner.instances[0].scene.params());
+    settings.static_data = false;
+    settings.blueprint = false;
+    settings.time_offset = *offset;
+    let fields = crate::display::fields(runner.instances[0].scene.params());
+    let mut recorder = Recorder::new(rec, &configs, &settings, &fields)?;
+    drop(configs);
+    let log = |recorder: &mut Recorder, runner: &StepRunner| -> Result<()> {
+        let instances: Vec<&hox_scenes::Instance> = runner.instances.iter().collect();
+        recorder.log_frame(rec, &instances, &vec![0.0; instances.len()])?;
+        for (j, m) in runner.measured().iter().enumerate() {
+            if m.value.is_finite() {
+                rec.log(
+                    format!("lesson/measure/step_{}/{}", k + 1, ["a", "b"][j.min(1)]),
+                    &rerun::Scalars::single(m.value),
+                )?;
+            }
+        }
+        Ok(())
+    };
+    log(&mut recorder, runner)?;
+    let total = match step.run {
+        hox_scenes::lesson::Run::Seconds(s) => s,
+        _ => hox_scenes::SETTLE_CAP_SECS,
+    };
+    while runner.advance() {
+        log(&mut recorder, runner)?;
+        progress("recording", runner.instances[0].sim.time_secs() / total);
+    }
+    log(&mut recorder, runner)?;
+    let measured = runner.measured();
+    let mut end = runner
+        .instances
+        .iter()
+        .map(|i| (i.sim.frames() as i64, i.sim.time_secs()))
+        .fold((0i64, 0.0f64), |a, b| (a.0.max(b.0), a.1.max(b.1)));
+    // a step shown at rest (static) holds its question two seconds before the answer
+    if end.1 < 1.0 {
+        end = (end.0 + 120, end.1 + 2.0);
+    }
+    // the answer and the numbers close the segment; then the bodies go
+    rec.set_time_sequence("frame", offset.0 + end.0);
+    rec.set_duration_secs("sim_time", offset.1 + end.1);
+    rec.log("lesson/step", &rerun::TextDocument::from_markdown(step_markdown(lesson, k, Some(&measured))))?;
+    // a short pause on the answer before the next step
+    let pause = (30i64, 0.5f64);
+    rec.set_time_sequence("frame", offset.0 + end.0 + pause.0);
+    rec.set_duration_secs("sim_time", offset.1 + end.1 + pause.1);
+    recorder.clear(rec)?;
+    *offset = (offset.0 + end.0 + pause.0 + 1, offset.1 + end.1 + pause.1 + 1.0 / 60.0);
+    Ok(measured)
+}
+
+/// The lesson recording's layout: the 3D view large, the step's text and the measurement beside.
+fn blueprint() -> bp::Blueprint {
+    let view3d = bp::Spatial3DView::new("3D").with_origin("world").with_contents(["+ world/**"]);
+    let text = bp::TextDocumentView::new("Step").with_origin("lesson/step").with_contents(["+ lesson/step"]);
+    let goal = bp::TextDocumentView::new("Lesson").with_origin("lesson/goal").with_contents(["+ lesson/goal"]);
+    let measure = bp::TimeSeriesView::new("Measurement (A, B per step)")
+        .with_origin("lesson/measure")
+        .with_contents(["+ lesson/measure/**"]);
+    let root = bp::Horizontal::new([
+        bp::ContainerLike::from(view3d),
+        bp::Vertical::new([goal.into(), text.into(), measure.into()]).with_row_shares([0.7, 2.2, 1.0]).into(),
+    ])
+    .with_column_shares([0.62, 0.38]);
+    bp::Blueprint::new(root)
+        .with_auto_views(false)
+        .with_auto_layout(false)
+        .with_blueprint_panel(bp::BlueprintPanel::from_state(bp::components::PanelState::Collapsed))
+        .with_selection_panel(bp::SelectionPanel::from_state(bp::components::PanelState::Collapsed))
+        .with_time_panel(
+            bp::TimePanel::new().with_state(bp::components::PanelState::Collapsed).with_timeline("sim_time"),
+        )
+}

@@ -1,0 +1,322 @@
+//! Lessons in the app (issue #21): a lesson's steps ([`hox_scenes::lesson`]) set the
+//! configurations, camera and view; a panel shows the step's text, its question, the live
+//! measurement of each configuration beside it and, on demand, the answer. Keys: → / N next
+//! step, ← / B previous, A reveal the answer (plus the app's own: space, E settle, R reset).
+//! **Presenter mode** (P, or `--presenter`): the interface scaled up for a projector at the
+//! back of a room, the side panel and plots hidden so the 3D view fills the window, the step's
+//! caption and numbers over it.
+
+use super::HoxApp;
+use super::session::Session;
+use eframe::egui;
+use hox_scenes::lesson::{Lesson, Measured, Run};
+
+/// Interface scale of presenter mode.
+pub const PRESENTER_ZOOM: f32 = 1.6;
+
+/// A lesson under way.
+pub struct LessonState {
+    pub lesson: Lesson,
+    pub step: usize,
+    pub revealed: bool,
+    /// Simulated seconds the step plays for ([`Run::Seconds`]), then the app pauses.
+    play_until_secs: Option<f64>,
+    /// Why the last step could not be set up, if it could not.
+    pub problem: Option<String>,
+    /// What each configuration's measurement is against, when it needs one of its own (the
+    /// solver's error: the static solution of that mesh, solved when the step opens).
+    own_references: Vec<Option<hox_scenes::reference::Reference>>,
+}
+
+impl LessonState {
+    /// The measurement of every session now, for the step on screen.
+    pub fn measured(&self, sessions: &[Session]) -> Vec<Measured> {
+        let measure = self.lesson.steps[self.step].measure;
+        sessions
+            .iter()
+            .enumerate()
+            .map(|(k, s)| match &s.failure {
+                Some(f) => Measured { value: f64::INFINITY, text: format!("failed: {f}") },
+                None => {
+                    let reference = self.own_references.get(k).and_then(Option::as_ref).or(s.reference.reference());
+                    hox_scenes::lesson::measure(measure, &s.instance, reference, s.ms_per_frame, f64::INFINITY)
+                }
+            })
+            .collect()
+    }
+}
+
+impl HoxApp {
+    /// Opens `lesson` on its first step.
+    pub fn open_lesson(&mut self, lesson: Lesson) {
+        self.lesson = Some(LessonState {
+            lesson,
+            step: 0,
+            revealed: false,
+            play_until_secs: None,
+            problem: None,
+            own_references: Vec::new(),
+        });
+        self.go_to_step(0);
+    }
+
+    /// Sets up step `k` of the open lesson: its configurations (side by side when two), camera
+    /// and view, and starts it as it says (plays its seconds, settles, or shows the static
+    /// equilibrium).
+    pub fn go_to_step(&mut self, k: usize) {
+        let Some(state) = &mut self.lesson else { return };
+        let k = k.min(state.lesson.steps.len() - 1);
+        state.step = k;
+        state.revealed = false;
+        state.problem = None;
+        let step = state.lesson.steps[k].clone();
+        let mut sessions = Vec::new();
+        for scene in &step.configurations {
+            let base = match hox_scenes::by_name(scene.name()) {
+                Ok(b) => b,
+                Err(e) => {
+                    state.problem = Some(e.to_string());
+                    return;
+                }
+            };
+            match Session::new(base, scene.params().clone()) {
+                Ok(s) => sessions.push(s),
+                Err(e) => {
+                    state.problem = Some(e);
+                    return;
+                }
+            }
+        }
+        state.own_references = step
+            .configurations
+            .iter()
+            .map(|scene| match step.measure {
+                hox_scenes::lesson::Measure::SolverError => {
+                    hox_scenes::lesson::reference_for(step.measure, scene, &mut |_, _| {}).ok().flatten()
+                }
+                _ => None,
+            })
+            .collect();
+        if step.run == Run::Static {
+            for s in &mut sessions {
+                if let Err(e) = s.show_static_equilibrium() {
+                    state.problem = Some(e);
+                }
+            }
+        }
+        state.play_until_secs = match step.run {
+            Run::Seconds(secs) => Some(secs),
+            _ => None,
+        };
+        self.join_background();
+        self.sessions = sessions;
+        self.compare = self.sessions.len() > 1;
+        self.active = 0;
+        self.show_reference_element = step.reference_element;
+        if step.reference_element
+            && let Some(et) = hox_sim::element::ElementType::from_name(&step.configurations[0].params().element)
+        {
+            self.reference_element.set_element(et);
+        }
+        self.rebuilt();
+        let preset = step
+            .camera
+            .as_deref()
+            .and_then(|c| super::viewport::ViewPreset::ALL.into_iter().find(|p| p.name() == c))
+            .unwrap_or_default();
+        self.set_camera(preset);
+        self.playback.playing = step.run != Run::Static;
+        if step.run == Run::Settle {
+            self.settle();
+        }
+    }
+
+    /// The next (`+1`) or previous (`-1`) step.
+    pub fn lesson_step(&mut self, delta: i64) {
+        let Some(state) = &self.lesson else { return };
+        let last = state.lesson.steps.len() as i64 - 1;
+        let k = (state.step as i64 + delta).clamp(0, last) as usize;
+        if k != state.step {
+            self.go_to_step(k);
+        }
+    }
+
+    /// Reveals the step's answer.
+    pub fn reveal_answer(&mut self) {
+        if let Some(state) = &mut self.lesson {
+            state.revealed = true;
+        }
+    }
+
+    /// A step that plays for some seconds pauses at its end.
+    pub(super) fn lesson_after_advance(&mut self) {
+        let Some(until) = self.lesson.as_ref().and_then(|s| s.play_until_secs) else { return };
+        if self.sessions.first().is_some_and(|s| s.instance.sim.time_secs() >= until - 1e-9) {
+            self.playback.playing = false;
+            if let Some(state) = &mut self.lesson {
+                state.play_until_secs = None;
+            }
+        }
+    }
+
+    /// The lesson's keys: → / N next, ← / B previous, A answer, P presenter mode.
+    pub(super) fn lesson_shortcuts(&mut self, ctx: &egui::Context) {
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let (next, previous, answer, presenter) = ctx.input(|i| {
+            (
+                i.key_pressed(egui::Key::ArrowRight) || i.key_pressed(egui::Key::N),
+                i.key_pressed(egui::Key::ArrowLeft) || i.key_pressed(egui::Key::B),
+                i.key_pressed(egui::Key::A),
+                i.key_pressed(egui::Key::P),
+            )
+        });
+        if presenter {
+            self.set_presenter(!self.presenter);
+        }
+        if self.lesson.is_none() {
+            return;
+        }
+        if next {
+            self.lesson_step(1);
+        }
+        if previous {
+            self.lesson_step(-1);
+        }
+        if answer {
+            self.reveal_answer();
+        }
+    }
+
+    /// Presenter mode on or off: a larger interface, the 3D view filling the window.
+    pub fn set_presenter(&mut self, on: bool) {
+        self.presenter = on;
+        self.zoom_wanted = Some(if on { PRESENTER_ZOOM } else { 1.0 });
+    }
+}
+
+/// The lesson panel: title, step, text, question, the live measurement of A and B, the answer
+/// on demand, and the step buttons.
+pub fn lesson_panel_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    let Some(state) = &app.lesson else { return };
+    let step = &state.lesson.steps[state.step];
+    let measured = state.measured(&app.sessions);
+    let n = state.lesson.steps.len();
+    ui.heading(&state.lesson.title);
+    ui.label(egui::RichText::new(&state.lesson.goal).italics());
+    ui.separator();
+    ui.label(egui::RichText::new(format!("Step {} of {n}: {}", state.step + 1, step.title)).strong().size(18.0));
+    ui.label(&step.text);
+    ui.add_space(6.0);
+    ui.label(egui::RichText::new(format!("Question: {}", step.question)).strong());
+    ui.add_space(6.0);
+    ui.label(egui::RichText::new(step.measure.title()).underline());
+    for (k, (m, s)) in measured.iter().zip(&app.sessions).enumerate() {
+        ui.label(egui::RichText::new(format!("{} {}: {}", ["A", "B"][k.min(1)], s.label(), m.text)).monospace());
+    }
+    if let Some(p) = &state.problem {
+        ui.colored_label(egui::Color32::from_rgb(255, 120, 90), p);
+    }
+    ui.add_space(6.0);
+    let revealed = state.revealed;
+    let (at, answer) = (state.step, step.answer.clone());
+    if revealed {
+        ui.label(egui::RichText::new(format!("Answer: {answer}")).color(egui::Color32::from_rgb(250, 220, 120)));
+    } else if ui.button("Reveal the answer (A)").clicked() {
+        app.reveal_answer();
+    }
+    ui.add_space(6.0);
+    ui.horizontal(|ui| {
+        if ui.add_enabled(at > 0, egui::Button::new("◀ Previous (←)")).clicked() {
+            app.lesson_step(-1);
+        }
+        if ui.add_enabled(at + 1 < n, egui::Button::new("Next (→) ▶")).clicked() {
+            app.lesson_step(1);
+        }
+        if ui.button("Close lesson").clicked() {
+            app.lesson = None;
+        }
+    });
+}
+
+/// In presenter mode: the step's caption and numbers over the 3D view's top left corner.
+pub fn caption_ui(app: &HoxApp, ctx: &egui::Context) {
+    let Some(state) = &app.lesson else { return };
+    let step = &state.lesson.steps[state.step];
+    let measured = state.measured(&app.sessions);
+    egui::Area::new(egui::Id::unique("lesson-caption")).fixed_pos(egui::pos2(12.0, 40.0)).show(ctx, |ui| {
+        egui::Frame::new()
+            .fill(egui::Color32::from_rgba_unmultiplied(0, 0, 0, 180))
+            .inner_margin(10.0)
+            .corner_radius(6.0)
+            .show(ui, |ui| {
+                ui.set_max_width(560.0);
+                ui.label(
+                    egui::RichText::new(format!("{} — {}", state.lesson.title, step.title))
+                        .strong()
+                        .color(egui::Color32::WHITE),
+                );
+                ui.label(egui::RichText::new(&step.question).color(egui::Color32::WHITE));
+                for (k, m) in measured.iter().enumerate() {
+                    ui.label(
+                        egui::RichText::new(format!("{}: {}", ["A", "B"][k.min(1)], m.text))
+                            .monospace()
+                            .color(egui::Color32::from_rgb(250, 220, 120)),
+                    );
+                }
+                if state.revealed {
+                    ui.label(egui::RichText::new(&step.answer).color(egui::Color32::from_rgb(180, 230, 255)));
+                }
+            });
+    });
+}
+
+/// The Lessons menu: every built-in lesson.
+pub fn lessons_menu_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.menu_button("Lessons", |ui| {
+        match hox_scenes::lesson::registry() {
+            Ok(all) => {
+                for l in all {
+                    if ui.button(&l.title).on_hover_text(&l.goal).clicked() {
+                        app.open_lesson(l);
+                        ui.close();
+                    }
+                }
+            }
+            Err(e) => {
+                ui.label(e.to_string());
+            }
+        }
+        ui.separator();
+        let mut on = app.presenter;
+        if ui.checkbox(&mut on, "Presenter mode (P)").clicked() {
+            app.set_presenter(on);
+        }
+    });
+}
+
+/// The first start's offer: the lessons, or the free app.
+pub fn welcome_ui(app: &mut HoxApp, ctx: &egui::Context) {
+    if !app.offer_lessons {
+        return;
+    }
+    let mut open = true;
+    egui::Window::new("Welcome to hox").collapsible(false).open(&mut open).show(ctx, |ui| {
+        ui.label("Start with a guided lesson, or explore freely (the Lessons menu has them all).");
+        if let Ok(all) = hox_scenes::lesson::registry() {
+            for l in all {
+                if ui.button(&l.title).on_hover_text(&l.goal).clicked() {
+                    app.open_lesson(l);
+                    app.offer_lessons = false;
+                }
+            }
+        }
+        if ui.button("Explore freely").clicked() {
+            app.offer_lessons = false;
+        }
+    });
+    if !open {
+        app.offer_lessons = false;
+    }
+}
