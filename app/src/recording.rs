@@ -550,16 +550,21 @@ impl Recorder {
             bp::Vertical::new(charts).with_row_shares(probe_rows).into(),
         ])
         .with_column_shares([0.54, 0.18, 0.28]);
-        // the side panels folded away: the views get the window
-        bp::Blueprint::new(root)
-            .with_auto_views(false)
-            .with_auto_layout(false)
-            .with_blueprint_panel(bp::BlueprintPanel::from_state(bp::components::PanelState::Collapsed))
-            .with_selection_panel(bp::SelectionPanel::from_state(bp::components::PanelState::Collapsed))
-            .with_time_panel(
-                bp::TimePanel::new().with_state(bp::components::PanelState::Collapsed).with_timeline("sim_time"),
-            )
+        blueprint_of(root)
     }
+}
+
+/// A blueprint of exactly the views under `root`, the side panels folded away (the views get
+/// the window) and the time panel collapsed to its play bar on `sim_time`.
+pub fn blueprint_of(root: impl Into<bp::ContainerLike>) -> bp::Blueprint {
+    bp::Blueprint::new(root)
+        .with_auto_views(false)
+        .with_auto_layout(false)
+        .with_blueprint_panel(bp::BlueprintPanel::from_state(bp::components::PanelState::Collapsed))
+        .with_selection_panel(bp::SelectionPanel::from_state(bp::components::PanelState::Collapsed))
+        .with_time_panel(
+            bp::TimePanel::new().with_state(bp::components::PanelState::Collapsed).with_timeline("sim_time"),
+        )
 }
 
 /// A vertical viridis bar, bottom to top, as an RGB image.

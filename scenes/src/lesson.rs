@@ -283,9 +283,9 @@ impl Lesson {
                 measure,
                 camera: s.camera.clone(),
                 reference_element,
-                text: s.text.trim().to_string(),
-                question: s.question.trim().to_string(),
-                answer: s.answer.trim().to_string(),
+                text: reflow(&s.text),
+                question: reflow(&s.question),
+                answer: reflow(&s.answer),
             });
         }
         Ok(Lesson {
@@ -312,6 +312,16 @@ impl Lesson {
             })).collect::<Vec<_>>(),
         })
     }
+}
+
+/// Text as written in a TOML multi-line string, as paragraphs: single line breaks become spaces
+/// (the app and the viewer wrap to their width), blank lines stay.
+fn reflow(text: &str) -> String {
+    text.trim()
+        .split("\n\n")
+        .map(|p| p.split_whitespace().collect::<Vec<_>>().join(" "))
+        .collect::<Vec<_>>()
+        .join("\n\n")
 }
 
 /// The overrides a step's `a` or `b` table sets, by the parameter table's command-line keys;
@@ -537,7 +547,9 @@ pub fn measure(
         Measure::MaxDisplacement => metres(instance.sim.displacements().iter().map(|u| u.norm()).fold(0.0, f64::max)),
         Measure::ShapeMinimum => {
             let v = shape_minimum(instance.sim.mesh().blocks[0].element_type);
-            Measured { value: v, text: format!("min N_i = {v:.4}") }
+            // no "−0.0000" for a minimum that is zero up to rounding
+            let shown = if v.abs() < 5e-5 { 0.0 } else { v };
+            Measured { value: v, text: format!("min N_i = {shown:.4}") }
         }
     }
 }

@@ -261,12 +261,5 @@ fn blueprint() -> bp::Blueprint {
         bp::Vertical::new([goal.into(), text.into(), measure.into()]).with_row_shares([0.7, 2.2, 1.0]).into(),
     ])
     .with_column_shares([0.62, 0.38]);
-    bp::Blueprint::new(root)
-        .with_auto_views(false)
-        .with_auto_layout(false)
-        .with_blueprint_panel(bp::BlueprintPanel::from_state(bp::components::PanelState::Collapsed))
-        .with_selection_panel(bp::SelectionPanel::from_state(bp::components::PanelState::Collapsed))
-        .with_time_panel(
-            bp::TimePanel::new().with_state(bp::components::PanelState::Collapsed).with_timeline("sim_time"),
-        )
+    crate::recording::blueprint_of(root)
 }

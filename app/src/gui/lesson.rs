@@ -228,10 +228,10 @@ pub fn lesson_panel_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     }
     ui.add_space(6.0);
     ui.horizontal(|ui| {
-        if ui.add_enabled(at > 0, egui::Button::new("◀ Previous (←)")).clicked() {
+        if ui.add_enabled(at > 0, egui::Button::new("< Previous (left arrow)")).clicked() {
             app.lesson_step(-1);
         }
-        if ui.add_enabled(at + 1 < n, egui::Button::new("Next (→) ▶")).clicked() {
+        if ui.add_enabled(at + 1 < n, egui::Button::new("Next (right arrow) >")).clicked() {
             app.lesson_step(1);
         }
         if ui.button("Close lesson").clicked() {
