@@ -42,6 +42,9 @@ fn quadrature_one_point_per_hexahedron_lets_hourglass_modes_sag_the_beam() {
     assert!(q1[0] > 4.0 * q1[1], "one point {} m against eight {} m", q1[0], q1[1]);
     let p2 = step("quadrature", 2);
     assert!((p2[0] / p2[1] - 1.0).abs() < 1e-3, "more points buy nothing: {p2:?}");
+    // …and cost time: measured side by side in one run, a ratio
+    let ms = step("quadrature", 3);
+    assert!(ms[1] > 1.5 * ms[0], "degree 6 against the default: {ms:?} ms per frame");
 }
 
 #[test]
