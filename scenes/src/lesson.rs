@@ -67,12 +67,16 @@ pub enum Measure {
     Substeps,
     /// The largest node displacement at the end, m.
     MaxDisplacement,
+    /// How far the second probe's displacement is from the first's turned half a turn about
+    /// the x axis, `|u₂ − diag(1, −1, −1) u₁|`, m: zero when a beam twisted about its axis
+    /// responds symmetrically (probes at opposite corners of a cross-section).
+    Asymmetry,
     /// The most negative value of the element's shape functions over the reference element.
     ShapeMinimum,
 }
 
 impl Measure {
-    pub const ALL: [Measure; 9] = [
+    pub const ALL: [Measure; 10] = [
         Measure::SettledError,
         Measure::SolverError,
         Measure::TipUz,
@@ -81,6 +85,7 @@ impl Measure {
         Measure::MinDetF,
         Measure::Substeps,
         Measure::MaxDisplacement,
+        Measure::Asymmetry,
         Measure::ShapeMinimum,
     ];
 
@@ -94,6 +99,7 @@ impl Measure {
             Measure::MinDetF => "min-det-f",
             Measure::Substeps => "substeps",
             Measure::MaxDisplacement => "max-displacement",
+            Measure::Asymmetry => "asymmetry",
             Measure::ShapeMinimum => "shape-minimum",
         }
     }
@@ -109,6 +115,7 @@ impl Measure {
             Measure::MinDetF => "smallest det F",
             Measure::Substeps => "substeps per frame",
             Measure::MaxDisplacement => "largest node displacement",
+            Measure::Asymmetry => "asymmetry of the twist (opposite corners)",
             Measure::ShapeMinimum => "most negative shape-function value",
         }
     }
@@ -119,7 +126,8 @@ impl Measure {
             | Measure::SolverError
             | Measure::TipUz
             | Measure::TipUy
-            | Measure::MaxDisplacement => "m",
+            | Measure::MaxDisplacement
+            | Measure::Asymmetry => "m",
             Measure::MsPerFrame => "ms",
             Measure::MinDetF | Measure::Substeps | Measure::ShapeMinimum => "",
         }
@@ -545,6 +553,15 @@ pub fn measure(
             Measured { value: n, text: format!("{n} substeps per frame") }
         }
         Measure::MaxDisplacement => metres(instance.sim.displacements().iter().map(|u| u.norm()).fold(0.0, f64::max)),
+        Measure::Asymmetry => {
+            let p = instance.probe_displacements();
+            match (p.first(), p.get(1)) {
+                (Some((_, a)), Some((_, b))) => {
+                    metres(((b[0] - a[0]).powi(2) + (b[1] + a[1]).powi(2) + (b[2] + a[2]).powi(2)).sqrt())
+                }
+                _ => Measured { value: f64::NAN, text: "needs two probes".into() },
+            }
+        }
         Measure::ShapeMinimum => {
             let v = shape_minimum(instance.sim.mesh().blocks[0].element_type);
             // no "−0.0000" for a minimum that is zero up to rounding

@@ -34,6 +34,9 @@ fn mesh_bias_the_six_split_bends_sideways_the_five_split_does_not() {
     let p2 = step("mesh-bias", 2);
     // quadratic elements: the split matters far less
     assert!(p2[1].abs() < 0.05 * p1[1].abs(), "P2 {p2:?} against P1 {p1:?}");
+    // under torsion the five-split's opposite corners are mirror images, the six-split's not
+    let twist = step("mesh-bias", 3);
+    assert!(twist[0] < 1e-6 && twist[1] > 0.01, "{twist:?}");
 }
 
 #[test]
@@ -90,10 +93,13 @@ fn why_high_order_p2_160_beats_p1_1280_in_accuracy_and_cost() {
 fn accuracy_cost_the_error_splits_into_the_mesh_s_and_the_solver_s() {
     let substeps = step("accuracy-cost", 1);
     assert!(substeps[1] < 0.5 * substeps[0], "100 substeps nearer the mesh's equilibrium: {substeps:?}");
-    let solver = step("accuracy-cost", 2);
+    let iterations = step("accuracy-cost", 2);
+    assert!(iterations[1] < 0.1 * iterations[0], "two iterations far nearer: {iterations:?}");
+    assert!(iterations[1] < substeps[1], "and nearer than twice the substeps: {iterations:?} {substeps:?}");
+    let solver = step("accuracy-cost", 3);
     assert!(solver[1] < 0.01 * solver[0], "Newton settles at the equilibrium: {solver:?}");
-    let whole = step("accuracy-cost", 3);
+    let whole = step("accuracy-cost", 4);
     assert!(whole[0] < whole[1], "XPBD's bias cancels part of the coarse mesh's error: {whole:?}");
-    let ms = step("accuracy-cost", 4);
+    let ms = step("accuracy-cost", 5);
     assert!(ms[1] > 1.4 * ms[0], "twice the substeps, about twice the time: {ms:?}");
 }

@@ -456,7 +456,7 @@ fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
     use super::viewport::ViewPreset;
     let mut h = harness(args::parse_for_test(&["--lesson", "mesh-bias"]));
     h.run_steps(3);
-    h.get_by_label_contains("Step 1 of 2: Five against six");
+    h.get_by_label_contains("Step 1 of 3: Five against six");
     h.get_by_label_contains("Question: Does either tip move sideways");
     let labels: Vec<String> = h.state().sessions.iter().map(|s| s.label()).collect();
     assert_eq!(labels, ["P1 8×2×2 five", "P1 8×2×2 six"]);
@@ -470,12 +470,12 @@ fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
     h.get_by_label_contains("Answer: B does");
     h.key_press(egui::Key::ArrowRight);
     h.run_steps(3);
-    h.get_by_label_contains("Step 2 of 2: Does high order help?");
+    h.get_by_label_contains("Step 2 of 3: Does high order help?");
     assert!(h.state().sessions.iter().all(|s| s.config.element == "p2"));
     assert!(h.query_by_label_contains("Answer:").is_none(), "a new step hides its answer");
     h.key_press(egui::Key::ArrowLeft);
     h.run_steps(3);
-    h.get_by_label_contains("Step 1 of 2");
+    h.get_by_label_contains("Step 1 of 3");
     // presenter mode: no side panels; the caption carries the numbers
     h.key_press(egui::Key::P);
     h.run_steps(3);
