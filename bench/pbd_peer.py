@@ -14,8 +14,8 @@ PBD's solid method 3 is its XPBD FEM tetrahedron (the constitutive model of Bend
 2014 / PBD's `FEMTetConstraint`): one constraint per tetrahedron, like hox's energy
 formulation; stiffness is Young's modulus, 3 MPa, Poisson ratio 0.35. Times are medians of ms
 per frame on one thread (PBD's OpenMP loop is limited with OMP_NUM_THREADS=1); hox is timed
-with both of its sweeps: serial (element order, the default) and colour (four tetrahedra of one
-colour per 256-bit register, `SolverSettings::parallel`).
+with both of its sweeps: colour (the default: four tetrahedra of one colour per 256-bit register,
+`Sweep::Colour`) and element order (`Sweep::Element`, the order before issue #22).
 """
 import argparse
 import json
@@ -119,15 +119,15 @@ def main() -> None:
                              env=env, check=True, capture_output=True, text=True).stdout
         pbd_ms = json.loads(out.strip().splitlines()[-1])["ms_per_frame"]
         hox_out = subprocess.run(cargo() + args.hox.split() + [str(args.frames), "1", label], cwd=ROOT, check=True, capture_output=True, text=True,
-                                 env=dict(os.environ, HOX_BENCH_COLOUR_ON_ONE="1")).stdout
-        # one row per sweep: serial (element order) and colour (four tetrahedra per register)
+                                 env=dict(os.environ, HOX_BENCH_ELEMENT_ORDER="1")).stdout
+        # one row per sweep: colour (the default: four tetrahedra per register) and element (mesh order)
         hox = {line.split("|")[4].strip(): float(line.split("|")[6]) for line in hox_out.splitlines() if line.startswith("| P1")}
-        rows.append((label, len(mesh["tets"]) // 4, pbd_ms, hox["serial"], hox.get("colour", float("nan"))))
-        print(f"{label}: PBD {pbd_ms:.2f} ms/frame, hox serial {hox['serial']:.2f}, colour sweep {hox.get('colour', float('nan')):.2f} ms/frame", file=sys.stderr)
-    print("| beam | tetrahedra | PBD ms/frame (1 thread) | hox serial sweep ms/frame | hox / PBD | hox colour sweep (SIMD ×4) ms/frame | hox / PBD |")
+        rows.append((label, len(mesh["tets"]) // 4, pbd_ms, hox["colour"], hox.get("element", float("nan"))))
+        print(f"{label}: PBD {pbd_ms:.2f} ms/frame, hox default (colour) {hox['colour']:.2f}, element order {hox.get('element', float('nan')):.2f} ms/frame", file=sys.stderr)
+    print("| beam | tetrahedra | PBD ms/frame (1 thread) | hox default (colour sweep, SIMD ×4) ms/frame | hox / PBD | hox element-order sweep ms/frame | hox / PBD |")
     print("|---|---|---|---|---|---|---|")
-    for label, n, p, h, c in rows:
-        print(f"| {label} | {n} | {p:.2f} | {h:.2f} | {h / p:.2f} | {c:.2f} | {c / p:.2f} |")
+    for label, n, p, h, e in rows:
+        print(f"| {label} | {n} | {p:.2f} | {h:.2f} | {h / p:.2f} | {e:.2f} | {e / p:.2f} |")
 
 
 if __name__ == "__main__":

@@ -88,16 +88,17 @@ pub enum Command {
         /// Timed frames per configuration (the median is reported).
         #[arg(long, default_value_t = 20)]
         frames: usize,
-        /// Thread counts, comma-separated (1: the serial sweep; more: the parallel colour sweep).
+        /// Thread counts, comma-separated.
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
         threads: Vec<usize>,
         /// Only the configurations whose label contains this (e.g. "p1", "r2").
         #[arg(long, default_value = "")]
         only: String,
-        /// Also time the colour sweep on one thread (linear tetrahedra four per 256-bit
-        /// register; `--colour-on-one false`: the serial sweep only). XPBD only.
-        #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
-        colour_on_one: bool,
+        /// The sweep orders timed, comma-separated: colour (the default everywhere: four
+        /// elements per 256-bit register, every thread) on each thread count, element (mesh
+        /// order, one thread) on one thread. XPBD only.
+        #[arg(long, value_delimiter = ',', default_value = "colour,element")]
+        sweep: Vec<String>,
         /// The solver timed: xpbd (the table above), vbd (µs per node update and per element
         /// visit) or newton (ms per iteration and per factorisation); the thread counts run side
         /// by side, with the speed-up over one thread.
@@ -175,8 +176,8 @@ pub fn main(cli: Cli) -> Result<()> {
             simulate::simulate(&scene, &mesh, &physics, seconds, settle, &vtk, &reference, json)
         }
         Command::Study { quick, out } => study::study(quick, &out),
-        Command::Bench { frames, threads, only, colour_on_one, solver } => {
-            bench::bench(frames, &threads, &only, colour_on_one, &solver)
+        Command::Bench { frames, threads, only, sweep, solver } => {
+            bench::bench(frames, &threads, &only, &sweep, &solver)
         }
         Command::Static { scene, mesh, physics, tolerance, load_steps, reference, json } => {
             statics::static_command(&scene, &mesh, &physics, tolerance, load_steps, &reference, json)

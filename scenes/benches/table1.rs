@@ -10,6 +10,7 @@ use criterion::{BatchSize, Criterion, SamplingMode, criterion_group, criterion_m
 use hox_scenes::bench::{CASES, bending_beam};
 use hox_sim::Vec3;
 use hox_sim::fem::energy::{element_grads, gather};
+use hox_sim::solver::Sweep;
 use hox_sim::xpbd::constraint::project_energy_constraint;
 use hox_sim::xpbd::kernels::{Multipliers, PackedBlock, Positions, colour_sweep, energy_sweep};
 use std::time::Duration;
@@ -26,7 +27,7 @@ fn frames(c: &mut Criterion) {
         for (threads, colour) in [(1, false), (1, true), (2, true)] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
             let mut sim = pool.install(|| {
-                let mut sim = bending_beam(case, colour).expect("beam");
+                let mut sim = bending_beam(case, if colour { Sweep::Colour } else { Sweep::Element }).expect("beam");
                 for _ in 0..5 {
                     sim.step_frame().expect("frame");
                 }
@@ -44,7 +45,7 @@ fn frames(c: &mut Criterion) {
 /// `hox_sim::xpbd::kernels` against the generic `constraint::project_energy_constraint`.
 fn kernels(c: &mut Criterion) {
     for case in [&CASES[0], &CASES[3]] {
-        let mut sim = bending_beam(case, false).expect("beam");
+        let mut sim = bending_beam(case, Sweep::Element).expect("beam");
         for _ in 0..5 {
             sim.step_frame().expect("frame");
         }
@@ -114,7 +115,7 @@ fn kernels(c: &mut Criterion) {
 /// One colour sweep over every element of the sagged P1 beam: one element at a time against
 /// four same-colour elements per 256-bit register (`hox_sim::xpbd::kernels::p1x4`).
 fn colour_batches(c: &mut Criterion) {
-    let mut sim = bending_beam(&CASES[0], true).expect("beam");
+    let mut sim = bending_beam(&CASES[0], Sweep::Colour).expect("beam");
     for _ in 0..5 {
         sim.step_frame().expect("frame");
     }

@@ -8,7 +8,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .find(|c| c.label().eq_ignore_ascii_case(&label))
         .ok_or_else(|| format!("no benchmark case labelled '{label}'"))?;
-    let sim = hox_scenes::bench::bending_beam(case, false)?;
+    let sim = hox_scenes::bench::bending_beam(case, hox_sim::solver::Sweep::Element)?;
     let mesh = sim.mesh();
     let positions: Vec<String> = mesh.rest_positions.iter().map(|p| format!("[{},{},{}]", p.x, p.y, p.z)).collect();
     let tets: Vec<String> = mesh.blocks[0].connectivity.iter().map(u32::to_string).collect();

@@ -1,8 +1,8 @@
 //! Prints the `hox bench` table without building the app:
 //! `cargo run --release -p hox-scenes --example bench_table [-- FRAMES [THREADS [FILTER]]]`
 //! (THREADS: comma-separated, default 1,2; FILTER: a substring of the configuration label;
-//! on one thread both the serial sweep and the colour sweep are timed, the latter with linear
-//! tetrahedra four per 256-bit register; HOX_BENCH_COLOUR_ON_ONE=0 times the serial sweep only).
+//! the colour sweep, the default, on every thread count, and the element-order sweep on one thread;
+//! HOX_BENCH_ELEMENT_ORDER=0 times the colour sweep only).
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -15,10 +15,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rows = hox_scenes::bench::run(
         &filter,
         &threads,
-        std::env::var("HOX_BENCH_COLOUR_ON_ONE").map_or(true, |v| v != "0"),
+        if std::env::var("HOX_BENCH_ELEMENT_ORDER").is_ok_and(|v| v == "0") {
+            &[hox_sim::solver::Sweep::Colour][..]
+        } else {
+            &[hox_sim::solver::Sweep::Colour, hox_sim::solver::Sweep::Element][..]
+        },
         frames,
         &mut |r| eprintln!("{}", r.progress_line()),
     )?;
-    print!("{}", hox_scenes::bench::markdown(&rows));
+    print!("{}", hox_scenes::bench::markdown(&rows, hox_scenes::bench::peak_gflops_per_core()));
     Ok(())
 }

@@ -20,7 +20,7 @@ fn main() {
         row(format!("scene {name}"), elements, instance.sim.stability());
     }
     for case in hox_scenes::bench::CASES.iter() {
-        let mut sim = hox_scenes::bench::bending_beam(case, false).expect("benchmark beam");
+        let mut sim = hox_scenes::bench::bending_beam(case, hox_sim::solver::Sweep::Element).expect("benchmark beam");
         let elements = sim.mesh().num_elements();
         row(format!("bench {}", case.label()), elements, sim.stability());
     }

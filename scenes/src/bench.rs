@@ -12,26 +12,25 @@
 //! - per element: displacements `u_i = x_i − X_i` (3N), `Σ_i w_i |∇_i U|²` (6N), the update
 //!   (10, one square root and one division counted as 1 each) and `x_i += w_i step ∇_i U` (7N).
 //!
-//! So `flops = Q (36 N + 174) + 16 N + 10`: 384 for P1. Achieved GFLOP/s = flops × elements ×
-//! substeps / time. The machine's peak is stated in [`PEAK_GFLOPS_PER_CORE`].
+//! So `flops = Q (36 N + 174) + 16 N + 10`: 392 for P1. Achieved GFLOP/s = flops × elements ×
+//! substeps / time. The machine's peak is measured ([`peak`]): one core running nothing but
+//! independent 256-bit fused multiply–adds.
 //!
 //! The implicit solvers (VBD, Newton) on the same beams: [`solver`] (`hox bench --solver`).
 
+pub mod peak;
 pub mod solver;
 
 use crate::params::SceneOverrides;
 use crate::{Instance, SceneError};
 use hox_sim::measure::median;
-use hox_sim::solver::Simulation;
+use hox_sim::solver::{Simulation, Sweep};
 use std::time::Instant;
 
-/// Peak double-precision rate of one core of this machine with the instructions the kernels
-/// use (AVX2 with FMA), GFLOP/s: 2.7 GHz (the TSC rate the kernel reports) × 2 FMA units ×
-/// 4 doubles × 2 flops per FMA. The machine also has AVX-512 (twice this); scalar code has a
-/// quarter of it, [`SCALAR_PEAK_GFLOPS_PER_CORE`].
-pub const PEAK_GFLOPS_PER_CORE: f64 = 2.7 * 2.0 * 4.0 * 2.0;
-/// 2.7 GHz × 2 FMA units × 1 double × 2 flops.
-pub const SCALAR_PEAK_GFLOPS_PER_CORE: f64 = 2.7 * 2.0 * 2.0;
+/// The peak rate used when the CPU cannot be measured (no AVX2): 2.7 GHz × 2 FMA units ×
+/// 4 doubles × 2 flops per FMA, the nominal figure of the project's first machine. Where AVX2
+/// and FMA exist, `hox bench` measures the peak instead ([`peak::measured_avx2_peak_gflops`]).
+pub const NOMINAL_PEAK_GFLOPS_PER_CORE: f64 = 2.7 * 2.0 * 4.0 * 2.0;
 
 /// One benchmarked beam.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,8 +51,10 @@ impl BenchCase {
 }
 
 /// The five rows of Table 1, then Q1, Q2, prism and pyramid beams of comparable node count
-/// (the meshes of the study, `scenes/src/study.rs`).
-pub const CASES: [BenchCase; 9] = [
+/// (the meshes of the study, `scenes/src/study.rs`), then a large beam of every element type
+/// but P1 (whose largest is Table 1's 81,920): 32 cells along the beam (24 for the pyramids),
+/// large enough for the colour sweep to cut it into slabs for the threads.
+pub const CASES: [BenchCase; 15] = [
     BenchCase { element: "p1", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: Some(43.6) },
     BenchCase { element: "p1", grid: [16, 4, 4], refine: 1, paper_ms_per_frame: Some(363.0) },
     BenchCase { element: "p1", grid: [16, 4, 4], refine: 2, paper_ms_per_frame: Some(3116.0) },
@@ -63,21 +64,27 @@ pub const CASES: [BenchCase; 9] = [
     BenchCase { element: "q2", grid: [8, 2, 2], refine: 0, paper_ms_per_frame: None },
     BenchCase { element: "prism", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: None },
     BenchCase { element: "pyramid", grid: [12, 3, 3], refine: 0, paper_ms_per_frame: None },
+    BenchCase { element: "p2", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { element: "p3", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { element: "q1", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { element: "q2", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { element: "prism", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { element: "pyramid", grid: [24, 6, 6], refine: 0, paper_ms_per_frame: None },
 ];
 
 /// The paper's bending beam for `case`, at rest: the `bending` scene with the case's element
-/// type, grid and refinement; `parallel` selects the colour sweep.
-pub fn bending_beam(case: &BenchCase, parallel: bool) -> Result<Simulation, SceneError> {
-    beam(case, parallel, None)
+/// type, grid and refinement, swept in the order `sweep`.
+pub fn bending_beam(case: &BenchCase, sweep: Sweep) -> Result<Simulation, SceneError> {
+    beam(case, sweep, None)
 }
 
 /// [`bending_beam`], solved by `method` if given (else the scene's own solver).
-fn beam(case: &BenchCase, parallel: bool, method: Option<hox_sim::solver::Method>) -> Result<Simulation, SceneError> {
+fn beam(case: &BenchCase, sweep: Sweep, method: Option<hox_sim::solver::Method>) -> Result<Simulation, SceneError> {
     let overrides = SceneOverrides {
         element: Some(case.element.to_string()),
         grid: Some(case.grid),
         refine: Some(case.refine),
-        parallel: Some(parallel),
+        sweep: Some(sweep.name().to_string()),
         method: method.map(|m| m.name().to_string()),
         ..SceneOverrides::default()
     };
@@ -87,7 +94,7 @@ fn beam(case: &BenchCase, parallel: bool, method: Option<hox_sim::solver::Method
 /// Flops of one energy-constraint projection of an element with `nodes` nodes and `points`
 /// quadrature points (see the module doc).
 pub fn flops_per_element(nodes: usize, points: usize) -> f64 {
-    (points * (36 * nodes + 174) + 16 * nodes + 10) as f64
+    hox_sim::xpbd::kernels::flops_per_element(nodes, points) as f64
 }
 
 /// One measured row.
@@ -99,8 +106,8 @@ pub struct BenchRow {
     pub points_per_element: usize,
     /// Rayon threads.
     pub threads: usize,
-    /// The parallel colour sweep (else the serial sweep in element order).
-    pub parallel: bool,
+    /// The sweep's order: colour by colour (the default) or element by element.
+    pub sweep: Sweep,
     pub ms_per_frame: f64,
     /// `ms_per_frame / (elements × substeps)`, in ns.
     pub ns_per_element_substep: f64,
@@ -109,13 +116,13 @@ pub struct BenchRow {
 
 impl BenchRow {
     /// The progress line printed as each row is measured, e.g.
-    /// `P2 8x2x2 on 1 thread(s), parallel false: 2.08 ms/frame`.
+    /// `P2 8x2x2 on 1 thread(s), colour sweep: 2.08 ms/frame`.
     pub fn progress_line(&self) -> String {
         format!(
-            "{} on {} thread(s), parallel {}: {:.2} ms/frame",
+            "{} on {} thread(s), {} sweep: {:.2} ms/frame",
             self.case.label(),
             self.threads,
-            self.parallel,
+            self.sweep.name(),
             self.ms_per_frame
         )
     }
@@ -126,13 +133,13 @@ impl BenchRow {
     }
 }
 
-/// Times `case` with the serial sweep or the `parallel` colour sweep, in a rayon pool of
+/// Times `case` with the sweep `sweep`, in a rayon pool of
 /// `threads`: `warmup_frames` untimed, then the median of `frames` timed frames. Frames are
 /// also capped by `budget_secs` of timed work (at least 3 frames).
 pub fn measure(
     case: &BenchCase,
     threads: usize,
-    parallel: bool,
+    sweep: Sweep,
     warmup_frames: usize,
     frames: usize,
     budget_secs: f64,
@@ -145,7 +152,7 @@ pub fn measure(
     let failed =
         |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: case.label(), message: e.to_string() };
     pool.install(|| {
-        let mut sim = bending_beam(case, parallel)?;
+        let mut sim = bending_beam(case, sweep)?;
         for _ in 0..warmup_frames {
             sim.step_frame().map_err(failed)?;
         }
@@ -170,7 +177,7 @@ pub fn measure(
             nodes: sim.mesh().num_nodes(),
             points_per_element: g.points_per_element,
             threads,
-            parallel,
+            sweep,
             ms_per_frame,
             ns_per_element_substep: ms_per_frame * 1e6 / (elements as f64 * substeps),
             gflops: flops / (ms_per_frame * 1e6),
@@ -178,32 +185,39 @@ pub fn measure(
     })
 }
 
-/// The table `hox bench` prints: per case, one row per thread count.
-pub fn markdown(rows: &[BenchRow]) -> String {
-    let mut s = String::from(
-        "| configuration | elements | threads | sweep | paper ms/frame | ours ms/frame | paper / ours | ns per element·substep | GFLOP/s | % of AVX2 peak | % of scalar peak |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+/// The table `hox bench` prints: per case, one row per thread count and sweep; `peak_gflops`
+/// is one core's AVX2 FMA peak ([`peak::measured_avx2_peak_gflops`]), a quarter of it the
+/// scalar peak (one double per FMA).
+pub fn markdown(rows: &[BenchRow], peak_gflops: f64) -> String {
+    let mut s = format!(
+        "| configuration | elements | threads | sweep | paper ms/frame | ours ms/frame | paper / ours | ns per element·substep | GFLOP/s | % of AVX2 peak ({peak_gflops:.1} GFLOP/s per core) | % of scalar peak |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let paper = r.case.paper_ms_per_frame.map_or(String::new(), |p| format!("{p}"));
         let ratio = r.speedup_over_paper().map_or(String::new(), |x| format!("{x:.1}×"));
-        let peak = PEAK_GFLOPS_PER_CORE * r.threads as f64;
-        let scalar_peak = SCALAR_PEAK_GFLOPS_PER_CORE * r.threads as f64;
+        let peak = peak_gflops * r.threads as f64;
         s.push_str(&format!(
             "| {} | {} | {} | {} | {} | {:.2} | {} | {:.1} | {:.2} | {:.1} % | {:.1} % |\n",
             r.case.label(),
             r.elements,
             r.threads,
-            if r.parallel { "colour" } else { "serial" },
+            r.sweep.name(),
             paper,
             r.ms_per_frame,
             ratio,
             r.ns_per_element_substep,
             r.gflops,
             100.0 * r.gflops / peak,
-            100.0 * r.gflops / scalar_peak,
+            400.0 * r.gflops / peak,
         ));
     }
     s
+}
+
+/// One core's AVX2 peak as `hox bench` reports it: measured where the CPU has AVX2 and FMA,
+/// else [`NOMINAL_PEAK_GFLOPS_PER_CORE`].
+pub fn peak_gflops_per_core() -> f64 {
+    peak::measured_avx2_peak_gflops().unwrap_or(NOMINAL_PEAK_GFLOPS_PER_CORE)
 }
 
 /// Untimed frames before the timed ones (the beam starts at rest and sags).
@@ -223,24 +237,24 @@ pub fn matching_cases(filter: &str) -> Vec<&'static BenchCase> {
 }
 
 /// Measures the case labelled `filter`, or else every case whose label contains it (ignoring
-/// case), on each of `threads`
-/// (1: the serial sweep; more: the parallel colour sweep; with `colour_on_one`, also the
-/// colour sweep on one thread, which projects linear tetrahedra four per 256-bit register:
-/// `hox_sim::xpbd::kernels::p1x4`), reporting each row to `progress` as it is measured (what
-/// `hox bench` runs).
+/// case), on each of `threads` with each of `sweeps` (the element-order sweep runs on one
+/// thread whatever the pool, so it is measured on one thread only), reporting each row to
+/// `progress` as it is measured (what `hox bench` runs).
 pub fn run(
     filter: &str,
     threads: &[usize],
-    colour_on_one: bool,
+    sweeps: &[Sweep],
     frames: usize,
     progress: &mut dyn FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, SceneError> {
     let mut rows = Vec::new();
     for case in matching_cases(filter) {
         for &t in threads {
-            let sweeps: &[bool] = if t == 1 && colour_on_one { &[false, true] } else { &[t > 1] };
-            for &parallel in sweeps {
-                let row = measure(case, t, parallel, WARMUP_FRAMES, frames, BUDGET_SECS)?;
+            for &sweep in sweeps {
+                if sweep == Sweep::Element && t > 1 {
+                    continue;
+                }
+                let row = measure(case, t, sweep, WARMUP_FRAMES, frames, BUDGET_SECS)?;
                 progress(&row);
                 rows.push(row);
             }
@@ -260,9 +274,9 @@ mod tests {
     fn the_benchmark_beam_is_the_bending_scene_file() {
         let scene = crate::by_name("bending").unwrap();
         let case = BenchCase { element: "q1", grid: [4, 1, 1], refine: 0, paper_ms_per_frame: None };
-        let sim = bending_beam(&case, true).unwrap();
+        let sim = bending_beam(&case, Sweep::Element).unwrap();
         assert_eq!(*sim.material(), scene.material());
-        assert_eq!(*sim.settings(), hox_sim::solver::SolverSettings { parallel: true, ..scene.settings() });
+        assert_eq!(*sim.settings(), hox_sim::solver::SolverSettings { sweep: Sweep::Element, ..scene.settings() });
         let (lo, hi) = sim.mesh().bounding_box();
         assert_eq!([lo, hi].map(|p| [p.x, p.y, p.z]), [scene.params().box_min_m, scene.params().box_max_m]);
         assert_eq!(sim.mesh().num_elements(), 4);

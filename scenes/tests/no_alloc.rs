@@ -35,7 +35,8 @@ fn allocations_per_run(parallel: bool, element: &str) -> u64 {
 fn allocations_of(case: &hox_scenes::bench::BenchCase, parallel: bool) -> u64 {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     pool.install(|| {
-        let mut sim = bending_beam(case, parallel).unwrap();
+        let sweep = if parallel { hox_sim::solver::Sweep::Colour } else { hox_sim::solver::Sweep::Element };
+        let mut sim = bending_beam(case, sweep).unwrap();
         for _ in 0..2 {
             sim.step_frame().unwrap();
         }

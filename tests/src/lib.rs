@@ -65,7 +65,7 @@ pub fn settings(formulation: Formulation, substeps: u32, frames_per_second: f64)
         frames_per_second,
         formulation,
         quadrature_degree: None,
-        parallel: false,
+        sweep: hox_sim::solver::Sweep::Element,
         stability_guard: true,
         ..Default::default()
     }

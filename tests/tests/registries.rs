@@ -60,7 +60,7 @@ fn bending(element: ElementType, material: MaterialModel, parallel: bool, formul
         material: Some(material.name().into()),
         grid: Some([2, 1, 1]),
         substeps: Some(10),
-        parallel: Some(parallel),
+        sweep: Some(if parallel { "colour" } else { "element" }.into()),
         formulation: Some(formulation.name().into()),
         ..SceneOverrides::default()
     };

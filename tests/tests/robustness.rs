@@ -1076,7 +1076,7 @@ impl Effect for NanAt {
 fn guarded(parallel: bool, effects: Vec<Box<dyn Effect>>) -> Simulation {
     let mesh = beam("p2", 1.0, 4);
     let mut st = settings(Formulation::Energy, 50, 60.0);
-    st.parallel = parallel;
+    st.sweep = if parallel { hox_sim::solver::Sweep::Colour } else { hox_sim::solver::Sweep::Element };
     let mut all: Vec<Box<dyn Effect>> = vec![clamp_x0(&mesh), Box::new(Gravity::new(GRAVITY_M_S2))];
     all.extend(effects);
     Simulation::new(mesh, material(SNH, 1e6, 0.3), st, all).unwrap()

@@ -2,10 +2,17 @@
 //! (`--solver vbd|newton`) an implicit solver on the same beams.
 
 use anyhow::{Result, bail};
-use hox_sim::solver::Method;
+use hox_sim::solver::{Method, Sweep};
 
-pub fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool, solver: &str) -> Result<()> {
+pub fn bench(frames: usize, threads: &[usize], only: &str, sweeps: &[String], solver: &str) -> Result<()> {
     let method = hox_scenes::bench::solver::parse_solver(solver)?;
+    let sweeps = sweeps
+        .iter()
+        .map(|s| {
+            Sweep::from_name(s.trim())
+                .ok_or_else(|| anyhow::anyhow!("--sweep: unknown sweep '{s}' (colour or element)"))
+        })
+        .collect::<Result<Vec<_>>>()?;
     if frames == 0 || threads.contains(&0) {
         bail!("--frames and every --threads count must be at least 1");
     }
@@ -13,9 +20,8 @@ pub fn bench(frames: usize, threads: &[usize], only: &str, colour_on_one: bool, 
         bail!("no configuration matches '{only}'");
     }
     if method == Method::Xpbd {
-        let rows =
-            hox_scenes::bench::run(only, threads, colour_on_one, frames, &mut |r| eprintln!("{}", r.progress_line()))?;
-        print!("{}", hox_scenes::bench::markdown(&rows));
+        let rows = hox_scenes::bench::run(only, threads, &sweeps, frames, &mut |r| eprintln!("{}", r.progress_line()))?;
+        print!("{}", hox_scenes::bench::markdown(&rows, hox_scenes::bench::peak_gflops_per_core()));
     } else {
         let rows =
             hox_scenes::bench::solver::run(only, method, threads, frames, &mut |r| eprintln!("{}", r.progress_line()))?;

@@ -13,7 +13,7 @@ pub struct MeshArgs {
     pub overrides: SceneOverrides,
 }
 
-/// The material, solver and effect parameters (`--material --youngs … --parallel
+/// The material, solver and effect parameters (`--material --youngs … --sweep
 /// --no-stability-guard --damping`).
 #[derive(Clone, Debug, Default)]
 pub struct PhysicsArgs {

@@ -46,7 +46,8 @@ pub fn parse_solver(name: &str) -> Result<Method, SceneError> {
 /// The benchmark beam of `case` ([`super::bending_beam`]) solved by `method`; `parallel` selects
 /// the colour sweep (VBD's parallel node sweep).
 pub fn bending_beam_solved_by(case: &BenchCase, method: Method, parallel: bool) -> Result<Simulation, SceneError> {
-    super::beam(case, parallel, Some(method))
+    let sweep = if parallel { hox_sim::solver::Sweep::Colour } else { hox_sim::solver::Sweep::Element };
+    super::beam(case, sweep, Some(method))
 }
 
 /// One measured row: a case, a solver and a thread count.
@@ -207,7 +208,7 @@ fn row(case: &BenchCase, method: Method, threads: usize, sim: &Simulation, timed
         case: *case,
         method,
         threads,
-        parallel: sim.settings().parallel,
+        parallel: sim.settings().sweep.is_colour(),
         nodes: sim.mesh().num_nodes(),
         elements: sim.mesh().num_elements(),
         free_nodes,

@@ -15,7 +15,7 @@ use hox_sim::Vec3;
 use hox_sim::io::gmsh::ImportedMesh;
 use hox_sim::material::{Material, MaterialError, MaterialModel};
 use hox_sim::mesh::structured::BoxMeshSpec;
-use hox_sim::solver::{Method, NewtonSettings, SolverSettings, VbdInit, VbdSettings};
+use hox_sim::solver::{Method, NewtonSettings, SolverSettings, Sweep, VbdInit, VbdSettings};
 use hox_sim::xpbd::constraint::Formulation;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -139,7 +139,7 @@ impl Scene {
             frames_per_second: p.frames_per_second,
             formulation: Formulation::from_name(&p.formulation).unwrap_or(Formulation::Energy),
             quadrature_degree: p.quadrature_degree,
-            parallel: p.parallel,
+            sweep: Sweep::from_name(&p.sweep).unwrap_or_default(),
             stability_guard: p.stability_guard,
             // the names were checked against the table's choices
             method: Method::from_name(&p.method).unwrap_or_default(),

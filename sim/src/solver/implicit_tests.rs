@@ -141,7 +141,7 @@ fn implicit_solvers_are_bitwise_identical_on_1_and_2_threads_and_serial() {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
                 let mut settings = implicit(method, 60.0);
-                settings.parallel = parallel;
+                settings.sweep = if parallel { super::Sweep::Colour } else { super::Sweep::Element };
                 settings.vbd.iterations = 5;
                 let mut sim =
                     Simulation::new(mesh.clone(), material, settings, cantilever_effects(&clamped, 0.0)).unwrap();

@@ -41,7 +41,7 @@ mod xpbd;
 pub use method::Method;
 pub use newmark::Newmark;
 pub use residual::StaticResidual;
-pub use settings::{NewtonSettings, SolverSettings, VbdInit, VbdSettings};
+pub use settings::{NewtonSettings, SolverSettings, Sweep, VbdInit, VbdSettings};
 
 use crate::Vec3;
 use crate::effect::{Effect, EffectState};
@@ -225,23 +225,26 @@ impl Simulation {
     pub fn effects(&self) -> &[Box<dyn Effect>] {
         &self.effects
     }
-    /// Whether the colour sweep (`SolverSettings::parallel`) projects linear tetrahedra with
-    /// StVK four at a time in one 256-bit register per quantity (on by default where the CPU
-    /// has AVX2 and FMA; equal to the one-at-a-time colour sweep up to round-off). Off: one at
-    /// a time, for comparison.
+    /// Whether the colour sweep ([`Sweep::Colour`]) projects four same-colour elements at a
+    /// time, one per lane of a 256-bit register (on by default where the CPU has AVX2 and FMA;
+    /// every element type and material; equal to the one-at-a-time colour sweep up to
+    /// round-off). Off: one at a time, for comparison.
     pub fn set_simd_batches(&mut self, on: bool) {
         if let Some(x) = self.solver.as_xpbd_mut() {
             x.simd_batches = on;
         }
     }
 
-    /// On two or more threads the parallel sweep cuts a block of at least `per_thread` elements
-    /// per thread into one slab per thread ([`crate::xpbd::kernels::Partition`]: two synchronisations
-    /// per sweep instead of one per colour); smaller blocks are swept colour by colour. Default
-    /// [`crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD`]; `usize::MAX`: never.
-    pub fn set_partition_threshold(&mut self, per_thread: usize) {
+    /// The colour sweep cuts a block into [`crate::xpbd::kernels::slab_count`]`(size, per_slab)`
+    /// slabs (`size` in [`crate::xpbd::kernels::p1_equivalents`]) swept side by side in two
+    /// phases ([`crate::xpbd::kernels::Partition`]: two synchronisations per sweep instead of one
+    /// per colour) when the block holds at least [`crate::xpbd::kernels::MIN_SLABS`] slabs of
+    /// `per_slab`. The count depends on the block alone, never on the thread count, so neither
+    /// does the result. Default
+    /// [`crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_SLAB`]; `usize::MAX`: never.
+    pub fn set_partition_threshold(&mut self, per_slab: usize) {
         if let Some(x) = self.solver.as_xpbd_mut() {
-            x.partition_min_per_thread = per_thread;
+            x.partition_min_per_slab = per_slab;
         }
     }
 

@@ -1,5 +1,5 @@
 //! What a run is asked to do: the solver ([`Method`]), substeps, iterations, frame rate,
-//! formulation, quadrature degree, serial or parallel sweep, the stability guard, and the
+//! formulation, quadrature degree, the sweep's order ([`Sweep`]), the stability guard, and the
 //! implicit solvers' own settings ([`VbdSettings`], [`NewtonSettings`]) ([`SolverSettings`]).
 
 use super::SimError;
@@ -18,11 +18,9 @@ pub struct SolverSettings {
     pub formulation: Formulation,
     /// Quadrature degree for the elastic energy; None: each element type's default.
     pub quadrature_degree: Option<usize>,
-    /// Project same-colour elements in parallel (rayon's thread pool); otherwise serially in
-    /// element order. Both are Gauss–Seidel sweeps, in different orders. On two or more
-    /// threads a large block is cut into one slab per thread instead
-    /// ([`Simulation::set_partition_threshold`](super::Simulation::set_partition_threshold)); that order depends on the thread count.
-    pub parallel: bool,
+    /// The order of XPBD's Gauss–Seidel sweep ([`Sweep`]): colour by colour (the default) or
+    /// element by element.
+    pub sweep: Sweep,
     /// The stability guard ([`crate::solver::stability`]): when the requested substep has `h ω_max`
     /// above [`crate::solver::stability::guard_trigger_h_omega`] (3; 1.5 for the energy formulation at
     /// ν ≥ 0.45), take enough substeps for
@@ -33,6 +31,40 @@ pub struct SolverSettings {
     pub steps_per_frame: u32,
     pub vbd: VbdSettings,
     pub newton: NewtonSettings,
+}
+
+/// The order in which XPBD's Gauss–Seidel sweep projects the element constraints. Both are
+/// Gauss–Seidel sweeps over the same constraints; they differ in order, so their results differ
+/// by what the order changes (well below the solver's own bias), never by the thread count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Sweep {
+    /// Colour by colour (no two elements of a colour share a node), four same-colour elements per
+    /// AVX2 register, each colour cut between rayon's threads; a large block is first cut into
+    /// slabs swept side by side, their count set by the block's size alone
+    /// ([`crate::xpbd::kernels::slab_count`]). The default: the fastest on one thread and on
+    /// many, and the same bits on any thread count.
+    #[default]
+    Colour,
+    /// Element after element in mesh order, on one thread: the order the paper's figures and the
+    /// results published before the colour sweep became the default (issue #22) used.
+    Element,
+}
+
+impl Sweep {
+    pub const ALL: [Sweep; 2] = [Sweep::Colour, Sweep::Element];
+    pub fn name(self) -> &'static str {
+        match self {
+            Sweep::Colour => "colour",
+            Sweep::Element => "element",
+        }
+    }
+    pub fn from_name(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == s)
+    }
+    /// Whether the sweep goes colour by colour (and may use every thread).
+    pub fn is_colour(self) -> bool {
+        self == Sweep::Colour
+    }
 }
 
 /// Vertex block descent's settings ([`crate::solver::Method::Vbd`]).
@@ -109,7 +141,7 @@ impl Default for SolverSettings {
             frames_per_second: 60.0,
             formulation: Formulation::Energy,
             quadrature_degree: None,
-            parallel: false,
+            sweep: Sweep::Colour,
             stability_guard: true,
             method: Method::Xpbd,
             steps_per_frame: 1,

@@ -1,5 +1,5 @@
 //! One Gauss–Seidel sweep of [`Xpbd`] over every element constraint: in element order,
-//! or colour by colour with the elements of a colour projected in parallel. The energy
+//! or colour by colour with the elements of a colour projected in parallel ([`super::Sweep`]). The energy
 //! formulation goes through the specialised sweep ([`crate::xpbd::kernels`]); the split
 //! formulation (and any node count without a specialised sweep) through the generic kernels of
 //! [`crate::xpbd::constraint`], element by element: gather, project, check, scatter.
@@ -26,8 +26,8 @@ impl Xpbd {
         counters: &mut SolverCounters,
     ) -> Result<(), BadElement> {
         let inv_dt2 = 1.0 / (s.h * s.h);
-        if s.settings.parallel {
-            return self.project_elements_parallel(s, positions, counters, inv_dt2);
+        if s.settings.sweep.is_colour() {
+            return self.project_elements_by_colour(s, positions, counters, inv_dt2);
         }
         for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
             let block = &s.mesh.blocks[bi];
@@ -94,11 +94,11 @@ impl Xpbd {
         Ok(())
     }
 
-    /// The parallel sweep: same-colour elements touch disjoint nodes and multipliers, so they
-    /// are projected concurrently and the result does not depend on the scheduling. On two or
-    /// more threads, large blocks of the energy formulation are swept slab by slab
-    /// ([`crate::xpbd::kernels::Partition`]), which depends on the thread count.
-    fn project_elements_parallel(
+    /// The colour sweep: same-colour elements touch disjoint nodes and multipliers, so they
+    /// are projected concurrently and the result does not depend on the scheduling or the thread
+    /// count. Large blocks of the energy formulation are swept slab by slab
+    /// ([`crate::xpbd::kernels::Partition`]), their slab count set by the block's size alone.
+    fn project_elements_by_colour(
         &mut self,
         s: &StepInput<'_>,
         positions: &mut [Vec3],
@@ -115,21 +115,22 @@ impl Xpbd {
                 // SAFETY of the aliasing: the specialised sweep writes positions through its own
                 // pointer, and nothing else touches them meanwhile.
                 let all = unsafe { positions.slice_mut(0, positions.len()) };
-                let threads = rayon::current_num_threads();
                 use crate::xpbd::kernels::BlockSweep;
-                let sweep = if threads >= 2 && block.len() >= threads.saturating_mul(self.partition_min_per_thread) {
-                    if self.partitions[bi].threads != threads {
-                        self.partitions[bi] = crate::xpbd::kernels::Partition::new(
-                            block,
-                            &s.geometry[bi],
-                            &self.colours[bi],
-                            &s.mesh.rest_positions,
-                            threads,
-                        );
-                    }
-                    BlockSweep::Slabs(&self.partitions[bi])
-                } else {
-                    BlockSweep::Colours(&self.packed.colour[bi])
+                let size = crate::xpbd::kernels::p1_equivalents(block.len(), n, s.geometry[bi].points_per_element);
+                let slabs = crate::xpbd::kernels::slab_count(size, self.partition_min_per_slab);
+                if slabs >= 2 && self.partitions[bi].0 != slabs {
+                    let partition = crate::xpbd::kernels::Partition::new(
+                        block,
+                        &s.geometry[bi],
+                        &self.colours[bi],
+                        &s.mesh.rest_positions,
+                        slabs,
+                    );
+                    self.partitions[bi] = (slabs, partition);
+                }
+                let sweep = match &self.partitions[bi] {
+                    (count, Some(partition)) if slabs >= 2 && *count == slabs => BlockSweep::Slabs(partition),
+                    _ => BlockSweep::Colours(&self.packed.colour[bi]),
                 };
                 let result = crate::xpbd::kernels::parallel_energy_block(
                     n,

@@ -83,7 +83,7 @@ fn settled_xpbd_error(
         frames_per_second: 1.0 / dt_secs,
         formulation,
         quadrature_degree: None,
-        parallel: false,
+        sweep: Sweep::Element,
         stability_guard: false,
         ..Default::default()
     };
@@ -222,9 +222,14 @@ fn beam_sim(parallel: bool, formulation: Formulation) -> Simulation {
     let mesh = cantilever(ElementType::from_name("p2").unwrap());
     let clamped = clamped_at_x0(&mesh);
     let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
-    let settings = SolverSettings { formulation, parallel, ..SolverSettings::default() };
+    let settings = SolverSettings { formulation, sweep: sweep_of(parallel), ..SolverSettings::default() };
     let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped })];
     Simulation::new(mesh, material, settings, effects).unwrap()
+}
+
+/// The colour sweep for `colour`, else the element-order sweep.
+fn sweep_of(colour: bool) -> Sweep {
+    if colour { Sweep::Colour } else { Sweep::Element }
 }
 
 /// The parallel sweep's result does not depend on the number of threads or the scheduling:
@@ -258,7 +263,7 @@ fn sweeps_agree_and_settle(mesh: Mesh, parallel_runs: &[(usize, usize)]) {
     let u_max = reference.iter().zip(&mesh.rest_positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
     for formulation in Formulation::ALL {
         let sim = |parallel: bool| {
-            let settings = SolverSettings { formulation, parallel, ..SolverSettings::default() };
+            let settings = SolverSettings { formulation, sweep: sweep_of(parallel), ..SolverSettings::default() };
             let effects: Vec<Box<dyn Effect>> =
                 vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.clone() })];
             Simulation::new(mesh.clone(), material, settings, effects).unwrap()
@@ -319,39 +324,96 @@ fn sagging_p1_beam() -> Simulation {
     let mesh = beam(ElementType::from_name("p1").unwrap(), [16, 4, 4]);
     let clamped = clamped_at_x0(&mesh);
     let material = Material::new(MaterialModel::StVenantKirchhoff, 3.0e6, 0.35, 1000.0).unwrap();
-    let settings = SolverSettings { parallel: true, ..SolverSettings::default() };
+    let settings = SolverSettings { sweep: Sweep::Colour, ..SolverSettings::default() };
     let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped })];
     Simulation::new(mesh, material, settings, effects).unwrap()
 }
 
-/// The slab sweep is deterministic for a given thread count, uses its slabs, and keeps every
-/// slab element inside its slab.
+/// The slab sweep uses its slabs (two phases whose slabs share no node), and gives the same bits
+/// on one thread and on two: the slab count is the block's, not the pool's.
 #[test]
-fn slab_sweep_is_deterministic_for_a_thread_count() {
-    let run = || {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+fn slab_sweep_is_bitwise_the_same_on_one_and_two_threads() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
             let mut sim = sagging_p1_beam();
             sim.set_partition_threshold(0);
             for _ in 0..3 {
                 sim.step_frame().unwrap();
             }
-            let part = &sim.solver.as_xpbd().unwrap().partitions[0];
-            assert_eq!((part.threads, part.slabs.len()), (2, 2));
+            let part = sim.solver.as_xpbd().unwrap().partitions[0].1.as_ref().expect("a partition");
+            assert_eq!(part.slabs.len(), crate::xpbd::kernels::MIN_SLABS);
             let counts: Vec<usize> = part.slabs.iter().map(|s| s.len()).collect();
-            assert_eq!(counts.iter().sum::<usize>() + part.interface.len(), sim.mesh().num_elements());
-            assert!(counts.iter().all(|&c| c > sim.mesh().num_elements() / 3), "{counts:?}");
-            let mut owner = vec![usize::MAX; sim.mesh().num_nodes()];
-            for (s, slab) in part.slabs.iter().enumerate() {
-                for &n in &slab.nodes {
-                    assert!(owner[n as usize] == usize::MAX || owner[n as usize] == s, "node {n} in two slabs");
-                    owner[n as usize] = s;
+            assert_eq!(counts.iter().sum::<usize>(), sim.mesh().num_elements());
+            assert!(counts.iter().all(|&c| c > sim.mesh().num_elements() / 6), "{counts:?}");
+            // the slabs of one phase share no node
+            for phase in 0..2 {
+                let mut owner = vec![usize::MAX; sim.mesh().num_nodes()];
+                for (s, slab) in part.slabs.iter().enumerate().filter(|(s, _)| s % 2 == phase) {
+                    for &n in &slab.nodes {
+                        assert!(owner[n as usize] == usize::MAX || owner[n as usize] == s, "node {n} in two slabs");
+                        owner[n as usize] = s;
+                    }
                 }
             }
             sim.positions
         })
     };
-    assert_eq!(run(), run());
+    let one = run(1);
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(2));
+}
+
+/// The slab count is the block's alone: none below two slabs' worth, then two, more only for
+/// blocks large enough (powers of two up to the cap).
+#[test]
+fn the_slab_count_depends_on_the_block_size_alone() {
+    use crate::xpbd::kernels::{ELEMENTS_PER_EXTRA_SLAB, MAX_SLABS, MIN_SLABS, p1_equivalents, slab_count};
+    assert_eq!(slab_count(1_280, 1024), 1);
+    assert_eq!(slab_count(4_095, 1024), 1);
+    assert_eq!(slab_count(4_096, 1024), MIN_SLABS);
+    assert_eq!(slab_count(81_920, 1024), 4);
+    assert_eq!(slab_count(8 * ELEMENTS_PER_EXTRA_SLAB, 1024), 8);
+    assert_eq!(slab_count(15 * ELEMENTS_PER_EXTRA_SLAB, 1024), 8);
+    assert_eq!(slab_count(usize::MAX / 2, 1024), MAX_SLABS);
+    assert_eq!(slab_count(usize::MAX / 2, usize::MAX), 1);
+    // sizes in linear tetrahedra of equal work: a Q2 hexahedron at 27 points does
+    // 27 (36·27 + 174) + 16·27 + 10 = 31,384 flops against P1's 392, so 100 of them weigh 8,006
+    assert_eq!(p1_equivalents(1, 4, 1), 1);
+    assert_eq!(p1_equivalents(100, 27, 27), 8_006);
+}
+
+/// The default sweep (colour by colour, four elements per register, slabs) gives the same bits
+/// on one thread and on two for every element type and material: the order it projects in is
+/// fixed by the mesh, and threads only share out the work.
+#[test]
+fn the_default_sweep_is_bitwise_the_same_on_one_and_two_threads_for_every_element_and_material() {
+    assert_eq!(SolverSettings::default().sweep, Sweep::Colour);
+    for name in ["p1", "p2", "p3", "q1", "q2", "prism", "pyramid"] {
+        let mesh = beam(ElementType::from_name(name).unwrap(), [8, 2, 2]);
+        let clamped = clamped_at_x0(&mesh);
+        for &model in MaterialModel::ALL.iter() {
+            let run = |threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| {
+                    let material = Material::new(model, 1.0e5, 0.3, 1000.0).unwrap();
+                    let settings = SolverSettings { substeps: 10, ..SolverSettings::default() };
+                    let effects: Vec<Box<dyn Effect>> =
+                        vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.clone() })];
+                    let mut sim = Simulation::new(mesh.clone(), material, settings, effects).unwrap();
+                    // slabs on this small beam too, so that they are part of what is compared
+                    sim.set_partition_threshold(8);
+                    for _ in 0..3 {
+                        sim.step_frame().unwrap();
+                    }
+                    sim.positions
+                })
+            };
+            let one = run(1);
+            assert!(one.iter().zip(&mesh.rest_positions).any(|(a, b)| a != b), "{name} {model:?}: nothing moved");
+            assert_eq!(one, run(2), "{name} {model:?}");
+        }
+    }
 }
 
 /// The colour sweep with four linear tetrahedra per register sags a beam as the one-at-a-time
@@ -421,7 +483,8 @@ fn an_unregistered_p4_meshes_steps_with_the_generic_kernels_and_builds_its_surfa
     let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e6, 0.3, 1000.0).unwrap();
     for formulation in Formulation::ALL {
         for parallel in [false, true] {
-            let settings = SolverSettings { substeps: 10, formulation, parallel, ..SolverSettings::default() };
+            let settings =
+                SolverSettings { substeps: 10, formulation, sweep: sweep_of(parallel), ..SolverSettings::default() };
             let effects: Vec<Box<dyn Effect>> =
                 vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.clone() })];
             let mut sim = Simulation::new(mesh.clone(), material, settings, effects).unwrap();

@@ -205,7 +205,7 @@ impl StepSolver for Vbd {
         }
         for k in 1..=s.settings.vbd.iterations {
             for colour in &self.colours {
-                counters.node_updates += sweep_colour(&update, colour, positions, s.settings.parallel)?;
+                counters.node_updates += sweep_colour(&update, colour, positions, s.settings.sweep.is_colour())?;
             }
             if rho > 0.0 {
                 omega = match k {

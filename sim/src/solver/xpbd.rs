@@ -4,7 +4,7 @@
 //! Gauss–Seidel sweeps (`sweep.rs`), each followed by every effect's own projection.
 //!
 //! Its state: the multipliers, the element colouring, the element data packed for the sweeps and
-//! the parallel sweep's slabs.
+//! the colour sweep's slabs.
 
 use super::SolverCounters;
 use super::method::{Hooks, Method, StepInput, StepSolver};
@@ -21,13 +21,15 @@ pub(crate) struct Xpbd {
     pub(super) colours: Vec<Vec<Vec<u32>>>,
     /// Per block, the element data packed for the sweeps (element order and colour order).
     pub(super) packed: crate::xpbd::kernels::SolverData,
-    /// The colour sweep projects linear tetrahedra four at a time ([`crate::xpbd::kernels::p1x4`]).
+    /// The colour sweep projects four elements at a time ([`crate::xpbd::kernels::p1x4`],
+    /// [`crate::xpbd::kernels::batch`]).
     pub(super) simd_batches: bool,
-    /// Per block, its cut into one slab per thread for the parallel sweep on two or more
-    /// threads (built for the current thread count on first use).
-    pub(super) partitions: Vec<crate::xpbd::kernels::Partition>,
-    /// Fewest elements per thread for which a block is partitioned.
-    pub(super) partition_min_per_thread: usize,
+    /// Per block, its cut into slabs for the colour sweep and the slab count it was made for
+    /// (built on first use; the count depends on the block's size alone; None: the block is too
+    /// thin for that many slabs and is swept colour by colour).
+    pub(super) partitions: Vec<(usize, Option<crate::xpbd::kernels::Partition>)>,
+    /// Fewest elements per slab ([`crate::xpbd::kernels::slab_count`]).
+    pub(super) partition_min_per_slab: usize,
 }
 
 impl Xpbd {
@@ -40,7 +42,7 @@ impl Xpbd {
             packed: crate::xpbd::kernels::SolverData::default(),
             simd_batches: true,
             partitions: Vec::new(),
-            partition_min_per_thread: crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_THREAD,
+            partition_min_per_slab: crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_SLAB,
         };
         xpbd.pack(mesh, geometry);
         xpbd.lambdas = Self::multipliers(geometry, settings.formulation);
@@ -49,7 +51,7 @@ impl Xpbd {
 
     fn pack(&mut self, mesh: &Mesh, geometry: &[BlockGeometry]) {
         self.packed = crate::xpbd::kernels::SolverData::new(&mesh.blocks, geometry, &self.colours);
-        self.partitions = vec![crate::xpbd::kernels::Partition::default(); mesh.blocks.len()];
+        self.partitions = vec![(0, None); mesh.blocks.len()];
     }
 
     fn multipliers(geometry: &[BlockGeometry], formulation: Formulation) -> Vec<Vec<f64>> {

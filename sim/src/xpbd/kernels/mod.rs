@@ -24,7 +24,8 @@
 //! ([`mul3`], [`LANES`]); `shared.rs` the raw shared pointers ([`SharedMut`]); `pack.rs` the
 //! packed element data ([`PackedBlock`]); `schedule.rs` the parallel schedules and every
 //! threshold that cuts work between threads ([`parallel_energy_block`], [`Partition`]);
-//! [`p1x4`] four linear tetrahedra per AVX2 register.
+//! [`p1x4`] four linear tetrahedra per AVX2 register, [`batch`] four elements of any other type
+//! (`lanes4.rs`: the four-lane type and what both batches share).
 
 mod pack;
 mod point_law;
@@ -34,13 +35,24 @@ mod simd;
 mod sweep;
 
 #[cfg(target_arch = "x86_64")]
+pub mod batch;
+#[cfg(target_arch = "x86_64")]
+mod lanes4;
+#[cfg(target_arch = "x86_64")]
 pub mod p1x4;
+
+/// Doubles per batch of four elements of `nodes` nodes and `points` quadrature points in
+/// [`PackedBlock::batches`] (the layouts of [`p1x4`] and [`batch`]).
+pub const fn batch_values(nodes: usize, points: usize) -> usize {
+    if nodes == 4 && points == 1 { BATCH_VALUES } else { points * (3 * nodes + 1) * 4 }
+}
 
 pub use pack::{BATCH_VALUES, BlockData, PackedBlock, SolverData};
 pub use point_law::{AnyMaterial, PointMaterial, Stvk};
 pub use schedule::{
-    BlockSweep, GENERIC_MIN_ELEMENTS_PER_TASK, PARTITION_MIN_ELEMENTS_PER_THREAD, Partition,
-    SWEEP_MIN_ELEMENTS_PER_THREAD, parallel_energy_block,
+    BlockSweep, ELEMENTS_PER_EXTRA_SLAB, GENERIC_MIN_ELEMENTS_PER_TASK, MAX_SLABS, MIN_SLABS,
+    PARTITION_MIN_ELEMENTS_PER_SLAB, Partition, SWEEP_MIN_ELEMENTS_PER_THREAD, flops_per_element, p1_equivalents,
+    parallel_energy_block, slab_count,
 };
 pub use shared::{Multipliers, Positions, SharedMut};
 pub use simd::{LANES, mul3, padded};

@@ -1,8 +1,8 @@
 //! The element data as the sweeps read it: a block's connectivity, material gradients (structure
 //! of arrays per element and point, padded to [`super::LANES`]) and quadrature volumes, copied
 //! in element order (the serial sweep) or colour by colour (the parallel sweeps, so that a
-//! colour is one contiguous range), plus the lane-interleaved batches of four linear tetrahedra
-//! ([`super::p1x4`]).
+//! colour is one contiguous range), plus the lane-interleaved batches of four elements
+//! ([`super::p1x4`], [`super::batch`]).
 
 use super::simd::padded;
 use crate::fem::geometry::BlockGeometry;
@@ -43,11 +43,12 @@ pub struct PackedBlock {
     pub element_ids: Option<Vec<u32>>,
     pub colour_starts: Vec<usize>,
     pub points: usize,
-    /// Linear tetrahedra in colour order only: the gradients and volumes of each colour's
-    /// first `4 ⌊len/4⌋` elements in batches of four, lane-interleaved (`p1x4::BATCH_VALUES`
-    /// per batch; see [`colour_sweep`](super::colour_sweep)). Empty otherwise.
-    pub p1x4: Vec<f64>,
-    /// The first batch of colour `c` in [`PackedBlock::p1x4`] (one more entry than colours).
+    /// In colour order only: the gradients and volumes of each colour's first `4 ⌊len/4⌋`
+    /// elements in batches of four, lane-interleaved ([`super::batch_values`] per batch: the
+    /// layout of [`super::p1x4`] for the linear tetrahedron at one point, of [`super::batch`]
+    /// otherwise; see [`colour_sweep`](super::colour_sweep)). Empty in element order.
+    pub batches: Vec<f64>,
+    /// The first batch of colour `c` in [`PackedBlock::batches`] (one more entry than colours).
     pub colour_batches: Vec<usize>,
 }
 
@@ -76,7 +77,7 @@ impl PackedBlock {
             element_ids: None,
             colour_starts: Vec::with_capacity(colours.len() + 1),
             points: q,
-            p1x4: Vec::new(),
+            batches: Vec::new(),
             colour_batches: vec![0],
         };
         packed.colour_starts.push(0);
@@ -95,16 +96,27 @@ impl PackedBlock {
                 ids.push(e as u32);
             }
             packed.colour_starts.push(ids.len());
-            if batches && n == 4 && q == 1 {
+            if batches {
                 for four in colour.chunks_exact(4) {
-                    for r in 1..4 {
-                        for c in 0..3 {
-                            packed.p1x4.extend(four.iter().map(|&e| geometry.gradients(e as usize, 0)[r][c]));
+                    if n == 4 && q == 1 {
+                        for r in 1..4 {
+                            for c in 0..3 {
+                                packed.batches.extend(four.iter().map(|&e| geometry.gradients(e as usize, 0)[r][c]));
+                            }
                         }
+                        packed.batches.extend(four.iter().map(|&e| geometry.volumes(e as usize)[0]));
+                        continue;
                     }
-                    packed.p1x4.extend(four.iter().map(|&e| geometry.volumes(e as usize)[0]));
+                    for p in 0..q {
+                        for axis in 0..3 {
+                            for i in 0..n {
+                                packed.batches.extend(four.iter().map(|&e| geometry.gradients(e as usize, p)[i][axis]));
+                            }
+                        }
+                        packed.batches.extend(four.iter().map(|&e| geometry.volumes(e as usize)[p]));
+                    }
                 }
-                packed.colour_batches.push(packed.p1x4.len() / BATCH_VALUES);
+                packed.colour_batches.push(packed.batches.len() / super::batch_values(n, q));
             }
         }
         packed.element_ids = Some(ids);

@@ -1,6 +1,6 @@
 //! Scheduling the parallel sweep: the thresholds that cut the work between threads (all of them
-//! here), colour after colour in contiguous chunks ([`parallel_energy_block`]), or one slab per
-//! thread ([`Partition`]).
+//! here), colour after colour in contiguous chunks ([`parallel_energy_block`]), or slab by slab in
+//! two phases ([`Partition`]).
 
 use super::pack::PackedBlock;
 use super::shared::{Multipliers, Positions};
@@ -15,8 +15,8 @@ use crate::mesh::ElementBlock;
 // their multipliers, so projecting them in any grouping and order gives the same positions
 // bitwise (the four-lane batches are fixed by the colour's start, not by the cut), and a
 // non-finite correction is reported for the first bad element of the colour whatever the cut.
-// (The slab partition is the exception that changes the order, hence the result: it depends on
-// the thread count, see [`Partition`].)
+// The slab partition changes the order, hence the result, but its slab count depends on the
+// block's size alone ([`slab_count`]), so the result still does not depend on the thread count.
 
 /// Fewest elements per thread in the specialised sweep ([`parallel_energy_block`]): a colour is
 /// cut into at most one contiguous chunk per thread, each at least this long (a colour shorter
@@ -30,17 +30,58 @@ pub const SWEEP_MIN_ELEMENTS_PER_THREAD: usize = 256;
 /// several times more per element, so shorter tasks still pay for themselves.
 pub const GENERIC_MIN_ELEMENTS_PER_TASK: usize = 64;
 
-/// Fewest elements per thread for which the parallel sweep cuts a block into slabs
-/// ([`Partition`]) instead of synchronising the threads after every colour (the default of
-/// `Simulation::set_partition_threshold`).
-pub const PARTITION_MIN_ELEMENTS_PER_THREAD: usize = 2048;
+/// Fewest elements per slab, in [`p1_equivalents`] ([`slab_count`]; the default of
+/// `Simulation::set_partition_threshold`): a block of at least [`MIN_SLABS`] times this is cut
+/// into slabs ([`Partition`]) instead of synchronising the threads after every colour. 1,024
+/// linear tetrahedra take ≈ 30 µs per sweep, well above the cost of a join.
+pub const PARTITION_MIN_ELEMENTS_PER_SLAB: usize = 1024;
+
+/// Elements per slab, in [`p1_equivalents`], past which a block is cut into more than
+/// [`MIN_SLABS`] slabs (up to [`MAX_SLABS`]).
+pub const ELEMENTS_PER_EXTRA_SLAB: usize = 32_768;
+
+/// The fewest slabs a cut block has: two phases of two slabs each.
+pub const MIN_SLABS: usize = 4;
+
+/// The most slabs a block is cut into.
+pub const MAX_SLABS: usize = 16;
+
+/// Flops of one energy-constraint projection of an element with `nodes` nodes and `points`
+/// quadrature points, a fused multiply–add counted as 2: per point `F` (18N), the StVK law (165)
+/// and `∇_i U += V P ∇N_i` (18N + 9); per element the displacements (3N), `Σ w|∇U|²` (6N), the
+/// update (10) and the scatter (7N). 392 for P1, 31,384 for Q2 at 27 points.
+pub const fn flops_per_element(nodes: usize, points: usize) -> usize {
+    points * (36 * nodes + 174) + 16 * nodes + 10
+}
+
+/// A block's size in linear tetrahedra of equal work: `len` elements of `nodes` nodes and
+/// `points` points, weighted by [`flops_per_element`] against P1's — what the slab thresholds
+/// are stated in, so that a block of 13 Q2 hexahedra at 27 points counts as much as 1,024 P1
+/// tetrahedra.
+pub fn p1_equivalents(len: usize, nodes: usize, points: usize) -> usize {
+    len.saturating_mul(flops_per_element(nodes, points)) / flops_per_element(4, 1)
+}
+
+/// How many slabs the colour sweep cuts a block of `len` elements into, `len` in
+/// [`p1_equivalents`]: 1 (no cut: colour by colour) below [`MIN_SLABS`]` min_per_slab`, else the
+/// largest power of two at most `len / ELEMENTS_PER_EXTRA_SLAB`, between [`MIN_SLABS`] and
+/// [`MAX_SLABS`]. A function of the block alone: the sweep's order, hence its result, never
+/// depends on the thread count, and on a machine with fewer threads than slabs per phase a
+/// thread sweeps several slabs in turn.
+pub fn slab_count(len: usize, min_per_slab: usize) -> usize {
+    if len < min_per_slab.saturating_mul(MIN_SLABS) {
+        return 1;
+    }
+    let wanted = (len / ELEMENTS_PER_EXTRA_SLAB).clamp(MIN_SLABS, MAX_SLABS);
+    1 << wanted.ilog2()
+}
 
 /// How [`parallel_energy_block`] sweeps a block.
 #[derive(Clone, Copy, Debug)]
 pub enum BlockSweep<'a> {
     /// Colour after colour (the block packed in colour order).
     Colours(&'a PackedBlock),
-    /// Slab by slab, then the interface ([`Partition`]).
+    /// Slab by slab, the even slabs side by side, then the odd ones ([`Partition`]).
     Slabs(&'a Partition),
 }
 
@@ -124,33 +165,38 @@ pub fn parallel_energy_block(
     Some(Ok(projected))
 }
 
-/// A block cut for `threads` threads: its nodes split into one slab per thread along the longest
-/// axis of the rest shape (cuts at the quantiles of the element centroids, so each slab holds
-/// about as many elements); the elements whose nodes all lie in slab `s` are `slabs[s]`, the
-/// others (touching two slabs) `interface`, each packed colour by colour (the block's colouring
-/// restricted to them, element order kept inside a colour).
+/// A block cut into slabs ([`slab_count`]) along the longest axis of its rest shape: element
+/// `e` belongs to slab `s` when its centroid lies between cuts `s − 1` and `s`, the cuts at the
+/// quantiles of the centroids (so each slab holds about as many elements), and each slab is
+/// packed colour by colour (the block's colouring restricted to it, element order kept inside a
+/// colour).
 ///
-/// One Gauss–Seidel sweep ([`parallel_energy_block`] with [`BlockSweep::Slabs`]) is then every slab swept colour after
-/// colour by its own thread with no synchronisation (no two slabs share a node), one join, and
-/// the interface elements swept on one thread: two synchronisations per sweep instead of one per
-/// colour. The order (and so the result, bitwise) depends on the thread count, not on the
-/// scheduling.
+/// One Gauss–Seidel sweep ([`parallel_energy_block`] with [`BlockSweep::Slabs`]) is then two
+/// phases, a red–black ordering of the slabs: the even slabs side by side, one task each, swept
+/// colour after colour with no synchronisation, one join, then the odd slabs likewise. Two slabs of
+/// one phase share no node, because the slab between them is thicker than an element (checked
+/// when the partition is made: a block too thin for its slab count is not cut, [`Partition::new`]
+/// gives None). Two synchronisations per sweep instead of one per colour, and no element swept
+/// alone. The order (and so the result, bitwise) depends on the slab count, not on the thread
+/// count or the scheduling.
 #[derive(Clone, Debug, Default)]
 pub struct Partition {
-    pub threads: usize,
     pub slabs: Vec<PackedBlock>,
-    pub interface: PackedBlock,
 }
 
 impl Partition {
+    /// `block` cut into `slabs` slabs (even, at least 2), or None when two slabs of one phase
+    /// would share a node.
     pub fn new(
         block: &ElementBlock,
         geometry: &BlockGeometry,
         colours: &[Vec<u32>],
         rest: &[Vec3],
-        threads: usize,
-    ) -> Self {
-        let threads = threads.max(1);
+        slabs: usize,
+    ) -> Option<Self> {
+        if slabs < 2 || !slabs.is_multiple_of(2) || block.len() < slabs {
+            return None;
+        }
         let n = block.nodes_per_element();
         let centroid = |e: usize| block.element(e).iter().map(|&i| rest[i as usize]).sum::<Vec3>() / n as f64;
         let (lo, hi) = block
@@ -160,31 +206,39 @@ impl Partition {
                 (lo.inf(&rest[i as usize]), hi.sup(&rest[i as usize]))
             });
         let axis = (hi - lo).iamax();
-        let mut along: Vec<f64> = (0..block.len()).map(|e| centroid(e)[axis]).collect();
-        along.sort_by(f64::total_cmp);
-        // slab s holds the nodes with cuts[s − 1] ≤ coordinate < cuts[s]
-        let cuts: Vec<f64> = (1..threads).map(|s| along[along.len() * s / threads]).collect();
-        let slab_of_node = |i: u32| cuts.partition_point(|&c| c <= rest[i as usize][axis]);
-        let slab_of_element = |e: u32| {
-            let nodes = block.element(e as usize);
-            let s = slab_of_node(nodes[0]);
-            nodes.iter().all(|&i| slab_of_node(i) == s).then_some(s)
-        };
-        let owner: Vec<Option<usize>> = (0..block.len() as u32).map(slab_of_element).collect();
-        let restricted = |keep: &dyn Fn(Option<usize>) -> bool| -> Vec<Vec<u32>> {
+        let along: Vec<f64> = (0..block.len()).map(|e| centroid(e)[axis]).collect();
+        let mut sorted = along.clone();
+        sorted.sort_by(f64::total_cmp);
+        // slab s holds the elements with cuts[s − 1] ≤ centroid < cuts[s]
+        let cuts: Vec<f64> = (1..slabs).map(|s| sorted[sorted.len() * s / slabs]).collect();
+        let owner: Vec<usize> = along.iter().map(|&c| cuts.partition_point(|&cut| cut <= c)).collect();
+        // two slabs of one phase must not share a node
+        let mut node_slab = vec![usize::MAX; rest.len()];
+        for phase in 0..2 {
+            node_slab.fill(usize::MAX);
+            for (e, &s) in owner.iter().enumerate() {
+                if s % 2 != phase {
+                    continue;
+                }
+                for &i in block.element(e) {
+                    let slot = &mut node_slab[i as usize];
+                    if *slot != usize::MAX && *slot != s {
+                        return None;
+                    }
+                    *slot = s;
+                }
+            }
+        }
+        let restricted = |slab: usize| -> Vec<Vec<u32>> {
             colours
                 .iter()
-                .map(|c| c.iter().copied().filter(|&e| keep(owner[e as usize])).collect::<Vec<u32>>())
+                .map(|c| c.iter().copied().filter(|&e| owner[e as usize] == slab).collect::<Vec<u32>>())
                 .filter(|c| !c.is_empty())
                 .collect()
         };
-        Self {
-            threads,
-            slabs: (0..threads)
-                .map(|s| PackedBlock::in_colour_order(block, geometry, &restricted(&|o| o == Some(s))))
-                .collect(),
-            interface: PackedBlock::in_colour_order(block, geometry, &restricted(&|o| o.is_none())),
-        }
+        Some(Self {
+            slabs: (0..slabs).map(|s| PackedBlock::in_colour_order(block, geometry, &restricted(s))).collect(),
+        })
     }
 }
 
@@ -246,9 +300,9 @@ unsafe fn all_colours(
 }
 
 /// One Gauss–Seidel sweep of the energy formulation over a block cut by `partition` (see
-/// [`Partition`]): the slabs in parallel on rayon's current pool, then the interface. On a
-/// non-finite correction the slabs finish, and the error of the lowest slab that had one (or of
-/// the interface) is returned.
+/// [`Partition`]): the even slabs side by side on rayon's current pool, then the odd ones. On a
+/// non-finite correction the phase finishes, and the error of its lowest slab that had one is
+/// returned (the next phase is not swept).
 #[allow(clippy::too_many_arguments)]
 fn slab_sweep(
     nodes_per_element: usize,
@@ -262,8 +316,8 @@ fn slab_sweep(
     batched: bool,
 ) -> Result<u64, NonFiniteElement> {
     use rayon::prelude::*;
-    // SAFETY (both sweeps): the slabs' elements touch disjoint nodes (each node is in one slab)
-    // and own their multipliers; the interface runs after the join, alone; node and element
+    // SAFETY: the slabs of one phase touch disjoint nodes (checked by Partition::new) and their
+    // elements own their multipliers; the phases run one after the other; node and element
     // indices come from the mesh the positions and multipliers were sized for.
     let slab = |s: usize| unsafe {
         all_colours(
@@ -278,25 +332,16 @@ fn slab_sweep(
             batched,
         )
     };
-    let slabs = (0..partition.slabs.len())
-        .into_par_iter()
-        .with_max_len(1)
-        .map(|s| (s, slab(s)))
-        .reduce(|| (usize::MAX, Ok(0)), lowest_error)
-        .1?;
-    // SAFETY: see above.
-    let interface = unsafe {
-        all_colours(
-            nodes_per_element,
-            material,
-            positions,
-            rest,
-            inv_mass,
-            &partition.interface,
-            lambdas,
-            inv_dt2,
-            batched,
-        )
-    }?;
-    Ok(slabs + interface)
+    let mut projected = 0;
+    for phase in 0..2 {
+        // (no allocation inside a frame: the phase's slabs are 2k + phase)
+        projected += (0..partition.slabs.len() / 2)
+            .into_par_iter()
+            .with_max_len(1)
+            .map(|k| 2 * k + phase)
+            .map(|s| (s, slab(s)))
+            .reduce(|| (usize::MAX, Ok(0)), lowest_error)
+            .1?;
+    }
+    Ok(projected)
 }

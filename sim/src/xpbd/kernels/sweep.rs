@@ -3,7 +3,7 @@
 //! with the four-lane P1 batches, and the per-element projections [`project_p1`] and
 //! [`project_energy`] they run.
 
-use super::pack::{BATCH_VALUES, BlockData, PackedBlock};
+use super::pack::{BlockData, PackedBlock};
 use super::point_law::{AnyMaterial, PointMaterial, Stvk};
 use super::shared::{Multipliers, Positions};
 use super::simd::{LANES, axpy_lanes, fma_lanes, mul3};
@@ -11,8 +11,9 @@ use crate::Vec3;
 use crate::material::{Mat3, Material, MaterialModel};
 use crate::xpbd::constraint::xpbd_step;
 
+use super::batch_values;
 #[cfg(target_arch = "x86_64")]
-use super::p1x4;
+use super::{batch, lanes4, p1x4};
 
 /// What the sweep hands back when an element's corrections come out non-finite: its element
 /// index in the block and its first non-finite node (nothing was scattered for it).
@@ -273,11 +274,12 @@ pub fn project_energy<const N: usize, const P: usize, const FMA: bool, M: PointM
 
 /// The colour sweep over packed range `range` of colour `colour` of `packed` (a colour-ordered
 /// block), whose start is a multiple of 4 elements from the colour's start: as [`energy_sweep`],
-/// but with `batched` the linear tetrahedra with StVK go four at a time through
-/// [`p1x4::batches_avx2`] where the CPU has AVX2 and FMA (the colour's last `len mod 4`
-/// elements, and every other case, through the scalar sweep). Which elements are batched
-/// depends only on the colour, not on how its range is cut, so the result does not depend on
-/// the thread count.
+/// but with `batched` four elements at a time where the CPU has AVX2 and FMA — the linear
+/// tetrahedron at one point through [`p1x4::batches_avx2`], every other specialised node count
+/// through [`batch::batches_avx2`], StVK as a law over lanes and any other model lane by lane
+/// ([`lanes4::BatchLaw`]); the colour's last `len mod 4` elements through the scalar sweep. Which
+/// elements are batched depends only on the colour, not on how its range is cut, so the result
+/// does not depend on the thread count.
 ///
 /// # Safety
 /// As [`energy_sweep`].
@@ -295,6 +297,9 @@ pub unsafe fn colour_sweep(
     inv_dt2: f64,
     batched: bool,
 ) -> Option<Result<u64, NonFiniteElement>> {
+    if !SPECIALISED_NODE_COUNTS.contains(&nodes_per_element) {
+        return None;
+    }
     let data = packed.data();
     let colour_start = packed.colour_starts[colour];
     assert!((range.start - colour_start).is_multiple_of(4) && range.end <= packed.colour_starts[colour + 1]);
@@ -302,13 +307,12 @@ pub unsafe fn colour_sweep(
     let mut projected = 0;
     #[cfg(target_arch = "x86_64")]
     if batched
-        && nodes_per_element == 4
-        && packed.points == 1
-        && material.model == MaterialModel::StVenantKirchhoff
         && packed.colour_batches.len() == packed.colour_starts.len()
         && std::arch::is_x86_feature_detected!("avx2")
         && std::arch::is_x86_feature_detected!("fma")
     {
+        let (n, q) = (nodes_per_element, packed.points);
+        let per_batch = batch_values(n, q);
         let first = packed.colour_batches[colour] + (range.start - colour_start) / 4;
         let batches = (range.len() / 4).min(packed.colour_batches[colour + 1] - first);
         let ids = data.element_ids.expect("colour order");
@@ -316,16 +320,23 @@ pub unsafe fn colour_sweep(
             positions,
             rest,
             inv_mass,
-            nodes: &data.nodes[range.start * 4..(range.start + 4 * batches) * 4],
-            values: &packed.p1x4[first * BATCH_VALUES..(first + batches) * BATCH_VALUES],
+            nodes: &data.nodes[range.start * n..(range.start + 4 * batches) * n],
+            values: &packed.batches[first * per_batch..(first + batches) * per_batch],
             element_ids: &ids[range.start..range.start + 4 * batches],
             lambdas,
             inv_dt2,
         };
-        let l = material.lame();
         // SAFETY: forwarded from the caller; AVX2 and FMA were detected; the elements of a
         // batch are of one colour.
-        match unsafe { p1x4::batches_avx2(&Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa }, io, batches) } {
+        let result = unsafe {
+            if material.model == MaterialModel::StVenantKirchhoff {
+                let l = material.lame();
+                batches_of(n, q, &Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa }, io, batches)
+            } else {
+                batches_of(n, q, &AnyMaterial(material), io, batches)
+            }
+        };
+        match result {
             Ok(k) => projected = k,
             Err(bad) => return Some(Err(bad)),
         }
@@ -335,4 +346,32 @@ pub unsafe fn colour_sweep(
     let rest_of =
         unsafe { energy_sweep(nodes_per_element, material, positions, rest, inv_mass, &data, tail, lambdas, inv_dt2) }?;
     Some(rest_of.map(|k| k + projected))
+}
+
+/// The batches of `io` for `n` nodes and `q` points, by the kernel of that node count.
+///
+/// # Safety
+/// As [`p1x4::batches_avx2`]; `n` one of [`SPECIALISED_NODE_COUNTS`].
+#[cfg(target_arch = "x86_64")]
+unsafe fn batches_of<L: lanes4::BatchLaw>(
+    n: usize,
+    q: usize,
+    law: &L,
+    io: p1x4::BatchIo<'_>,
+    batches: usize,
+) -> Result<u64, NonFiniteElement> {
+    // SAFETY: forwarded.
+    unsafe {
+        match n {
+            4 if q == 1 => p1x4::batches_avx2(law, io, batches),
+            4 => batch::batches_avx2::<4, L>(law, io, q, batches),
+            5 => batch::batches_avx2::<5, L>(law, io, q, batches),
+            6 => batch::batches_avx2::<6, L>(law, io, q, batches),
+            8 => batch::batches_avx2::<8, L>(law, io, q, batches),
+            10 => batch::batches_avx2::<10, L>(law, io, q, batches),
+            20 => batch::batches_avx2::<20, L>(law, io, q, batches),
+            27 => batch::batches_avx2::<27, L>(law, io, q, batches),
+            _ => unreachable!("{n} nodes: no specialised sweep"),
+        }
+    }
 }

@@ -192,27 +192,12 @@ fn p1_colour_sweep_matches_the_generic_kernel() {
     }
 }
 
-/// A P1 beam, its colour-packed block, a deformed state and inverse masses with every node at
-/// x < 0.3 pinned (so whole elements are pinned too).
-fn p1_colour_case() -> (crate::mesh::Mesh, PackedBlock, Vec<Vec3>, Vec<f64>) {
-    let (mesh, _, _, packed) = p1_beam(1);
-    let deformed: Vec<Vec3> = mesh
-        .rest_positions
-        .iter()
-        .enumerate()
-        .map(|(i, p)| p + 0.02 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin()))
-        .collect();
-    let w: Vec<f64> = mesh
-        .rest_positions
-        .iter()
-        .enumerate()
-        .map(|(i, p)| if p.x < 0.3 { 0.0 } else { 1.0 + 0.01 * (i % 7) as f64 })
-        .collect();
-    (mesh, packed, deformed, w)
-}
-
-/// Every colour of `packed` through [`colour_sweep`], batched or not; the first error stops.
-fn sweep_colours(
+/// Every colour of `packed` (`n` nodes per element) through [`colour_sweep`] with `material`,
+/// batched or not; the first error stops.
+#[allow(clippy::too_many_arguments)]
+fn sweep_colours_of(
+    n: usize,
+    material: &crate::material::Material,
     packed: &PackedBlock,
     rest: &[Vec3],
     w: &[f64],
@@ -220,14 +205,13 @@ fn sweep_colours(
     lambdas: &mut [f64],
     batched: bool,
 ) -> Result<u64, NonFiniteElement> {
-    let material = materials()[0];
     let mut done = 0;
     for c in 0..packed.num_colours() {
         // SAFETY: one thread, sizes from the mesh.
         done += unsafe {
             colour_sweep(
-                4,
-                &material,
+                n,
+                material,
                 Positions::new(x),
                 rest,
                 w,
@@ -242,77 +226,6 @@ fn sweep_colours(
         .unwrap()?;
     }
     Ok(done)
-}
-
-/// Four same-colour linear tetrahedra per 256-bit register give the one-at-a-time colour
-/// sweep's positions and multipliers up to round-off, skip the same pinned elements, and name
-/// the same element when one comes out non-finite, with the same nodes scattered before it.
-#[cfg(target_arch = "x86_64")]
-#[test]
-fn p1_batches_of_four_match_the_scalar_colour_sweep() {
-    if !(std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")) {
-        return;
-    }
-    let (mesh, packed, deformed, w) = p1_colour_case();
-    assert!(packed.colour_batches.last().copied().unwrap_or(0) * 4 > packed.len() / 2, "most elements in batches");
-    let n = mesh.blocks[0].len();
-    let run = |batched: bool, x: &mut Vec<Vec3>, lambdas: &mut Vec<f64>| {
-        let mut done = 0;
-        for _ in 0..5 {
-            lambdas.fill(0.0);
-            done += sweep_colours(&packed, &mesh.rest_positions, &w, x, lambdas, batched).unwrap();
-        }
-        done
-    };
-    let (mut x1, mut l1, mut x4, mut l4) = (deformed.clone(), vec![0.0; n], deformed.clone(), vec![0.0; n]);
-    let (done1, done4) = (run(false, &mut x1, &mut l1), run(true, &mut x4, &mut l4));
-    assert_eq!(done1, done4);
-    assert!(done1 < 5 * n as u64, "some elements are all pinned");
-    let scale = x1.iter().zip(&deformed).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-    let gap = x1.iter().zip(&x4).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-    assert!(scale > 1e-3 && gap <= 1e-12 * scale, "{gap:e} against {scale:e}");
-    for (a, b) in l1.iter().zip(&l4) {
-        assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{a} {b}");
-    }
-    for (i, (a, b)) in x4.iter().zip(&deformed).enumerate() {
-        if w[i] == 0.0 {
-            assert_eq!(a, b, "a pinned node stays");
-        }
-    }
-
-    // a non-finite node first met (in sweep order) in the third lane of a batch past the first colour
-    let mut first_seen = vec![usize::MAX; mesh.num_nodes()];
-    for (k, four) in packed.nodes.chunks_exact(4).enumerate() {
-        for &nd in four {
-            first_seen[nd as usize] = first_seen[nd as usize].min(k);
-        }
-    }
-    let c = (1..packed.num_colours()).find(|&c| packed.colour(c).len() >= 8).unwrap();
-    let k = (packed.colour(c).start..packed.colour(c).end - 4)
-        .find(|&k| {
-            (k - packed.colour(c).start) % 4 == 2
-                && first_seen[packed.nodes[4 * k + 1] as usize] == k
-                && w[packed.nodes[4 * k + 1] as usize] > 0.0
-        })
-        .expect("a node first met in a third lane");
-    let bad_node = packed.nodes[4 * k + 1];
-    let (mut x1, mut l1, mut x4, mut l4) = (deformed.clone(), vec![0.0; n], deformed.clone(), vec![0.0; n]);
-    x1[bad_node as usize].y = f64::NAN;
-    x4[bad_node as usize].y = f64::NAN;
-    let (r1, r4) = (
-        sweep_colours(&packed, &mesh.rest_positions, &w, &mut x1, &mut l1, false),
-        sweep_colours(&packed, &mesh.rest_positions, &w, &mut x4, &mut l4, true),
-    );
-    let bad = r1.unwrap_err();
-    assert_eq!(bad, r4.unwrap_err());
-    assert_eq!(bad.node, bad_node);
-    assert_eq!(bad.element, packed.element_ids.as_ref().unwrap()[k] as usize);
-    for (a, b) in x1.iter().zip(&x4) {
-        assert!((a - b).norm() <= 1e-12 || a.y.is_nan() && b.y.is_nan(), "{a} {b}");
-    }
-    for (a, b) in l1.iter().zip(&l4) {
-        assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{a} {b}");
-    }
 }
 
 /// The sweep's StVK ([`Stvk`], nalgebra's column-major form, kept for speed) is the material's
@@ -339,5 +252,120 @@ fn the_sweeps_stvk_is_the_materials_point_law_bit_for_bit() {
         let (psi, p) = law.energy_and_pk1::<true>(&f);
         let (psi_l, p_l) = energy_and_pk1::<Scalar<true>>(Scalar(law.mu_pa), Scalar(law.lambda_pa), &from_mat3(&f));
         assert_eq!((psi.to_bits(), p.map(f64::to_bits)), (psi_l.0.to_bits(), to_mat3(&p_l).map(f64::to_bits)));
+    }
+}
+
+/// Four same-colour elements per register, for every element type (the linear tetrahedron also
+/// at a raised quadrature degree, through the generic batch) and every material, on curved
+/// elements (every rest node moved by a smooth map): the one-at-a-time colour sweep's positions
+/// and multipliers up to round-off, the same pinned elements skipped, and the same element and
+/// node named when a correction comes out non-finite, with the same nodes scattered before it.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn batches_of_four_match_the_scalar_colour_sweep_for_every_element_type_and_material() {
+    use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+    if !(std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")) {
+        return;
+    }
+    let cases = [
+        ("p1", Some(2)),
+        ("p1", None),
+        ("p2", None),
+        ("p3", None),
+        ("q1", None),
+        ("q2", None),
+        ("prism", None),
+        ("pyramid", None),
+    ];
+    for (name, degree) in cases {
+        let mut mesh = BoxMeshSpec {
+            grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(2.0, 0.5, 0.5), cells: [8, 4, 4] },
+            element_type: crate::element::ElementType::from_name(name).unwrap(),
+            split: TetSplit::Five,
+            refine: 0,
+        }
+        .build()
+        .unwrap();
+        for p in &mut mesh.rest_positions {
+            *p += 0.04 * Vec3::new((3.0 * p.y + p.z).sin(), (2.0 * p.x).sin(), (2.5 * p.x + p.y).cos());
+        }
+        let geo = crate::fem::geometry::precompute(&mesh, degree).unwrap();
+        let block = &mesh.blocks[0];
+        let n = block.nodes_per_element();
+        let colours = crate::xpbd::colouring::colour_elements(block, mesh.num_nodes());
+        let packed = PackedBlock::in_colour_order(block, &geo[0], &colours);
+        let what = format!("{name} (quadrature degree {degree:?})");
+        assert!(packed.colour_batches.last().copied().unwrap_or(0) > 0, "{what}: some elements in batches");
+        let deformed: Vec<Vec3> = mesh
+            .rest_positions
+            .iter()
+            .enumerate()
+            .map(|(i, p)| p + 0.03 * Vec3::new((i as f64).sin(), (i as f64 * 0.3).cos(), (i as f64 * 1.7).sin()))
+            .collect();
+        let w: Vec<f64> = mesh
+            .rest_positions
+            .iter()
+            .enumerate()
+            .map(|(i, p)| if p.x < 0.3 { 0.0 } else { 1.0 + 0.01 * (i % 7) as f64 })
+            .collect();
+        let elements = block.len();
+        for material in materials() {
+            let what = format!("{what} {:?}", material.model);
+            let run = |batched: bool, x: &mut Vec<Vec3>, lambdas: &mut Vec<f64>| {
+                let mut done = 0;
+                for _ in 0..3 {
+                    lambdas.fill(0.0);
+                    done +=
+                        sweep_colours_of(n, &material, &packed, &mesh.rest_positions, &w, x, lambdas, batched).unwrap();
+                }
+                done
+            };
+            let (mut x1, mut l1) = (deformed.clone(), vec![0.0; elements]);
+            let (mut x4, mut l4) = (deformed.clone(), vec![0.0; elements]);
+            let (done1, done4) = (run(false, &mut x1, &mut l1), run(true, &mut x4, &mut l4));
+            assert_eq!(done1, done4, "{what}");
+            let scale = x1.iter().zip(&deformed).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+            let gap = x1.iter().zip(&x4).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+            assert!(scale > 1e-4 && gap <= 1e-11 * scale, "{what}: {gap:e} against {scale:e}");
+            for (a, b) in l1.iter().zip(&l4) {
+                assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-12), "{what}: {a} {b}");
+            }
+            for (i, (a, b)) in x4.iter().zip(&deformed).enumerate() {
+                if w[i] == 0.0 {
+                    assert_eq!(a, b, "{what}: a pinned node stays");
+                }
+            }
+        }
+        // a non-finite node first met (in sweep order) in the third lane of a batch
+        let mut first_seen = vec![usize::MAX; mesh.num_nodes()];
+        for (k, element) in packed.nodes.chunks_exact(n).enumerate() {
+            for &nd in element {
+                first_seen[nd as usize] = first_seen[nd as usize].min(k);
+            }
+        }
+        let batched_end = |c: usize| packed.colour(c).start + 4 * (packed.colour(c).len() / 4);
+        let k = (0..packed.num_colours())
+            .flat_map(|c| (packed.colour(c).start..batched_end(c)).map(move |k| (c, k)))
+            .find(|&(c, k)| {
+                let node = packed.nodes[n * k + n - 1] as usize;
+                (k - packed.colour(c).start) % 4 == 2 && first_seen[node] == k && w[node] > 0.0
+            })
+            .map(|(_, k)| k)
+            .expect("a node first met in a third lane");
+        let bad_node = packed.nodes[n * k + n - 1];
+        let material = materials()[0];
+        let (mut x1, mut l1) = (deformed.clone(), vec![0.0; elements]);
+        let (mut x4, mut l4) = (deformed.clone(), vec![0.0; elements]);
+        x1[bad_node as usize].y = f64::NAN;
+        x4[bad_node as usize].y = f64::NAN;
+        let r1 = sweep_colours_of(n, &material, &packed, &mesh.rest_positions, &w, &mut x1, &mut l1, false);
+        let r4 = sweep_colours_of(n, &material, &packed, &mesh.rest_positions, &w, &mut x4, &mut l4, true);
+        let bad = r1.unwrap_err();
+        assert_eq!(bad, r4.unwrap_err(), "{name}");
+        assert_eq!(bad.node, bad_node, "{name}");
+        assert_eq!(bad.element, packed.element_ids.as_ref().unwrap()[k] as usize, "{name}");
+        for (a, b) in x1.iter().zip(&x4) {
+            assert!((a - b).norm() <= 1e-12 || a.y.is_nan() && b.y.is_nan(), "{name}: {a} {b}");
+        }
     }
 }

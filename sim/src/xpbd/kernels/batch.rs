@@ -1,0 +1,109 @@
+//! Every element type four at a time: four consecutive elements of one colour (they share no
+//! node) projected together, one element per 64-bit lane of a 256-bit register (AVX2 + FMA), for
+//! any node count `N` and any number of quadrature points — the P2, P3, Q1, Q2, prism and
+//! pyramid elements and the linear tetrahedron at a raised quadrature degree (at one point it
+//! has its own batch, [`super::p1x4`]).
+//!
+//! Per lane this is [`super::project_energy`] (Saillant et al. §3: for each point
+//! `F_q = I + Σ_i u_i ⊗ ∇_X N_i(r_q)`, `U = Σ_q V_q ψ(F_q)`, `∇_i U = Σ_q V_q P(F_q) ∇_X N_i(r_q)`,
+//! then `C = √(2U)` and the XPBD update) followed by the non-finite check and the scatter of the
+//! scalar sweep ([`super::lanes4::finish_batch`]); the point law runs on four lanes
+//! ([`super::lanes4::BatchLaw`]). Every node loop is four elements wide with no horizontal sum:
+//! `F` takes `9N` fused multiply–adds per point and batch, `∇U` another `9N`. Results equal the
+//! scalar colour sweep's up to the order of floating-point operations (its node loops sum in
+//! four partial sums, these in node order).
+//!
+//! The rest data of a batch is stored lane-interleaved in [`super::PackedBlock::batches`]:
+//! per quadrature point `q`, `∂N_i/∂X_b` for `b < 3`, `i < N` (index `b N + i`) as four lanes
+//! each, then the four volumes `V_q`: [`super::batch_values`]`(N, Q)` doubles per batch.
+
+use super::lanes4::{BatchLaw, F64x4, V3, finish_batch, gather};
+use super::p1x4::BatchIo;
+use super::{NonFiniteElement, batch_values};
+
+/// Projects `batches` batches of four `N`-node elements with `points` quadrature points and the
+/// point law `law`, as [`super::p1x4::batches_avx2`] does for the linear tetrahedron (same
+/// return value, same handling of pinned and non-finite elements).
+///
+/// # Safety
+/// As [`super::p1x4::batches_avx2`], with `4 N` node indices and [`batch_values`]`(N, points)`
+/// values per batch.
+#[target_feature(enable = "avx2,fma")]
+pub unsafe fn batches_avx2<const N: usize, L: BatchLaw>(
+    law: &L,
+    io: BatchIo<'_>,
+    points: usize,
+    batches: usize,
+) -> Result<u64, NonFiniteElement> {
+    let per_batch = batch_values(N, points);
+    let per_point = (3 * N + 1) * 4;
+    assert!(
+        !(N == 4 && points == 1)
+            && io.nodes.len() >= batches * 4 * N
+            && io.values.len() >= batches * per_batch
+            && io.element_ids.len() >= batches * 4
+    );
+    let (one, zero) = (F64x4::splat(1.0), F64x4::zero());
+    let mut projected = 0u64;
+    for b in 0..batches {
+        let nodes = &io.nodes[b * 4 * N..(b + 1) * 4 * N];
+        // SAFETY: forwarded from the caller.
+        let Some(gathered) = (unsafe { gather::<N>(io.positions, io.rest, io.inv_mass, nodes) }) else {
+            continue;
+        };
+        let u = &gathered.u;
+        let vals = &io.values[b * per_batch..(b + 1) * per_batch];
+        let mut grad: [V3; N] = [[zero; 3]; N];
+        let mut energy = zero;
+        for q in 0..points {
+            let base = vals[q * per_point..(q + 1) * per_point].as_ptr();
+            // F_ab = δ_ab + Σ_i u_ia ∂N_i/∂X_b, node after node
+            let mut f = [[zero; 3]; 3];
+            for i in 0..N {
+                // SAFETY: base points to this point's (3N + 1) × 4 doubles.
+                let g = unsafe { [load(base, i), load(base, N + i), load(base, 2 * N + i)] };
+                for a in 0..3 {
+                    for c in 0..3 {
+                        f[a][c] = u[i][a].fma(g[c], f[a][c]);
+                    }
+                }
+            }
+            for a in 0..3 {
+                f[a][a] = f[a][a].add(one);
+            }
+            // SAFETY: compiled with AVX2 and FMA.
+            let (psi, p) = unsafe { law.energy_and_pk1(&f) };
+            // SAFETY: as above.
+            let v = unsafe { load(base, 3 * N) };
+            energy = v.fma(psi, energy);
+            let mut vp = [[zero; 3]; 3];
+            for a in 0..3 {
+                for c in 0..3 {
+                    vp[a][c] = p[a][c].mul(v);
+                }
+            }
+            // ∇_i U += V P ∇N_i
+            for i in 0..N {
+                // SAFETY: base points to this point's (3N + 1) × 4 doubles.
+                let g = unsafe { [load(base, i), load(base, N + i), load(base, 2 * N + i)] };
+                for a in 0..3 {
+                    grad[i][a] = vp[a][2].fma(g[2], vp[a][1].fma(g[1], vp[a][0].fma(g[0], grad[i][a])));
+                }
+            }
+        }
+        let ids: &[u32; 4] = io.element_ids[b * 4..(b + 1) * 4].try_into().expect("4 ids");
+        // SAFETY: nodes checked by gather, ids by finish_batch; forwarded from the caller.
+        projected +=
+            unsafe { finish_batch::<N>(&gathered, energy, &grad, io.positions, io.lambdas, nodes, ids, io.inv_dt2) }?;
+    }
+    Ok(projected)
+}
+
+/// Lanes `4k..4k + 4` from `base`.
+///
+/// # Safety
+/// `base` points to at least `4k + 4` doubles; only called under AVX2.
+#[inline(always)]
+unsafe fn load(base: *const f64, k: usize) -> F64x4 {
+    unsafe { F64x4::load(base.add(4 * k)) }
+}
