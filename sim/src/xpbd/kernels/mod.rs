@@ -44,7 +44,13 @@ pub mod p1x4;
 /// Doubles per batch of four elements of `nodes` nodes and `points` quadrature points in
 /// [`PackedBlock::batches`] (the layouts of [`p1x4`] and [`batch`]).
 pub const fn batch_values(nodes: usize, points: usize) -> usize {
-    if nodes == 4 && points == 1 { BATCH_VALUES } else { points * (3 * nodes + 1) * 4 }
+    if nodes == 4 && points == 1 {
+        BATCH_VALUES
+    } else if batch::from_reference_gradients(nodes) {
+        points * batch::POINT_VALUES
+    } else {
+        points * (3 * nodes + 1) * 4
+    }
 }
 
 pub use pack::{BATCH_VALUES, BlockData, PackedBlock, SolverData};

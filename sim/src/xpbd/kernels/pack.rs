@@ -7,6 +7,7 @@
 use super::simd::padded;
 use crate::fem::geometry::BlockGeometry;
 use crate::mesh::ElementBlock;
+use nalgebra::Matrix3;
 
 /// One block's element data as the sweep reads it (a view of a [`PackedBlock`]).
 #[derive(Clone, Copy, Debug)]
@@ -48,6 +49,9 @@ pub struct PackedBlock {
     /// layout of [`super::p1x4`] for the linear tetrahedron at one point, of [`super::batch`]
     /// otherwise; see [`colour_sweep`](super::colour_sweep)). Empty in element order.
     pub batches: Vec<f64>,
+    /// In colour order only: `∂N_i/∂r_b(r_q)` at `(q 3 + b) N + i`, the reference gradients the
+    /// batches of [`super::batch`] read (the same for every element of the block).
+    pub ref_grads: Vec<f64>,
     /// The first batch of colour `c` in [`PackedBlock::batches`] (one more entry than colours).
     pub colour_batches: Vec<usize>,
 }
@@ -78,9 +82,28 @@ impl PackedBlock {
             colour_starts: Vec::with_capacity(colours.len() + 1),
             points: q,
             batches: Vec::new(),
+            ref_grads: Vec::new(),
             colour_batches: vec![0],
         };
         packed.colour_starts.push(0);
+        // the reference gradients at each point, shared by every element of the block
+        let ref_grads: Vec<Vec<[f64; 3]>> = geometry
+            .quadrature
+            .points
+            .iter()
+            .map(|r| {
+                let mut g = vec![[0.0; 3]; n];
+                geometry.element_type.shape_gradients(r, &mut g);
+                g
+            })
+            .collect();
+        if batches && super::batch::from_reference_gradients(n) {
+            for g in &ref_grads {
+                for axis in 0..3 {
+                    packed.ref_grads.extend(g.iter().map(|gi| gi[axis]));
+                }
+            }
+        }
         for colour in colours {
             for &e in colour {
                 let e = e as usize;
@@ -107,10 +130,27 @@ impl PackedBlock {
                         packed.batches.extend(four.iter().map(|&e| geometry.volumes(e as usize)[0]));
                         continue;
                     }
+                    if !super::batch::from_reference_gradients(n) {
+                        for p in 0..q {
+                            for axis in 0..3 {
+                                for i in 0..n {
+                                    packed
+                                        .batches
+                                        .extend(four.iter().map(|&e| geometry.gradients(e as usize, p)[i][axis]));
+                                }
+                            }
+                            packed.batches.extend(four.iter().map(|&e| geometry.volumes(e as usize)[p]));
+                        }
+                        continue;
+                    }
                     for p in 0..q {
-                        for axis in 0..3 {
-                            for i in 0..n {
-                                packed.batches.extend(four.iter().map(|&e| geometry.gradients(e as usize, p)[i][axis]));
+                        let jinv: Vec<Matrix3<f64>> = four
+                            .iter()
+                            .map(|&e| inverse_jacobian(&ref_grads[p], geometry.gradients(e as usize, p)))
+                            .collect();
+                        for r in 0..3 {
+                            for c in 0..3 {
+                                packed.batches.extend(jinv.iter().map(|j| j[(r, c)]));
                             }
                         }
                         packed.batches.extend(four.iter().map(|&e| geometry.volumes(e as usize)[p]));
@@ -170,4 +210,19 @@ impl SolverData {
                 .collect(),
         }
     }
+}
+
+/// `J⁻¹` at a point from the reference gradients `g_r` (`∂N_i/∂r`) and the material gradients
+/// `g_x` (`∇_X N_i = J⁻ᵀ ∂N_i/∂r`) of the element there: the least-squares solution of
+/// `G_r J⁻¹ = G_x` (rows `g_rᵢᵀ`, `g_xᵢᵀ`), `J⁻¹ = (G_rᵀ G_r)⁻¹ G_rᵀ G_x`, exact up to round-off
+/// since every element's reference gradients span the three directions.
+fn inverse_jacobian(g_r: &[[f64; 3]], g_x: &[crate::Vec3]) -> Matrix3<f64> {
+    let mut gtg = Matrix3::zeros();
+    let mut gtx = Matrix3::zeros();
+    for (r, x) in g_r.iter().zip(g_x) {
+        let r = crate::Vec3::from(*r);
+        gtg += r * r.transpose();
+        gtx += r * x.transpose();
+    }
+    gtg.try_inverse().expect("reference gradients span three directions") * gtx
 }

@@ -331,9 +331,9 @@ pub unsafe fn colour_sweep(
         let result = unsafe {
             if material.model == MaterialModel::StVenantKirchhoff {
                 let l = material.lame();
-                batches_of(n, q, &Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa }, io, batches)
+                batches_of(n, q, &packed.ref_grads, &Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa }, io, batches)
             } else {
-                batches_of(n, q, &AnyMaterial(material), io, batches)
+                batches_of(n, q, &packed.ref_grads, &AnyMaterial(material), io, batches)
             }
         };
         match result {
@@ -356,6 +356,7 @@ pub unsafe fn colour_sweep(
 unsafe fn batches_of<L: lanes4::BatchLaw>(
     n: usize,
     q: usize,
+    ref_grads: &[f64],
     law: &L,
     io: p1x4::BatchIo<'_>,
     batches: usize,
@@ -364,13 +365,13 @@ unsafe fn batches_of<L: lanes4::BatchLaw>(
     unsafe {
         match n {
             4 if q == 1 => p1x4::batches_avx2(law, io, batches),
-            4 => batch::batches_avx2::<4, L>(law, io, q, batches),
-            5 => batch::batches_avx2::<5, L>(law, io, q, batches),
-            6 => batch::batches_avx2::<6, L>(law, io, q, batches),
-            8 => batch::batches_avx2::<8, L>(law, io, q, batches),
-            10 => batch::batches_avx2::<10, L>(law, io, q, batches),
-            20 => batch::batches_avx2::<20, L>(law, io, q, batches),
-            27 => batch::batches_avx2::<27, L>(law, io, q, batches),
+            4 => batch::batches_avx2::<4, L>(law, io, ref_grads, q, batches),
+            5 => batch::batches_avx2::<5, L>(law, io, ref_grads, q, batches),
+            6 => batch::batches_avx2::<6, L>(law, io, ref_grads, q, batches),
+            8 => batch::batches_avx2::<8, L>(law, io, ref_grads, q, batches),
+            10 => batch::batches_avx2::<10, L>(law, io, ref_grads, q, batches),
+            20 => batch::batches_avx2::<20, L>(law, io, ref_grads, q, batches),
+            27 => batch::batches_avx2::<27, L>(law, io, ref_grads, q, batches),
             _ => unreachable!("{n} nodes: no specialised sweep"),
         }
     }
