@@ -48,7 +48,7 @@ def cargo() -> list:
 
 def beam_mesh(label: str) -> dict:
     out = subprocess.run(
-        cargo() + ["run", "--quiet", "--release", "-p", "hox-sim", "--example", "beam_mesh", "--", label],
+        cargo() + ["run", "--quiet", "--release", "-p", "hox-scenes", "--example", "beam_mesh", "--", label],
         cwd=ROOT, check=True, capture_output=True, text=True,
     ).stdout
     return json.loads(out)
