@@ -383,6 +383,40 @@ fn the_slab_count_depends_on_the_block_size_alone() {
     assert_eq!(p1_equivalents(100, 27, 27), 8_006);
 }
 
+/// On a mesh with enough nodes for the substep's node loops to run on every thread
+/// ([`NODE_LOOP_MIN_NODES_PER_THREAD`]), one thread and two give the same bits, and a node made
+/// non-finite is named the same.
+#[test]
+fn large_meshes_step_their_nodes_on_every_thread_with_the_same_bits() {
+    let mesh = beam(ElementType::from_name("p1").unwrap(), [64, 16, 16]);
+    assert!(mesh.num_nodes() >= 2 * NODE_LOOP_MIN_NODES_PER_THREAD);
+    let clamped = clamped_at_x0(&mesh);
+    let run = |threads: usize, poison: Option<usize>| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let material = Material::new(MaterialModel::StVenantKirchhoff, 3.0e6, 0.35, 1000.0).unwrap();
+            let effects: Vec<Box<dyn Effect>> =
+                vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.clone() })];
+            let mut sim = Simulation::new(mesh.clone(), material, SolverSettings::default(), effects).unwrap();
+            for _ in 0..3 {
+                sim.substep().unwrap();
+            }
+            if let Some(node) = poison {
+                sim.velocities[node].z = f64::INFINITY;
+                return Err(sim.substep().unwrap_err().to_string());
+            }
+            Ok(sim.positions)
+        })
+    };
+    let one = run(1, None).unwrap();
+    assert!(one.iter().zip(&mesh.rest_positions).any(|(a, b)| a != b));
+    assert_eq!(one, run(2, None).unwrap());
+    let node = mesh.num_nodes() - 7;
+    let (e1, e2) = (run(1, Some(node)).unwrap_err(), run(2, Some(node)).unwrap_err());
+    assert_eq!(e1, e2);
+    assert!(e1.contains("node") && e1.contains("substep 4"), "{e1}");
+}
+
 /// The default sweep (colour by colour, four elements per register, slabs) gives the same bits
 /// on one thread and on two for every element type and material: the order it projects in is
 /// fixed by the mesh, and threads only share out the work.
