@@ -526,9 +526,10 @@ impl Simulation {
         // threads would otherwise wait on them: 19 k nodes are ≈ 10 % of a substep of the
         // 81,920-tetrahedron beam on two threads); each node on its own, so the same bits
         let chunks = node_chunks(self.positions.len(), self.settings.sweep);
+        // nodes per chunk (all of them when serial)
+        let c = self.positions.len().div_ceil(chunks).max(1);
         if chunks > 1 {
             use rayon::prelude::*;
-            let c = self.positions.len().div_ceil(chunks);
             self.prev_positions
                 .par_chunks_mut(c)
                 .zip(self.positions.par_chunks_mut(c))
@@ -578,7 +579,6 @@ impl Simulation {
         let inv_h = 1.0 / h;
         if chunks > 1 {
             use rayon::prelude::*;
-            let c = self.positions.len().div_ceil(chunks);
             self.velocities
                 .par_chunks_mut(c)
                 .zip(self.positions.par_chunks(c))
@@ -596,7 +596,6 @@ impl Simulation {
         hook!(after_velocity_update);
         let all_finite = chunks > 1 && {
             use rayon::prelude::*;
-            let c = self.positions.len().div_ceil(chunks);
             self.positions.par_chunks(c).zip(self.velocities.par_chunks(c)).all(|(x, v)| {
                 let mut check = 0.0;
                 for (x, v) in x.iter().zip(v) {

@@ -33,7 +33,7 @@
 //! the four volumes; or, from reference gradients, `(J⁻¹)_{bc}` for `b, c < 3` (index `3b + c`)
 //! then the volumes: [`super::batch_values`]`(N, Q)` doubles per batch.
 
-use super::lanes4::{BatchLaw, F64x4, V3, finish_batch, gather};
+use super::lanes4::{BatchLaw, F64x4, V3, finish_batch, gather, scaled};
 use super::p1x4::BatchIo;
 use super::{NonFiniteElement, batch_values};
 
@@ -96,12 +96,7 @@ pub unsafe fn batches_avx2<const N: usize, L: BatchLaw>(
                 // SAFETY: as above.
                 let v = unsafe { load(base, 3 * N) };
                 energy = v.fma(psi, energy);
-                let mut vp = [[zero; 3]; 3];
-                for a in 0..3 {
-                    for c in 0..3 {
-                        vp[a][c] = p[a][c].mul(v);
-                    }
-                }
+                let vp = scaled(&p, v);
                 // ∇_i U += V P ∇N_i
                 for i in 0..N {
                     // SAFETY: as above.
@@ -111,63 +106,59 @@ pub unsafe fn batches_avx2<const N: usize, L: BatchLaw>(
                     }
                 }
             }
-        }
-        for q in 0..if from_reference_gradients(N) { points } else { 0 } {
-            let base = vals[q * POINT_VALUES..(q + 1) * POINT_VALUES].as_ptr();
-            let table = &ref_grads[q * 3 * N..(q + 1) * 3 * N];
-            let gr: [&[f64; N]; 3] = [
-                table[..N].try_into().expect("N"),
-                table[N..2 * N].try_into().expect("N"),
-                table[2 * N..].try_into().expect("N"),
-            ];
-            // Fr_ab = Σ_i u_ia ∂N_i/∂r_b, node after node
-            let mut fr = [[zero; 3]; 3];
-            for i in 0..N {
-                let g = [F64x4::splat(gr[0][i]), F64x4::splat(gr[1][i]), F64x4::splat(gr[2][i])];
-                for a in 0..3 {
-                    for c in 0..3 {
-                        fr[a][c] = u[i][a].fma(g[c], fr[a][c]);
+        } else {
+            for q in 0..points {
+                let base = vals[q * POINT_VALUES..(q + 1) * POINT_VALUES].as_ptr();
+                let table = &ref_grads[q * 3 * N..(q + 1) * 3 * N];
+                let gr: [&[f64; N]; 3] = [
+                    table[..N].try_into().expect("N"),
+                    table[N..2 * N].try_into().expect("N"),
+                    table[2 * N..].try_into().expect("N"),
+                ];
+                // Fr_ab = Σ_i u_ia ∂N_i/∂r_b, node after node
+                let mut fr = [[zero; 3]; 3];
+                for i in 0..N {
+                    let g = [F64x4::splat(gr[0][i]), F64x4::splat(gr[1][i]), F64x4::splat(gr[2][i])];
+                    for a in 0..3 {
+                        for c in 0..3 {
+                            fr[a][c] = u[i][a].fma(g[c], fr[a][c]);
+                        }
                     }
                 }
-            }
-            // SAFETY: base points to this point's 10 × 4 doubles.
-            let mut jinv = [[zero; 3]; 3];
-            for r in 0..3 {
-                for c in 0..3 {
-                    jinv[r][c] = unsafe { load(base, 3 * r + c) };
-                }
-            }
-            // F = I + Fr J⁻¹
-            let mut f = [[zero; 3]; 3];
-            for a in 0..3 {
-                for c in 0..3 {
-                    let m = fr[a][2].fma(jinv[2][c], fr[a][1].fma(jinv[1][c], fr[a][0].mul(jinv[0][c])));
-                    f[a][c] = if a == c { one.add(m) } else { m };
-                }
-            }
-            // SAFETY: compiled with AVX2 and FMA.
-            let (psi, p) = unsafe { law.energy_and_pk1(&f) };
-            // SAFETY: as above.
-            let v = unsafe { load(base, 9) };
-            energy = v.fma(psi, energy);
-            // M = V P J⁻ᵀ: M_ab = Σ_c (V P)_ac (J⁻¹)_bc
-            let mut vp = [[zero; 3]; 3];
-            for a in 0..3 {
-                for c in 0..3 {
-                    vp[a][c] = p[a][c].mul(v);
-                }
-            }
-            let mut m = [[zero; 3]; 3];
-            for a in 0..3 {
+                // SAFETY: base points to this point's 10 × 4 doubles.
+                let mut jinv = [[zero; 3]; 3];
                 for r in 0..3 {
-                    m[a][r] = vp[a][2].fma(jinv[r][2], vp[a][1].fma(jinv[r][1], vp[a][0].mul(jinv[r][0])));
+                    for c in 0..3 {
+                        jinv[r][c] = unsafe { load(base, 3 * r + c) };
+                    }
                 }
-            }
-            // ∇_i U += M ∇_r N_i
-            for i in 0..N {
-                let g = [F64x4::splat(gr[0][i]), F64x4::splat(gr[1][i]), F64x4::splat(gr[2][i])];
+                // F = I + Fr J⁻¹
+                let mut f = [[zero; 3]; 3];
                 for a in 0..3 {
-                    grad[i][a] = m[a][2].fma(g[2], m[a][1].fma(g[1], m[a][0].fma(g[0], grad[i][a])));
+                    for c in 0..3 {
+                        let m = fr[a][2].fma(jinv[2][c], fr[a][1].fma(jinv[1][c], fr[a][0].mul(jinv[0][c])));
+                        f[a][c] = if a == c { one.add(m) } else { m };
+                    }
+                }
+                // SAFETY: compiled with AVX2 and FMA.
+                let (psi, p) = unsafe { law.energy_and_pk1(&f) };
+                // SAFETY: as above.
+                let v = unsafe { load(base, 9) };
+                energy = v.fma(psi, energy);
+                // M = V P J⁻ᵀ: M_ab = Σ_c (V P)_ac (J⁻¹)_bc
+                let vp = scaled(&p, v);
+                let mut m = [[zero; 3]; 3];
+                for a in 0..3 {
+                    for r in 0..3 {
+                        m[a][r] = vp[a][2].fma(jinv[r][2], vp[a][1].fma(jinv[r][1], vp[a][0].mul(jinv[r][0])));
+                    }
+                }
+                // ∇_i U += M ∇_r N_i
+                for i in 0..N {
+                    let g = [F64x4::splat(gr[0][i]), F64x4::splat(gr[1][i]), F64x4::splat(gr[2][i])];
+                    for a in 0..3 {
+                        grad[i][a] = m[a][2].fma(g[2], m[a][1].fma(g[1], m[a][0].fma(g[0], grad[i][a])));
+                    }
                 }
             }
         }

@@ -215,6 +215,19 @@ pub unsafe fn store_rows(v: V3, out: [*mut Vec3; 4], lanes: u32) {
     }
 }
 
+/// `m v`: every entry of a 3×3 matrix of lanes scaled by the lanes `v` (the quadrature volume
+/// times the stress, `V P`, of every batch kernel).
+#[inline(always)]
+pub fn scaled(m: &M3<F64x4>, v: F64x4) -> M3<F64x4> {
+    let mut out = *m;
+    for row in &mut out {
+        for x in row {
+            *x = x.mul(v);
+        }
+    }
+    out
+}
+
 /// A point law on four elements at a time: `(ψ(F), P(F))` per lane.
 pub trait BatchLaw: Sync {
     /// # Safety

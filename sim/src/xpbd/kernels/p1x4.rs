@@ -14,7 +14,7 @@
 //! [`super::PackedBlock::p1x4`]: [`BATCH_VALUES`] doubles per batch, `G[r][c]` (`∂N_{r+1}/∂X_c`)
 //! for `r, c < 3` as four lanes each, then the four volumes.
 
-use super::lanes4::{BatchLaw, F64x4, finish_batch, gather};
+use super::lanes4::{BatchLaw, F64x4, finish_batch, gather, scaled};
 use super::{BATCH_VALUES, Multipliers, NonFiniteElement, Positions};
 use crate::Vec3;
 
@@ -88,12 +88,7 @@ pub unsafe fn batches_avx2<L: BatchLaw>(law: &L, io: BatchIo<'_>, batches: usize
         // SAFETY: compiled with AVX2 and FMA.
         let (psi, p) = unsafe { law.energy_and_pk1(&f) };
         // ∇_{j+1} U = V P g_j (H = (V P) Gᵀ), ∇_0 U = −Σ
-        let mut vp = [[zero; 3]; 3];
-        for r in 0..3 {
-            for c in 0..3 {
-                vp[r][c] = p[r][c].mul(v);
-            }
-        }
+        let vp = scaled(&p, v);
         let mut grad = [[zero; 3]; 4];
         for j in 0..3 {
             for a in 0..3 {
