@@ -1,7 +1,8 @@
 //! Running a scene: for a given simulated time, or until it settles.
 //!
 //! **Settling** (`RunMode::Settle`): velocity damping `v ← v e^{−c h}` with the scene's
-//! `settle_damping_per_sec` is added, and once all prescribed ramps and moving planes have
+//! `settle_damping_per_sec` (`vbd_settle_damping_per_sec` for VBD, whose unconverged steps
+//! leave the slow modes too soft for the same damping) is added, and once all prescribed ramps and moving planes have
 //! stopped the run ends
 //! - **settled** (in equilibrium) once, for `SETTLE_EQUILIBRIUM_FRAMES` consecutive frames, the
 //!   static residual — the unbalanced force on the free nodes relative to the load
@@ -279,7 +280,12 @@ pub struct Settler {
 impl Settler {
     /// Adds the scene's settle damping to `instance` and starts counting.
     pub fn start(instance: &mut Instance, cap_secs: f64) -> Result<Settler, SceneError> {
-        let damping = instance.scene.params().settle_damping_per_sec;
+        let params = instance.scene.params();
+        let damping = if crate::params::is_vbd(params) {
+            params.vbd_settle_damping_per_sec
+        } else {
+            params.settle_damping_per_sec
+        };
         if damping > 0.0 && !instance.sim.effects().iter().any(|e| e.name() == SETTLE_DAMPING_NAME) {
             instance.sim.add_effect(Box::new(SettleDamping(Damping { rate_per_sec: damping }))).map_err(|e| {
                 SceneError::Simulation { source_name: instance.scene.source.clone(), message: e.to_string() }

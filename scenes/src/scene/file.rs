@@ -25,7 +25,8 @@
 //! quadrature_degree = 2   # omit for each element type's default
 //! duration_secs = 3       # default run length
 //! settle_damping_per_sec = 10  # velocity damping used by --settle
-//! parallel = false        # project elements colour by colour on all threads
+//! vbd_settle_damping_per_sec = 2  # the same with --solver vbd
+//! sweep = "colour"         # XPBD's sweep: colour (default) or element order
 //! stability_guard = true   # above h·ω_max = 3, substeps with h·ω_max ≤ 1 (hox_sim::solver::stability)
 //! [effect]                # optional: effects any scene can switch on
 //! damping_per_sec = 0     # velocity damping of every node, always on (0: none)

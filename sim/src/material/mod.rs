@@ -85,6 +85,25 @@ pub trait HyperelasticModel: Sync + Send + 'static {
             sum
         })
     }
+    /// One node's share at one point, per unit volume: the force direction `P(F) g` and the
+    /// block `B(F, g)` of [`HyperelasticModel::node_block`], sharing the common work (what a
+    /// vertex block descent visit asks for every point of every element around a node).
+    /// Default: from [`HyperelasticModel::energy_density_and_pk1`] and `node_block`.
+    fn node_force_and_block(&self, l: Lame, f: &Mat3, g: &Vector3<f64>) -> (Vector3<f64>, Mat3) {
+        (self.energy_density_and_pk1(l, f).1 * g, self.node_block(l, f, g))
+    }
+    /// `Σ_q V_q (P(F_q) g_q, B(F_q, g_q))` over the points of one element visit
+    /// ([`NodeVisit`]): one call per element, so a model can keep its point law inlined.
+    /// Default: [`HyperelasticModel::node_force_and_block`] point by point.
+    fn node_visit(&self, l: Lame, points: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
+        let (mut force, mut block) = (Vector3::zeros(), Mat3::zeros());
+        for (q, v) in points.volumes.iter().enumerate() {
+            let (fq, bq) = self.node_force_and_block(l, &points.f[q], &points.grads[q * points.stride]);
+            force += fq * *v;
+            block += bq * *v;
+        }
+        (force, block)
+    }
     /// The split constraints `[deviatoric, hydrostatic]` at F.
     fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2];
     /// Stiffness k_t (Pa) of each split term.
@@ -97,6 +116,17 @@ pub trait HyperelasticModel: Sync + Send + 'static {
     fn smooth_above_det_f(&self) -> f64 {
         f64::NEG_INFINITY
     }
+}
+
+/// One node's visit of one element (vertex block descent): the element's `F_q` at its points,
+/// the node's material gradients `grads[q · stride]` and the volumes `V_q`.
+#[derive(Clone, Copy)]
+pub struct NodeVisit<'a> {
+    pub f: &'a [Mat3],
+    /// `∇_X N_a(r_q)` is `grads[q * stride]`.
+    pub grads: &'a [Vector3<f64>],
+    pub stride: usize,
+    pub volumes: &'a [f64],
 }
 
 /// A hyperelastic constitutive model, by reference to its registered law (compare
@@ -327,6 +357,21 @@ impl Material {
         self.model.law().node_block(self.lame(), f, g)
     }
 
+    /// `(P(F) g, B(F, g))` per unit volume ([`HyperelasticModel::node_force_and_block`]) with the
+    /// Lamé parameters `l` of this material ([`Material::lame`], computed once by a caller that
+    /// visits many points).
+    #[inline]
+    pub fn node_force_and_block(&self, l: Lame, f: &Mat3, g: &Vector3<f64>) -> (Vector3<f64>, Mat3) {
+        self.model.law().node_force_and_block(l, f, g)
+    }
+
+    /// `Σ_q V_q (P(F_q) g_q, B(F_q, g_q))` over one element visit
+    /// ([`HyperelasticModel::node_visit`]).
+    #[inline]
+    pub fn node_visit(&self, l: Lame, points: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
+        self.model.law().node_visit(l, points)
+    }
+
     pub fn dpdf_projected(&self, f: &Mat3) -> Mat9 {
         project_psd(&self.dpdf(f))
     }
@@ -423,7 +468,8 @@ fn dpdf_from_directional(dp: impl Fn(&Mat3) -> Mat3) -> Mat9 {
 
 /// The nearest (Frobenius) positive semi-definite matrix to the symmetric part of `m`, written
 /// once for each size: negative eigenvalues clamped to 0; the symmetric part unchanged when
-/// already PSD; non-finite input returned as is.
+/// already PSD (checked first by a Cholesky factorisation, which positive definite matrices —
+/// most of a solve's — pass); non-finite input returned as is.
 macro_rules! project_psd_fn {
     ($(#[$doc:meta])* $vis:vis fn $name:ident($ty:ty)) => {
         $(#[$doc])*
@@ -432,6 +478,11 @@ macro_rules! project_psd_fn {
                 return *m;
             }
             let sym = (m + m.transpose()) * 0.5;
+            // positive definite (a Cholesky factor exists): already its own projection, and
+            // the eigen-decomposition below, tens of times dearer, is skipped
+            if sym.cholesky().is_some() {
+                return sym;
+            }
             match SymmetricEigen::try_new(sym, f64::EPSILON, 10_000) {
                 Some(eig) => {
                     if eig.eigenvalues.iter().all(|&l| l >= 0.0) {
@@ -493,6 +544,7 @@ mod tests {
         every_registered_model_has_split_gradients_matching_finite_differences: check_split_gradients_fd,
         every_registered_model_linearises_to_linear_elasticity_at_rest: check_linearisation_at_rest,
         every_registered_model_agrees_between_energy_and_pk1_and_separate_calls: check_energy_and_pk1_consistent,
+        every_registered_model_has_node_force_and_block_matching_dpdf: check_node_force_and_block_match_dpdf,
     }
 
     #[test]

@@ -26,7 +26,8 @@
 //! (shear) stress as 2μE; a NaN or infinite entry of F otherwise propagates into ψ and P.
 
 use super::lane::{Lane, M3, Scalar, from_mat3, to_mat3, tr_mat_mul};
-use super::{HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, dpdf_from_directional, node_block_from_directional};
+use super::{HyperelasticModel, Lame, Mat3, Mat9, NodeVisit, SplitTerm, dpdf_from_directional};
+use nalgebra::Vector3;
 
 /// E = ½(H + Hᵀ + HᵀH), H = F − I (Green–Lagrange).
 #[inline(always)]
@@ -84,6 +85,135 @@ pub fn energy_and_pk1<L: Lane>(mu: L, lambda: L, f: &M3<L>) -> (L, M3<L>) {
     (energy_from_strain(mu, lambda, &e, tr), super::lane::mat_mul(f, &s))
 }
 
+/// `Σ_k m_kr m_kc` (columns `r`, `c`: `(mᵀm)_rc`).
+#[inline(always)]
+fn col_dot<L: Lane>(m: &M3<L>, r: usize, c: usize) -> L {
+    m[2][r].mul_add(m[2][c], m[1][r].mul_add(m[1][c], m[0][r].mul(m[0][c])))
+}
+
+/// `Σ_k m_rk m_ck` (rows `r`, `c`: `(m mᵀ)_rc`).
+#[inline(always)]
+fn row_dot<L: Lane>(m: &M3<L>, r: usize, c: usize) -> L {
+    m[r][2].mul_add(m[c][2], m[r][1].mul_add(m[c][1], m[r][0].mul(m[c][0])))
+}
+
+/// `m v` for a symmetric `m` given by its entries `[m00, m11, m22, m01, m02, m12]`.
+#[inline(always)]
+fn sym_mul<L: Lane>(m: &[L; 6], v: &[L; 3]) -> [L; 3] {
+    let [m00, m11, m22, m01, m02, m12] = *m;
+    [
+        m02.mul_add(v[2], m01.mul_add(v[1], m00.mul(v[0]))),
+        m12.mul_add(v[2], m11.mul_add(v[1], m01.mul(v[0]))),
+        m22.mul_add(v[2], m12.mul_add(v[1], m02.mul(v[0]))),
+    ]
+}
+
+/// `m v` for a full `m`.
+#[inline(always)]
+fn mat_vec<L: Lane>(m: &M3<L>, v: &[L; 3]) -> [L; 3] {
+    let mut out = [v[0]; 3];
+    for r in 0..3 {
+        out[r] = m[r][2].mul_add(v[2], m[r][1].mul_add(v[1], m[r][0].mul(v[0])));
+    }
+    out
+}
+
+/// One node's share at one point ([`HyperelasticModel::node_force_and_block`]) in closed form,
+/// written once over [`Lane`]s (one point on [`Scalar`], four on the AVX2 lanes of
+/// [`node_visit_avx2`]): `P g = F (S g)` and `B = (g·S g) I + (μ + λ) u ⊗ u + μ |g|² F Fᵀ`,
+/// `u = F g`, on the six independent entries of the symmetric `E`, `S` and `B`
+/// (`[b00, b11, b22, b01, b02, b12]`). `E = (H + Hᵀ + HᵀH)/2` with `H = F − I`, as
+/// [`green_strain`] forms it.
+#[inline(always)]
+pub fn node_point<L: Lane>(mu: L, lambda: L, f: &M3<L>, g: &[L; 3]) -> ([L; 3], [L; 6]) {
+    let (one, half) = (L::splat(1.0), L::splat(0.5));
+    let mut h = *f;
+    for i in 0..3 {
+        h[i][i] = f[i][i].sub(one);
+    }
+    let mut e = [one; 6];
+    for (k, (r, c)) in [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)].into_iter().enumerate() {
+        e[k] = h[r][c].add(h[c][r]).add(col_dot(&h, r, c)).mul(half);
+    }
+    let (two_mu, lt) = (mu.add(mu), lambda.mul(e[0].add(e[1]).add(e[2])));
+    let mut s = e;
+    for (k, sk) in s.iter_mut().enumerate() {
+        *sk = if k < 3 { two_mu.mul_add(e[k], lt) } else { two_mu.mul(e[k]) };
+    }
+    let sg = sym_mul(&s, g);
+    let u = mat_vec(f, g);
+    let c_uu = mu.add(lambda);
+    let c_ff = mu.mul(g[2].mul_add(g[2], g[1].mul_add(g[1], g[0].mul(g[0]))));
+    let diag = g[2].mul_add(sg[2], g[1].mul_add(sg[1], g[0].mul(sg[0])));
+    let mut b = [one; 6];
+    for (k, (r, c)) in [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)].into_iter().enumerate() {
+        b[k] = c_ff.mul_add(row_dot(f, r, c), c_uu.mul(u[r]).mul(u[c]));
+        if k < 3 {
+            b[k] = b[k].add(diag);
+        }
+    }
+    (mat_vec(f, &sg), b)
+}
+
+/// A symmetric block from its entries `[b00, b11, b22, b01, b02, b12]`.
+fn sym_mat3(b: &[f64; 6]) -> Mat3 {
+    let [b00, b11, b22, b01, b02, b12] = *b;
+    Mat3::new(b00, b01, b02, b01, b11, b12, b02, b12, b22)
+}
+
+/// [`HyperelasticModel::node_visit`] four points at a time, one per AVX2 lane (points past the
+/// last repeat it with zero volume).
+///
+/// # Safety
+/// The CPU has AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn node_visit_avx2(l: Lame, p: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
+    use crate::xpbd::kernels::lanes4::F64x4;
+    let (mu, lambda) = (F64x4::splat(l.mu_pa), F64x4::splat(l.lambda_pa));
+    let (mut force, mut block) = ([F64x4::zero(); 3], [F64x4::zero(); 6]);
+    let points = p.volumes.len();
+    let mut q0 = 0;
+    while q0 < points {
+        let mut at = [q0; 4];
+        let mut v = [0.0; 4];
+        for k in 0..4 {
+            if q0 + k < points {
+                at[k] = q0 + k;
+                v[k] = p.volumes[q0 + k];
+            }
+        }
+        let mut f = [[F64x4::zero(); 3]; 3];
+        for (r, row) in f.iter_mut().enumerate() {
+            for (c, x) in row.iter_mut().enumerate() {
+                *x = F64x4::new(p.f[at[0]][(r, c)], p.f[at[1]][(r, c)], p.f[at[2]][(r, c)], p.f[at[3]][(r, c)]);
+            }
+        }
+        let mut g = [F64x4::zero(); 3];
+        for (c, x) in g.iter_mut().enumerate() {
+            let gq = |k: usize| p.grads[at[k] * p.stride][c];
+            *x = F64x4::new(gq(0), gq(1), gq(2), gq(3));
+        }
+        let v = F64x4::new(v[0], v[1], v[2], v[3]);
+        let (fo, bo) = node_point(mu, lambda, &f, &g);
+        for k in 0..3 {
+            force[k] = fo[k].fma(v, force[k]);
+        }
+        for k in 0..6 {
+            block[k] = bo[k].fma(v, block[k]);
+        }
+        q0 += 4;
+    }
+    let (mut fsum, mut bsum) = ([0.0; 3], [0.0; 6]);
+    for k in 0..3 {
+        fsum[k] = force[k].lanes().iter().sum();
+    }
+    for k in 0..6 {
+        bsum[k] = block[k].lanes().iter().sum();
+    }
+    (Vector3::from(fsum), sym_mat3(&bsum))
+}
+
 /// E of an nalgebra F (plain `f64`).
 fn strain(f: &Mat3) -> Mat3 {
     to_mat3(&green_strain(&from_mat3::<false>(f)))
@@ -123,7 +253,35 @@ impl HyperelasticModel for StVenantKirchhoff {
     }
 
     fn node_block(&self, l: Lame, f: &Mat3, g: &nalgebra::Vector3<f64>) -> Mat3 {
-        node_block_from_directional(linearisation(l, f), g)
+        self.node_force_and_block(l, f, g).1
+    }
+
+    /// Closed form: with `dF = e_k ⊗ g`, `dE = (g ⊗ F_kᵀ + F_kᵀ ⊗ g)/2` (`F_k` row `k`), so
+    /// column `k` of `B` is `(g·S g) e_k + (μ + λ)(F g)_k F g + μ |g|² (F Fᵀ) e_k`:
+    /// `B = (g·S g) I + (μ + λ) u ⊗ u + μ |g|² F Fᵀ`, `u = F g`, and `P g = F (S g)`.
+    fn node_force_and_block(&self, l: Lame, f: &Mat3, g: &Vector3<f64>) -> (Vector3<f64>, Mat3) {
+        let g = [Scalar::<false>(g[0]), Scalar(g[1]), Scalar(g[2])];
+        let (force, b) = node_point(Scalar(l.mu_pa), Scalar(l.lambda_pa), &from_mat3::<false>(f), &g);
+        (Vector3::new(force[0].0, force[1].0, force[2].0), sym_mat3(&b.map(|x| x.0)))
+    }
+
+    /// Four points per AVX2 register where the CPU has it and the element more than one point.
+    fn node_visit(&self, l: Lame, points: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
+        #[cfg(target_arch = "x86_64")]
+        if points.volumes.len() > 1
+            && std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma")
+        {
+            // SAFETY: the CPU has AVX2 and FMA (checked)
+            return unsafe { node_visit_avx2(l, points) };
+        }
+        let (mut force, mut block) = (Vector3::zeros(), Mat3::zeros());
+        for (q, v) in points.volumes.iter().enumerate() {
+            let (fq, bq) = self.node_force_and_block(l, &points.f[q], &points.grads[q * points.stride]);
+            force += fq * *v;
+            block += bq * *v;
+        }
+        (force, block)
     }
 
     fn split_terms(&self, _l: Lame, f: &Mat3) -> [SplitTerm; 2] {

@@ -277,6 +277,32 @@ pub fn check_energy_and_pk1_consistent(model: MaterialModel) {
     });
 }
 
+/// A node's share at a point ([`Material::node_force_and_block`], vertex block descent's visit):
+/// `P g` and `Σ_{c,d} ∂P_{rc}/∂F_{kd} g_c g_d` contracted from the full `dP/dF`, for any `g`.
+pub fn check_node_force_and_block_match_dpdf(model: MaterialModel) {
+    let g = prop::array::uniform3(-3.0f64..3.0).prop_map(|a| Vector3::from_column_slice(&a));
+    run((material(model), deformation(model), g), |(m, f, g)| {
+        let (force, block) = m.node_force_and_block(m.lame(), &f, &g);
+        let p = m.pk1(&f);
+        prop_assert!((force - p * g).norm() <= 1e-12 * (p.norm() * g.norm()).max(1e-300), "P g = {force}");
+        let c = m.dpdf(&f);
+        let expected = Mat3::from_fn(|r, k| {
+            let mut sum = 0.0;
+            for cc in 0..3 {
+                for d in 0..3 {
+                    sum += c[(r + 3 * cc, k + 3 * d)] * g[cc] * g[d];
+                }
+            }
+            sum
+        });
+        let scale = (c.norm() * g.norm_squared()).max(1e-300);
+        prop_assert!((block - expected).norm() <= 1e-12 * scale, "block {block}, from dP/dF {expected}");
+        prop_assert_eq!(block, block.transpose());
+        prop_assert_eq!(block, m.node_block(&f, &g));
+        Ok(())
+    });
+}
+
 /// ψ ≥ 0 on random F; exactly when λ ≥ 0, up to rounding otherwise.
 pub fn check_energy_nonnegative(model: MaterialModel, nu_min: f64) {
     run((material_with_nu(model, nu_min, 0.48), deformation_with_amplitude(model, 0.6)), |(m, f)| {

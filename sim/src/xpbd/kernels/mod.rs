@@ -37,7 +37,7 @@ mod sweep;
 #[cfg(target_arch = "x86_64")]
 pub mod batch;
 #[cfg(target_arch = "x86_64")]
-mod lanes4;
+pub(crate) mod lanes4;
 #[cfg(target_arch = "x86_64")]
 pub mod p1x4;
 
