@@ -96,13 +96,7 @@ pub trait HyperelasticModel: Sync + Send + 'static {
     /// ([`NodeVisit`]): one call per element, so a model can keep its point law inlined.
     /// Default: [`HyperelasticModel::node_force_and_block`] point by point.
     fn node_visit(&self, l: Lame, points: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
-        let (mut force, mut block) = (Vector3::zeros(), Mat3::zeros());
-        for (q, v) in points.volumes.iter().enumerate() {
-            let (fq, bq) = self.node_force_and_block(l, &points.f[q], &points.grads[q * points.stride]);
-            force += fq * *v;
-            block += bq * *v;
-        }
-        (force, block)
+        points.sum(|f, g| self.node_force_and_block(l, f, g))
     }
     /// The split constraints `[deviatoric, hydrostatic]` at F.
     fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2];
@@ -127,6 +121,20 @@ pub struct NodeVisit<'a> {
     pub grads: &'a [Vector3<f64>],
     pub stride: usize,
     pub volumes: &'a [f64],
+}
+
+impl NodeVisit<'_> {
+    /// `Σ_q V_q point(F_q, g_q)`, point by point.
+    #[inline]
+    pub fn sum(&self, point: impl Fn(&Mat3, &Vector3<f64>) -> (Vector3<f64>, Mat3)) -> (Vector3<f64>, Mat3) {
+        let (mut force, mut block) = (Vector3::zeros(), Mat3::zeros());
+        for (q, v) in self.volumes.iter().enumerate() {
+            let (fq, bq) = point(&self.f[q], &self.grads[q * self.stride]);
+            force += fq * *v;
+            block += bq * *v;
+        }
+        (force, block)
+    }
 }
 
 /// A hyperelastic constitutive model, by reference to its registered law (compare

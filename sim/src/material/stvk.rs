@@ -275,13 +275,7 @@ impl HyperelasticModel for StVenantKirchhoff {
             // SAFETY: the CPU has AVX2 and FMA (checked)
             return unsafe { node_visit_avx2(l, points) };
         }
-        let (mut force, mut block) = (Vector3::zeros(), Mat3::zeros());
-        for (q, v) in points.volumes.iter().enumerate() {
-            let (fq, bq) = self.node_force_and_block(l, &points.f[q], &points.grads[q * points.stride]);
-            force += fq * *v;
-            block += bq * *v;
-        }
-        (force, block)
+        points.sum(|f, g| self.node_force_and_block(l, f, g))
     }
 
     fn split_terms(&self, _l: Lame, f: &Mat3) -> [SplitTerm; 2] {
