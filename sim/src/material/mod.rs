@@ -113,25 +113,43 @@ pub trait HyperelasticModel: Sync + Send + 'static {
 }
 
 /// One node's visit of one element (vertex block descent): the element's `F_q` at its points,
-/// the node's material gradients `grads[q · stride]` and the volumes `V_q`.
+/// the node's material gradients `∇_X N_a(r_q)` and the volumes `V_q`, **lane-major**: the
+/// points in chunks of `width` (4 for elements with several points, one AVX2 register per
+/// chunk; 1 for one-point elements), each quantity's entry stored for the chunk's points side by
+/// side, so a four-lane law loads a register per entry. Chunk `k`, point `j` of it:
+/// `F_q[r][c] = f[(9k + 3r + c)·width + j]`, `∇N[c] = grads[(3k + c)·width + j]`,
+/// `V_q = volumes[k·width + j]`; past the last point a chunk is padded with `V = 0`, `F = I`,
+/// `∇N = 0`.
 #[derive(Clone, Copy)]
 pub struct NodeVisit<'a> {
-    pub f: &'a [Mat3],
-    /// `∇_X N_a(r_q)` is `grads[q * stride]`.
-    pub grads: &'a [Vector3<f64>],
-    pub stride: usize,
+    pub width: usize,
+    pub f: &'a [f64],
+    pub grads: &'a [f64],
     pub volumes: &'a [f64],
 }
 
 impl NodeVisit<'_> {
-    /// `Σ_q V_q point(F_q, g_q)`, point by point.
+    /// The visit's `F_q`, `∇N` and `V_q` at point `j` of chunk `k`.
+    #[inline]
+    pub fn point(&self, k: usize, j: usize) -> (Mat3, Vector3<f64>, f64) {
+        let w = self.width;
+        let f = Mat3::from_fn(|r, c| self.f[(9 * k + 3 * r + c) * w + j]);
+        let g = Vector3::from_fn(|c, _| self.grads[(3 * k + c) * w + j]);
+        (f, g, self.volumes[k * w + j])
+    }
+
+    /// `Σ_q V_q point(F_q, g_q)`, point by point (padding skipped).
     #[inline]
     pub fn sum(&self, point: impl Fn(&Mat3, &Vector3<f64>) -> (Vector3<f64>, Mat3)) -> (Vector3<f64>, Mat3) {
         let (mut force, mut block) = (Vector3::zeros(), Mat3::zeros());
-        for (q, v) in self.volumes.iter().enumerate() {
-            let (fq, bq) = point(&self.f[q], &self.grads[q * self.stride]);
-            force += fq * *v;
-            block += bq * *v;
+        for (p, &v) in self.volumes.iter().enumerate() {
+            if v == 0.0 {
+                continue;
+            }
+            let (f, g, _) = self.point(p / self.width, p % self.width);
+            let (fq, bq) = point(&f, &g);
+            force += fq * v;
+            block += bq * v;
         }
         (force, block)
     }
@@ -514,10 +532,27 @@ project_psd_fn!(
     fn project_psd(Mat9)
 );
 project_psd_fn!(
-    /// Nearest PSD matrix to the symmetric part of a 3 × 3 block (a node's Hessian block in
-    /// vertex block descent).
-    pub fn project_psd3(Matrix3<f64>)
+    /// [`project_psd3`] past its positive-definite test.
+    fn project_psd3_general(Matrix3<f64>)
 );
+
+/// Nearest PSD matrix to the symmetric part of a 3 × 3 block (a node's Hessian block in vertex
+/// block descent). A block whose leading minors are all positive (Sylvester's criterion: positive
+/// definite, the usual case) is its own projection, told in a dozen flops.
+#[inline]
+pub fn project_psd3(m: &Matrix3<f64>) -> Matrix3<f64> {
+    let (a, d, f) = (m[(0, 0)], m[(1, 1)], m[(2, 2)]);
+    let b = 0.5 * (m[(0, 1)] + m[(1, 0)]);
+    let c = 0.5 * (m[(0, 2)] + m[(2, 0)]);
+    let e = 0.5 * (m[(1, 2)] + m[(2, 1)]);
+    let minor2 = a * d - b * b;
+    let det = a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c);
+    // NaN fails every comparison and goes on to the general path
+    if a > 0.0 && minor2 > 0.0 && det > 0.0 {
+        return Matrix3::new(a, b, c, b, d, e, c, e, f);
+    }
+    project_psd3_general(m)
+}
 
 #[cfg(test)]
 mod tests {
@@ -553,6 +588,7 @@ mod tests {
         every_registered_model_linearises_to_linear_elasticity_at_rest: check_linearisation_at_rest,
         every_registered_model_agrees_between_energy_and_pk1_and_separate_calls: check_energy_and_pk1_consistent,
         every_registered_model_has_node_force_and_block_matching_dpdf: check_node_force_and_block_match_dpdf,
+        every_registered_model_has_a_node_visit_summing_its_points: check_node_visit_matches_point_sum,
     }
 
     #[test]

@@ -161,57 +161,39 @@ fn sym_mat3(b: &[f64; 6]) -> Mat3 {
     Mat3::new(b00, b01, b02, b01, b11, b12, b02, b12, b22)
 }
 
-/// [`HyperelasticModel::node_visit`] four points at a time, one per AVX2 lane (points past the
-/// last repeat it with zero volume).
+/// [`HyperelasticModel::node_visit`] four points at a time, one chunk of the lane-major visit
+/// per AVX2 register (padding has zero volume).
 ///
 /// # Safety
-/// The CPU has AVX2 and FMA.
+/// The CPU has AVX2 and FMA; `p.width` is 4.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn node_visit_avx2(l: Lame, p: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
     use crate::xpbd::kernels::lanes4::F64x4;
+    debug_assert_eq!(p.width, 4);
     let (mu, lambda) = (F64x4::splat(l.mu_pa), F64x4::splat(l.lambda_pa));
     let (mut force, mut block) = ([F64x4::zero(); 3], [F64x4::zero(); 6]);
-    let points = p.volumes.len();
-    let mut q0 = 0;
-    while q0 < points {
-        let mut at = [q0; 4];
-        let mut v = [0.0; 4];
-        for k in 0..4 {
-            if q0 + k < points {
-                at[k] = q0 + k;
-                v[k] = p.volumes[q0 + k];
-            }
-        }
-        let mut f = [[F64x4::zero(); 3]; 3];
-        for (r, row) in f.iter_mut().enumerate() {
-            for (c, x) in row.iter_mut().enumerate() {
-                *x = F64x4::new(p.f[at[0]][(r, c)], p.f[at[1]][(r, c)], p.f[at[2]][(r, c)], p.f[at[3]][(r, c)]);
-            }
-        }
-        let mut g = [F64x4::zero(); 3];
-        for (c, x) in g.iter_mut().enumerate() {
-            let gq = |k: usize| p.grads[at[k] * p.stride][c];
-            *x = F64x4::new(gq(0), gq(1), gq(2), gq(3));
-        }
-        let v = F64x4::new(v[0], v[1], v[2], v[3]);
+    // whole chunks only, so every load below is in bounds
+    let chunks = (p.volumes.len() / 4).min(p.f.len() / 36).min(p.grads.len() / 12);
+    for k in 0..chunks {
+        // SAFETY: in bounds (whole chunks)
+        let at = |s: &[f64], i: usize| unsafe { F64x4::load(s.as_ptr().add(4 * i)) };
+        let f: [[F64x4; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| at(p.f, 9 * k + 3 * r + c)));
+        let g: [F64x4; 3] = std::array::from_fn(|c| at(p.grads, 3 * k + c));
+        let v = at(p.volumes, k);
         let (fo, bo) = node_point(mu, lambda, &f, &g);
-        for k in 0..3 {
-            force[k] = fo[k].fma(v, force[k]);
+        for i in 0..3 {
+            force[i] = fo[i].fma(v, force[i]);
         }
-        for k in 0..6 {
-            block[k] = bo[k].fma(v, block[k]);
+        for i in 0..6 {
+            block[i] = bo[i].fma(v, block[i]);
         }
-        q0 += 4;
     }
-    let (mut fsum, mut bsum) = ([0.0; 3], [0.0; 6]);
-    for k in 0..3 {
-        fsum[k] = force[k].lanes().iter().sum();
-    }
-    for k in 0..6 {
-        bsum[k] = block[k].lanes().iter().sum();
-    }
-    (Vector3::from(fsum), sym_mat3(&bsum))
+    let zero = F64x4::zero();
+    let [f0, f1, f2, b0] = F64x4::horizontal_sums([force[0], force[1], force[2], block[0]]).lanes();
+    let [b1, b2, b3, b4] = F64x4::horizontal_sums([block[1], block[2], block[3], block[4]]).lanes();
+    let [b5, ..] = F64x4::horizontal_sums([block[5], zero, zero, zero]).lanes();
+    (Vector3::new(f0, f1, f2), sym_mat3(&[b0, b1, b2, b3, b4, b5]))
 }
 
 /// E of an nalgebra F (plain `f64`).
@@ -265,10 +247,10 @@ impl HyperelasticModel for StVenantKirchhoff {
         (Vector3::new(force[0].0, force[1].0, force[2].0), sym_mat3(&b.map(|x| x.0)))
     }
 
-    /// Four points per AVX2 register where the CPU has it and the element more than one point.
+    /// Four points per AVX2 register where the CPU has it and the visit is four lanes wide.
     fn node_visit(&self, l: Lame, points: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
         #[cfg(target_arch = "x86_64")]
-        if points.volumes.len() > 1
+        if points.width == 4
             && std::arch::is_x86_feature_detected!("avx2")
             && std::arch::is_x86_feature_detected!("fma")
         {

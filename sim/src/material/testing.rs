@@ -2,7 +2,7 @@
 //! shared by every material model (run on every model of the registry by the
 //! `every_registered_model_*` tests in `material/mod.rs`).
 
-use super::{Lame, Mat3, Mat9, Material, MaterialModel};
+use super::{Lame, Mat3, Mat9, Material, MaterialModel, NodeVisit};
 use nalgebra::{Rotation3, SymmetricEigen, Vector3};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
@@ -299,6 +299,47 @@ pub fn check_node_force_and_block_match_dpdf(model: MaterialModel) {
         prop_assert!((block - expected).norm() <= 1e-12 * scale, "block {block}, from dP/dF {expected}");
         prop_assert_eq!(block, block.transpose());
         prop_assert_eq!(block, m.node_block(&f, &g));
+        Ok(())
+    });
+}
+
+/// A whole node visit ([`Material::node_visit`], lane-major, a model's own fast path such as
+/// StVK's four lanes per AVX2 register) is `Σ_q V_q` of the point-by-point
+/// [`Material::node_force_and_block`], on five points (two chunks of four lanes, the second
+/// padded) and on one point (one lane).
+pub fn check_node_visit_matches_point_sum(model: MaterialModel) {
+    let g = prop::array::uniform3(-3.0f64..3.0).prop_map(|a| Vector3::from_column_slice(&a));
+    let points = prop::collection::vec((deformation(model), g, 0.01f64..1.0), 5);
+    run((material(model), points), |(m, points)| {
+        for (width, used) in [(4usize, 5usize), (1, 1)] {
+            let chunks = used.div_ceil(width);
+            let (mut f, mut grads, mut volumes) =
+                (vec![0.0; 9 * chunks * width], vec![0.0; 3 * chunks * width], vec![0.0; chunks * width]);
+            for k in 0..chunks {
+                for d in [0, 4, 8] {
+                    f[(9 * k + d) * width..][..width].fill(1.0);
+                }
+            }
+            let (mut force, mut block) = (Vector3::zeros(), Mat3::zeros());
+            for (q, (fq, gq, v)) in points.iter().take(used).enumerate() {
+                let (k, j) = (q / width, q % width);
+                for r in 0..3 {
+                    for c in 0..3 {
+                        f[(9 * k + 3 * r + c) * width + j] = fq[(r, c)];
+                    }
+                    grads[(3 * k + r) * width + j] = gq[r];
+                }
+                volumes[k * width + j] = *v;
+                let (fo, bo) = m.node_force_and_block(m.lame(), fq, gq);
+                force += fo * *v;
+                block += bo * *v;
+            }
+            let visit = NodeVisit { width, f: &f, grads: &grads, volumes: &volumes };
+            let (got_force, got_block) = m.node_visit(m.lame(), visit);
+            let scale = force.norm().max(block.norm()).max(1e-300);
+            prop_assert!((got_force - force).norm() <= 1e-12 * scale, "force {got_force} vs {force} (width {width})");
+            prop_assert!((got_block - block).norm() <= 1e-12 * scale, "block {got_block} vs {block} (width {width})");
+        }
         Ok(())
     });
 }

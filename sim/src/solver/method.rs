@@ -182,7 +182,7 @@ pub(crate) trait StepSolver: Send {
 pub(crate) fn make(mesh: &Mesh, geometry: &[BlockGeometry], settings: &SolverSettings) -> Box<dyn StepSolver> {
     match settings.method {
         Method::Xpbd => Box::new(super::xpbd::Xpbd::new(mesh, geometry, settings)),
-        Method::Vbd => Box::new(super::vbd::Vbd::new(mesh, settings)),
+        Method::Vbd => Box::new(super::vbd::Vbd::new(mesh, geometry, settings)),
         Method::Newton => Box::new(super::newton::Newton::new(mesh)),
     }
 }

@@ -29,11 +29,16 @@
 //! - Effects: contact's projection runs after every sweep; attachments are springs in `G`.
 //!
 //! **Cost.** A sweep visits every (node, element holding it) pair with the element's whole
-//! quadrature, so it is kept to what the visit cannot avoid: the elements' `F_q` are cached and
-//! moved with each node ([`PointGradients`]) instead of gathered and summed per visit; `P g` and
-//! the block come from one call that shares their work ([`crate::material::Material::node_force_and_block`],
-//! closed form for StVK); the projection of a block that is already positive definite is one
-//! 3 × 3 Cholesky factorisation, not an eigen-decomposition.
+//! quadrature, so it is kept to what the visit cannot avoid: the elements' `F_q` are cached
+//! lane-major (four points per AVX2 register, [`PointLanes`]) and moved with each node and each
+//! acceleration step instead of gathered and summed per visit; `P g` and the block come from one
+//! call that shares their work ([`crate::material::Material::node_visit`], closed form for StVK
+//! on four lanes); a block is tested positive definite by its leading minors before any
+//! eigen-decomposition ([`crate::material::project_psd3`]); the node update and the `F_q` moves
+//! are compiled for AVX2 and FMA where the CPU has them ([`Fused`]), and the 3 × 3 solve is a
+//! hand-written Cholesky.
+//! Measured on Gmsh's P2 beam (1,471 elements, docs/PERFORMANCE.md): about 570 instructions
+//! per node-element visit, half of them the StVK law.
 
 use super::SolverCounters;
 use super::method::{Hooks, Method, StepInput, StepSolver};
@@ -41,12 +46,11 @@ use super::nan_guard::{BadElement, ORIGIN_VBD};
 use super::settings::{SolverSettings, VbdInit};
 use crate::Vec3;
 use crate::effect::{ImplicitRole, NodeSpring};
-use crate::fem::energy::{element_grads, gather};
-use crate::fem::geometry::{BlockGeometry, deformation_gradient};
+use crate::fem::energy::element_grads;
+use crate::fem::geometry::BlockGeometry;
 use crate::material::{Lame, NodeVisit, project_psd3};
 use crate::mesh::Mesh;
 use crate::mesh::adjacency::{NodeIncidence, colour_nodes};
-use crate::xpbd::constraint::NodeScratch;
 use crate::xpbd::kernels::SharedMut;
 use nalgebra::Matrix3;
 
@@ -66,11 +70,14 @@ pub(crate) struct Vbd {
     y: Vec<Vec3>,
     prev_iter: Vec<Vec3>,
     prev_prev: Vec<Vec3>,
-    f_points: PointGradients,
+    lanes: PointLanes,
+    /// The `F_q` at the last two sweeps, for the acceleration.
+    f_snapshots: Snapshots,
+    fused: Fused,
 }
 
 impl Vbd {
-    pub fn new(mesh: &Mesh, _settings: &SolverSettings) -> Self {
+    pub fn new(mesh: &Mesh, geometry: &[BlockGeometry], _settings: &SolverSettings) -> Self {
         let incidence = NodeIncidence::new(mesh);
         let colours = colour_nodes(mesh, &incidence);
         Self {
@@ -82,41 +89,298 @@ impl Vbd {
             y: Vec::new(),
             prev_iter: Vec::new(),
             prev_prev: Vec::new(),
-            f_points: PointGradients::default(),
+            lanes: PointLanes::new(mesh, geometry),
+            f_snapshots: Snapshots::default(),
+            fused: Fused::detect(),
         }
     }
 }
 
-/// `F_q` of every quadrature point of every element, block by block (`e · points + q`), kept in
-/// step with the positions: refreshed from them before each sweep ([`PointGradients::refresh`]),
-/// then moved by `Δ ⊗ ∇_X N_a(r_q)` when node `a` of the element moves by `Δ` (`F` is linear in
-/// the positions), so a node visit reads its elements' `F_q` instead of gathering their nodes.
+/// What a node visit reads of each element, lane-major ([`NodeVisit`]): per block, the points
+/// in chunks of `width` (4 where the element has several points, one AVX2 register per chunk; 1
+/// for one-point elements), the nodes' `∇_X N_a(r_q)` and the volumes `V_q` (padding: zero), and
+/// the elements' `F_q`, kept in step with the positions: refreshed from them before each sweep
+/// ([`PointLanes::refresh`]), then moved by `Δ ⊗ ∇_X N_a(r_q)` when node `a` of the element
+/// moves by `Δ` ([`carry_points`]; `F` is linear in the positions), so a node visit reads its
+/// elements' `F_q` instead of gathering their nodes.
 #[derive(Default)]
-struct PointGradients {
-    blocks: Vec<Vec<Matrix3<f64>>>,
+struct PointLanes {
+    blocks: Vec<LaneBlock>,
 }
 
-/// Fewest elements per parallel task of [`PointGradients::refresh`].
+/// One block's lane-major data ([`PointLanes`]); element `e`'s entries start at `e ·` the
+/// per-element lengths.
+#[derive(Default)]
+struct LaneBlock {
+    nodes: usize,
+    chunks: usize,
+    width: usize,
+    /// Element `e`, node `a`, chunk `k`, coordinate `c`, lane `j`: `(((e·nodes + a)·chunks + k)·3 + c)·width + j`.
+    grads: Vec<f64>,
+    /// Element `e`, chunk `k`, lane `j`: `(e·chunks + k)·width + j`.
+    volumes: Vec<f64>,
+    /// Element `e`, chunk `k`, entry `(r, c)`, lane `j`: `((e·chunks + k)·9 + 3r + c)·width + j`.
+    f: Vec<f64>,
+}
+
+/// Fewest elements per parallel task of [`PointLanes::refresh`].
 const MIN_ELEMENTS_PER_TASK: usize = 256;
 
-impl PointGradients {
-    fn refresh(&mut self, mesh: &Mesh, geometry: &[BlockGeometry], positions: &[Vec3]) {
-        use rayon::prelude::*;
-        self.blocks.resize_with(mesh.blocks.len(), Vec::new);
-        for ((fb, block), g) in self.blocks.iter_mut().zip(&mesh.blocks).zip(geometry) {
-            let (n, points) = (g.nodes_per_element, g.points_per_element);
-            fb.resize(block.len() * points, Matrix3::zeros());
-            fb.par_chunks_mut(points).with_min_len(MIN_ELEMENTS_PER_TASK).enumerate().for_each(|(e, out)| {
-                let nodes = block.element(e);
-                let (mut x, mut rest) = (NodeScratch::new(Vec3::zeros(), n), NodeScratch::new(Vec3::zeros(), n));
-                let (x, rest) = (x.as_mut_slice(), rest.as_mut_slice());
-                gather(positions, nodes, x);
-                gather(&mesh.rest_positions, nodes, rest);
-                let grads = element_grads(g, e);
-                for (q, f) in out.iter_mut().enumerate() {
-                    *f = deformation_gradient(x, rest, &grads[q * n..(q + 1) * n]);
+impl LaneBlock {
+    fn new(block: &crate::mesh::ElementBlock, g: &BlockGeometry) -> Self {
+        let (nodes, points) = (g.nodes_per_element, g.points_per_element);
+        let width = if points > 1 { 4 } else { 1 };
+        let chunks = points.div_ceil(width);
+        let elements = block.len();
+        let mut lanes = LaneBlock {
+            nodes,
+            chunks,
+            width,
+            grads: vec![0.0; elements * nodes * chunks * 3 * width],
+            volumes: vec![0.0; elements * chunks * width],
+            f: Vec::new(),
+        };
+        for e in 0..elements {
+            let (grads, volumes) = (element_grads(g, e), g.volumes(e));
+            for (q, &v) in volumes.iter().enumerate() {
+                let (k, j) = (q / width, q % width);
+                lanes.volumes[(e * chunks + k) * width + j] = v;
+                for a in 0..nodes {
+                    for c in 0..3 {
+                        lanes.grads[(((e * nodes + a) * chunks + k) * 3 + c) * width + j] = grads[q * nodes + a][c];
+                    }
                 }
+            }
+        }
+        lanes
+    }
+    /// The read-only part and `F_q`.
+    fn split(&mut self) -> (LaneGeometry<'_>, &mut Vec<f64>) {
+        let LaneBlock { nodes, chunks, width, grads, volumes, f } = self;
+        let geometry = LaneGeometry { nodes: *nodes, chunks: *chunks, width: *width, grads, volumes };
+        (geometry, f)
+    }
+}
+
+/// `f += Σ_r Σ_c d_r ∇N_c` into entry `(r, c)` of every chunk, `W` lanes wide (`F_q += d ⊗ ∇N`);
+/// `FMA`: fused multiply-adds (only where the CPU has them: the [`Fused`] paths).
+#[inline(always)]
+fn add_outer<const W: usize, const FMA: bool>(f: &mut [f64], d: &Vec3, grads: &[f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if W == 4 && FMA {
+        use crate::xpbd::kernels::lanes4::F64x4;
+        let dr = [F64x4::splat(d[0]), F64x4::splat(d[1]), F64x4::splat(d[2])];
+        for (fk, gk) in f.chunks_exact_mut(36).zip(grads.chunks_exact(12)) {
+            // SAFETY: in bounds (chunks of 36 and 12); the fused paths run only where the CPU
+            // has AVX2 and FMA
+            unsafe {
+                let g = [F64x4::load(gk.as_ptr()), F64x4::load(gk.as_ptr().add(4)), F64x4::load(gk.as_ptr().add(8))];
+                for (r, dr) in dr.iter().enumerate() {
+                    for (c, g) in g.iter().enumerate() {
+                        let p = fk.as_mut_ptr().add(4 * (3 * r + c));
+                        dr.fma(*g, F64x4::load(p)).store(p);
+                    }
+                }
+            }
+        }
+        return;
+    }
+    for (fk, gk) in f.chunks_exact_mut(9 * W).zip(grads.chunks_exact(3 * W)) {
+        for r in 0..3 {
+            for c in 0..3 {
+                let (dst, src) = (&mut fk[(3 * r + c) * W..][..W], &gk[c * W..][..W]);
+                for j in 0..W {
+                    dst[j] = if FMA { d[r].mul_add(src[j], dst[j]) } else { dst[j] + d[r] * src[j] };
+                }
+            }
+        }
+    }
+}
+
+/// [`add_outer`] at the block's width.
+#[inline(always)]
+fn add_outer_any<const FMA: bool>(width: usize, f: &mut [f64], d: &Vec3, grads: &[f64]) {
+    match width {
+        4 => add_outer::<4, FMA>(f, d, grads),
+        _ => add_outer::<1, FMA>(f, d, grads),
+    }
+}
+
+/// Whether the CPU has AVX2 and FMA: the sweep's node updates and `F_q` refreshes are then
+/// compiled for them (four-lane `F_q` moves in one fused instruction per entry).
+#[derive(Clone, Copy)]
+struct Fused(bool);
+
+impl Fused {
+    fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            Fused(std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma"))
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            Fused(false)
+        }
+    }
+}
+
+/// What an `F_q` refresh reads.
+struct RefreshInput<'a> {
+    lanes: LaneGeometry<'a>,
+    mesh: &'a Mesh,
+    positions: &'a [Vec3],
+}
+
+/// Element `e`'s `F_q` from the positions (`out`: its lane-major entries).
+#[inline(always)]
+fn refresh_element<const FMA: bool>(input: &RefreshInput<'_>, e: usize, nodes: &[u32], out: &mut [f64]) {
+    let w = input.lanes.width;
+    out.fill(0.0);
+    for k in 0..input.lanes.chunks {
+        for diagonal in [0, 4, 8] {
+            out[(9 * k + diagonal) * w..][..w].fill(1.0);
+        }
+    }
+    for (a, &node) in nodes.iter().enumerate() {
+        let u = input.positions[node as usize] - input.mesh.rest_positions[node as usize];
+        add_outer_any::<FMA>(w, out, &u, input.lanes.node_grads(e, a));
+    }
+}
+
+/// [`refresh_element`] compiled for AVX2 and FMA.
+///
+/// # Safety
+/// The CPU has AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn refresh_element_fused(input: &RefreshInput<'_>, e: usize, nodes: &[u32], out: &mut [f64]) {
+    refresh_element::<true>(input, e, nodes, out)
+}
+
+/// What a block's lane-major data holds besides `F_q` (read-only during a sweep).
+#[derive(Clone, Copy)]
+struct LaneGeometry<'a> {
+    nodes: usize,
+    chunks: usize,
+    width: usize,
+    grads: &'a [f64],
+    volumes: &'a [f64],
+}
+
+impl<'a> LaneGeometry<'a> {
+    fn grads_len(&self) -> usize {
+        self.chunks * 3 * self.width
+    }
+    fn volumes_len(&self) -> usize {
+        self.chunks * self.width
+    }
+    fn f_len(&self) -> usize {
+        self.chunks * 9 * self.width
+    }
+    /// Node `a` of element `e`: its gradients.
+    #[inline(always)]
+    fn node_grads(&self, e: usize, a: usize) -> &'a [f64] {
+        let len = self.grads_len();
+        &self.grads[(e * self.nodes + a) * len..][..len]
+    }
+    #[inline(always)]
+    fn volumes(&self, e: usize) -> &'a [f64] {
+        let len = self.volumes_len();
+        &self.volumes[e * len..][..len]
+    }
+}
+
+impl PointLanes {
+    fn new(mesh: &Mesh, geometry: &[BlockGeometry]) -> Self {
+        Self { blocks: mesh.blocks.iter().zip(geometry).map(|(block, g)| LaneBlock::new(block, g)).collect() }
+    }
+
+    /// `F_q = I + Σ_a (x_a − X_a) ⊗ ∇_X N_a(r_q)` of every element from the positions.
+    fn refresh(&mut self, mesh: &Mesh, positions: &[Vec3], fused: Fused) {
+        use rayon::prelude::*;
+        for (lanes, block) in self.blocks.iter_mut().zip(&mesh.blocks) {
+            let (geometry, f) = lanes.split();
+            let len = geometry.f_len();
+            let input = RefreshInput { lanes: geometry, mesh, positions };
+            f.resize(block.len() * len, 0.0);
+            f.par_chunks_mut(len).with_min_len(MIN_ELEMENTS_PER_TASK).enumerate().for_each(|(e, out)| {
+                let nodes = block.element(e);
+                #[cfg(target_arch = "x86_64")]
+                if fused.0 {
+                    // SAFETY: the CPU has AVX2 and FMA (detected)
+                    return unsafe { refresh_element_fused(&input, e, nodes, out) };
+                }
+                refresh_element::<false>(&input, e, nodes, out)
             });
+        }
+    }
+}
+
+/// One block of [`PointLanes`] as the sweep uses it: `F_q` written by the node updates of a
+/// colour in parallel, the rest read.
+#[derive(Clone, Copy)]
+struct LaneView<'a> {
+    geometry: LaneGeometry<'a>,
+    f_len: usize,
+    f: SharedMut<f64>,
+}
+
+impl<'a> LaneView<'a> {
+    fn of(lanes: &'a mut PointLanes) -> Vec<LaneView<'a>> {
+        lanes
+            .blocks
+            .iter_mut()
+            .map(|b| {
+                let (geometry, f) = b.split();
+                LaneView { geometry, f_len: geometry.f_len(), f: SharedMut::new(f) }
+            })
+            .collect()
+    }
+
+    /// Element `e`'s `F_q`.
+    ///
+    /// # Safety
+    /// No other thread may access them while the slice lives.
+    #[inline(always)]
+    #[allow(clippy::mut_from_ref)] // one element per task of a colour: the point of SharedMut
+    unsafe fn f_mut(&self, e: usize) -> &mut [f64] {
+        // SAFETY: the caller's promise
+        unsafe { self.f.slice_mut(e * self.f_len, self.f_len) }
+    }
+}
+
+/// The `F_q` of every block at sweeps `k − 2` and `k − 1` of the Chebyshev acceleration, mixed
+/// as the positions are: `F⁽ᵏ⁾ = ω_k (F̄⁽ᵏ⁾ − F⁽ᵏ⁻²⁾) + F⁽ᵏ⁻²⁾`.
+#[derive(Default)]
+struct Snapshots {
+    prev_prev: Vec<Vec<f64>>,
+    prev_iter: Vec<Vec<f64>>,
+}
+
+impl Snapshots {
+    /// Both snapshots at the current `F_q`.
+    fn start(&mut self, lanes: &PointLanes) {
+        for snapshot in [&mut self.prev_prev, &mut self.prev_iter] {
+            snapshot.resize_with(lanes.blocks.len(), Vec::new);
+            for (to, from) in snapshot.iter_mut().zip(&lanes.blocks) {
+                to.clear();
+                to.extend_from_slice(&from.f);
+            }
+        }
+    }
+
+    /// After a sweep: mixes the `F_q` with factor `omega` (when accelerating), then moves the
+    /// snapshots on.
+    fn advance(&mut self, lanes: &mut PointLanes, omega: Option<f64>) {
+        for ((block, prev_prev), prev_iter) in lanes.blocks.iter_mut().zip(&mut self.prev_prev).zip(&mut self.prev_iter)
+        {
+            if let Some(omega) = omega {
+                for (f, &p) in block.f.iter_mut().zip(prev_prev.iter()) {
+                    *f = (*f - p) * omega + p;
+                }
+            }
+            std::mem::swap(prev_prev, prev_iter);
+            prev_iter.copy_from_slice(&block.f);
         }
     }
 }
@@ -129,6 +393,7 @@ struct NodeUpdate<'a> {
     springs: &'a [NodeSpring],
     w: f64,
     lame: Lame,
+    fused: Fused,
 }
 
 impl NodeUpdate<'_> {
@@ -139,11 +404,40 @@ impl NodeUpdate<'_> {
     /// # Safety
     /// No other thread may access node `i` or the `F_q` of an element holding it meanwhile
     /// (nodes of one colour share no element).
-    unsafe fn step(
+    unsafe fn step(&self, i: usize, positions: SharedMut<Vec3>, lanes: &[LaneView<'_>]) -> Result<bool, BadElement> {
+        #[cfg(target_arch = "x86_64")]
+        if self.fused.0 {
+            // SAFETY: the CPU has AVX2 and FMA (detected); the caller's promise
+            return unsafe { self.step_fused(i, positions, lanes) };
+        }
+        // SAFETY: the caller's promise
+        unsafe { self.step_in::<false>(i, positions, lanes) }
+    }
+
+    /// [`NodeUpdate::step`] compiled for AVX2 and FMA.
+    ///
+    /// # Safety
+    /// [`NodeUpdate::step`]'s, and the CPU has AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn step_fused(
         &self,
         i: usize,
         positions: SharedMut<Vec3>,
-        f_points: &[SharedMut<Matrix3<f64>>],
+        lanes: &[LaneView<'_>],
+    ) -> Result<bool, BadElement> {
+        // SAFETY: the caller's promise
+        unsafe { self.step_in::<true>(i, positions, lanes) }
+    }
+
+    /// # Safety
+    /// [`NodeUpdate::step`]'s; with `FMA`, the CPU has FMA.
+    #[inline(always)]
+    unsafe fn step_in<const FMA: bool>(
+        &self,
+        i: usize,
+        positions: SharedMut<Vec3>,
+        lanes: &[LaneView<'_>],
     ) -> Result<bool, BadElement> {
         let s = self.input;
         // SAFETY: the caller's promise
@@ -153,11 +447,11 @@ impl NodeUpdate<'_> {
         let mut h = Matrix3::identity() * m_w;
         for inc in self.incidence.of(i) {
             let (b, e, a) = (inc.block as usize, inc.element as usize, inc.local as usize);
-            let g = &s.geometry[b];
-            let (n, points) = (g.nodes_per_element, g.points_per_element);
+            let l = &lanes[b];
             // SAFETY: an element holding node i
-            let fq: &[Matrix3<f64>] = unsafe { f_points[b].slice_mut(e * points, points) };
-            let visit = NodeVisit { f: fq, grads: &element_grads(g, e)[a..], stride: n, volumes: g.volumes(e) };
+            let fq = unsafe { l.f_mut(e) };
+            let g = &l.geometry;
+            let visit = NodeVisit { width: g.width, f: fq, grads: g.node_grads(e, a), volumes: g.volumes(e) };
             let (force, block) = s.material.node_visit(self.lame, visit);
             f -= force;
             h += project_psd3(&block);
@@ -169,40 +463,52 @@ impl NodeUpdate<'_> {
         if f == Vec3::zeros() {
             return Ok(false);
         }
-        let d = match h.cholesky().map(|c| c.solve(&f)) {
-            Some(d) if d.iter().all(|c| c.is_finite()) => d,
-            _ => return Err(BadElement::at_node(s.mesh, i, ORIGIN_VBD)),
+        let Some(d) = solve_spd3(&h, &f) else {
+            return Err(BadElement::at_node(s.mesh, i, ORIGIN_VBD));
         };
         // SAFETY: the caller's promise
         unsafe {
             positions.write(i, xi + d);
-            carry_points(self.incidence, s.geometry, i, d, f_points);
+            carry_points::<FMA>(self.incidence, i, d, lanes);
         }
         Ok(true)
     }
 }
 
+/// `H⁻¹ f` for a symmetric positive definite 3 × 3 `H` by its Cholesky factor `L Lᵀ` (lower
+/// triangle read); `None` when `H` is not positive definite or the result not finite.
+#[inline(always)]
+fn solve_spd3(h: &Matrix3<f64>, f: &Vec3) -> Option<Vec3> {
+    let l00 = h[(0, 0)].sqrt();
+    let (l10, l20) = (h[(1, 0)] / l00, h[(2, 0)] / l00);
+    let l11 = (h[(1, 1)] - l10 * l10).sqrt();
+    let l21 = (h[(2, 1)] - l20 * l10) / l11;
+    let l22 = (h[(2, 2)] - l20 * l20 - l21 * l21).sqrt();
+    // L z = f, then Lᵀ d = z
+    let z0 = f[0] / l00;
+    let z1 = (f[1] - l10 * z0) / l11;
+    let z2 = (f[2] - l20 * z0 - l21 * z1) / l22;
+    let d2 = z2 / l22;
+    let d1 = (z1 - l21 * d2) / l11;
+    let d0 = (z0 - l10 * d1 - l20 * d2) / l00;
+    // a non-positive pivot's square root is NaN (or zero, dividing to ±∞)
+    let d = Vec3::new(d0, d1, d2);
+    d.iter().all(|c| c.is_finite()).then_some(d)
+}
+
 /// Moves the `F_q` of every element holding node `i` by `Δ ⊗ ∇_X N_a(r_q)` (node `i` moved by `d`).
 ///
 /// # Safety
-/// No other thread may access the `F_q` of an element holding node `i` meanwhile.
-unsafe fn carry_points(
-    incidence: &NodeIncidence,
-    geometry: &[BlockGeometry],
-    i: usize,
-    d: Vec3,
-    f_points: &[SharedMut<Matrix3<f64>>],
-) {
+/// No other thread may access the `F_q` of an element holding node `i` meanwhile; with `FMA`,
+/// the CPU has FMA.
+#[inline(always)]
+unsafe fn carry_points<const FMA: bool>(incidence: &NodeIncidence, i: usize, d: Vec3, lanes: &[LaneView<'_>]) {
     for inc in incidence.of(i) {
         let (b, e, a) = (inc.block as usize, inc.element as usize, inc.local as usize);
-        let g = &geometry[b];
-        let (n, points) = (g.nodes_per_element, g.points_per_element);
-        let grads = element_grads(g, e);
+        let l = &lanes[b];
         // SAFETY: the caller's promise
-        let fq = unsafe { f_points[b].slice_mut(e * points, points) };
-        for (q, fq) in fq.iter_mut().enumerate() {
-            *fq += d * grads[q * n + a].transpose();
-        }
+        let fq = unsafe { l.f_mut(e) };
+        add_outer_any::<FMA>(l.geometry.width, fq, &d, l.geometry.node_grads(e, a));
     }
 }
 
@@ -228,7 +534,11 @@ impl StepSolver for Vbd {
         self.v_start.resize(num_nodes, Vec3::zeros());
     }
 
-    fn rebuild(&mut self, _mesh: &Mesh, _geometry: &[BlockGeometry], _settings: &SolverSettings, _geo: bool) {}
+    fn rebuild(&mut self, mesh: &Mesh, geometry: &[BlockGeometry], _settings: &SolverSettings, geometry_changed: bool) {
+        if geometry_changed {
+            self.lanes = PointLanes::new(mesh, geometry);
+        }
+    }
 
     fn solve_step(
         &mut self,
@@ -272,6 +582,7 @@ impl StepSolver for Vbd {
             springs: &springs,
             w: 1.0 / (h * h),
             lame: s.material.lame(),
+            fused: self.fused,
         };
         let rho = s.settings.vbd.chebyshev_rho;
         let mut omega = 1.0;
@@ -281,14 +592,21 @@ impl StepSolver for Vbd {
             self.prev_iter.clear();
             self.prev_iter.extend_from_slice(positions);
         }
+        // the initial guess moved the positions as a whole: F_q from them, then in step with
+        // each node move, each acceleration (F is affine in the positions, so it mixes as they
+        // do) and, after a projection moved the positions, from them again
+        let mut stale = true;
         for k in 1..=s.settings.vbd.iterations {
-            // positions moved as a whole since the last sweep (initial guess, acceleration,
-            // contact): F_q from them, then in step with each node move
-            self.f_points.refresh(s.mesh, s.geometry, positions);
-            let f_points: Vec<_> = self.f_points.blocks.iter_mut().map(|fb| SharedMut::new(fb)).collect();
+            if stale {
+                self.lanes.refresh(s.mesh, positions, self.fused);
+            }
+            if rho > 0.0 && k == 1 {
+                self.f_snapshots.start(&self.lanes);
+            }
+            let lanes = LaneView::of(&mut self.lanes);
             for colour in &self.colours {
                 counters.node_updates +=
-                    sweep_colour(&update, colour, positions, &f_points, s.settings.sweep.is_colour())?;
+                    sweep_colour(&update, colour, positions, &lanes, s.settings.sweep.is_colour())?;
             }
             if rho > 0.0 {
                 omega = match k {
@@ -296,7 +614,8 @@ impl StepSolver for Vbd {
                     2 => 2.0 / (2.0 - rho * rho),
                     _ => 4.0 / (4.0 - rho * rho * omega),
                 };
-                if k >= 2 && omega > 1.0 {
+                let mix = k >= 2 && omega > 1.0;
+                if mix {
                     for (i, x) in positions.iter_mut().enumerate() {
                         if s.inv_mass[i] > 0.0 {
                             *x = (*x - self.prev_prev[i]) * omega + self.prev_prev[i];
@@ -305,8 +624,11 @@ impl StepSolver for Vbd {
                 }
                 std::mem::swap(&mut self.prev_prev, &mut self.prev_iter);
                 self.prev_iter.copy_from_slice(positions);
+                self.f_snapshots.advance(&mut self.lanes, mix.then_some(omega));
             }
+            let projections = *hooks.calls;
             hooks.after_projection(positions, Some(ImplicitRole::Projection));
+            stale = *hooks.calls != projections;
             counters.solver_iterations += 1;
         }
         Ok(())
@@ -318,7 +640,7 @@ fn sweep_colour(
     update: &NodeUpdate<'_>,
     colour: &[u32],
     positions: &mut [Vec3],
-    f_points: &[SharedMut<Matrix3<f64>>],
+    lanes: &[LaneView<'_>],
     parallel: bool,
 ) -> Result<u64, BadElement> {
     let inv_mass = update.input.inv_mass;
@@ -330,7 +652,7 @@ fn sweep_colour(
         if inv_mass[i] == 0.0 {
             return Ok(0);
         }
-        Ok(u64::from(unsafe { update.step(i, shared, f_points) }?))
+        Ok(u64::from(unsafe { update.step(i, shared, lanes) }?))
     };
     if !parallel {
         return colour.iter().map(node).sum();
@@ -343,7 +665,7 @@ fn sweep_colour(
 mod tests {
     use super::*;
     use crate::element::ElementType;
-    use crate::fem::geometry::precompute;
+    use crate::fem::geometry::{deformation_gradient, precompute};
 
     /// The cached `F_q` carried along node moves are the `F_q` recomputed from the moved
     /// positions (to rounding), on every element type, a mixed mesh's shared nodes included.
@@ -354,21 +676,47 @@ mod tests {
             let geometry = precompute(&mesh, None).unwrap();
             let incidence = NodeIncidence::new(&mesh);
             let mut x = mesh.rest_positions.clone();
-            let mut cached = PointGradients::default();
-            cached.refresh(&mesh, &geometry, &x);
+            let mut cached = PointLanes::new(&mesh, &geometry);
+            cached.refresh(&mesh, &x, Fused::detect());
             for (k, i) in (0..mesh.num_nodes()).step_by(3).enumerate() {
                 let d = Vec3::new(0.01 * k as f64, -0.02, 0.015 * (k % 4) as f64);
                 x[i] += d;
-                let shared: Vec<_> = cached.blocks.iter_mut().map(|b| SharedMut::new(b)).collect();
+                let lanes = LaneView::of(&mut cached);
                 // SAFETY: one thread
-                unsafe { carry_points(&incidence, &geometry, i, d, &shared) };
+                unsafe { carry_points::<false>(&incidence, i, d, &lanes) };
             }
-            let mut fresh = PointGradients::default();
-            fresh.refresh(&mesh, &geometry, &x);
-            for (a, b) in cached.blocks.iter().flatten().zip(fresh.blocks.iter().flatten()) {
-                assert!((a - b).norm() < 1e-12, "{et}: carried {a} vs recomputed {b}");
+            let mut fresh = PointLanes::new(&mesh, &geometry);
+            fresh.refresh(&mesh, &x, Fused(false));
+            // and both are the F_q of the element's own gather (lane-major, padding F = I)
+            let mut moved = false;
+            for ((lanes, block), g) in fresh.blocks.iter().zip(&mesh.blocks).zip(&geometry) {
+                let (n, points) = (g.nodes_per_element, g.points_per_element);
+                for e in 0..block.len() {
+                    let nodes = block.element(e);
+                    let (xe, re): (Vec<_>, Vec<_>) =
+                        nodes.iter().map(|&i| (x[i as usize], mesh.rest_positions[i as usize])).unzip();
+                    let grads = element_grads(g, e);
+                    let len = 9 * lanes.chunks * lanes.width;
+                    let f_e = &lanes.f[e * len..][..len];
+                    for p in 0..lanes.chunks * lanes.width {
+                        let (k, j) = (p / lanes.width, p % lanes.width);
+                        let expected = if p < points {
+                            deformation_gradient(&xe, &re, &grads[p * n..(p + 1) * n])
+                        } else {
+                            Matrix3::identity()
+                        };
+                        moved |= (expected - Matrix3::identity()).norm() > 1e-3;
+                        let got = Matrix3::from_fn(|r, c| f_e[(9 * k + 3 * r + c) * lanes.width + j]);
+                        assert!((got - expected).norm() < 1e-12, "{et}: lane-major {got} vs gathered {expected}");
+                    }
+                }
             }
-            assert!(fresh.blocks.iter().flatten().any(|f| (f - Matrix3::identity()).norm() > 1e-3), "{et}: moved");
+            for (a, b) in cached.blocks.iter().zip(&fresh.blocks) {
+                for (u, v) in a.f.iter().zip(&b.f) {
+                    assert!((u - v).abs() < 1e-12, "{et}: carried {u} vs recomputed {v}");
+                }
+            }
+            assert!(moved, "{et}: no F_q moved");
         }
     }
 }

@@ -42,6 +42,23 @@ impl F64x4 {
     pub unsafe fn load(p: *const f64) -> Self {
         Self(unsafe { _mm256_loadu_pd(p) })
     }
+    /// # Safety
+    /// `p` points to four writable doubles.
+    #[inline(always)]
+    pub unsafe fn store(self, p: *mut f64) {
+        unsafe { _mm256_storeu_pd(p, self.0) }
+    }
+    /// Lane `k` holds the sum of `v[k]`'s four lanes (`(a₀ + a₁) + (a₂ + a₃)`).
+    #[inline(always)]
+    pub fn horizontal_sums(v: [Self; 4]) -> Self {
+        unsafe {
+            let h01 = _mm256_hadd_pd(v[0].0, v[1].0); // a0+a1, b0+b1, a2+a3, b2+b3
+            let h23 = _mm256_hadd_pd(v[2].0, v[3].0);
+            let low = _mm256_permute2f128_pd::<0x20>(h01, h23);
+            let high = _mm256_permute2f128_pd::<0x31>(h01, h23);
+            Self(_mm256_add_pd(low, high))
+        }
+    }
     #[inline(always)]
     pub fn add(self, o: Self) -> Self {
         Self(unsafe { _mm256_add_pd(self.0, o.0) })
