@@ -49,6 +49,9 @@ pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
 
 /// 3×3 matrix of `f64` (deformation gradients, stresses).
 pub type Mat3 = Matrix3<f64>;
+/// [`HyperelasticModel::node_visit_kernel`]: unsafe to call only in that the model that returned
+/// it checked what the CPU has; any visit of the width asked for is valid input.
+pub type NodeVisitKernel = unsafe fn(Lame, NodeVisit<'_>) -> (Vector3<f64>, Mat3);
 /// 9×9 matrix of `f64` acting on column-major vec(F) (index = row + 3·col).
 pub type Mat9 = SMatrix<f64, 9, 9>;
 
@@ -97,6 +100,12 @@ pub trait HyperelasticModel: Sync + Send + 'static {
     /// Default: [`HyperelasticModel::node_force_and_block`] point by point.
     fn node_visit(&self, l: Lame, points: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
         points.sum(|f, g| self.node_force_and_block(l, f, g))
+    }
+    /// A kernel computing [`HyperelasticModel::node_visit`] for visits `width` lanes wide on
+    /// this CPU, which a solver may resolve once and call at every visit without the dispatch
+    /// (StVK: its four-lane AVX2 law). Default: none.
+    fn node_visit_kernel(&self, _width: usize) -> Option<NodeVisitKernel> {
+        None
     }
     /// The split constraints `[deviatoric, hydrostatic]` at F.
     fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2];
@@ -396,6 +405,11 @@ impl Material {
     #[inline]
     pub fn node_visit(&self, l: Lame, points: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
         self.model.law().node_visit(l, points)
+    }
+
+    /// [`HyperelasticModel::node_visit_kernel`].
+    pub fn node_visit_kernel(&self, width: usize) -> Option<NodeVisitKernel> {
+        self.model.law().node_visit_kernel(width)
     }
 
     pub fn dpdf_projected(&self, f: &Mat3) -> Mat9 {

@@ -26,7 +26,7 @@
 //! (shear) stress as 2μE; a NaN or infinite entry of F otherwise propagates into ψ and P.
 
 use super::lane::{Lane, M3, Scalar, from_mat3, to_mat3, tr_mat_mul};
-use super::{HyperelasticModel, Lame, Mat3, Mat9, NodeVisit, SplitTerm, dpdf_from_directional};
+use super::{HyperelasticModel, Lame, Mat3, Mat9, NodeVisit, NodeVisitKernel, SplitTerm, dpdf_from_directional};
 use nalgebra::Vector3;
 
 /// E = ½(H + Hᵀ + HᵀH), H = F − I (Green–Lagrange).
@@ -249,15 +249,19 @@ impl HyperelasticModel for StVenantKirchhoff {
 
     /// Four points per AVX2 register where the CPU has it and the visit is four lanes wide.
     fn node_visit(&self, l: Lame, points: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
-        #[cfg(target_arch = "x86_64")]
-        if points.width == 4
-            && std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("fma")
-        {
-            // SAFETY: the CPU has AVX2 and FMA (checked)
-            return unsafe { node_visit_avx2(l, points) };
+        if let Some(kernel) = self.node_visit_kernel(points.width) {
+            // SAFETY: the kernel is for this width on this CPU
+            return unsafe { kernel(l, points) };
         }
         points.sum(|f, g| self.node_force_and_block(l, f, g))
+    }
+
+    fn node_visit_kernel(&self, width: usize) -> Option<NodeVisitKernel> {
+        #[cfg(target_arch = "x86_64")]
+        if width == 4 && std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+            return Some(node_visit_avx2);
+        }
+        None
     }
 
     fn split_terms(&self, _l: Lame, f: &Mat3) -> [SplitTerm; 2] {

@@ -48,7 +48,7 @@ use crate::Vec3;
 use crate::effect::{ImplicitRole, NodeSpring};
 use crate::fem::energy::element_grads;
 use crate::fem::geometry::BlockGeometry;
-use crate::material::{Lame, NodeVisit, project_psd3};
+use crate::material::{Lame, Material, NodeVisit, NodeVisitKernel, project_psd3};
 use crate::mesh::Mesh;
 use crate::mesh::adjacency::{NodeIncidence, colour_nodes};
 use crate::xpbd::kernels::SharedMut;
@@ -321,18 +321,21 @@ impl PointLanes {
 #[derive(Clone, Copy)]
 struct LaneView<'a> {
     geometry: LaneGeometry<'a>,
+    /// The material's kernel for this width, resolved once ([`Material::node_visit_kernel`]).
+    kernel: Option<NodeVisitKernel>,
     f_len: usize,
     f: SharedMut<f64>,
 }
 
 impl<'a> LaneView<'a> {
-    fn of(lanes: &'a mut PointLanes) -> Vec<LaneView<'a>> {
+    fn of(lanes: &'a mut PointLanes, material: &Material) -> Vec<LaneView<'a>> {
         lanes
             .blocks
             .iter_mut()
             .map(|b| {
                 let (geometry, f) = b.split();
-                LaneView { geometry, f_len: geometry.f_len(), f: SharedMut::new(f) }
+                let kernel = material.node_visit_kernel(geometry.width);
+                LaneView { geometry, kernel, f_len: geometry.f_len(), f: SharedMut::new(f) }
             })
             .collect()
     }
@@ -452,7 +455,11 @@ impl NodeUpdate<'_> {
             let fq = unsafe { l.f_mut(e) };
             let g = &l.geometry;
             let visit = NodeVisit { width: g.width, f: fq, grads: g.node_grads(e, a), volumes: g.volumes(e) };
-            let (force, block) = s.material.node_visit(self.lame, visit);
+            let (force, block) = match l.kernel {
+                // SAFETY: the material's kernel for this width on this CPU
+                Some(kernel) => unsafe { kernel(self.lame, visit) },
+                None => s.material.node_visit(self.lame, visit),
+            };
             f -= force;
             h += project_psd3(&block);
         }
@@ -603,7 +610,7 @@ impl StepSolver for Vbd {
             if rho > 0.0 && k == 1 {
                 self.f_snapshots.start(&self.lanes);
             }
-            let lanes = LaneView::of(&mut self.lanes);
+            let lanes = LaneView::of(&mut self.lanes, s.material);
             for colour in &self.colours {
                 counters.node_updates +=
                     sweep_colour(&update, colour, positions, &lanes, s.settings.sweep.is_colour())?;
@@ -681,7 +688,9 @@ mod tests {
             for (k, i) in (0..mesh.num_nodes()).step_by(3).enumerate() {
                 let d = Vec3::new(0.01 * k as f64, -0.02, 0.015 * (k % 4) as f64);
                 x[i] += d;
-                let lanes = LaneView::of(&mut cached);
+                let material =
+                    Material::new(crate::material::MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
+                let lanes = LaneView::of(&mut cached, &material);
                 // SAFETY: one thread
                 unsafe { carry_points::<false>(&incidence, i, d, &lanes) };
             }
