@@ -37,7 +37,7 @@
 //! eigen-decomposition ([`crate::material::project_psd3`]); the node update and the `F_q` moves
 //! are compiled for AVX2 and FMA where the CPU has them ([`Fused`]), and the 3 × 3 solve is a
 //! hand-written Cholesky.
-//! Measured on Gmsh's P2 beam (1,471 elements, docs/PERFORMANCE.md): about 570 instructions
+//! Measured on Gmsh's P2 beam (1,471 elements, docs/PERFORMANCE.md): about 530 instructions
 //! per node-element visit, half of them the StVK law.
 
 use super::SolverCounters;
