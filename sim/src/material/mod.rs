@@ -800,5 +800,11 @@ mod psd3_tests {
         assert!((p * v - 3.0 * v).norm() < 1e-12);
         let bad = Matrix3::new(f64::NAN, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
         assert!(project_psd3(&bad)[(0, 0)].is_nan());
+        // the fast path (positive leading minors) returns the symmetric part, not the input
+        let asymmetric = Matrix3::new(4.0, 2.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 2.0);
+        assert_eq!(project_psd3(&asymmetric), Matrix3::new(4.0, 1.0, 0.0, 1.0, 3.0, 0.0, 0.0, 0.0, 2.0));
+        // first two minors positive, the determinant negative: not taken for definite
+        let last_negative = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, -1.0));
+        assert_eq!(project_psd3(&last_negative), Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 0.0)));
     }
 }

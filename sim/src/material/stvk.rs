@@ -170,7 +170,7 @@ fn sym_mat3(b: &[f64; 6]) -> Mat3 {
 #[target_feature(enable = "avx2,fma")]
 unsafe fn node_visit_avx2(l: Lame, p: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
     use crate::xpbd::kernels::lanes4::F64x4;
-    debug_assert_eq!(p.width, 4);
+    assert_eq!(p.width, 4, "a four-lane kernel given a visit {} lanes wide", p.width);
     let (mu, lambda) = (F64x4::splat(l.mu_pa), F64x4::splat(l.lambda_pa));
     let (mut force, mut block) = ([F64x4::zero(); 3], [F64x4::zero(); 6]);
     // whole chunks only, so every load below is in bounds

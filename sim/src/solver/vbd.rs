@@ -99,10 +99,11 @@ impl Vbd {
 /// What a node visit reads of each element, lane-major ([`NodeVisit`]): per block, the points
 /// in chunks of `width` (4 where the element has several points, one AVX2 register per chunk; 1
 /// for one-point elements), the nodes' `∇_X N_a(r_q)` and the volumes `V_q` (padding: zero), and
-/// the elements' `F_q`, kept in step with the positions: refreshed from them before each sweep
-/// ([`PointLanes::refresh`]), then moved by `Δ ⊗ ∇_X N_a(r_q)` when node `a` of the element
-/// moves by `Δ` ([`carry_points`]; `F` is linear in the positions), so a node visit reads its
-/// elements' `F_q` instead of gathering their nodes.
+/// the elements' `F_q`, kept in step with the positions: refreshed from them at the start of a
+/// step and after a projection moved them ([`PointLanes::refresh`]), moved by `Δ ⊗ ∇_X N_a(r_q)`
+/// when node `a` of the element moves by `Δ` ([`carry_points`]; `F` is affine in the positions)
+/// and mixed as the positions are by the Chebyshev step ([`Snapshots`]), so a node visit reads
+/// its elements' `F_q` instead of gathering their nodes.
 #[derive(Default)]
 struct PointLanes {
     blocks: Vec<LaneBlock>,
@@ -110,7 +111,7 @@ struct PointLanes {
 
 /// One block's lane-major data ([`PointLanes`]); element `e`'s entries start at `e ·` the
 /// per-element lengths.
-#[derive(Default)]
+#[derive(Clone, Default)]
 struct LaneBlock {
     nodes: usize,
     chunks: usize,
@@ -163,16 +164,18 @@ impl LaneBlock {
 }
 
 /// `f += Σ_r Σ_c d_r ∇N_c` into entry `(r, c)` of every chunk, `W` lanes wide (`F_q += d ⊗ ∇N`);
-/// `FMA`: fused multiply-adds (only where the CPU has them: the [`Fused`] paths).
+/// `FMA`: fused multiply-adds, on AVX2 registers when `W` is 4.
+///
+/// # Safety
+/// With `FMA`, the CPU has AVX2 and FMA (the [`Fused`] paths).
 #[inline(always)]
-fn add_outer<const W: usize, const FMA: bool>(f: &mut [f64], d: &Vec3, grads: &[f64]) {
+unsafe fn add_outer<const W: usize, const FMA: bool>(f: &mut [f64], d: &Vec3, grads: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     if W == 4 && FMA {
         use crate::xpbd::kernels::lanes4::F64x4;
         let dr = [F64x4::splat(d[0]), F64x4::splat(d[1]), F64x4::splat(d[2])];
         for (fk, gk) in f.chunks_exact_mut(36).zip(grads.chunks_exact(12)) {
-            // SAFETY: in bounds (chunks of 36 and 12); the fused paths run only where the CPU
-            // has AVX2 and FMA
+            // SAFETY: in bounds (chunks of 36 and 12); the caller's promise for the instructions
             unsafe {
                 let g = [F64x4::load(gk.as_ptr()), F64x4::load(gk.as_ptr().add(4)), F64x4::load(gk.as_ptr().add(8))];
                 for (r, dr) in dr.iter().enumerate() {
@@ -198,11 +201,17 @@ fn add_outer<const W: usize, const FMA: bool>(f: &mut [f64], d: &Vec3, grads: &[
 }
 
 /// [`add_outer`] at the block's width.
+///
+/// # Safety
+/// [`add_outer`]'s.
 #[inline(always)]
-fn add_outer_any<const FMA: bool>(width: usize, f: &mut [f64], d: &Vec3, grads: &[f64]) {
-    match width {
-        4 => add_outer::<4, FMA>(f, d, grads),
-        _ => add_outer::<1, FMA>(f, d, grads),
+unsafe fn add_outer_any<const FMA: bool>(width: usize, f: &mut [f64], d: &Vec3, grads: &[f64]) {
+    // SAFETY: the caller's promise
+    unsafe {
+        match width {
+            4 => add_outer::<4, FMA>(f, d, grads),
+            _ => add_outer::<1, FMA>(f, d, grads),
+        }
     }
 }
 
@@ -232,8 +241,11 @@ struct RefreshInput<'a> {
 }
 
 /// Element `e`'s `F_q` from the positions (`out`: its lane-major entries).
+///
+/// # Safety
+/// [`add_outer`]'s.
 #[inline(always)]
-fn refresh_element<const FMA: bool>(input: &RefreshInput<'_>, e: usize, nodes: &[u32], out: &mut [f64]) {
+unsafe fn refresh_element<const FMA: bool>(input: &RefreshInput<'_>, e: usize, nodes: &[u32], out: &mut [f64]) {
     let w = input.lanes.width;
     out.fill(0.0);
     for k in 0..input.lanes.chunks {
@@ -243,7 +255,8 @@ fn refresh_element<const FMA: bool>(input: &RefreshInput<'_>, e: usize, nodes: &
     }
     for (a, &node) in nodes.iter().enumerate() {
         let u = input.positions[node as usize] - input.mesh.rest_positions[node as usize];
-        add_outer_any::<FMA>(w, out, &u, input.lanes.node_grads(e, a));
+        // SAFETY: the caller's promise
+        unsafe { add_outer_any::<FMA>(w, out, &u, input.lanes.node_grads(e, a)) };
     }
 }
 
@@ -254,7 +267,8 @@ fn refresh_element<const FMA: bool>(input: &RefreshInput<'_>, e: usize, nodes: &
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn refresh_element_fused(input: &RefreshInput<'_>, e: usize, nodes: &[u32], out: &mut [f64]) {
-    refresh_element::<true>(input, e, nodes, out)
+    // SAFETY: the CPU has AVX2 and FMA (the caller's promise)
+    unsafe { refresh_element::<true>(input, e, nodes, out) }
 }
 
 /// What a block's lane-major data holds besides `F_q` (read-only during a sweep).
@@ -291,6 +305,18 @@ impl<'a> LaneGeometry<'a> {
 }
 
 impl PointLanes {
+    /// (Tests.) The carried and mixed `F_q` are those of the positions, to rounding.
+    #[cfg(test)]
+    fn assert_in_step_with(&self, mesh: &Mesh, positions: &[Vec3]) {
+        let mut fresh = PointLanes { blocks: self.blocks.clone() };
+        fresh.refresh(mesh, positions, Fused(false));
+        for (kept, fresh) in self.blocks.iter().zip(&fresh.blocks) {
+            for (a, b) in kept.f.iter().zip(&fresh.f) {
+                assert!((a - b).abs() <= 1e-9 * b.abs().max(1.0), "kept F_q entry {a}, from the positions {b}");
+            }
+        }
+    }
+
     fn new(mesh: &Mesh, geometry: &[BlockGeometry]) -> Self {
         Self { blocks: mesh.blocks.iter().zip(geometry).map(|(block, g)| LaneBlock::new(block, g)).collect() }
     }
@@ -310,7 +336,8 @@ impl PointLanes {
                     // SAFETY: the CPU has AVX2 and FMA (detected)
                     return unsafe { refresh_element_fused(&input, e, nodes, out) };
                 }
-                refresh_element::<false>(&input, e, nodes, out)
+                // SAFETY: no fused instructions
+                unsafe { refresh_element::<false>(&input, e, nodes, out) }
             });
         }
     }
@@ -434,7 +461,7 @@ impl NodeUpdate<'_> {
     }
 
     /// # Safety
-    /// [`NodeUpdate::step`]'s; with `FMA`, the CPU has FMA.
+    /// [`NodeUpdate::step`]'s; with `FMA`, the CPU has AVX2 and FMA.
     #[inline(always)]
     unsafe fn step_in<const FMA: bool>(
         &self,
@@ -507,7 +534,7 @@ fn solve_spd3(h: &Matrix3<f64>, f: &Vec3) -> Option<Vec3> {
 ///
 /// # Safety
 /// No other thread may access the `F_q` of an element holding node `i` meanwhile; with `FMA`,
-/// the CPU has FMA.
+/// the CPU has AVX2 and FMA.
 #[inline(always)]
 unsafe fn carry_points<const FMA: bool>(incidence: &NodeIncidence, i: usize, d: Vec3, lanes: &[LaneView<'_>]) {
     for inc in incidence.of(i) {
@@ -515,7 +542,8 @@ unsafe fn carry_points<const FMA: bool>(incidence: &NodeIncidence, i: usize, d: 
         let l = &lanes[b];
         // SAFETY: the caller's promise
         let fq = unsafe { l.f_mut(e) };
-        add_outer_any::<FMA>(l.geometry.width, fq, &d, l.geometry.node_grads(e, a));
+        // SAFETY: the caller's promise
+        unsafe { add_outer_any::<FMA>(l.geometry.width, fq, &d, l.geometry.node_grads(e, a)) };
     }
 }
 
@@ -636,6 +664,10 @@ impl StepSolver for Vbd {
             let projections = *hooks.calls;
             hooks.after_projection(positions, Some(ImplicitRole::Projection));
             stale = *hooks.calls != projections;
+            #[cfg(test)]
+            if !stale {
+                self.lanes.assert_in_step_with(s.mesh, positions);
+            }
             counters.solver_iterations += 1;
         }
         Ok(())
@@ -674,6 +706,53 @@ mod tests {
     use crate::element::ElementType;
     use crate::fem::geometry::{deformation_gradient, precompute};
 
+    /// [`carry_points`] on the fused path where `fused` says the CPU has it.
+    ///
+    /// # Safety
+    /// [`carry_points`]'s; `fused` from [`Fused::detect`].
+    unsafe fn carry_on_this_cpu(fused: Fused, incidence: &NodeIncidence, i: usize, d: Vec3, lanes: &[LaneView<'_>]) {
+        #[cfg(target_arch = "x86_64")]
+        if fused.0 {
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn carry_fused(incidence: &NodeIncidence, i: usize, d: Vec3, lanes: &[LaneView<'_>]) {
+                // SAFETY: the caller's promise
+                unsafe { carry_points::<true>(incidence, i, d, lanes) }
+            }
+            // SAFETY: the caller's promise
+            return unsafe { carry_fused(incidence, i, d, lanes) };
+        }
+        // SAFETY: the caller's promise
+        unsafe { carry_points::<false>(incidence, i, d, lanes) }
+    }
+
+    /// `H⁻¹ f` of the hand-written 3 × 3 Cholesky is nalgebra's on random SPD matrices, and not
+    /// positive definite (a zero or negative pivot) or non-finite input gives `None`.
+    #[test]
+    fn solve_spd3_matches_a_cholesky_solve_and_refuses_what_is_not_positive_definite() {
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for _ in 0..200 {
+            let a = Matrix3::from_fn(|_, _| next());
+            let h = a * a.transpose() + Matrix3::identity() * 0.01;
+            let f = Vec3::new(next(), next(), next());
+            let want = h.cholesky().unwrap().solve(&f);
+            let got = solve_spd3(&h, &f).unwrap();
+            assert!((got - want).norm() <= 1e-10 * want.norm(), "{got} vs {want}");
+        }
+        let f = Vec3::new(1.0, 2.0, 3.0);
+        for bad in [
+            Matrix3::from_diagonal(&Vec3::new(1.0, 0.0, 1.0)),
+            Matrix3::from_diagonal(&Vec3::new(1.0, 1.0, -2.0)),
+            Matrix3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+            Matrix3::from_diagonal(&Vec3::new(f64::NAN, 1.0, 1.0)),
+        ] {
+            assert_eq!(solve_spd3(&bad, &f), None, "{bad}");
+        }
+    }
+
     /// The cached `F_q` carried along node moves are the `F_q` recomputed from the moved
     /// positions (to rounding), on every element type, a mixed mesh's shared nodes included.
     #[test]
@@ -682,17 +761,25 @@ mod tests {
             let mesh = super::super::tests::one_cell_cantilever(et);
             let geometry = precompute(&mesh, None).unwrap();
             let incidence = NodeIncidence::new(&mesh);
-            let mut x = mesh.rest_positions.clone();
+            // from a deformed start, refreshed and carried on this CPU's path (fused where it
+            // has AVX2 and FMA), against a plain refresh of the end positions
+            let mut x: Vec<Vec3> = mesh
+                .rest_positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| p + Vec3::new(0.003 * (i % 5) as f64, 0.002 * (i % 3) as f64, -0.004 * (i % 2) as f64))
+                .collect();
+            let fused = Fused::detect();
+            let material =
+                Material::new(crate::material::MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
             let mut cached = PointLanes::new(&mesh, &geometry);
-            cached.refresh(&mesh, &x, Fused::detect());
+            cached.refresh(&mesh, &x, fused);
             for (k, i) in (0..mesh.num_nodes()).step_by(3).enumerate() {
                 let d = Vec3::new(0.01 * k as f64, -0.02, 0.015 * (k % 4) as f64);
                 x[i] += d;
-                let material =
-                    Material::new(crate::material::MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
                 let lanes = LaneView::of(&mut cached, &material);
-                // SAFETY: one thread
-                unsafe { carry_points::<false>(&incidence, i, d, &lanes) };
+                // SAFETY: one thread; the fused path only where the CPU has AVX2 and FMA
+                unsafe { carry_on_this_cpu(fused, &incidence, i, d, &lanes) };
             }
             let mut fresh = PointLanes::new(&mesh, &geometry);
             fresh.refresh(&mesh, &x, Fused(false));
