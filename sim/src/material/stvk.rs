@@ -258,7 +258,7 @@ impl HyperelasticModel for StVenantKirchhoff {
 
     fn node_visit_kernel(&self, width: usize) -> Option<NodeVisitKernel> {
         #[cfg(target_arch = "x86_64")]
-        if width == 4 && std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        if width == 4 && crate::xpbd::kernels::lanes4::available() {
             return Some(node_visit_avx2);
         }
         None

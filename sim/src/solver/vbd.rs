@@ -224,7 +224,7 @@ impl Fused {
     fn detect() -> Self {
         #[cfg(target_arch = "x86_64")]
         {
-            Fused(std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma"))
+            Fused(crate::xpbd::kernels::lanes4::available())
         }
         #[cfg(not(target_arch = "x86_64"))]
         {

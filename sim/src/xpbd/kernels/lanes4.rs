@@ -16,6 +16,13 @@ use crate::material::lane::{Lane, M3};
 use crate::material::{Mat3, stvk};
 use std::arch::x86_64::*;
 
+/// Whether this CPU has AVX2 and FMA, which every function of this module needs (the runtime
+/// check before any of them runs).
+#[inline]
+pub fn available() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+}
+
 /// Four doubles, one per element.
 #[derive(Clone, Copy)]
 pub struct F64x4(pub __m256d);

@@ -49,7 +49,7 @@ pub unsafe fn energy_sweep(
 ) -> Option<Result<u64, NonFiniteElement>> {
     let io = SweepIo { positions, rest, inv_mass, data, lambdas, inv_dt2 };
     #[cfg(target_arch = "x86_64")]
-    let wide = std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma");
+    let wide = super::lanes4::available();
     macro_rules! dispatch {
         ($(($n:literal, $p:literal)),*) => {
             match nodes_per_element {
@@ -306,11 +306,7 @@ pub unsafe fn colour_sweep(
     let mut tail = range.clone();
     let mut projected = 0;
     #[cfg(target_arch = "x86_64")]
-    if batched
-        && packed.colour_batches.len() == packed.colour_starts.len()
-        && std::arch::is_x86_feature_detected!("avx2")
-        && std::arch::is_x86_feature_detected!("fma")
-    {
+    if batched && packed.colour_batches.len() == packed.colour_starts.len() && super::lanes4::available() {
         let (n, q) = (nodes_per_element, packed.points);
         let per_batch = batch_values(n, q);
         let first = packed.colour_batches[colour] + (range.start - colour_start) / 4;
