@@ -1,8 +1,9 @@
 //! Running a scene: for a given simulated time, or until it settles.
 //!
 //! **Settling** (`RunMode::Settle`): velocity damping `v ← v e^{−c h}` with the scene's
-//! `settle_damping_per_sec` (`vbd_settle_damping_per_sec` for VBD, whose unconverged steps
-//! leave the slow modes too soft for the same damping) is added, and once all prescribed ramps and moving planes have
+//! `settle_damping_per_sec` (`vbd_settle_damping_per_sec` for VBD: the same 10/s by default,
+//! 2/s settling fastest without its coarse correction, whose unconverged steps leave the slow
+//! modes too soft) is added, and once all prescribed ramps and moving planes have
 //! stopped the run ends
 //! - **settled** (in equilibrium) once, for `SETTLE_EQUILIBRIUM_FRAMES` consecutive frames, the
 //!   static residual — the unbalanced force on the free nodes relative to the load

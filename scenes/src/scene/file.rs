@@ -25,7 +25,7 @@
 //! quadrature_degree = 2   # omit for each element type's default
 //! duration_secs = 3       # default run length
 //! settle_damping_per_sec = 10  # velocity damping used by --settle
-//! vbd_settle_damping_per_sec = 2  # the same with --solver vbd
+//! vbd_settle_damping_per_sec = 10 # the same with --solver vbd (2 settles fastest with vbd_coarse_cells = 0)
 //! sweep = "colour"         # XPBD's sweep: colour (default) or element order
 //! stability_guard = true   # above h·ω_max = 3, substeps with h·ω_max ≤ 1 (hox_sim::solver::stability)
 //! [effect]                # optional: effects any scene can switch on

@@ -147,6 +147,7 @@ impl Scene {
             vbd: VbdSettings {
                 iterations: p.vbd_iterations,
                 chebyshev_rho: p.chebyshev_rho,
+                coarse_cells: p.vbd_coarse_cells,
                 init: VbdInit::from_name(&p.vbd_init).unwrap_or_default(),
             },
             newton: NewtonSettings { tolerance: p.newton_tolerance, ..Default::default() },

@@ -36,6 +36,7 @@ pub mod stability;
 pub mod statics;
 mod sweep;
 mod vbd;
+mod vbd_coarse;
 mod xpbd;
 
 pub use method::Method;
@@ -105,6 +106,8 @@ pub struct SolverCounters {
     pub solver_iterations: u64,
     /// VBD's node block updates.
     pub node_updates: u64,
+    /// VBD's coarse-grid corrections that moved the nodes ([`vbd_coarse`]).
+    pub coarse_corrections: u64,
     /// Newton's numeric factorisations of the stiffness.
     pub factorizations: u64,
     /// Newton steps that reached their iteration limit before the tolerance.

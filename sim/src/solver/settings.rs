@@ -78,6 +78,14 @@ pub struct VbdSettings {
     pub chebyshev_rho: f64,
     /// Where a step's iterations start.
     pub init: VbdInit,
+    /// About how many cells the two-level correction's coarse grid has (0: off, the paper's VBD
+    /// alone; at most [`VbdSettings::MAX_COARSE_CELLS`]; [`crate::solver`]'s `vbd_coarse`).
+    pub coarse_cells: u32,
+}
+
+impl VbdSettings {
+    /// The coarse grid's largest cell count: its dense matrix of `3 × nodes` rows stays small.
+    pub const MAX_COARSE_CELLS: u32 = 256;
 }
 
 /// Where vertex block descent starts a step (Chen et al. 2024, §3.5).
@@ -109,7 +117,7 @@ impl VbdInit {
 
 impl Default for VbdSettings {
     fn default() -> Self {
-        Self { iterations: 10, chebyshev_rho: 0.9, init: VbdInit::Adaptive }
+        Self { iterations: 10, chebyshev_rho: 0.9, init: VbdInit::Adaptive, coarse_cells: 32 }
     }
 }
 
@@ -168,6 +176,13 @@ impl SolverSettings {
         }
         if self.vbd.iterations == 0 {
             return bad("VBD iterations must be at least 1, got 0".into());
+        }
+        if self.vbd.coarse_cells > VbdSettings::MAX_COARSE_CELLS {
+            return bad(format!(
+                "VBD's coarse grid may have at most {} cells, got {}",
+                VbdSettings::MAX_COARSE_CELLS,
+                self.vbd.coarse_cells
+            ));
         }
         if !(0.0..1.0).contains(&self.vbd.chebyshev_rho) {
             return bad(format!("the Chebyshev ρ must be in [0, 1), got {}", self.vbd.chebyshev_rho));
