@@ -78,9 +78,8 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
         let ms = value("P2 8x2x2 five", solver, "ms_per_frame_1_thread");
         assert!(ms > 0.0 && ms.is_finite(), "{solver}: {ms} ms");
         let period = value("P2 8x2x2 five", solver, "period_error_pct");
-        // VBD at its default 10 sweeps per step is far from converged in motion (docs/STUDY.md)
-        let bound = if solver == "vbd" { 500.0 } else { 20.0 };
-        assert!(period.abs() < bound, "{solver}: period error {period} %");
+        // VBD follows the motion since its coarse correction (+23 to +165 % without it)
+        assert!(period.abs() < 20.0, "{solver}: period error {period} %");
     }
     // the converged solvers sit on the static solution; XPBD at the paper's settings does not
     assert!(value("P2 8x2x2 five", "newton", "solver_error_pct") < 0.1);

@@ -16,8 +16,12 @@
 //!   any mesh of any element type gets one, as it only reads the nodes' rest positions;
 //! - `H` the projected Hessian of `G` (`M/h²`, the elements' Hessians with `∂P/∂F` projected to
 //!   positive semi-definite per quadrature point as Newton's, the springs' `k I`), made at the
-//!   current positions every [`super::VbdSettings::coarse_refresh_steps`] steps and kept
-//!   factored (dense Cholesky) in between;
+//!   current positions every [`REFRESH_STEPS`] steps (sooner when the line search finds it off)
+//!   and kept factored (dense Cholesky) in between; a drag spring that appears or goes between
+//!   two makings is in `∇G` at once and in the matrix at the next;
+//! - the step length `α` by a secant on the directional derivative,
+//!   `α = −s₀/(s₁ − s₀)`, `s_t = ∇G(x + t U δ) · U δ` (exact on a quadratic `G`; `α = 1` where
+//!   the curvature along `U δ` is not positive), at most 2;
 //! - `∇G(x) = M (x − y)/h² + ∇U(x) + Σ_k k_k (x_{n_k} − t_k)` on the free nodes.
 //!
 //! The coarse matrix is `Uᵀ H U` assembled element by element, never the fine `H`.
@@ -30,6 +34,38 @@ use crate::fem::energy::{for_each_element, total_energy_and_gradient};
 use crate::fem::geometry::deformation_gradient;
 use crate::mesh::Mesh;
 use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
+
+/// Cells per axis for a box of extents `ext_m`: near-cubic cells, at least one across every
+/// direction however thin (a plate's bending needs the in-plane motion to vary across its
+/// thickness), and no more than `cells_wanted` in all: a direction thinner than a cell gets one,
+/// the cell size is set by the others, and the direction with the most cells gives one up until
+/// the count fits.
+fn grid_cells(ext_m: &Vec3, cells_wanted: usize) -> [usize; 3] {
+    let mut thin = [false; 3];
+    let mut cells = [1usize; 3];
+    loop {
+        let wide: Vec<usize> = (0..3).filter(|&a| !thin[a] && ext_m[a] > 0.0).collect();
+        if wide.is_empty() {
+            break;
+        }
+        let volume: f64 = wide.iter().map(|&a| ext_m[a]).product();
+        let cell_size_m = (volume / cells_wanted as f64).powf(1.0 / wide.len() as f64);
+        match wide.iter().find(|&&a| ext_m[a] < cell_size_m) {
+            Some(&a) => thin[a] = true,
+            None => {
+                for &a in &wide {
+                    cells[a] = ((ext_m[a] / cell_size_m).round() as usize).max(1);
+                }
+                break;
+            }
+        }
+    }
+    while cells.iter().product::<usize>() > cells_wanted {
+        let Some(a) = (0..3).filter(|&a| cells[a] > 1).max_by_key(|&a| cells[a]) else { break };
+        cells[a] -= 1;
+    }
+    cells
+}
 
 /// A fine node's coarse nodes (the 8 corners of its cell) and their trilinear weights.
 type Corners = [(u32, f64); 8];
@@ -90,14 +126,8 @@ impl CoarseSpace {
             .iter()
             .fold((Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
         let ext = hi - lo;
-        let largest = ext.max().max(f64::MIN_POSITIVE);
-        let floor = 1e-3 * largest;
-        let volume: f64 = ext.iter().map(|e| e.max(floor)).product();
         let cells_wanted = (target_cells as usize).min(mesh.num_nodes() / NODES_PER_CELL).max(1);
-        let size = (volume / cells_wanted as f64).cbrt();
-        // at least one cell across every direction, however thin: a plate's bending needs the
-        // in-plane motion to vary across its thickness
-        let cells: [usize; 3] = std::array::from_fn(|a| ((ext[a] / size).round() as usize).max(1));
+        let cells = grid_cells(&ext, cells_wanted);
         let dims = cells.map(|c| c + 1);
         let corners = mesh
             .rest_positions
@@ -143,7 +173,7 @@ impl CoarseSpace {
     fn make(&mut self, s: &StepInput<'_>, x: &[Vec3], springs: &[NodeSpring]) {
         let n = 3 * self.num_coarse;
         let mut a = DMatrix::<f64>::zeros(n, n);
-        let w = 1.0 / (s.h * s.h);
+        let inv_h2_per_s2 = 1.0 / (s.h * s.h);
         let free = |i: usize| s.inv_mass[i] > 0.0;
         let add_node_diag = |a: &mut DMatrix<f64>, i: usize, k: f64| {
             for &(cj, wj) in &self.corners[i] {
@@ -157,7 +187,7 @@ impl CoarseSpace {
         };
         for i in 0..x.len() {
             if free(i) {
-                add_node_diag(&mut a, i, s.masses_kg[i] * w);
+                add_node_diag(&mut a, i, s.masses_kg[i] * inv_h2_per_s2);
             }
         }
         for sp in springs {
@@ -169,16 +199,23 @@ impl CoarseSpace {
         // gradients `G_J = Σ_a φ_J(X_a) ∇_X N_a(r_q)`, so that `δF_q = Σ_J δ_J ⊗ G_J` and the
         // element adds `V_q Σ_{c,d} ∂P_{rc}/∂F_{kd} (G_J)_c (G_K)_d` to block `(J, K)`
         let corners = &self.corners;
-        let (mut local, mut weights, mut gq, mut t) =
-            (Vec::<u32>::new(), Vec::<f64>::new(), Vec::<Vec3>::new(), Vec::<[f64; 27]>::new());
+        let (mut local, mut slots, mut weights) =
+            (Vec::<u32>::new(), Vec::<(usize, usize, f64)>::new(), Vec::<f64>::new());
+        let (mut gq, mut t) = (Vec::<Vec3>::new(), Vec::<[f64; 27]>::new());
         for_each_element(s.mesh, s.geometry, x, |el| {
             let n = el.nodes.len();
+            // the element's coarse nodes `local`, each free node's weights on them by local index
             local.clear();
-            for &i in el.nodes {
+            slots.clear();
+            for (a, &i) in el.nodes.iter().enumerate() {
                 if free(i as usize) {
                     for &(c, wc) in &corners[i as usize] {
-                        if wc != 0.0 && !local.contains(&c) {
-                            local.push(c);
+                        if wc != 0.0 {
+                            let j = local.iter().position(|&l| l == c).unwrap_or_else(|| {
+                                local.push(c);
+                                local.len() - 1
+                            });
+                            slots.push((a, j, wc));
                         }
                     }
                 }
@@ -190,15 +227,8 @@ impl CoarseSpace {
             // weights[a · m + j] = φ_{local[j]}(X_a) on free nodes
             weights.clear();
             weights.resize(n * m, 0.0);
-            for (a, &i) in el.nodes.iter().enumerate() {
-                if free(i as usize) {
-                    for &(c, wc) in &corners[i as usize] {
-                        if wc != 0.0 {
-                            let j = local.iter().position(|&l| l == c).unwrap_or(0);
-                            weights[a * m + j] += wc;
-                        }
-                    }
-                }
+            for &(a, j, wc) in &slots {
+                weights[a * m + j] += wc;
             }
             let grads = el.grads();
             gq.resize(m, Vec3::zeros());
@@ -313,9 +343,9 @@ impl CoarseSpace {
 fn potential_gradient(s: &StepInput<'_>, x: &[Vec3], y: &[Vec3], springs: &[NodeSpring], out: &mut Vec<Vec3>) {
     out.resize(x.len(), Vec3::zeros());
     total_energy_and_gradient(s.mesh, s.geometry, s.material, x, out);
-    let w = 1.0 / (s.h * s.h);
+    let inv_h2_per_s2 = 1.0 / (s.h * s.h);
     for (i, g) in out.iter_mut().enumerate() {
-        *g += (x[i] - y[i]) * (s.masses_kg[i] * w);
+        *g += (x[i] - y[i]) * (s.masses_kg[i] * inv_h2_per_s2);
     }
     for sp in springs {
         out[sp.node as usize] += (x[sp.node as usize] - sp.target_m) * sp.stiffness_n_per_m;
@@ -354,6 +384,26 @@ mod tests {
                 }
             }
             r.iter().map(|v| v.norm_squared()).sum::<f64>().sqrt()
+        }
+    }
+
+    /// Near-cubic cells, one across a thin direction, never more than asked for in all.
+    #[test]
+    fn the_grid_has_near_cubic_cells_and_at_most_the_cells_asked_for() {
+        assert_eq!(grid_cells(&Vec3::new(2.0, 0.5, 0.5), 32), [8, 2, 2]);
+        assert_eq!(grid_cells(&Vec3::new(1.0, 1.0, 1.0), 27), [3, 3, 3]);
+        // a plate: one cell across its thickness, the rest square
+        let plate = grid_cells(&Vec3::new(1.0, 1.0, 1e-3), 32);
+        assert_eq!(plate[2], 1);
+        assert!(plate[0].abs_diff(plate[1]) <= 1 && plate.iter().product::<usize>() <= 32, "{plate:?}");
+        // a rod, a point, a count below what rounding gives
+        assert_eq!(grid_cells(&Vec3::new(1.0, 1e-9, 1e-9), 32), [32, 1, 1]);
+        assert_eq!(grid_cells(&Vec3::zeros(), 32), [1, 1, 1]);
+        for wanted in 1..=300 {
+            for ext in [Vec3::new(2.0, 0.5, 0.5), Vec3::new(1.0, 1.0, 1e-3), Vec3::new(0.3, 5.0, 1.0)] {
+                let cells = grid_cells(&ext, wanted);
+                assert!(cells.iter().product::<usize>() <= wanted, "{ext:?} {wanted}: {cells:?}");
+            }
         }
     }
 
