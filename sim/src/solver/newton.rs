@@ -79,17 +79,19 @@ impl Newton {
     }
 }
 
-/// The incremental potential and its gradient (free nodes only; held ones get a zero gradient).
-struct Potential<'a> {
-    input: &'a StepInput<'a>,
-    y: &'a [Vec3],
-    springs: &'a [NodeSpring],
-    w: f64,
+/// The incremental potential and its gradient (free nodes only; held ones get a zero gradient);
+/// also VBD's coarse correction's gradient ([`super::vbd_coarse`]).
+pub(super) struct Potential<'a> {
+    pub input: &'a StepInput<'a>,
+    pub y: &'a [Vec3],
+    pub springs: &'a [NodeSpring],
+    /// `1/h²`.
+    pub w: f64,
 }
 
 impl Potential<'_> {
     /// `E(x)` and `∇E(x)` (zero on held nodes), and the reactions `‖∇U − m a‖` at the held nodes.
-    fn eval(&self, x: &[Vec3], grad: &mut [Vec3]) -> (f64, f64) {
+    pub fn eval(&self, x: &[Vec3], grad: &mut [Vec3]) -> (f64, f64) {
         let s = self.input;
         let mut e = total_energy_and_gradient(s.mesh, s.geometry, s.material, x, grad);
         let mut reactions = 0.0;

@@ -27,10 +27,11 @@
 //! The coarse matrix is `Uᵀ H U` assembled element by element, never the fine `H`.
 
 use super::method::StepInput;
+use super::newton::Potential;
 use super::settings::SolverSettings;
 use crate::Vec3;
 use crate::effect::NodeSpring;
-use crate::fem::energy::{for_each_element, total_energy_and_gradient};
+use crate::fem::energy::for_each_element;
 use crate::fem::geometry::deformation_gradient;
 use crate::mesh::Mesh;
 use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
@@ -338,18 +339,10 @@ impl CoarseSpace {
     }
 }
 
-/// `∇G(x)` on every node (held ones included; the caller skips them): `M (x − y)/h² + ∇U(x)`
-/// plus the springs' pull.
+/// `∇G(x)` into `out`: Newton's [`Potential`] (zero on held nodes).
 fn potential_gradient(s: &StepInput<'_>, x: &[Vec3], y: &[Vec3], springs: &[NodeSpring], out: &mut Vec<Vec3>) {
     out.resize(x.len(), Vec3::zeros());
-    total_energy_and_gradient(s.mesh, s.geometry, s.material, x, out);
-    let inv_h2_per_s2 = 1.0 / (s.h * s.h);
-    for (i, g) in out.iter_mut().enumerate() {
-        *g += (x[i] - y[i]) * (s.masses_kg[i] * inv_h2_per_s2);
-    }
-    for sp in springs {
-        out[sp.node as usize] += (x[sp.node as usize] - sp.target_m) * sp.stiffness_n_per_m;
-    }
+    Potential { input: s, y, springs, w: 1.0 / (s.h * s.h) }.eval(x, out);
 }
 
 /// `Σ_i a_i · b_i` over the nodes `b` moves (held nodes have `b_i = 0`).
