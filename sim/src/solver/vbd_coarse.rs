@@ -286,22 +286,28 @@ impl CoarseSpace {
         self.age += 1;
     }
 
+    /// `Uᵀ g`: a per-node field restricted to the coarse nodes (held nodes' rows of `U` are zero).
+    fn restrict(&self, g: &[Vec3], inv_mass: &[f64]) -> DVector<f64> {
+        let mut r = DVector::<f64>::zeros(3 * self.num_coarse);
+        for (i, gi) in g.iter().enumerate() {
+            if inv_mass[i] == 0.0 {
+                continue;
+            }
+            for &(c, wc) in &self.corners[i] {
+                for k in 0..3 {
+                    r[3 * c as usize + k] += wc * gi[k];
+                }
+            }
+        }
+        r
+    }
+
     /// One coarse correction of the free nodes of `x` towards the minimiser of `G`, scaled by
     /// the secant line search; returns whether it moved them.
     pub fn correct(&mut self, s: &StepInput<'_>, x: &mut [Vec3], y: &[Vec3], springs: &[NodeSpring]) -> bool {
         let Some(factor) = &self.factor else { return false };
         potential_gradient(s, x, y, springs, &mut self.grad);
-        let mut r = DVector::<f64>::zeros(3 * self.num_coarse);
-        for (i, g) in self.grad.iter().enumerate() {
-            if s.inv_mass[i] == 0.0 {
-                continue;
-            }
-            for &(c, wc) in &self.corners[i] {
-                for k in 0..3 {
-                    r[3 * c as usize + k] -= wc * g[k];
-                }
-            }
-        }
+        let r = -self.restrict(&self.grad, s.inv_mass);
         let delta = factor.solve(&r);
         self.step.clear();
         self.step.resize(x.len(), Vec3::zeros());
@@ -368,15 +374,7 @@ mod tests {
         /// `Uᵀ ∇G(x)` on the coarse nodes.
         fn coarse_gradient(&mut self, s: &StepInput<'_>, x: &[Vec3], y: &[Vec3]) -> f64 {
             potential_gradient(s, x, y, &[], &mut self.grad);
-            let mut r = vec![Vec3::zeros(); self.num_coarse];
-            for (i, g) in self.grad.iter().enumerate() {
-                if s.inv_mass[i] > 0.0 {
-                    for &(c, wc) in &self.corners[i] {
-                        r[c as usize] += g * wc;
-                    }
-                }
-            }
-            r.iter().map(|v| v.norm_squared()).sum::<f64>().sqrt()
+            self.restrict(&self.grad, s.inv_mass).norm()
         }
     }
 
