@@ -146,11 +146,10 @@ pub fn config_label(instance: &Instance) -> String {
     let mesh = instance.sim.mesh();
     let types: Vec<&str> = mesh.blocks.iter().map(|b| b.element_type.name()).collect();
     let label = format!("{} {}", types.join("+"), mesh.num_elements());
-    // XPBD, the paper's solver, is unnamed (the labels of earlier recordings stay as they were)
-    match instance.sim.method() {
-        hox_sim::solver::Method::Xpbd => label,
-        other => format!("{label} {other}"),
-    }
+    // the default solver (XPBD, the paper's) is unnamed (the labels of earlier recordings stay
+    // as they were)
+    let method = instance.sim.method();
+    if method == hox_sim::solver::Method::default() { label } else { format!("{label} {method}") }
 }
 
 /// Line colours of the configurations in the charts, in order (Tableau 10).

@@ -7,35 +7,50 @@
 //! element energy `U_e = Σ_q w_q det J(X, r_q) ψ(F_q)` and its gradient
 //! `∂U_e/∂x_i = Σ_q w_q det J(X, r_q) P(F_q) ∇_X N_i(r_q)` drive XPBD constraints.
 //!
-//! Where to find things — one folder ("room") per concern, each reading only the rooms listed
-//! before it (no cycles):
+//! Where to find things — one folder ("room") per concern, in this order: each reads only the
+//! rooms listed before it (no cycles; `tests/tests/rooms.rs` fails on an import against it, and
+//! docs/ARCHITECTURE.md states the same order):
+//! - [`math`]: the number types below everything — the lane a point law is written over
+//!   ([`math::lane::Lane`]: one `f64` or four SIMD lanes), the AVX2 four-lane type and the one
+//!   runtime CPU check, the shared pointer of parallel sweeps.
 //! - [`element`]: reference elements (P1, P2, P3, Q1, Q2, prism, pyramid), Gmsh node order.
-//! - [`material`]: hyperelastic models ψ(F), P(F), dP/dF; each point law written once over a
-//!   [`material::lane::Lane`] (one `f64` or four SIMD lanes).
+//! - [`material`]: hyperelastic models ψ(F), P(F), dP/dF and their registry.
 //! - [`mesh`]: meshes (blocks of one element type), structured beams, shared high-order nodes.
 //! - [`fem`]: the finite-element model of a mesh — quadrature rules, precomputed gradients and
 //!   volumes (`geometry`, with the one Jacobian and the one deformation gradient), lumped masses,
 //!   element and mesh energy with gradient and Hessian.
-//! - [`io`]: mesh files — Gmsh import, VTK/PVD export.
+//! - [`measure`]: probes, the display surface and the fields drawn on it, min det F, the one
+//!   [`measure::median`].
+//! - [`io`]: mesh files — Gmsh import, VTK/PVD export (with the fields of [`measure`]).
 //! - [`xpbd`]: the XPBD projection — pure constraint kernels (energy and split formulations),
 //!   the hot sweep specialised per node count (`xpbd::kernels`), element colouring.
 //! - [`effect`]: opt-in effects (gravity, clamps, prescribed motion, contact, damping, drag).
-//! - [`solver`]: the stateful XPBD [`solver::Simulation`] (settings, sweep, NaN guard), the
-//!   stability guard, and static equilibrium by Newton's method (`solver::statics`).
-//! - [`measure`]: probes, the display surface, min det F, the one [`measure::median`].
+//! - [`solver`]: the stateful [`solver::Simulation`] (the step skeleton, the NaN and stability
+//!   guards) and its solvers — XPBD, VBD, Newton — behind one trait and one registry, and
+//!   static equilibrium by the same Newton (`solver::statics`).
 //!
 //! Timing the paper's Table 1 beams (`hox bench`) lives in the scenes crate (`hox_scenes::bench`):
 //! the beam is the bending scene file's.
 
-pub mod effect;
+pub mod math;
+
 pub mod element;
-pub mod fem;
-pub mod io;
+
 pub mod material;
-pub mod measure;
+
 pub mod mesh;
-pub mod solver;
+
+pub mod fem;
+
+pub mod measure;
+
+pub mod io;
+
 pub mod xpbd;
+
+pub mod effect;
+
+pub mod solver;
 
 pub use nalgebra;
 

@@ -19,7 +19,7 @@ pub fn bench(frames: usize, threads: &[usize], only: &str, sweeps: &[String], so
     if hox_scenes::bench::matching_cases(only).is_empty() {
         bail!("no configuration matches '{only}'");
     }
-    if method == Method::Xpbd {
+    if !method.is_implicit() {
         let rows = hox_scenes::bench::run(only, threads, &sweeps, frames, &mut |r| eprintln!("{}", r.progress_line()))?;
         print!("{}", hox_scenes::bench::markdown(&rows, hox_scenes::bench::peak_gflops_per_core()));
     } else {

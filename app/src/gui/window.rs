@@ -26,13 +26,7 @@ impl HoxApp {
         ui.horizontal_wrapped(|ui| {
             for (k, s) in self.sessions.iter().enumerate() {
                 let sim = &s.instance.sim;
-                let solver = match sim.method() {
-                    hox_sim::solver::Method::Xpbd => format!("xpbd, {} constraints", sim.num_constraints()),
-                    hox_sim::solver::Method::Vbd => format!("vbd, {} sweeps", sim.settings().vbd.iterations),
-                    hox_sim::solver::Method::Newton => {
-                        format!("newton, {} factorisations", sim.counters().factorizations)
-                    }
-                };
+                let solver = sim.work_summary();
                 // one short line per configuration; the details on hover
                 let mut text = format!(
                     "{}{}: {} nodes, {} el, {:.1} ms/frame, {}",

@@ -14,7 +14,7 @@
 
 use crate::Vec3;
 use crate::fem::geometry::{BlockGeometry, deformation_gradient};
-use crate::material::Material;
+use crate::material::{Material, contract};
 use crate::mesh::Mesh;
 use nalgebra::DMatrix;
 
@@ -72,15 +72,10 @@ pub fn element_hessian(
         let c = if projected { material.dpdf_projected(&f) } else { material.dpdf(&f) };
         for i in 0..n {
             for j in 0..n {
+                let block = contract(&c, &g[i], &g[j]);
                 for a in 0..3 {
                     for b in 0..3 {
-                        let mut s = 0.0;
-                        for cc in 0..3 {
-                            for d in 0..3 {
-                                s += c[(a + 3 * cc, b + 3 * d)] * g[i][cc] * g[j][d];
-                            }
-                        }
-                        h[(3 * i + a, 3 * j + b)] += v * s;
+                        h[(3 * i + a, 3 * j + b)] += v * block[(a, b)];
                     }
                 }
             }
@@ -115,16 +110,10 @@ pub fn element_node_gradient_and_block(
             block += material.node_block(&f, &ga) * *v;
             continue;
         }
-        let c = material.dpdf_projected(&f);
+        let b = contract(&material.dpdf_projected(&f), &ga, &ga);
         for r in 0..3 {
             for k in 0..3 {
-                let mut sum = 0.0;
-                for cc in 0..3 {
-                    for d in 0..3 {
-                        sum += c[(r + 3 * cc, k + 3 * d)] * ga[cc] * ga[d];
-                    }
-                }
-                block[(r, k)] += v * sum;
+                block[(r, k)] += v * b[(r, k)];
             }
         }
     }

@@ -13,7 +13,7 @@
 //! **The registry.** Each model is one file implementing [`HyperelasticModel`] and one entry of
 //! [`MaterialModel::ALL`] (the table above is documentation); [`Material`] dispatches through
 //! the law there (no per-model `match`), and the `every_registered_model_*` tests check every
-//! registered model against finite differences. Point laws written once over a [`lane::Lane`]
+//! registered model against finite differences. Point laws written once over a [`crate::math::lane::Lane`]
 //! serve the SIMD kernels too ([`stvk::energy_and_pk1`]).
 //!
 //! Conventions shared by every model:
@@ -34,21 +34,25 @@
 //!   stiffnesses k_t are [`Material::split_stiffness_pa`]. The XPBD compliance
 //!   of term t at a quadrature point of reference volume V_q is 1/(k_t · V_q).
 
-use nalgebra::{Matrix3, SMatrix, SymmetricEigen, Vector3};
+use nalgebra::{SMatrix, Vector3};
 
 #[cfg(test)]
 mod testing;
 
-pub mod lane;
+pub use crate::math::lane;
+mod psd;
+pub mod tangent;
 pub mod neo_hookean;
 pub mod stable_neo_hookean;
 pub mod stable_neo_hookean_log;
 pub mod stvk;
 
 pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
+pub use psd::{project_psd, project_psd3};
+pub use tangent::{FastLaw, contract};
 
 /// 3×3 matrix of `f64` (deformation gradients, stresses).
-pub type Mat3 = Matrix3<f64>;
+pub use crate::math::Mat3;
 /// [`HyperelasticModel::node_visit_kernel`]: unsafe to call only in that the model that returned
 /// it checked what the CPU has; any visit of the width asked for is valid input.
 pub type NodeVisitKernel = unsafe fn(Lame, NodeVisit<'_>) -> (Vector3<f64>, Mat3);
@@ -72,21 +76,20 @@ pub trait HyperelasticModel: Sync + Send + 'static {
     fn energy_density_and_pk1(&self, l: Lame, f: &Mat3) -> (f64, Mat3);
     /// dP/dF on column-major vec(F), exactly symmetric.
     fn dpdf(&self, l: Lame, f: &Mat3) -> Mat9;
+    /// The tangent contracted with two vectors at one point, per unit volume:
+    /// `C(a, b)_{rk} = Σ_{c,d} ∂P_{rc}/∂F_{kd} a_c b_d` — the 3×3 block of an element Hessian
+    /// coupling the nodes whose material gradients are `a` and `b` (fenris'
+    /// `compute_stress_contraction`). Default: [`contract`] of [`HyperelasticModel::dpdf`], the
+    /// one place the sum is written.
+    fn stress_contraction(&self, l: Lame, f: &Mat3, a: &Vector3<f64>, b: &Vector3<f64>) -> Mat3 {
+        contract(&self.dpdf(l, f), a, b)
+    }
     /// One node's 3×3 block of an element Hessian at one quadrature point, per unit volume:
-    /// `B_{rk} = Σ_{c,d} ∂P_{rc}/∂F_{kd} g_c g_d` with `g = ∇_X N_a`, i.e. column `k` is
-    /// `dP[e_k ⊗ g] g` — three directional derivatives where [`HyperelasticModel::dpdf`] takes
-    /// nine (vertex block descent's per-node Hessian). Symmetric. Default: from `dpdf`.
+    /// `B = C(g, g)` with `g = ∇_X N_a` ([`HyperelasticModel::stress_contraction`]), i.e. column
+    /// `k` is `dP[e_k ⊗ g] g` — three directional derivatives where [`HyperelasticModel::dpdf`]
+    /// takes nine (vertex block descent's per-node Hessian). Symmetric. Default: the contraction.
     fn node_block(&self, l: Lame, f: &Mat3, g: &Vector3<f64>) -> Mat3 {
-        let c = self.dpdf(l, f);
-        Mat3::from_fn(|r, k| {
-            let mut sum = 0.0;
-            for cc in 0..3 {
-                for d in 0..3 {
-                    sum += c[(r + 3 * cc, k + 3 * d)] * g[cc] * g[d];
-                }
-            }
-            sum
-        })
+        self.stress_contraction(l, f, g, g)
     }
     /// One node's share at one point, per unit volume: the force direction `P(F) g` and the
     /// block `B(F, g)` of [`HyperelasticModel::node_block`], sharing the common work (what a
@@ -105,6 +108,12 @@ pub trait HyperelasticModel: Sync + Send + 'static {
     /// this CPU, which a solver may resolve once and call at every visit without the dispatch
     /// (StVK: its four-lane AVX2 law). Default: none.
     fn node_visit_kernel(&self, _width: usize) -> Option<NodeVisitKernel> {
+        None
+    }
+    /// A point law the XPBD sweep has compiled inline for this model ([`FastLaw`]), which it then
+    /// runs instead of calling [`HyperelasticModel::energy_density_and_pk1`] through the
+    /// registry (StVK: its Lamé parameters computed once per sweep). Default: none.
+    fn fast_law(&self, _l: Lame) -> Option<FastLaw> {
         None
     }
     /// The split constraints `[deviatoric, hydrostatic]` at F.
@@ -387,6 +396,12 @@ impl Material {
     /// semi-definite matrix: symmetric eigen-decomposition with negative
     /// eigenvalues clamped to 0. Returned unchanged when already PSD.
     /// Non-finite input is returned as is.
+    /// The point law the XPBD sweep runs inline for this material, if its model offers one
+    /// ([`HyperelasticModel::fast_law`]).
+    pub fn fast_law(&self) -> Option<FastLaw> {
+        self.model.law().fast_law(self.lame())
+    }
+
     /// One node's 3×3 Hessian block per unit volume at `f` ([`HyperelasticModel::node_block`]).
     pub fn node_block(&self, f: &Mat3, g: &Vector3<f64>) -> Mat3 {
         self.model.law().node_block(self.lame(), f, g)
@@ -506,305 +521,5 @@ fn dpdf_from_directional(dp: impl Fn(&Mat3) -> Mat3) -> Mat9 {
     (out + out.transpose()) * 0.5
 }
 
-/// The nearest (Frobenius) positive semi-definite matrix to the symmetric part of `m`, written
-/// once for each size: negative eigenvalues clamped to 0; the symmetric part unchanged when
-/// already PSD (checked first by a Cholesky factorisation, which positive definite matrices —
-/// most of a solve's — pass); non-finite input returned as is.
-macro_rules! project_psd_fn {
-    ($(#[$doc:meta])* $vis:vis fn $name:ident($ty:ty)) => {
-        $(#[$doc])*
-        $vis fn $name(m: &$ty) -> $ty {
-            if !m.iter().all(|x| x.is_finite()) {
-                return *m;
-            }
-            let sym = (m + m.transpose()) * 0.5;
-            // positive definite (a Cholesky factor exists): already its own projection, and
-            // the eigen-decomposition below, tens of times dearer, is skipped
-            if sym.cholesky().is_some() {
-                return sym;
-            }
-            match SymmetricEigen::try_new(sym, f64::EPSILON, 10_000) {
-                Some(eig) => {
-                    if eig.eigenvalues.iter().all(|&l| l >= 0.0) {
-                        return sym;
-                    }
-                    let clamped = eig.eigenvalues.map(|l| l.max(0.0));
-                    let q = &eig.eigenvectors;
-                    let out = q * <$ty>::from_diagonal(&clamped) * q.transpose();
-                    (out + out.transpose()) * 0.5
-                }
-                // Not expected for finite symmetric input; fall back to a PSD
-                // (diagonal, clamped) approximation rather than failing.
-                None => <$ty>::from_diagonal(&sym.diagonal().map(|d| d.max(0.0))),
-            }
-        }
-    };
-}
-
-project_psd_fn!(
-    /// Nearest PSD matrix (Frobenius norm) to the symmetric part of `m` (a `dP/dF`).
-    fn project_psd(Mat9)
-);
-project_psd_fn!(
-    /// [`project_psd3`] past its positive-definite test.
-    fn project_psd3_general(Matrix3<f64>)
-);
-
-/// Nearest PSD matrix to the symmetric part of a 3 × 3 block (a node's Hessian block in vertex
-/// block descent). A block whose leading minors are all positive (Sylvester's criterion: positive
-/// definite, the usual case) is its own projection, told in a dozen flops.
-#[inline]
-pub fn project_psd3(m: &Matrix3<f64>) -> Matrix3<f64> {
-    let (a, d, f) = (m[(0, 0)], m[(1, 1)], m[(2, 2)]);
-    let b = 0.5 * (m[(0, 1)] + m[(1, 0)]);
-    let c = 0.5 * (m[(0, 2)] + m[(2, 0)]);
-    let e = 0.5 * (m[(1, 2)] + m[(2, 1)]);
-    let minor2 = a * d - b * b;
-    let det = a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c);
-    // NaN fails every comparison and goes on to the general path
-    if a > 0.0 && minor2 > 0.0 && det > 0.0 {
-        return Matrix3::new(a, b, c, b, d, e, c, e, f);
-    }
-    project_psd3_general(m)
-}
-
 #[cfg(test)]
-mod tests {
-    use super::testing;
-    use super::*;
-    use proptest::prelude::*;
-
-    /// Every shared check of `testing` (finite differences of ψ → P → dP/dF and of the split
-    /// terms, symmetry, rest state, rotation invariance, linearisation), on every model of the
-    /// registry, [`MaterialModel::ALL`]: a new model is checked as soon as it is registered.
-    macro_rules! every_registered_model {
-        ($($test:ident: $check:ident),* $(,)?) => {$(
-            #[test]
-            fn $test() {
-                for &model in MaterialModel::ALL {
-                    eprintln!("{}: {model}", stringify!($check)); // names the model of a failure
-                    testing::$check(model);
-                }
-            }
-        )*};
-    }
-
-    every_registered_model! {
-        every_registered_model_has_zero_energy_and_stress_at_rest: check_rest_state,
-        every_registered_model_has_pk1_matching_energy_finite_differences: check_pk1_matches_energy_fd,
-        every_registered_model_has_dpdf_matching_pk1_finite_differences: check_dpdf_matches_pk1_fd,
-        every_registered_model_has_dpdf_with_major_symmetry: check_dpdf_symmetric,
-        every_registered_model_projects_dpdf_to_the_nearest_psd: check_projected_psd,
-        every_registered_model_has_projected_dpdf_equal_to_dpdf_at_rest: check_projected_at_rest,
-        every_registered_model_is_rotation_invariant: check_rotation_invariance,
-        every_registered_model_satisfies_the_split_energy_identity: check_split_identity,
-        every_registered_model_has_split_gradients_matching_finite_differences: check_split_gradients_fd,
-        every_registered_model_linearises_to_linear_elasticity_at_rest: check_linearisation_at_rest,
-        every_registered_model_agrees_between_energy_and_pk1_and_separate_calls: check_energy_and_pk1_consistent,
-        every_registered_model_has_node_force_and_block_matching_dpdf: check_node_force_and_block_match_dpdf,
-        every_registered_model_has_a_node_visit_summing_its_points: check_node_visit_matches_point_sum,
-    }
-
-    #[test]
-    fn registered_names_are_unique() {
-        for (i, a) in MaterialModel::ALL.iter().enumerate() {
-            for b in &MaterialModel::ALL[i + 1..] {
-                assert_ne!(a.name(), b.name());
-                assert_ne!(a, b);
-            }
-        }
-    }
-
-    #[test]
-    fn names_round_trip() {
-        for &m in MaterialModel::ALL {
-            assert_eq!(MaterialModel::from_name(m.name()), Some(m));
-            assert_eq!(MaterialModel::from_name(&m.name().to_uppercase()), Some(m));
-            assert_eq!(MaterialModel::from_name(m.long_name()), Some(m));
-            assert_eq!(m.to_string(), m.name());
-        }
-        // the built-in models keep their names and places (a new model goes after them)
-        let names: Vec<&str> = MaterialModel::ALL.iter().map(|m| m.name()).collect();
-        assert_eq!(names[..4], ["stvk", "snh", "snh-log", "nh"]);
-        assert_eq!(MaterialModel::from_name(" SNH-Log "), Some(MaterialModel::StableNeoHookeanLog));
-        assert_eq!(
-            MaterialModel::from_name("stable Neo-Hookean with log term"),
-            Some(MaterialModel::StableNeoHookeanLog)
-        );
-        assert_eq!(MaterialModel::from_name(" StVK "), Some(MaterialModel::StVenantKirchhoff));
-        assert_eq!(MaterialModel::from_name("NH"), Some(MaterialModel::NeoHookean));
-        assert_eq!(MaterialModel::from_name("Snh"), Some(MaterialModel::StableNeoHookean));
-        assert_eq!(MaterialModel::from_name("neo"), None);
-        assert_eq!(MaterialModel::from_name(""), None);
-        assert_eq!(MaterialModel::StVenantKirchhoff.long_name(), "Saint-Venant–Kirchhoff");
-    }
-
-    #[test]
-    fn lame_from_youngs_poisson() {
-        let l = Lame::from_youngs_poisson(1.0, 0.25);
-        assert!((l.mu_pa - 0.4).abs() < 1e-15);
-        assert!((l.lambda_pa - 0.4).abs() < 1e-15);
-        let l = Lame::from_youngs_poisson(2.0e6, 0.0);
-        assert_eq!(l.lambda_pa, 0.0);
-        assert!((l.mu_pa - 1.0e6).abs() < 1e-9);
-        let m = Material::new(MaterialModel::NeoHookean, 1.0e5, 0.3, 1000.0).expect("valid");
-        assert_eq!(m.lame(), Lame::from_youngs_poisson(1.0e5, 0.3));
-    }
-
-    #[test]
-    fn new_accepts_valid_parameters() {
-        for &model in MaterialModel::ALL {
-            for nu in [-0.99, -0.5, 0.0, 0.3, 0.49, 0.4999] {
-                let m = Material::new(model, 1.0e6, nu, 1100.0).expect("valid parameters");
-                assert_eq!(m.model, model);
-                assert_eq!(m.youngs_modulus_pa, 1.0e6);
-                assert_eq!(m.poisson_ratio, nu);
-                assert_eq!(m.density_kg_m3, 1100.0);
-            }
-        }
-    }
-
-    fn err(model: MaterialModel, e: f64, nu: f64, rho: f64) -> String {
-        match Material::new(model, e, nu, rho) {
-            Ok(m) => panic!("accepted invalid parameters: {m:?}"),
-            Err(err) => err.to_string(),
-        }
-    }
-
-    #[test]
-    fn new_rejects_invalid_parameters_with_named_messages() {
-        for &model in MaterialModel::ALL {
-            for nu in [0.5, 0.7, -1.0, -1.5, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-                let msg = err(model, 1.0e6, nu, 1000.0);
-                assert!(msg.contains("Poisson ratio"), "{msg}");
-                assert!(msg.contains(model.name()), "{msg}");
-            }
-            for e in [0.0, -0.0, -3.0, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-                let msg = err(model, e, 0.3, 1000.0);
-                assert!(msg.contains("Young's modulus"), "{msg}");
-            }
-            for rho in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-                let msg = err(model, 1.0e6, 0.3, rho);
-                assert!(msg.contains("density"), "{msg}");
-            }
-        }
-        assert_eq!(
-            err(MaterialModel::StVenantKirchhoff, -3.0, 0.3, 1000.0),
-            "Young's modulus must be a finite positive number of pascals, got -3"
-        );
-        assert_eq!(
-            err(MaterialModel::StVenantKirchhoff, 1.0e6, 0.5, 1000.0),
-            "Poisson ratio must lie in (-1, 0.5) for stvk (λ → ∞ at 0.5), got 0.5"
-        );
-        assert_eq!(
-            err(MaterialModel::NeoHookean, 1.0e6, 0.3, -2.5),
-            "density must be a finite positive number of kg/m³, got -2.5"
-        );
-        assert!(err(MaterialModel::NeoHookean, f64::NAN, 0.3, 1.0).ends_with("got NaN"));
-        assert_eq!(
-            Material::new(MaterialModel::NeoHookean, 1.0e6, 0.7, 1.0),
-            Err(MaterialError::PoissonRatio { model: MaterialModel::NeoHookean, poisson_ratio: 0.7 })
-        );
-        // Valid-looking E and ν whose Lamé parameters overflow.
-        let msg = err(MaterialModel::StableNeoHookean, 1.0e308, 0.5 - 1.0e-12, 1.0);
-        assert!(msg.contains("Lamé"), "{msg}");
-    }
-
-    #[test]
-    fn cofactor_is_det_times_inverse_transpose() {
-        testing::run(testing::general_matrix(1.5), |f| {
-            prop_assume!(f.determinant().abs() > 1e-3);
-            let inv_t = f.try_inverse().expect("invertible").transpose();
-            let expected = inv_t * f.determinant();
-            let cof = cofactor(&f);
-            prop_assert!((cof - expected).norm() <= 1e-9 * (1.0 + expected.norm()));
-            prop_assert!((det_minus_one(&f) - (f.determinant() - 1.0)).abs() <= 1e-12 * (1.0 + f.norm().powi(3)));
-            Ok(())
-        });
-    }
-
-    #[test]
-    fn cofactor_directional_matches_finite_differences() {
-        testing::run((testing::general_matrix(1.5), testing::general_matrix(1.0)), |(f, df)| {
-            let h = 1e-6;
-            let fd = (cofactor(&(f + df * h)) - cofactor(&(f - df * h))) / (2.0 * h);
-            let an = cofactor_directional(&f, &df);
-            prop_assert!((fd - an).norm() <= 1e-7 * (1.0 + an.norm()));
-            Ok(())
-        });
-    }
-
-    #[test]
-    fn projection_of_known_matrix() {
-        let mut d = Mat9::zeros();
-        for i in 0..9 {
-            d[(i, i)] = i as f64 - 4.0; // eigenvalues -4..4
-        }
-        let r = testing::random_orthogonal9(7);
-        let m = r * d * r.transpose();
-        let p = project_psd(&m);
-        let mut expected = Mat9::zeros();
-        for i in 0..9 {
-            expected[(i, i)] = (i as f64 - 4.0).max(0.0);
-        }
-        let expected = r * expected * r.transpose();
-        assert!((p - expected).norm() < 1e-12 * expected.norm().max(1.0), "{p}");
-        // Already positive definite: returned unchanged (bit for bit).
-        let mut pd = Mat9::zeros();
-        for i in 0..9 {
-            pd[(i, i)] = i as f64 + 1.0;
-        }
-        let pd = r * pd * r.transpose();
-        let pd = (pd + pd.transpose()) * 0.5;
-        assert_eq!(project_psd(&pd), pd);
-        // Non-finite input passes through instead of looping.
-        let mut bad = m;
-        bad[(3, 4)] = f64::NAN;
-        assert!(project_psd(&bad)[(3, 4)].is_nan());
-    }
-
-    #[test]
-    fn split_stiffness_is_positive_for_nonnegative_poisson_ratio() {
-        testing::run((0.0f64..0.49, 3.0f64..9.0), |(nu, log_e)| {
-            for &model in MaterialModel::ALL {
-                let m = Material::new(model, 10f64.powf(log_e), nu, 1000.0).expect("valid");
-                let k = m.split_stiffness_pa();
-                prop_assert!(k[0] > 0.0);
-                prop_assert!(k[1] >= 0.0);
-            }
-            Ok(())
-        });
-    }
-}
-
-#[cfg(test)]
-mod psd3_tests {
-    use super::project_psd3;
-    use nalgebra::{Matrix3, SymmetricEigen};
-
-    /// A positive definite block comes back as it was; an indefinite one comes back with its
-    /// negative eigenvalues at 0 and its eigenvectors kept (the nearest PSD matrix); non-finite
-    /// input is returned as is.
-    #[test]
-    fn psd3_projection_keeps_pd_blocks_and_clamps_negative_eigenvalues() {
-        let pd = Matrix3::new(4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0);
-        assert_eq!(project_psd3(&pd), pd);
-        let indefinite = Matrix3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, -3.0); // eigenvalues 3, -1, -3
-        let p = project_psd3(&indefinite);
-        let eig = SymmetricEigen::new(p).eigenvalues;
-        let mut e: Vec<f64> = eig.iter().copied().collect();
-        e.sort_by(f64::total_cmp);
-        assert!(e[0].abs() < 1e-12 && e[1].abs() < 1e-12 && (e[2] - 3.0).abs() < 1e-12, "{e:?}");
-        // the kept eigenvector (1, 1, 0)/√2 with eigenvalue 3
-        let v = nalgebra::Vector3::new(1.0, 1.0, 0.0).normalize();
-        assert!((p * v - 3.0 * v).norm() < 1e-12);
-        let bad = Matrix3::new(f64::NAN, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-        assert!(project_psd3(&bad)[(0, 0)].is_nan());
-        // the fast path (positive leading minors) returns the symmetric part, not the input
-        let asymmetric = Matrix3::new(4.0, 2.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 2.0);
-        assert_eq!(project_psd3(&asymmetric), Matrix3::new(4.0, 1.0, 0.0, 1.0, 3.0, 0.0, 0.0, 0.0, 2.0));
-        // first two minors positive, the determinant negative: not taken for definite
-        let last_negative = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, -1.0));
-        assert_eq!(project_psd3(&last_negative), Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 0.0)));
-    }
-}
+mod tests;

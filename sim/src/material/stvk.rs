@@ -25,8 +25,8 @@
 //! λ tr(E) is added to the diagonal of S only, so a non-finite tr(E) leaves the off-diagonal
 //! (shear) stress as 2μE; a NaN or infinite entry of F otherwise propagates into ψ and P.
 
-use super::lane::{Lane, M3, Scalar, from_mat3, to_mat3, tr_mat_mul};
-use super::{HyperelasticModel, Lame, Mat3, Mat9, NodeVisit, NodeVisitKernel, SplitTerm, dpdf_from_directional};
+use crate::math::lane::{Lane, M3, Scalar, from_mat3, to_mat3, tr_mat_mul};
+use super::{FastLaw, HyperelasticModel, Lame, Mat3, Mat9, NodeVisit, NodeVisitKernel, SplitTerm, dpdf_from_directional};
 use nalgebra::Vector3;
 
 /// E = ½(H + Hᵀ + HᵀH), H = F − I (Green–Lagrange).
@@ -82,7 +82,7 @@ pub fn energy_and_pk1<L: Lane>(mu: L, lambda: L, f: &M3<L>) -> (L, M3<L>) {
     let e = green_strain(f);
     let tr = trace(&e);
     let s = second_piola(mu, lambda, &e, tr);
-    (energy_from_strain(mu, lambda, &e, tr), super::lane::mat_mul(f, &s))
+    (energy_from_strain(mu, lambda, &e, tr), crate::math::lane::mat_mul(f, &s))
 }
 
 /// `Σ_k m_kr m_kc` (columns `r`, `c`: `(mᵀm)_rc`).
@@ -169,7 +169,7 @@ fn sym_mat3(b: &[f64; 6]) -> Mat3 {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn node_visit_avx2(l: Lame, p: NodeVisit<'_>) -> (Vector3<f64>, Mat3) {
-    use crate::xpbd::kernels::lanes4::F64x4;
+    use crate::math::f64x4::F64x4;
     assert_eq!(p.width, 4, "a four-lane kernel given a visit {} lanes wide", p.width);
     let (mu, lambda) = (F64x4::splat(l.mu_pa), F64x4::splat(l.lambda_pa));
     let (mut force, mut block) = ([F64x4::zero(); 3], [F64x4::zero(); 6]);
@@ -212,6 +212,9 @@ fn stress(l: Lame, e: &Mat3) -> Mat3 {
 pub struct StVenantKirchhoff;
 
 impl HyperelasticModel for StVenantKirchhoff {
+    fn fast_law(&self, l: Lame) -> Option<FastLaw> {
+        Some(FastLaw::StVenantKirchhoff(l))
+    }
     fn name(&self) -> &'static str {
         "stvk"
     }
@@ -258,7 +261,7 @@ impl HyperelasticModel for StVenantKirchhoff {
 
     fn node_visit_kernel(&self, width: usize) -> Option<NodeVisitKernel> {
         #[cfg(target_arch = "x86_64")]
-        if width == 4 && crate::xpbd::kernels::lanes4::available() {
+        if width == 4 && crate::math::f64x4::available() {
             return Some(node_visit_avx2);
         }
         None

@@ -12,17 +12,22 @@
 //!
 //! `(2/h²)(x − ỹ)ᵀ M (x − ỹ) + U(x) − (M g)ᵀ x`,
 //!
-//! which is the backward-Euler incremental potential of [`super::newton`] with the step `h/2` and
-//! the prediction `ỹ + (h²/4) g`: the same Newton solver (sparse Cholesky, line search) does it.
+//! which is the backward-Euler incremental potential ([`super::potential`]) with the step `h/2` and
+//! the prediction `ỹ + (h²/4) g`: the one Newton ([`super::newton_core`]) solves it.
 //! Then `v_{n+1} = v_n + (h/2)(a_n + a_{n+1})`. The start is `a_0 = g − ∇U(x_0)/m` on the free
 //! nodes (`g` for a body released from rest), zero on the held ones.
 //!
 //! Only gravity and clamps are honoured (the reference motion of the bending beam needs no
 //! more); any other effect is refused by name.
 
-use super::method::{Hooks, StepInput, StepSolver};
-use super::newton::Newton;
-use super::{SimError, Simulation, SolverCounters};
+use super::error::{SimError, SolverCounters};
+use super::nan_guard::{BadElement, ORIGIN_NEWTON};
+use super::newton_core::{Failure, HessianModel, Objective, Outcome, Scratch, minimise};
+use super::potential::Potential;
+use super::settings::SolverSettings;
+use super::simulation::Simulation;
+use super::sparse::SparsePattern;
+use super::step::StepInput;
 use crate::Vec3;
 use crate::fem::energy::total_energy_and_gradient;
 
@@ -30,14 +35,24 @@ use crate::fem::energy::total_energy_and_gradient;
 const HONOURED: [&str; 2] = ["gravity", "clamp"];
 
 /// A Newmark (average acceleration) integrator driving a [`Simulation`]'s positions and
-/// velocities with a fixed step, for reference motions.
+/// velocities with a fixed step, for reference motions. It reads the simulation's model through
+/// its public interface and solves each step with the one Newton ([`super::newton_core`]).
 pub struct Newmark {
-    newton: Newton,
+    pattern: Option<SparsePattern>,
+    scratch: Scratch,
     accelerations_m_s2: Vec<Vec3>,
     h_secs: f64,
     time_secs: f64,
     counters: SolverCounters,
-    settings: super::SolverSettings,
+    settings: SolverSettings,
+}
+
+struct HalfStep<'a>(Potential<'a>);
+
+impl Objective for HalfStep<'_> {
+    fn eval(&self, x: &[Vec3], grad: &mut [Vec3]) -> (f64, f64) {
+        self.0.eval(x, grad)
+    }
 }
 
 impl Newmark {
@@ -50,7 +65,7 @@ impl Newmark {
         if !(tolerance > 0.0 && tolerance < 1.0) {
             return Err(SimError::Settings(format!("the Newmark tolerance must be in (0, 1), got {tolerance}")));
         }
-        if let Some(e) = sim.effects.iter().find(|e| !HONOURED.contains(&e.name())) {
+        if let Some(e) = sim.effects().iter().find(|e| !HONOURED.contains(&e.name())) {
             return Err(SimError::Unsupported {
                 solver: "newmark",
                 effect: e.name(),
@@ -59,17 +74,19 @@ impl Newmark {
         }
         let g = sim.body_acceleration_m_s2();
         let mut grad = vec![Vec3::zeros(); sim.positions.len()];
-        total_energy_and_gradient(&sim.mesh, &sim.geometry, &sim.material, &sim.positions, &mut grad);
+        total_energy_and_gradient(sim.mesh(), sim.geometry(), sim.material(), &sim.positions, &mut grad);
+        let inv_mass = sim.inv_mass();
         let accelerations_m_s2 = grad
             .iter()
             .enumerate()
-            .map(|(i, f)| if sim.inv_mass[i] > 0.0 { g - f * sim.inv_mass[i] } else { Vec3::zeros() })
+            .map(|(i, f)| if inv_mass[i] > 0.0 { g - f * inv_mass[i] } else { Vec3::zeros() })
             .collect();
-        let mut settings = sim.settings;
+        let mut settings = *sim.settings();
         settings.newton.tolerance = tolerance;
         settings.newton.refactor_every_iteration = false;
         Ok(Self {
-            newton: Newton::new(&sim.mesh),
+            pattern: None,
+            scratch: Scratch::default(),
             accelerations_m_s2,
             h_secs,
             time_secs: 0.0,
@@ -93,50 +110,78 @@ impl Newmark {
         let h = self.h_secs;
         let g = sim.body_acceleration_m_s2();
         let n = sim.positions.len();
-        sim.prev_positions.copy_from_slice(&sim.positions);
-        // the prediction of the half-step backward-Euler problem: ỹ + (h²/4) g on free nodes
-        let mut x = sim.positions.clone();
+        let inv_mass = sim.inv_mass().to_vec();
+        // ỹ = x_n + h v_n + (h²/4) a_n; the half-step problem's prediction is ỹ + (h²/4) g and
+        // its start ỹ (the prediction without the step's body acceleration, as Newton's)
+        let mut tilde = sim.positions.clone();
         for i in 0..n {
-            if sim.inv_mass[i] > 0.0 {
-                x[i] += sim.velocities[i] * h + (self.accelerations_m_s2[i] + g) * (0.25 * h * h);
+            if inv_mass[i] > 0.0 {
+                tilde[i] += sim.velocities[i] * h + self.accelerations_m_s2[i] * (0.25 * h * h);
             }
         }
-        let input = StepInput {
-            mesh: &sim.mesh,
-            geometry: &sim.geometry,
-            material: &sim.material,
-            masses_kg: &sim.masses_kg,
-            inv_mass: &sim.inv_mass,
-            prev_positions: &sim.prev_positions,
-            body_acceleration: g,
-            h: 0.5 * h,
-            settings: &self.settings,
-            model_version: sim.model_version,
+        let y: Vec<Vec3> =
+            tilde.iter().zip(&inv_mass).map(|(t, &w)| if w > 0.0 { t + g * (0.25 * h * h) } else { *t }).collect();
+        let mut x = tilde.clone();
+        let outcome = {
+            let mesh = sim.mesh();
+            if self.pattern.is_none() {
+                let pattern = SparsePattern::new(mesh, |i| inv_mass[i] == 0.0)
+                    .map_err(|e| SimError::Settings(format!("Newmark's stiffness pattern: {e:?}")))?;
+                self.pattern = Some(pattern);
+            }
+            let pattern = self.pattern.as_mut().expect("made above");
+            let w = 4.0 / (h * h);
+            let input = StepInput {
+                mesh,
+                geometry: sim.geometry(),
+                material: sim.material(),
+                masses_kg: sim.masses_kg(),
+                inv_mass: &inv_mass,
+                prev_positions: &sim.positions,
+                body_acceleration: g,
+                h: 0.5 * h,
+                settings: &self.settings,
+                model_version: 0,
+            };
+            let potential = HalfStep(Potential { input: &input, y: &y, springs: &[], w });
+            let mut diagonal = vec![0.0; pattern.free_dofs];
+            for (dof, &k) in pattern.dof_of.iter().enumerate() {
+                if k != usize::MAX {
+                    diagonal[k] = sim.masses_kg()[dof / 3] * w;
+                }
+            }
+            let model = HessianModel { mesh, geometry: sim.geometry(), material: sim.material(), diagonal: &diagonal };
+            let body_force: f64 = sim.masses_kg().iter().map(|m| m * g.norm()).sum();
+            minimise(
+                &potential,
+                &model,
+                pattern,
+                &mut x,
+                &self.settings.newton,
+                body_force,
+                &mut self.scratch,
+                &mut self.counters,
+                &mut |_| {},
+            )
         };
-        let mut calls = 0;
-        let mut no_effects: Vec<Box<dyn crate::effect::Effect>> = Vec::new();
-        let mut velocities = sim.velocities.clone();
-        let mut hooks = Hooks {
-            effects: &mut no_effects,
-            velocities: &mut velocities,
-            prev_positions: &sim.prev_positions,
-            rest: &sim.mesh.rest_positions,
-            inv_mass: &sim.inv_mass,
-            time_secs: self.time_secs,
-            h,
-            calls: &mut calls,
-        };
-        let solved = self.newton.solve_step(&input, &mut x, &mut hooks, &mut self.counters);
-        if let Err(bad) = solved {
-            return Err(sim.fail(bad));
+        match outcome {
+            Ok(Outcome::Converged { .. } | Outcome::Stalled { .. }) => {}
+            Ok(Outcome::Unconverged { .. }) => self.counters.unconverged_steps += 1,
+            Err(Failure::NonFinite { node }) => {
+                let bad = BadElement::at_node(sim.mesh(), node, ORIGIN_NEWTON);
+                return Err(sim.fail(bad));
+            }
+            Err(Failure::Factorisation(_)) => {
+                let bad = BadElement::at_node(sim.mesh(), 0, ORIGIN_NEWTON);
+                return Err(sim.fail(bad));
+            }
         }
         let four_over_h2 = 4.0 / (h * h);
         for i in 0..n {
-            if sim.inv_mass[i] == 0.0 {
+            if inv_mass[i] == 0.0 {
                 continue;
             }
-            let tilde = sim.positions[i] + sim.velocities[i] * h + self.accelerations_m_s2[i] * (0.25 * h * h);
-            let a_next = (x[i] - tilde) * four_over_h2;
+            let a_next = (x[i] - tilde[i]) * four_over_h2;
             sim.velocities[i] += (self.accelerations_m_s2[i] + a_next) * (0.5 * h);
             self.accelerations_m_s2[i] = a_next;
             sim.positions[i] = x[i];
@@ -151,7 +196,7 @@ impl Newmark {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{G, clamped_at_x0, one_cell_cantilever};
+    use crate::solver::tests::{G, clamped_at_x0, one_cell_cantilever};
     use super::*;
     use crate::effect::{Clamp, Damping, Effect, Gravity};
     use crate::element::ElementType;
@@ -166,7 +211,7 @@ mod tests {
         let clamped = clamped_at_x0(&mesh);
         let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
         let effects: Vec<Box<dyn Effect>> = vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped })];
-        Simulation::new(mesh, material, super::super::SolverSettings::default(), effects).unwrap()
+        Simulation::new(mesh, material, crate::solver::SolverSettings::default(), effects).unwrap()
     }
 
     /// Kinetic + elastic − gravity work: conserved by the trapezoidal rule up to the Newton
@@ -208,7 +253,7 @@ mod tests {
         // the contrast that makes Newmark the reference: at the same step, implicit Euler damps
         let mut euler = cantilever(et("p2"));
         let mut settings = *euler.settings();
-        settings.method = super::super::Method::Newton;
+        settings.method = crate::solver::Method::Newton;
         settings.frames_per_second = 1000.0;
         euler.set_settings(settings).unwrap();
         let mut sim = cantilever(et("p2"));

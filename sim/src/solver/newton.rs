@@ -29,105 +29,46 @@
 //! - The factorisation runs on one thread (`Par::Seq`), so results do not depend on the thread
 //!   count; the element Hessians are computed in parallel and summed in a fixed order.
 
-use super::SolverCounters;
-use super::method::{Hooks, Method, StepInput, StepSolver};
+use super::error::SolverCounters;
 use super::nan_guard::{BadElement, ORIGIN_NEWTON};
+use super::newton_core::{Failure, HessianModel, Objective, Outcome, Scratch, minimise};
+use super::potential::Potential;
 use super::settings::SolverSettings;
 use super::sparse::SparsePattern;
+use super::step::{Hooks, StepInput, StepSolver};
 use crate::Vec3;
-use crate::effect::NodeSpring;
-use crate::fem::energy::total_energy_and_gradient;
 use crate::fem::geometry::BlockGeometry;
 use crate::mesh::Mesh;
-
-/// The factorisation runs on one thread: results independent of the thread count.
-const SEQ: faer::Par = faer::Par::Seq;
-
-/// Residual decrease per iteration below which the kept factor is refreshed.
-const SLOW_RATIO: f64 = 0.25;
 
 pub(crate) struct Newton {
     pattern: Option<SparsePattern>,
     /// The model version and step the pattern and factor were made for.
     made_for: (u64, f64),
-    /// The body's size (largest extent of the rest shape), for the step-size test.
-    diagonal_m: f64,
-    residuals: Vec<f64>,
     y: Vec<Vec3>,
-    grad: Vec<Vec3>,
-    trial: Vec<Vec3>,
-    trial_grad: Vec<Vec3>,
+    scratch: Scratch,
 }
 
 impl Newton {
-    pub fn new(mesh: &Mesh) -> Self {
-        let (lo, hi) = mesh
-            .rest_positions
-            .iter()
-            .fold((Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
-        let diagonal_m = if mesh.rest_positions.is_empty() { 1.0 } else { (hi - lo).norm().max(f64::MIN_POSITIVE) };
-        Self {
-            pattern: None,
-            made_for: (u64::MAX, 0.0),
-            diagonal_m,
-            residuals: Vec::new(),
-            y: Vec::new(),
-            grad: Vec::new(),
-            trial: Vec::new(),
-            trial_grad: Vec::new(),
-        }
+    pub fn new(_mesh: &Mesh) -> Self {
+        Self { pattern: None, made_for: (u64::MAX, 0.0), y: Vec::new(), scratch: Scratch::default() }
     }
 }
 
-/// The incremental potential and its gradient (free nodes only; held ones get a zero gradient);
-/// also VBD's coarse correction's gradient ([`super::vbd_coarse`]).
-pub(super) struct Potential<'a> {
-    pub input: &'a StepInput<'a>,
-    pub y: &'a [Vec3],
-    pub springs: &'a [NodeSpring],
-    /// `1/h²`.
-    pub w: f64,
-}
-
-impl Potential<'_> {
-    /// `E(x)` and `∇E(x)` (zero on held nodes), and the reactions `‖∇U − m a‖` at the held nodes.
-    pub fn eval(&self, x: &[Vec3], grad: &mut [Vec3]) -> (f64, f64) {
-        let s = self.input;
-        let mut e = total_energy_and_gradient(s.mesh, s.geometry, s.material, x, grad);
-        let mut reactions = 0.0;
-        for (i, g) in grad.iter_mut().enumerate() {
-            if s.inv_mass[i] == 0.0 {
-                reactions += (*g - s.body_acceleration * s.masses_kg[i]).norm_squared();
-                *g = Vec3::zeros();
-                continue;
-            }
-            let d = x[i] - self.y[i];
-            e += 0.5 * s.masses_kg[i] * self.w * d.norm_squared();
-            *g += d * (s.masses_kg[i] * self.w);
-        }
-        for sp in self.springs {
-            let i = sp.node as usize;
-            let d = x[i] - sp.target_m;
-            e += 0.5 * sp.stiffness_n_per_m * d.norm_squared();
-            if s.inv_mass[i] > 0.0 {
-                grad[i] += d * sp.stiffness_n_per_m;
-            }
-        }
-        (e, reactions.sqrt())
+impl Objective for Potential<'_> {
+    fn eval(&self, x: &[Vec3], grad: &mut [Vec3]) -> (f64, f64) {
+        Potential::eval(self, x, grad)
     }
-}
-
-fn norm(v: &[Vec3]) -> f64 {
-    v.iter().map(|g| g.norm_squared()).sum::<f64>().sqrt()
-}
-
-fn first_non_finite(x: &[Vec3], g: &[Vec3]) -> Option<usize> {
-    x.iter().zip(g).position(|(a, b)| !a.iter().chain(b.iter()).all(|c| c.is_finite()))
 }
 
 impl StepSolver for Newton {
-    fn method(&self) -> Method {
-        Method::Newton
+    fn work_summary(&self, _settings: &SolverSettings, counters: &SolverCounters) -> String {
+        format!("newton, {} factorisations", counters.factorizations)
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
     }
 
     fn rebuild(&mut self, _mesh: &Mesh, _geometry: &[BlockGeometry], _settings: &SolverSettings, _geo: bool) {
@@ -135,7 +76,7 @@ impl StepSolver for Newton {
     }
 
     fn last_step_residuals(&self) -> &[f64] {
-        &self.residuals
+        &self.scratch.residuals
     }
 
     fn solve_step(
@@ -145,7 +86,6 @@ impl StepSolver for Newton {
         hooks: &mut Hooks<'_>,
         counters: &mut SolverCounters,
     ) -> Result<(), BadElement> {
-        let n = positions.len();
         let settings = s.settings.newton;
         let bad = |node: usize| BadElement::at_node(s.mesh, node, ORIGIN_NEWTON);
         if let Some(i) = super::nan_guard::first_non_finite_position(positions) {
@@ -168,102 +108,40 @@ impl StepSolver for Newton {
         let w = 1.0 / (s.h * s.h);
         let potential = Potential { input: s, y: &self.y, springs: &springs, w };
         let body_force: f64 = s.masses_kg.iter().map(|m| m * s.body_acceleration.norm()).sum();
-        self.grad.resize(n, Vec3::zeros());
-        self.trial_grad.resize(n, Vec3::zeros());
-        let (mut energy, mut reactions) = potential.eval(positions, &mut self.grad);
-        if let Some(node) = first_non_finite(positions, &self.grad) {
-            return Err(bad(node));
+        let mut diagonal = vec![0.0; pattern.free_dofs];
+        for (dof, &k) in pattern.dof_of.iter().enumerate() {
+            if k != usize::MAX {
+                diagonal[k] = s.masses_kg[dof / 3] * w;
+            }
         }
-        if !energy.is_finite() {
-            return Err(bad(0));
-        }
-        let diagonal: Vec<f64> = {
-            let mut d = vec![0.0; pattern.free_dofs];
-            for (dof, &k) in pattern.dof_of.iter().enumerate() {
+        for sp in &springs {
+            for a in 0..3 {
+                let k = pattern.dof_of[3 * sp.node as usize + a];
                 if k != usize::MAX {
-                    d[k] = s.masses_kg[dof / 3] * w;
+                    diagonal[k] += sp.stiffness_n_per_m;
                 }
             }
-            for sp in &springs {
-                for a in 0..3 {
-                    let k = pattern.dof_of[3 * sp.node as usize + a];
-                    if k != usize::MAX {
-                        d[k] += sp.stiffness_n_per_m;
-                    }
-                }
-            }
-            d
-        };
-        self.residuals.clear();
-        let mut step = vec![0.0; pattern.free_dofs];
-        let mut refactor = settings.refactor_every_iteration || !pattern.is_factored();
-        for _ in 0..settings.max_iterations {
-            let residual = norm(&self.grad) / super::residual::load_scale(body_force, reactions);
-            self.residuals.push(residual);
-            if residual <= settings.tolerance {
-                return Ok(());
-            }
-            counters.solver_iterations += 1;
-            if refactor {
-                // the exact Hessian where it is positive definite (quadratic convergence), else
-                // the one projected per quadrature point
-                let exact =
-                    pattern.assemble_and_factor(s.mesh, s.geometry, s.material, positions, &diagonal, false, SEQ);
-                if exact.is_err() {
-                    pattern
-                        .assemble_and_factor(s.mesh, s.geometry, s.material, positions, &diagonal, true, SEQ)
-                        .map_err(|_| bad(0))?;
-                    counters.factorizations += 1;
-                }
-                counters.factorizations += 1;
-            }
-            for (dof, &k) in pattern.dof_of.iter().enumerate() {
-                if k != usize::MAX {
-                    step[k] = -self.grad[dof / 3][dof % 3];
-                }
-            }
-            pattern.solve_in_place(&mut step, SEQ);
-            // backtracking on E: accept a decrease of E or, at its round-off floor, of the residual
-            let mut t = 1.0;
-            let mut accepted = false;
-            let old_norm = norm(&self.grad);
-            while t > 1e-8 {
-                self.trial.clear();
-                self.trial.extend_from_slice(positions);
-                for (dof, &k) in pattern.dof_of.iter().enumerate() {
-                    if k != usize::MAX {
-                        self.trial[dof / 3][dof % 3] += t * step[k];
-                    }
-                }
-                let (e, r) = potential.eval(&self.trial, &mut self.trial_grad);
-                if e.is_finite() && (e <= energy || norm(&self.trial_grad) < old_norm) {
-                    accepted = true;
-                    energy = e;
-                    reactions = r;
-                    break;
-                }
-                t *= 0.5;
-            }
-            if !accepted {
-                if refactor {
-                    break;
-                }
-                refactor = true;
-                continue;
-            }
-            positions.copy_from_slice(&self.trial);
-            std::mem::swap(&mut self.grad, &mut self.trial_grad);
-            let moved = step.iter().fold(0.0f64, |m, v| m.max(v.abs())) * t;
-            if moved <= 1e-12 * self.diagonal_m {
-                return Ok(());
-            }
-            let new_norm = norm(&self.grad);
-            refactor = settings.refactor_every_iteration || t < 1.0 || new_norm > SLOW_RATIO * old_norm;
         }
-        if let Some(node) = first_non_finite(positions, &self.grad) {
-            return Err(bad(node));
+        let model = HessianModel { mesh: s.mesh, geometry: s.geometry, material: s.material, diagonal: &diagonal };
+        let outcome = minimise(
+            &potential,
+            &model,
+            pattern,
+            positions,
+            &settings,
+            body_force,
+            &mut self.scratch,
+            counters,
+            &mut |_| {},
+        );
+        match outcome {
+            Ok(Outcome::Converged { .. } | Outcome::Stalled { .. }) => Ok(()),
+            Ok(Outcome::Unconverged { .. }) => {
+                counters.unconverged_steps += 1;
+                Ok(())
+            }
+            Err(Failure::NonFinite { node }) => Err(bad(node)),
+            Err(Failure::Factorisation(_)) => Err(bad(0)),
         }
-        counters.unconverged_steps += 1;
-        Ok(())
     }
 }

@@ -2,7 +2,7 @@
 //! formulation, quadrature degree, the sweep's order ([`Sweep`]), the stability guard, and the
 //! implicit solvers' own settings ([`VbdSettings`], [`NewtonSettings`]) ([`SolverSettings`]).
 
-use super::SimError;
+use super::error::SimError;
 use super::method::Method;
 use crate::xpbd::constraint::Formulation;
 

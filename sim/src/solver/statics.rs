@@ -3,16 +3,20 @@
 //! Newton's method on the total potential `Π(x) = Σ_e U_e(x) − Σ_i m_i a·x_i` (body
 //! acceleration `a`, the same lumped masses as XPBD) with Dirichlet nodes (clamped, or driven to
 //! prescribed positions), on the same elements, quadrature and materials as XPBD:
-//! - element Hessians `Σ_q V_q (∇_X N_i)ᵀ ∂P/∂F (∇_X N_j)` with `∂P/∂F` projected to positive
-//!   semi-definite per quadrature point, assembled into a sparse matrix on the free degrees of
-//!   freedom (lower triangle);
-//! - a sparse Cholesky factorisation (`faer`, AMD ordering; the symbolic analysis is done once);
-//! - a backtracking line search on `Π`;
+//! - the one Newton's method of hox ([`super::newton_core`], shared with Newton's implicit
+//!   Euler): element Hessians `Σ_q V_q (∇_X N_i)ᵀ ∂P/∂F (∇_X N_j)` (exact where positive
+//!   definite, else `∂P/∂F` projected per quadrature point) assembled on the free degrees of
+//!   freedom, a sparse Cholesky factorisation on one thread (`faer`, AMD ordering; the symbolic
+//!   analysis done once, the numeric factor reused while Newton converges fast), a
+//!   backtracking line search on `Π`;
 //! - load stepping: body force and prescribed positions are applied in increments
 //!   `s ∈ (0, 1]`, halved when Newton fails to converge within an increment;
 //! - convergence when the free residual `|∇Π|` is at most `tolerance` times the force scale
 //!   (body force `Σ m_i |a|`, or the reaction forces at the Dirichlet nodes if larger).
 
+use super::error::SolverCounters;
+use super::newton_core::{Failure, HessianModel, Objective, Outcome, Scratch, minimise};
+use super::settings::NewtonSettings;
 use super::sparse::{SparseError, SparsePattern};
 use crate::Vec3;
 use crate::effect::Prescribed;
@@ -81,11 +85,23 @@ pub fn solve(problem: &StaticProblem<'_>, progress: Progress<'_>) -> Result<Stat
     let mut done = 0.0;
     let mut increment = 1.0 / problem.load_steps.max(1) as f64;
     let mut last_residual = 0.0;
+    let mut scratch = Scratch::default();
     while done < 1.0 {
         let target = (done + increment).min(1.0);
         let mut trial = x.clone();
         apply_dirichlet(problem, target, &mut trial);
-        match newton(problem, &geo, &masses, &mut pattern, target, &mut trial, &mut total_iterations, progress) {
+        match newton(
+            problem,
+            &geo,
+            &masses,
+            &prescribed_node,
+            &mut pattern,
+            target,
+            &mut trial,
+            &mut total_iterations,
+            &mut scratch,
+            progress,
+        ) {
             Ok(residual) => {
                 x = trial;
                 done = target;
@@ -115,90 +131,99 @@ fn apply_dirichlet(problem: &StaticProblem<'_>, fraction: f64, x: &mut [Vec3]) {
     }
 }
 
+/// Newton's iterations per load increment ([`StaticProblem::newton_settings`]).
+pub const MAX_ITERATIONS_PER_INCREMENT: u32 = 50;
+
+impl StaticProblem<'_> {
+    /// The settings of the one Newton ([`super::newton_core`]) for this problem: its tolerance,
+    /// [`MAX_ITERATIONS_PER_INCREMENT`], the factor reused while it converges fast.
+    pub fn newton_settings(&self) -> NewtonSettings {
+        NewtonSettings {
+            tolerance: self.tolerance,
+            max_iterations: MAX_ITERATIONS_PER_INCREMENT,
+            refactor_every_iteration: false,
+        }
+    }
+}
+
+/// `Π(x) = Σ_e U_e(x) − Σ_i m_i a·x_i` with the body acceleration `a` at one load fraction.
+struct TotalPotential<'a> {
+    mesh: &'a Mesh,
+    geometry: &'a [BlockGeometry],
+    material: &'a Material,
+    masses_kg: &'a [f64],
+    acceleration_m_s2: Vec3,
+    held: &'a [bool],
+}
+
+impl Objective for TotalPotential<'_> {
+    fn eval(&self, x: &[Vec3], grad: &mut [Vec3]) -> (f64, f64) {
+        let mut pot = total_energy_and_gradient(self.mesh, self.geometry, self.material, x, grad);
+        let mut reactions = 0.0;
+        for (i, g) in grad.iter_mut().enumerate() {
+            pot -= self.masses_kg[i] * self.acceleration_m_s2.dot(&x[i]);
+            *g -= self.acceleration_m_s2 * self.masses_kg[i];
+            if self.held[i] {
+                reactions += g.norm_squared();
+                *g = Vec3::zeros();
+            }
+        }
+        (pot, reactions.sqrt())
+    }
+}
+
 /// Newton iterations at one load fraction; returns the relative residual reached.
 #[allow(clippy::too_many_arguments)]
 fn newton(
     problem: &StaticProblem<'_>,
     geo: &[BlockGeometry],
     masses: &[f64],
+    held: &[bool],
     pattern: &mut SparsePattern,
     fraction: f64,
-    x: &mut Vec<Vec3>,
+    x: &mut [Vec3],
     total_iterations: &mut usize,
+    scratch: &mut Scratch,
     progress: Progress<'_>,
 ) -> Result<f64, StaticError> {
-    let mesh = problem.mesh;
-    let n = mesh.num_nodes();
     let a = problem.acceleration_m_s2 * fraction;
-    let potential = |x: &[Vec3]| -> (f64, Vec<Vec3>) {
-        let mut g = vec![Vec3::zeros(); n];
-        let mut pot = total_energy_and_gradient(mesh, geo, &problem.material, x, &mut g);
-        for i in 0..n {
-            pot -= masses[i] * a.dot(&x[i]);
-            g[i] -= masses[i] * a;
-        }
-        (pot, g)
+    let objective = TotalPotential {
+        mesh: problem.mesh,
+        geometry: geo,
+        material: &problem.material,
+        masses_kg: masses,
+        acceleration_m_s2: a,
+        held,
     };
+    let model = HessianModel { mesh: problem.mesh, geometry: geo, material: &problem.material, diagonal: &[] };
     let body_force: f64 = masses.iter().map(|m| m * a.norm()).sum();
-    let dof_of = pattern.dof_of.clone();
-    let free_dofs = pattern.free_dofs;
-    let split = |g: &[Vec3]| -> (Vec<f64>, f64) {
-        let mut r = vec![0.0; free_dofs];
-        let mut reactions = 0.0;
-        for (d, &k) in dof_of.iter().enumerate() {
-            let v = g[d / 3][d % 3];
-            if k == usize::MAX {
-                reactions += v * v;
-            } else {
-                r[k] = v;
-            }
+    let mut counters = SolverCounters::default();
+    let mut iteration = *total_iterations;
+    let outcome = minimise(
+        &objective,
+        &model,
+        pattern,
+        x,
+        &problem.newton_settings(),
+        body_force,
+        scratch,
+        &mut counters,
+        &mut |residual| {
+            progress(fraction, iteration, residual);
+            iteration += 1;
+        },
+    );
+    *total_iterations += counters.solver_iterations as usize;
+    match outcome {
+        Ok(Outcome::Converged { residual }) => Ok(residual),
+        Ok(Outcome::Stalled { residual } | Outcome::Unconverged { residual }) => {
+            Err(StaticError::NotConverged { load_fraction: fraction, residual })
         }
-        (r, reactions.sqrt())
-    };
-    let (mut pot, mut g) = potential(x);
-    let mut residual = f64::INFINITY;
-    for _ in 0..50 {
-        let (r, reactions) = split(&g);
-        let scale = super::residual::load_scale(body_force, reactions);
-        residual = norm(&r) / scale;
-        progress(fraction, *total_iterations, residual);
-        if residual <= problem.tolerance {
-            return Ok(residual);
+        Err(Failure::NonFinite { .. }) => {
+            Err(StaticError::NotConverged { load_fraction: fraction, residual: f64::INFINITY })
         }
-        *total_iterations += 1;
-        let par = faer::get_global_parallelism();
-        pattern.assemble_and_factor(mesh, geo, &problem.material, x, &[], true, par)?;
-        let mut step: Vec<f64> = r.iter().map(|v| -v).collect();
-        pattern.solve_in_place(&mut step, par);
-        let mut t = 1.0;
-        let mut accepted = false;
-        while t > 1e-8 {
-            let mut xt = x.clone();
-            for (d, &k) in dof_of.iter().enumerate() {
-                if k != usize::MAX {
-                    xt[d / 3][d % 3] += t * step[k];
-                }
-            }
-            let (pt, gt) = potential(&xt);
-            // accept a decrease of Π or, at Π's round-off floor, of the residual
-            if pt.is_finite() && (pt <= pot || norm(&split(&gt).0) < norm(&r)) {
-                *x = xt;
-                pot = pt;
-                g = gt;
-                accepted = true;
-                break;
-            }
-            t *= 0.5;
-        }
-        if !accepted {
-            break;
-        }
+        Err(Failure::Factorisation(e)) => Err(e.into()),
     }
-    Err(StaticError::NotConverged { load_fraction: fraction, residual })
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|c| c * c).sum::<f64>().sqrt()
 }
 
 impl From<SparseError> for StaticError {

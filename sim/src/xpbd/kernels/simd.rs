@@ -4,7 +4,7 @@
 //! ([`padded`]).
 
 use crate::material::Mat3;
-use crate::material::lane::madd;
+use crate::math::lane::madd;
 
 /// `a b` for 3×3 matrices with `madd::<FMA>` (nalgebra's product never fuses).
 #[inline(always)]

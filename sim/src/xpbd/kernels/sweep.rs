@@ -8,7 +8,7 @@ use super::point_law::{AnyMaterial, PointMaterial, Stvk};
 use super::shared::{Multipliers, Positions};
 use super::simd::{LANES, axpy_lanes, fma_lanes, mul3};
 use crate::Vec3;
-use crate::material::{Mat3, Material, MaterialModel};
+use crate::material::{FastLaw, Mat3, Material};
 use crate::xpbd::constraint::xpbd_step;
 
 use super::batch_values;
@@ -53,8 +53,7 @@ pub unsafe fn energy_sweep(
     macro_rules! dispatch {
         ($(($n:literal, $p:literal)),*) => {
             match nodes_per_element {
-                $($n => Some(if material.model == MaterialModel::StVenantKirchhoff {
-                        let l = material.lame();
+                $($n => Some(if let Some(FastLaw::StVenantKirchhoff(l)) = material.fast_law() {
                         let m = Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa };
                         #[cfg(target_arch = "x86_64")]
                         if wide {
@@ -325,8 +324,7 @@ pub unsafe fn colour_sweep(
         // SAFETY: forwarded from the caller; AVX2 and FMA were detected; the elements of a
         // batch are of one colour.
         let result = unsafe {
-            if material.model == MaterialModel::StVenantKirchhoff {
-                let l = material.lame();
+            if let Some(FastLaw::StVenantKirchhoff(l)) = material.fast_law() {
                 batches_of(n, q, &packed.ref_grads, &Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa }, io, batches)
             } else {
                 batches_of(n, q, &packed.ref_grads, &AnyMaterial(material), io, batches)

@@ -3,33 +3,37 @@
 //! ([`crate::xpbd::constraint`]). Within a substep: every multiplier `λ ← 0`, then `iterations`
 //! Gauss–Seidel sweeps (`sweep.rs`), each followed by every effect's own projection.
 //!
+//! Files: this one (its state and the step), `sweep.rs` (one Gauss–Seidel sweep).
+//!
 //! Its state: the multipliers, the element colouring, the element data packed for the sweeps and
 //! the colour sweep's slabs.
 
-use super::SolverCounters;
-use super::method::{Hooks, Method, StepInput, StepSolver};
+use super::error::SolverCounters;
 use super::nan_guard::BadElement;
 use super::settings::SolverSettings;
+use super::step::{Hooks, StepInput, StepSolver};
 use crate::Vec3;
 use crate::fem::geometry::BlockGeometry;
 use crate::mesh::Mesh;
 use crate::xpbd::constraint::Formulation;
 
+mod sweep;
+
 pub(crate) struct Xpbd {
-    pub(super) lambdas: Vec<Vec<f64>>,
+    pub(crate) lambdas: Vec<Vec<f64>>,
     /// Per block, the elements grouped by colour (no two elements of a colour share a node).
-    pub(super) colours: Vec<Vec<Vec<u32>>>,
+    pub(crate) colours: Vec<Vec<Vec<u32>>>,
     /// Per block, the element data packed for the sweeps (element order and colour order).
-    pub(super) packed: crate::xpbd::kernels::SolverData,
+    pub(crate) packed: crate::xpbd::kernels::SolverData,
     /// The colour sweep projects four elements at a time ([`crate::xpbd::kernels::p1x4`],
     /// [`crate::xpbd::kernels::batch`]).
-    pub(super) simd_batches: bool,
+    pub(crate) simd_batches: bool,
     /// Per block, its cut into slabs for the colour sweep and the slab count it was made for
     /// (built on first use; the count depends on the block's size alone; None: the block is too
     /// thin for that many slabs and is swept colour by colour).
-    pub(super) partitions: Vec<(usize, Option<crate::xpbd::kernels::Partition>)>,
+    pub(crate) partitions: Vec<(usize, Option<crate::xpbd::kernels::Partition>)>,
     /// Fewest elements per slab ([`crate::xpbd::kernels::slab_count`]).
-    pub(super) partition_min_per_slab: usize,
+    pub(crate) partition_min_per_slab: usize,
 }
 
 impl Xpbd {
@@ -73,10 +77,6 @@ impl Xpbd {
 }
 
 impl StepSolver for Xpbd {
-    fn method(&self) -> Method {
-        Method::Xpbd
-    }
-
     fn solve_step(
         &mut self,
         input: &StepInput<'_>,
@@ -99,10 +99,13 @@ impl StepSolver for Xpbd {
         self.lambdas = Self::multipliers(geometry, settings.formulation);
     }
 
-    fn as_xpbd(&self) -> Option<&Xpbd> {
-        Some(self)
+    fn work_summary(&self, _settings: &SolverSettings, _counters: &SolverCounters) -> String {
+        format!("xpbd, {} constraints", self.num_constraints())
     }
-    fn as_xpbd_mut(&mut self) -> Option<&mut Xpbd> {
-        Some(self)
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
     }
 }

@@ -1,13 +1,13 @@
 //! One Gauss–Seidel sweep of [`Xpbd`] over every element constraint: in element order,
-//! or colour by colour with the elements of a colour projected in parallel ([`super::Sweep`]). The energy
+//! or colour by colour with the elements of a colour projected in parallel ([`crate::solver::Sweep`]). The energy
 //! formulation goes through the specialised sweep ([`crate::xpbd::kernels`]); the split
 //! formulation (and any node count without a specialised sweep) through the generic kernels of
 //! [`crate::xpbd::constraint`], element by element: gather, project, check, scatter.
 
-use super::SolverCounters;
-use super::method::StepInput;
-use super::nan_guard::{BadElement, non_finite_node};
-use super::xpbd::Xpbd;
+use super::Xpbd;
+use crate::solver::error::SolverCounters;
+use crate::solver::nan_guard::{BadElement, non_finite_node};
+use crate::solver::step::StepInput;
 use crate::Vec3;
 use crate::fem::energy::{element_grads, gather};
 use crate::fem::geometry::BlockGeometry;
@@ -106,7 +106,7 @@ impl Xpbd {
         inv_dt2: f64,
     ) -> Result<(), BadElement> {
         use rayon::prelude::*;
-        let positions = crate::xpbd::kernels::SharedMut::new(positions);
+        let positions = crate::math::shared::SharedMut::new(positions);
         for (bi, lambdas) in self.lambdas.iter_mut().enumerate() {
             let block = &s.mesh.blocks[bi];
             let n = block.nodes_per_element();
@@ -155,7 +155,7 @@ impl Xpbd {
                     None => {}
                 }
             }
-            let lambdas = crate::xpbd::kernels::SharedMut::new(lambdas);
+            let lambdas = crate::math::shared::SharedMut::new(lambdas);
             for colour in &self.colours[bi] {
                 let projected: Result<usize, BadElement> = colour
                     .par_iter()

@@ -26,13 +26,14 @@
 //!
 //! The coarse matrix is `Uᵀ H U` assembled element by element, never the fine `H`.
 
-use super::method::StepInput;
-use super::newton::Potential;
-use super::settings::SolverSettings;
+use crate::solver::potential::Potential;
+use crate::solver::settings::SolverSettings;
+use crate::solver::step::StepInput;
 use crate::Vec3;
 use crate::effect::NodeSpring;
 use crate::fem::energy::for_each_element;
 use crate::fem::geometry::deformation_gradient;
+use crate::material::tangent::{contract_left, contract_right};
 use crate::mesh::Mesh;
 use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
 
@@ -241,24 +242,18 @@ impl CoarseSpace {
                 }
                 let f = deformation_gradient(el.x, el.rest, g);
                 let c = s.material.dpdf_projected(&f);
-                // t_K[(r, cc), k] = Σ_d C[(r + 3cc), (k + 3d)] (G_K)_d
+                // C(G_J, G_K) in two stages ([`contract_right`], then [`contract_left`])
                 for (tk, gk) in t.iter_mut().zip(gq.iter()) {
-                    for r in 0..3 {
-                        for cc in 0..3 {
-                            for k in 0..3 {
-                                tk[9 * r + 3 * cc + k] = (0..3).map(|d| c[(r + 3 * cc, k + 3 * d)] * gk[d]).sum();
-                            }
-                        }
-                    }
+                    *tk = contract_right(&c, gk);
                 }
                 for (j, gj) in gq.iter().enumerate() {
                     let row = 3 * local[j] as usize;
                     for (kk, tk) in t.iter().enumerate() {
                         let col = 3 * local[kk] as usize;
+                        let b = contract_left(tk, gj);
                         for r in 0..3 {
                             for k in 0..3 {
-                                let b: f64 = (0..3).map(|cc| gj[cc] * tk[9 * r + 3 * cc + k]).sum();
-                                a[(row + r, col + k)] += v * b;
+                                a[(row + r, col + k)] += v * b[(r, k)];
                             }
                         }
                     }
@@ -358,8 +353,8 @@ fn dot(a: &[Vec3], b: &[Vec3]) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{G, beam, clamped_at_x0};
-    use super::super::{Simulation, SolverSettings};
+    use crate::solver::tests::{G, beam, clamped_at_x0};
+    use crate::solver::{Simulation, SolverSettings};
     use super::*;
     use crate::effect::{Clamp, Effect, Gravity};
     use crate::element::ElementType;

@@ -1,0 +1,14 @@
+//! The number types below every other room: the lane a point law is written over ([`lane`]: one
+//! `f64` or four SIMD lanes), the four-lane AVX2 type and the one runtime check that the CPU can
+//! run it ([`f64x4`]), and the raw shared pointer parallel sweeps write through ([`shared`]).
+//! It reads no other room (as Rapier keeps its SIMD number type in a `math` module below
+//! `dynamics`): the materials, the XPBD kernels and the solvers all build on it.
+
+pub mod lane;
+pub mod shared;
+
+#[cfg(target_arch = "x86_64")]
+pub mod f64x4;
+
+/// A 3×3 matrix of f64 (deformation gradients, stresses).
+pub type Mat3 = nalgebra::Matrix3<f64>;

@@ -1,0 +1,221 @@
+//! The one Newton's method of hox: it minimises a potential `Φ` over the free degrees of freedom
+//! for the static solver ([`super::statics`]: `Π(x) = Σ_e U_e(x) − Σ_i m_i a·x_i` at one load
+//! fraction), for Newton's implicit Euler (`newton.rs`: the incremental potential of
+//! [`super::potential`]) and so for the reference motion's Newmark steps (`newmark.rs`).
+//!
+//! Each iteration solves `K Δ = −∇Φ` with `K = D + Σ_e Σ_q V_q Gᵀ ∂P/∂F G` (`D` a diagonal such
+//! as `M/h²` plus spring stiffnesses, none for statics; sparse Cholesky, `sparse.rs`) and
+//! backtracks on `Φ` (Nocedal & Wright, *Numerical Optimization*, 2nd ed., §3.1 and §3.4). One
+//! policy for every caller:
+//! - **Hessian:** the exact one where it is positive definite (quadratic convergence), else
+//!   `∂P/∂F` projected to positive semi-definite per quadrature point.
+//! - **Factor reuse:** the numeric factor is kept between iterations (and, by the caller's
+//!   pattern, between steps) and refreshed at the current iterate when the residual falls by less
+//!   than 4× in an iteration or the line search had to cut the step;
+//!   [`super::NewtonSettings::refactor_every_iteration`] refreshes it every iteration (pure
+//!   Newton).
+//! - **Line search:** halve `t` from 1 until `Φ` does not increase or, at `Φ`'s round-off floor,
+//!   the residual falls; below `t = 1e-8` the step is refused: with a reused factor the factor
+//!   is refreshed and the iteration retried, with a fresh one the method stops.
+//! - **Convergence:** the free residual `‖∇Φ‖ ≤ tolerance · load`, the load as in
+//!   [`super::StaticResidual`] (the body force, or the reactions if larger); or a step that
+//!   moves no coordinate by more than `1e-12` of the body's size (stalled: converged for a time
+//!   step, whose start may already be the minimiser; the static solver asks for the tolerance).
+//! - **Bits:** the factorisation and solves run on one thread (`Par::Seq`) and the element
+//!   Hessians are summed in a fixed order, so results do not depend on the thread count.
+//! - **Settings:** tolerance, iteration limit and refactoring from [`super::NewtonSettings`].
+
+use super::error::SolverCounters;
+use super::residual::load_scale;
+use super::settings::NewtonSettings;
+use super::sparse::{SparseError, SparsePattern};
+use crate::Vec3;
+use crate::fem::geometry::BlockGeometry;
+use crate::material::Material;
+use crate::mesh::Mesh;
+
+/// The factorisation runs on one thread: results independent of the thread count.
+const SEQ: faer::Par = faer::Par::Seq;
+
+/// Residual decrease per iteration below which the kept factor is refreshed.
+const SLOW_RATIO: f64 = 0.25;
+
+/// Smallest line-search fraction tried before the step is refused.
+const MIN_STEP_FRACTION: f64 = 1e-8;
+
+/// A potential Newton minimises.
+pub(crate) trait Objective {
+    /// `Φ(x)` and `∇Φ(x)` into `grad`, zero on held nodes, and the reactions (the norm of what
+    /// the gradient would be on the held nodes), newtons.
+    fn eval(&self, x: &[Vec3], grad: &mut [Vec3]) -> (f64, f64);
+}
+
+/// The elastic model whose Hessian `K` is assembled, plus the diagonal `D` (one value per free
+/// DOF of the pattern, or empty for none).
+pub(crate) struct HessianModel<'a> {
+    pub mesh: &'a Mesh,
+    pub geometry: &'a [BlockGeometry],
+    pub material: &'a Material,
+    pub diagonal: &'a [f64],
+}
+
+/// How a minimisation ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Outcome {
+    /// The residual reached the tolerance.
+    Converged { residual: f64 },
+    /// A step moved no coordinate by more than `1e-12` of the body's size.
+    Stalled { residual: f64 },
+    /// The iteration limit was reached, or the line search failed with a fresh factor; `x` holds
+    /// the last accepted iterate.
+    Unconverged { residual: f64 },
+}
+
+/// Why a minimisation stopped without an iterate.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Failure {
+    /// A position or gradient entry of this node is not finite (0 when only `Φ` is).
+    NonFinite { node: usize },
+    /// `K` could not be factored even projected.
+    Factorisation(SparseError),
+}
+
+/// Buffers kept between minimisations (no allocation per step).
+#[derive(Default)]
+pub(crate) struct Scratch {
+    grad: Vec<Vec3>,
+    trial: Vec<Vec3>,
+    trial_grad: Vec<Vec3>,
+    step: Vec<f64>,
+    /// The relative residual at the start of each iteration of the last minimisation.
+    pub residuals: Vec<f64>,
+}
+
+/// The body's size (the diagonal of its rest bounding box), for the stalled-step test.
+pub(crate) fn body_size_m(rest: &[Vec3]) -> f64 {
+    if rest.is_empty() {
+        return 1.0;
+    }
+    let (lo, hi) = rest
+        .iter()
+        .fold((Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+    (hi - lo).norm().max(f64::MIN_POSITIVE)
+}
+
+fn norm(v: &[Vec3]) -> f64 {
+    v.iter().map(|g| g.norm_squared()).sum::<f64>().sqrt()
+}
+
+fn first_non_finite(x: &[Vec3], g: &[Vec3]) -> Option<usize> {
+    x.iter().zip(g).position(|(a, b)| !a.iter().chain(b.iter()).all(|c| c.is_finite()))
+}
+
+/// Minimises `objective` from `x` (held nodes already placed; they do not move) by Newton's
+/// method with the policy of the module doc. `body_force_n` is the load the residual is measured
+/// against (with the reactions); `on_iteration(residual)` is called at the start of every
+/// iteration; the counters count iterations and factorisations.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn minimise(
+    objective: &dyn Objective,
+    model: &HessianModel<'_>,
+    pattern: &mut SparsePattern,
+    x: &mut [Vec3],
+    settings: &NewtonSettings,
+    body_force_n: f64,
+    scratch: &mut Scratch,
+    counters: &mut SolverCounters,
+    on_iteration: &mut dyn FnMut(f64),
+) -> Result<Outcome, Failure> {
+    let n = x.len();
+    let body_size = body_size_m(&model.mesh.rest_positions);
+    scratch.grad.resize(n, Vec3::zeros());
+    scratch.trial_grad.resize(n, Vec3::zeros());
+    scratch.step.clear();
+    scratch.step.resize(pattern.free_dofs, 0.0);
+    scratch.residuals.clear();
+    let (mut energy, mut reactions) = objective.eval(x, &mut scratch.grad);
+    if let Some(node) = first_non_finite(x, &scratch.grad) {
+        return Err(Failure::NonFinite { node });
+    }
+    if !energy.is_finite() {
+        return Err(Failure::NonFinite { node: 0 });
+    }
+    let mut refactor = settings.refactor_every_iteration || !pattern.is_factored();
+    for _ in 0..settings.max_iterations {
+        let residual = norm(&scratch.grad) / load_scale(body_force_n, reactions);
+        scratch.residuals.push(residual);
+        on_iteration(residual);
+        if residual <= settings.tolerance {
+            return Ok(Outcome::Converged { residual });
+        }
+        counters.solver_iterations += 1;
+        if refactor {
+            // the exact Hessian where it is positive definite, else the projected one
+            let exact = pattern.assemble_and_factor(
+                model.mesh,
+                model.geometry,
+                model.material,
+                x,
+                model.diagonal,
+                false,
+                SEQ,
+            );
+            if exact.is_err() {
+                pattern
+                    .assemble_and_factor(model.mesh, model.geometry, model.material, x, model.diagonal, true, SEQ)
+                    .map_err(Failure::Factorisation)?;
+                counters.factorizations += 1;
+            }
+            counters.factorizations += 1;
+        }
+        let step = &mut scratch.step;
+        for (dof, &k) in pattern.dof_of.iter().enumerate() {
+            if k != usize::MAX {
+                step[k] = -scratch.grad[dof / 3][dof % 3];
+            }
+        }
+        pattern.solve_in_place(step, SEQ);
+        // backtracking on Φ: accept a decrease of Φ or, at its round-off floor, of the residual
+        let mut t = 1.0;
+        let mut accepted = false;
+        let old_norm = norm(&scratch.grad);
+        while t > MIN_STEP_FRACTION {
+            scratch.trial.clear();
+            scratch.trial.extend_from_slice(x);
+            for (dof, &k) in pattern.dof_of.iter().enumerate() {
+                if k != usize::MAX {
+                    scratch.trial[dof / 3][dof % 3] += t * step[k];
+                }
+            }
+            let (e, r) = objective.eval(&scratch.trial, &mut scratch.trial_grad);
+            if e.is_finite() && (e <= energy || norm(&scratch.trial_grad) < old_norm) {
+                accepted = true;
+                energy = e;
+                reactions = r;
+                break;
+            }
+            t *= 0.5;
+        }
+        if !accepted {
+            if refactor {
+                break;
+            }
+            refactor = true;
+            continue;
+        }
+        x.copy_from_slice(&scratch.trial);
+        std::mem::swap(&mut scratch.grad, &mut scratch.trial_grad);
+        let moved = step.iter().fold(0.0f64, |m, v| m.max(v.abs())) * t;
+        if moved <= 1e-12 * body_size {
+            let residual = norm(&scratch.grad) / load_scale(body_force_n, reactions);
+            return Ok(Outcome::Stalled { residual });
+        }
+        let new_norm = norm(&scratch.grad);
+        refactor = settings.refactor_every_iteration || t < 1.0 || new_norm > SLOW_RATIO * old_norm;
+    }
+    if let Some(node) = first_non_finite(x, &scratch.grad) {
+        return Err(Failure::NonFinite { node });
+    }
+    let residual = norm(&scratch.grad) / load_scale(body_force_n, reactions);
+    Ok(Outcome::Unconverged { residual })
+}

@@ -1,0 +1,285 @@
+//! Vertex block descent (Chen, Liu, Yang, Yuksel, "Vertex Block Descent", ACM Transactions on
+//! Graphics 43(4), 2024): implicit Euler's incremental potential
+//!
+//! `G(x) = Σ_i m_i/(2h²) |x_i − y_i|² + Σ_e U_e(x) + Σ_k k_k/2 |x_{n_k} − t_k|²`
+//!
+//! minimised by block Gauss–Seidel over the nodes. Each free node `i` takes one 3×3 Newton step
+//! on `G` with every other node fixed:
+//!
+//! `f_i = −(m_i/h²)(x_i − y_i) − Σ_{(e,a) ∋ i} Σ_q V_q P(F_q) ∇_X N_a(r_q) − Σ_k k_k (x_i − t_k)`,
+//! `H_i = (m_i/h²) I + Σ_{(e,a) ∋ i} Π_PSD(B_{e,a}) + Σ_k k_k I`, `x_i ← x_i + H_i⁻¹ f_i`,
+//!
+//! the sums running over every element holding the node with the element's own quadrature and
+//! material (a P3 node sums every quadrature point of every P3 element around it), `B_{e,a}` the
+//! diagonal block of the element Hessian ([`crate::fem::energy::element_node_gradient_and_block`])
+//! projected to positive semi-definite ([`crate::material::project_psd3`]), so `H_i` is positive
+//! definite and the update a descent step. Nodes are coloured so that nodes of one colour share no
+//! element ([`crate::mesh::adjacency::colour_nodes`]): colours run in order, the nodes of one
+//! colour in parallel; each node reads only the others and writes only itself, so serial and
+//! parallel sweeps, on any thread count, give the same bits.
+//!
+//! - **Initialisation** (§3.5 of the paper, [`super::VbdInit`]): by default
+//!   `x⁰ = x_n + h v_n + h² ã ĝ` with `ã` the body's acceleration along gravity `ĝ` over the
+//!   last step clamped to `[0, |g|]`, so a body at rest in equilibrium starts — and stays —
+//!   exactly there: VBD's fixed point is the static equilibrium for any iteration count.
+//! - **Acceleration** (§3.7): Chebyshev semi-iteration with spectral radius estimate `ρ`,
+//!   `x⁽ᵏ⁾ = ω_k (x̄⁽ᵏ⁾ − x⁽ᵏ⁻²⁾) + x⁽ᵏ⁻²⁾`, `ω_1 = 1`, `ω_2 = 2/(2 − ρ²)`,
+//!   `ω_k = 4/(4 − ρ² ω_{k−1})`; `ρ = 0.9` by default (measured: half the sweeps to settle the
+//!   bending beam; the authors' code ships it off; 0.95 at 5 sweeps per step diverged).
+//! - **Two-level correction** (ours, not the paper's; [`coarse`], on by default,
+//!   `coarse_cells = 0` turns it off): before the sweeps, the step's `G` is minimised over
+//!   smooth displacements — trilinear functions on a coarse grid over the body — by one Galerkin
+//!   coarse-grid correction with a secant line search. The sweeps barely move smooth error (a
+//!   beam's slow bending falls by about 0.5 % per sweep on Gmsh's P2 beam), so without it the
+//!   steps stay far from converged there: with it that beam settles in 122 frames, as Newton,
+//!   instead of 707, and each step costs two gradient evaluations more (plus the coarse matrix
+//!   every ten steps). Chebyshev starts after it.
+//! - Effects: contact's projection runs after every sweep; attachments are springs in `G`.
+//!
+//! **Cost.** A sweep visits every (node, element holding it) pair with the element's whole
+//! quadrature, so it is kept to what the visit cannot avoid: the elements' `F_q` are cached
+//! lane-major (four points per AVX2 register, [`PointLanes`]) and moved with each node and each
+//! acceleration step instead of gathered and summed per visit; `P g` and the block come from one
+//! call that shares their work ([`crate::material::Material::node_visit`], closed form for StVK
+//! on four lanes); a block is tested positive definite by its leading minors before any
+//! eigen-decomposition ([`crate::material::project_psd3`]); the node update and the `F_q` moves
+//! are compiled for AVX2 and FMA where the CPU has them ([`Fused`]), and the 3 × 3 solve is a
+//! hand-written Cholesky.
+//! Measured on Gmsh's P2 beam (1,471 elements, docs/PERFORMANCE.md): about 530 instructions
+//! per node-element visit, half of them the StVK law.
+
+use super::error::SolverCounters;
+use super::nan_guard::{BadElement, ORIGIN_VBD};
+use super::settings::{SolverSettings, VbdInit};
+use super::step::{Hooks, StepInput, StepSolver};
+use coarse::{CoarseSpace, coarse_cells};
+use lanes::{Fused, PointLanes, Snapshots};
+use node::NodeUpdate;
+
+mod coarse;
+mod lanes;
+mod node;
+use crate::Vec3;
+use crate::effect::{ImplicitRole, NodeSpring};
+use crate::fem::energy::element_grads;
+use crate::fem::geometry::BlockGeometry;
+use crate::material::{Lame, Material, NodeVisit, NodeVisitKernel, project_psd3};
+use crate::mesh::Mesh;
+use crate::mesh::adjacency::{NodeIncidence, colour_nodes};
+use crate::math::shared::SharedMut;
+use nalgebra::Matrix3;
+
+/// Fewest nodes per parallel task within a colour.
+const MIN_NODES_PER_TASK: usize = 16;
+/// Below this, the adaptive initialisation's acceleration along gravity counts as zero, m/s².
+const ADAPTIVE_ACCELERATION_FLOOR_M_S2: f64 = 1e-5;
+
+pub(crate) struct Vbd {
+    incidence: NodeIncidence,
+    colours: Vec<Vec<u32>>,
+    /// `v_n` and `v_{n−1}`, snapshots at the start of the last two steps.
+    v_start: Vec<Vec3>,
+    v_before: Vec<Vec3>,
+    /// Snapshots held (0 after a reset, up to 2).
+    history: u8,
+    y: Vec<Vec3>,
+    prev_iter: Vec<Vec3>,
+    prev_prev: Vec<Vec3>,
+    lanes: PointLanes,
+    /// The `F_q` at the last two sweeps, for the acceleration.
+    f_snapshots: Snapshots,
+    fused: Fused,
+    /// The two-level correction ([`coarse`]); None when `coarse_cells` is 0.
+    coarse: Option<CoarseSpace>,
+}
+
+impl Vbd {
+    pub fn new(mesh: &Mesh, geometry: &[BlockGeometry], settings: &SolverSettings) -> Self {
+        let incidence = NodeIncidence::new(mesh);
+        let colours = colour_nodes(mesh, &incidence);
+        Self {
+            incidence,
+            colours,
+            v_start: Vec::new(),
+            v_before: Vec::new(),
+            history: 0,
+            y: Vec::new(),
+            prev_iter: Vec::new(),
+            prev_prev: Vec::new(),
+            lanes: PointLanes::new(mesh, geometry),
+            f_snapshots: Snapshots::default(),
+            fused: Fused::detect(),
+            coarse: CoarseSpace::for_settings(mesh, settings),
+        }
+    }
+}
+
+impl StepSolver for Vbd {
+    fn work_summary(&self, settings: &SolverSettings, _counters: &SolverCounters) -> String {
+        format!("vbd, {} sweeps", settings.vbd.iterations)
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
+    }
+
+    fn begin_step(&mut self, velocities: &[Vec3]) {
+        let had = self.history >= 1 && self.v_start.len() == velocities.len();
+        if had {
+            std::mem::swap(&mut self.v_before, &mut self.v_start);
+        }
+        self.v_start.clear();
+        self.v_start.extend_from_slice(velocities);
+        self.history = if had { 2 } else { 1 };
+    }
+
+    fn reset_history(&mut self, warm: bool, num_nodes: usize) {
+        // a warm start is at rest: its last velocity is zero, so the next step sees ã = 0
+        self.history = if warm { 1 } else { 0 };
+        self.v_start.clear();
+        self.v_start.resize(num_nodes, Vec3::zeros());
+    }
+
+    fn rebuild(&mut self, mesh: &Mesh, geometry: &[BlockGeometry], settings: &SolverSettings, geometry_changed: bool) {
+        if geometry_changed {
+            self.lanes = PointLanes::new(mesh, geometry);
+        }
+        if geometry_changed || self.coarse.as_ref().map(CoarseSpace::target_cells) != coarse_cells(settings) {
+            self.coarse = CoarseSpace::for_settings(mesh, settings);
+        }
+    }
+
+    fn solve_step(
+        &mut self,
+        s: &StepInput<'_>,
+        positions: &mut [Vec3],
+        hooks: &mut Hooks<'_>,
+        counters: &mut SolverCounters,
+    ) -> Result<(), BadElement> {
+        let h = s.h;
+        if let Some(i) = super::nan_guard::first_non_finite_position(positions) {
+            return Err(BadElement::at_node(s.mesh, i, super::nan_guard::ORIGIN_INPUT));
+        }
+        self.y.clear();
+        self.y.extend_from_slice(positions);
+        // the initial guess
+        let g = s.body_acceleration;
+        let g_norm = g.norm();
+        for (i, x) in positions.iter_mut().enumerate() {
+            if s.inv_mass[i] == 0.0 {
+                continue;
+            }
+            let (xn, vn) = (s.prev_positions[i], self.v_start[i]);
+            *x = match s.settings.vbd.init {
+                VbdInit::Inertia => self.y[i],
+                VbdInit::Previous => xn,
+                VbdInit::Adaptive if g_norm == 0.0 => xn + vn * h,
+                VbdInit::Adaptive if self.history < 2 => self.y[i],
+                VbdInit::Adaptive => {
+                    let dir = g / g_norm;
+                    let a = ((vn - self.v_before[i]) / h).dot(&dir).clamp(0.0, g_norm);
+                    let a = if a < ADAPTIVE_ACCELERATION_FLOOR_M_S2 { 0.0 } else { a };
+                    xn + vn * h + dir * (a * h * h)
+                }
+            };
+        }
+        let springs = hooks.springs();
+        let update = NodeUpdate {
+            input: s,
+            incidence: &self.incidence,
+            y: &self.y,
+            springs: &springs,
+            w: 1.0 / (h * h),
+            lame: s.material.lame(),
+            fused: self.fused,
+        };
+        let rho = s.settings.vbd.chebyshev_rho;
+        let mut omega = 1.0;
+        // the two-level correction: the smooth error the sweeps barely touch, first
+        if let Some(c) = &mut self.coarse {
+            c.begin_step(s, positions, &springs);
+            counters.coarse_corrections += u64::from(c.correct(s, positions, &self.y, &springs));
+        }
+        if rho > 0.0 {
+            self.prev_prev.clear();
+            self.prev_prev.extend_from_slice(positions);
+            self.prev_iter.clear();
+            self.prev_iter.extend_from_slice(positions);
+        }
+        // the initial guess (and the correction) moved the positions as a whole: F_q from them,
+        // then in step with each node move, each acceleration (F is affine in the positions, so
+        // it mixes as they do) and, after a projection moved the positions, from them again
+        let mut stale = true;
+        for k in 1..=s.settings.vbd.iterations {
+            if stale {
+                self.lanes.refresh(s.mesh, positions, self.fused);
+            }
+            if rho > 0.0 && k == 1 {
+                self.f_snapshots.start(&self.lanes);
+            }
+            let lanes = LaneView::of(&mut self.lanes, s.material);
+            for colour in &self.colours {
+                counters.node_updates +=
+                    sweep_colour(&update, colour, positions, &lanes, s.settings.sweep.is_colour())?;
+            }
+            if rho > 0.0 {
+                omega = match k {
+                    1 => 1.0,
+                    2 => 2.0 / (2.0 - rho * rho),
+                    _ => 4.0 / (4.0 - rho * rho * omega),
+                };
+                let mix = k >= 2 && omega > 1.0;
+                if mix {
+                    for (i, x) in positions.iter_mut().enumerate() {
+                        if s.inv_mass[i] > 0.0 {
+                            *x = (*x - self.prev_prev[i]) * omega + self.prev_prev[i];
+                        }
+                    }
+                }
+                std::mem::swap(&mut self.prev_prev, &mut self.prev_iter);
+                self.prev_iter.copy_from_slice(positions);
+                self.f_snapshots.advance(&mut self.lanes, mix.then_some(omega));
+            }
+            let projections = *hooks.calls;
+            hooks.after_projection(positions, Some(ImplicitRole::Projection));
+            stale = *hooks.calls != projections;
+            #[cfg(test)]
+            if !stale {
+                self.lanes.assert_in_step_with(s.mesh, positions);
+            }
+            counters.solver_iterations += 1;
+        }
+        Ok(())
+    }
+}
+
+/// Updates the free nodes of one colour; returns how many moved.
+fn sweep_colour(
+    update: &NodeUpdate<'_>,
+    colour: &[u32],
+    positions: &mut [Vec3],
+    lanes: &[LaneView<'_>],
+    parallel: bool,
+) -> Result<u64, BadElement> {
+    let inv_mass = update.input.inv_mass;
+    let shared = SharedMut::new(positions);
+    // SAFETY: nodes of one colour share no element, so each task touches only its node and the
+    // F_q of elements no other task of this colour touches.
+    let node = |&i: &u32| -> Result<u64, BadElement> {
+        let i = i as usize;
+        if inv_mass[i] == 0.0 {
+            return Ok(0);
+        }
+        Ok(u64::from(unsafe { update.step(i, shared, lanes) }?))
+    };
+    if !parallel {
+        return colour.iter().map(node).sum();
+    }
+    use rayon::prelude::*;
+    colour.par_iter().with_min_len(MIN_NODES_PER_TASK).map(node).sum()
+}
+
+#[cfg(test)]
+mod tests;

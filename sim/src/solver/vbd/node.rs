@@ -1,0 +1,144 @@
+//! One VBD node update ([`NodeUpdate`]): the node's force and positive-definite block summed over
+//! the elements holding it, the springs and the inertia term, and the 3×3 Newton step
+//! `x_i ← x_i + H_i⁻¹ f_i` by a hand-written Cholesky ([`solve_spd3`]).
+
+use crate::Vec3;
+use crate::fem::geometry::BlockGeometry;
+use crate::material::{Lame, Material, NodeVisit, NodeVisitKernel, project_psd3};
+use crate::math::shared::SharedMut;
+use crate::mesh::Mesh;
+use crate::mesh::adjacency::NodeIncidence;
+use nalgebra::Matrix3;
+
+/// What a node update reads.
+pub(super) struct NodeUpdate<'a> {
+    pub(super) input: &'a StepInput<'a>,
+    pub(super) incidence: &'a NodeIncidence,
+    pub(super) y: &'a [Vec3],
+    pub(super) springs: &'a [NodeSpring],
+    pub(super) w: f64,
+    pub(super) lame: Lame,
+    pub(super) fused: Fused,
+}
+
+impl NodeUpdate<'_> {
+    /// Moves free node `i` by its Newton step on `G` with the others fixed, and the `F_q` of
+    /// the elements holding it with it; returns whether it moved (not when it has no
+    /// unbalanced force).
+    ///
+    /// # Safety
+    /// No other thread may access node `i` or the `F_q` of an element holding it meanwhile
+    /// (nodes of one colour share no element).
+    pub(super) unsafe fn step(&self, i: usize, positions: SharedMut<Vec3>, lanes: &[LaneView<'_>]) -> Result<bool, BadElement> {
+        #[cfg(target_arch = "x86_64")]
+        if self.fused.0 {
+            // SAFETY: the CPU has AVX2 and FMA (detected); the caller's promise
+            return unsafe { self.step_fused(i, positions, lanes) };
+        }
+        // SAFETY: the caller's promise
+        unsafe { self.step_in::<false>(i, positions, lanes) }
+    }
+
+    /// [`NodeUpdate::step`] compiled for AVX2 and FMA.
+    ///
+    /// # Safety
+    /// [`NodeUpdate::step`]'s, and the CPU has AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn step_fused(
+        &self,
+        i: usize,
+        positions: SharedMut<Vec3>,
+        lanes: &[LaneView<'_>],
+    ) -> Result<bool, BadElement> {
+        // SAFETY: the caller's promise
+        unsafe { self.step_in::<true>(i, positions, lanes) }
+    }
+
+    /// # Safety
+    /// [`NodeUpdate::step`]'s; with `FMA`, the CPU has AVX2 and FMA.
+    #[inline(always)]
+    pub(super) unsafe fn step_in<const FMA: bool>(
+        &self,
+        i: usize,
+        positions: SharedMut<Vec3>,
+        lanes: &[LaneView<'_>],
+    ) -> Result<bool, BadElement> {
+        let s = self.input;
+        // SAFETY: the caller's promise
+        let xi = unsafe { positions.read(i) };
+        let m_w = s.masses_kg[i] * self.w;
+        let mut f = (self.y[i] - xi) * m_w;
+        let mut h = Matrix3::identity() * m_w;
+        for inc in self.incidence.of(i) {
+            let (b, e, a) = (inc.block as usize, inc.element as usize, inc.local as usize);
+            let l = &lanes[b];
+            // SAFETY: an element holding node i
+            let fq = unsafe { l.f_mut(e) };
+            let g = &l.geometry;
+            let visit = NodeVisit { width: g.width, f: fq, grads: g.node_grads(e, a), volumes: g.volumes(e) };
+            let (force, block) = match l.kernel {
+                // SAFETY: the material's kernel for this width on this CPU
+                Some(kernel) => unsafe { kernel(self.lame, visit) },
+                None => s.material.node_visit(self.lame, visit),
+            };
+            f -= force;
+            h += project_psd3(&block);
+        }
+        for sp in self.springs.iter().filter(|sp| sp.node as usize == i) {
+            f -= (xi - sp.target_m) * sp.stiffness_n_per_m;
+            h += Matrix3::identity() * sp.stiffness_n_per_m;
+        }
+        if f == Vec3::zeros() {
+            return Ok(false);
+        }
+        let Some(d) = solve_spd3(&h, &f) else {
+            return Err(BadElement::at_node(s.mesh, i, ORIGIN_VBD));
+        };
+        // SAFETY: the caller's promise
+        unsafe {
+            positions.write(i, xi + d);
+            carry_points::<FMA>(self.incidence, i, d, lanes);
+        }
+        Ok(true)
+    }
+}
+
+/// `H⁻¹ f` for a symmetric positive definite 3 × 3 `H` by its Cholesky factor `L Lᵀ` (lower
+/// triangle read); `None` when `H` is not positive definite or the result not finite.
+#[inline(always)]
+pub(super) fn solve_spd3(h: &Matrix3<f64>, f: &Vec3) -> Option<Vec3> {
+    let l00 = h[(0, 0)].sqrt();
+    let (l10, l20) = (h[(1, 0)] / l00, h[(2, 0)] / l00);
+    let l11 = (h[(1, 1)] - l10 * l10).sqrt();
+    let l21 = (h[(2, 1)] - l20 * l10) / l11;
+    let l22 = (h[(2, 2)] - l20 * l20 - l21 * l21).sqrt();
+    // L z = f, then Lᵀ d = z
+    let z0 = f[0] / l00;
+    let z1 = (f[1] - l10 * z0) / l11;
+    let z2 = (f[2] - l20 * z0 - l21 * z1) / l22;
+    let d2 = z2 / l22;
+    let d1 = (z1 - l21 * d2) / l11;
+    let d0 = (z0 - l10 * d1 - l20 * d2) / l00;
+    // a non-positive pivot's square root is NaN (or zero, dividing to ±∞)
+    let d = Vec3::new(d0, d1, d2);
+    d.iter().all(|c| c.is_finite()).then_some(d)
+}
+
+/// Moves the `F_q` of every element holding node `i` by `Δ ⊗ ∇_X N_a(r_q)` (node `i` moved by `d`).
+///
+/// # Safety
+/// No other thread may access the `F_q` of an element holding node `i` meanwhile; with `FMA`,
+/// the CPU has AVX2 and FMA.
+#[inline(always)]
+pub(super) unsafe fn carry_points<const FMA: bool>(incidence: &NodeIncidence, i: usize, d: Vec3, lanes: &[LaneView<'_>]) {
+    for inc in incidence.of(i) {
+        let (b, e, a) = (inc.block as usize, inc.element as usize, inc.local as usize);
+        let l = &lanes[b];
+        // SAFETY: the caller's promise
+        let fq = unsafe { l.f_mut(e) };
+        // SAFETY: the caller's promise
+        unsafe { add_outer_any::<FMA>(l.geometry.width, fq, &d, l.geometry.node_grads(e, a)) };
+    }
+}
+
