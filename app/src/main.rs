@@ -47,14 +47,14 @@ struct Hox {
 #[derive(Subcommand)]
 enum Command {
     #[command(flatten)]
-    Headless(cli::Command),
+    Headless(Box<cli::Command>),
     /// Open the interactive app (the default when no command is given).
     App(Box<gui::AppArgs>),
 }
 
 fn main() -> std::process::ExitCode {
     let result = match Hox::parse().command {
-        Some(Command::Headless(command)) => cli::run(command),
+        Some(Command::Headless(command)) => cli::run(*command),
         Some(Command::App(args)) => gui::run(*args),
         None => gui::run(gui::AppArgs::default()),
     };
