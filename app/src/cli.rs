@@ -1,7 +1,8 @@
-//! The headless command line. JSON goes to stdout (`--json`), progress and messages to stderr.
+//! The headless commands: their arguments ([`Command`]) and what each runs, one file per command.
+//! JSON goes to stdout (`--json`), progress and messages to stderr.
 
 use anyhow::{Result, bail};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Subcommand};
 use hox_scenes::{Instance, Scene};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -10,25 +11,18 @@ use std::time::{Duration, Instant};
 mod bench;
 mod gmsh;
 mod inspect;
-pub mod lesson;
+mod lesson;
 mod list;
 mod mesh;
-mod params;
 mod record;
 mod reference;
 mod simulate;
 mod statics;
 mod study;
-pub use params::{DisplayArgs, MeshArgs, PhysicsArgs, overrides};
-pub use record::parse_compare;
+use crate::config::{MeshArgs, PhysicsArgs};
 
-#[derive(Parser)]
-#[command(name = "hox", version, about = "hox: see, measure and teach high-order finite elements in XPBD")]
-pub struct Cli {
-    #[command(subcommand)]
-    pub command: Option<Command>,
-}
-
+// The headless commands; `main.rs` adds `hox app`, the interactive one, beside them. (A plain
+// comment: clap's derive reads doc comments as help text, and the help stays as it was.)
 #[derive(Subcommand)]
 pub enum Command {
     /// List the element types: nodes, faces, default quadrature (degree and points).
@@ -141,8 +135,6 @@ pub enum Command {
     /// Run a lesson headlessly, step by step, printing each step's measurement; `--record`
     /// writes it as a Rerun file a student plays in the stock viewer.
     Lesson(Box<lesson::LessonArgs>),
-    /// Open the interactive app (the default when no command is given).
-    App(Box<crate::gui::AppArgs>),
 }
 
 #[derive(Args)]
@@ -167,8 +159,9 @@ pub fn note_stability(instance: &mut Instance) -> hox_sim::solver::stability::St
     stability
 }
 
-pub fn main(cli: Cli) -> Result<()> {
-    match cli.command.unwrap_or(Command::App(Box::default())) {
+/// Runs a headless command.
+pub fn run(command: Command) -> Result<()> {
+    match command {
         Command::Elements { json } => list::elements(json),
         Command::Scenes { json } => list::scenes(json),
         Command::Mesh { scene, mesh, json } => mesh::mesh_command(&scene, &mesh, json),
@@ -186,7 +179,6 @@ pub fn main(cli: Cli) -> Result<()> {
         Command::Inspect(args) => inspect::inspect(&args),
         Command::Lessons { json } => lesson::lessons(json),
         Command::Lesson(args) => lesson::lesson(&args),
-        Command::App(args) => crate::gui::run(*args),
     }
 }
 

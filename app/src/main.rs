@@ -1,23 +1,64 @@
-//! `hox`: the command-line entry point (headless).
+//! `hox`: the entry point. It parses the command line and runs one command, a headless one
+//! (`cli`) or the interactive app (`gui`):
 //!
-//! - `hox elements` lists the element types with their nodes and quadrature;
-//! - `hox scenes` lists the scene registry;
-//! - `hox mesh` builds a scene's mesh and prints its counts and volume;
-//! - `hox simulate` runs a scene for a time or until it settles and prints probe displacements.
+//! - `hox elements` lists the element types: nodes, faces, default quadrature;
+//! - `hox scenes` lists the built-in scenes;
+//! - `hox mesh` builds a scene's mesh and prints its element and node counts and volume;
+//! - `hox static` solves a scene's static equilibrium (Newton, load stepping) and prints the
+//!   probe displacements;
+//! - `hox study` runs the accuracy-versus-time study over the paper scenes and writes its tables
+//!   and chart;
+//! - `hox bench` times the XPBD loop on the paper's Table 1 beams and the other element types
+//!   (`--solver vbd|newton`: an implicit solver);
+//! - `hox simulate` runs a scene for a time or until it settles and prints the probe
+//!   displacements;
+//! - `hox record` records a scene, or configurations side by side, to a Rerun file (.rrd);
+//! - `hox inspect` reads a Rerun recording back and lists its entities, components and frames;
+//! - `hox lessons` lists the built-in lessons;
+//! - `hox lesson` runs a lesson headlessly step by step, and records it with `--record`;
+//! - `hox app` opens the interactive app (the default when no command is given).
+//!
+//! The app's modules ("rooms") use each other in one order, `colour`, `output` → `config` →
+//! `display` → `recording` → `cli`, `gui` → `main` (docs/ARCHITECTURE.md, kept by
+//! `app/tests/rooms.rs`): `cli` and `gui` share what both need through `config` and never
+//! use each other, so only this file knows both.
 //!
 //! Errors are printed as one clear message on stderr with a non-zero exit.
 
 mod cli;
 mod colour;
+mod config;
 mod display;
 mod gui;
 mod output;
 mod recording;
 
-use clap::Parser;
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "hox", version, about = "hox: see, measure and teach high-order finite elements in XPBD")]
+struct Hox {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+// Every command: the headless ones, then the app. (A plain comment: clap's derive reads doc
+// comments as help text, and the help stays as it was.)
+#[derive(Subcommand)]
+enum Command {
+    #[command(flatten)]
+    Headless(Box<cli::Command>),
+    /// Open the interactive app (the default when no command is given).
+    App(Box<gui::AppArgs>),
+}
 
 fn main() -> std::process::ExitCode {
-    match cli::main(cli::Cli::parse()) {
+    let result = match Hox::parse().command {
+        Some(Command::Headless(command)) => cli::run(*command),
+        Some(Command::App(args)) => gui::run(*args),
+        None => gui::run(gui::AppArgs::default()),
+    };
+    match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");

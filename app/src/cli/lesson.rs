@@ -29,15 +29,6 @@ pub struct LessonArgs {
     pub json: bool,
 }
 
-/// The lesson `args` names.
-pub fn load(name: Option<&str>, file: Option<&std::path::Path>) -> Result<Lesson> {
-    Ok(match (name, file) {
-        (_, Some(path)) => hox_scenes::lesson::from_file(path)?,
-        (Some(n), None) => hox_scenes::lesson::by_name(n)?,
-        (None, None) => anyhow::bail!("name a lesson (hox lessons lists them) or give --lesson-file"),
-    })
-}
-
 /// `hox lessons`: every built-in lesson, its goal and steps.
 pub fn lessons(json: bool) -> Result<()> {
     let all = hox_scenes::lesson::registry()?;
@@ -96,7 +87,7 @@ fn scene_label(scene: &hox_scenes::Scene) -> String {
 
 /// `hox lesson`: runs every step headlessly, prints the measurements, and records if asked.
 pub fn lesson(args: &LessonArgs) -> Result<()> {
-    let lesson = load(args.name.as_deref(), args.lesson_file.as_deref())?;
+    let lesson = crate::config::load_lesson(args.name.as_deref(), args.lesson_file.as_deref())?;
     if let Some(out) = &args.record {
         check_writable(out)?;
     }

@@ -1,6 +1,7 @@
 //! `hox mesh`: build a scene's mesh and print its element and node counts and volume.
 
-use super::{MeshArgs, SceneArgs, load_scene, overrides};
+use super::{SceneArgs, load_scene};
+use crate::config::{MeshArgs, overrides};
 use anyhow::{Context, Result};
 
 pub fn mesh_command(scene: &SceneArgs, mesh: &MeshArgs, json: bool) -> Result<()> {

@@ -1,7 +1,8 @@
 //! `hox record`: a scene, or several configurations of it side by side, to a Rerun .rrd file,
 //! headless.
 
-use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, load_scene, overrides};
+use super::{DelayedBar, SceneArgs, load_scene};
+use crate::config::{DisplayArgs, MeshArgs, PhysicsArgs, overrides, parse_compare};
 use crate::output::check_writable;
 use crate::recording::{Configuration, LogSettings, Recorder, config_label, entity_name};
 use anyhow::{Context, Result, bail};
@@ -42,7 +43,7 @@ pub struct RecordArgs {
     #[arg(long, value_name = "OPTION=VALUE,...", help = compare_help())]
     pub compare: Vec<String>,
     #[command(flatten)]
-    pub display: super::params::DisplayArgs,
+    pub display: DisplayArgs,
     #[command(flatten)]
     pub vtk: super::gmsh::VtkArgs,
     #[command(flatten)]
@@ -50,18 +51,6 @@ pub struct RecordArgs {
     /// Print a JSON summary on stdout.
     #[arg(long)]
     pub json: bool,
-}
-
-/// Applies one `--compare` value (`key=value,...`, the keys of the parameter table) on top of
-/// `base`; an unknown key or a bad value is an error naming it.
-pub fn parse_compare(spec: &str, base: &SceneOverrides) -> Result<SceneOverrides> {
-    let mut o = base.clone();
-    for pair in spec.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-        let (key, value) =
-            pair.split_once('=').with_context(|| format!("--compare '{spec}': '{pair}' is not option=value"))?;
-        o.set_text(key.trim(), value).map_err(|e| anyhow::anyhow!("--compare '{spec}': {e}"))?;
-    }
-    Ok(o)
 }
 
 pub fn record(args: &RecordArgs) -> Result<()> {

@@ -1,6 +1,7 @@
 //! `hox simulate`: run a scene for a time or until it settles and print the probe displacements.
 
-use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, gmsh, load_scene, note_stability, overrides, reference};
+use super::{DelayedBar, SceneArgs, gmsh, load_scene, note_stability, reference};
+use crate::config::{MeshArgs, PhysicsArgs, overrides};
 use anyhow::{Result, bail};
 use hox_scenes::{Instance, RunMode};
 

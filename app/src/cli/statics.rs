@@ -1,6 +1,7 @@
 //! `hox static`: a scene's static equilibrium by Newton's method (the reference XPBD settles to).
 
-use super::{DelayedBar, MeshArgs, PhysicsArgs, SceneArgs, load_scene, overrides, reference};
+use super::{DelayedBar, SceneArgs, load_scene, reference};
+use crate::config::{MeshArgs, PhysicsArgs, overrides};
 use anyhow::{Result, bail};
 use std::time::Instant;
 

@@ -30,11 +30,11 @@ pub struct AppArgs {
     #[arg(long, value_name = "OPTION=VALUE,...", num_args = 0..=1, default_missing_value = "")]
     pub compare: Vec<String>,
     #[command(flatten)]
-    pub mesh: crate::cli::MeshArgs,
+    pub mesh: crate::config::MeshArgs,
     #[command(flatten)]
-    pub physics: crate::cli::PhysicsArgs,
+    pub physics: crate::config::PhysicsArgs,
     #[command(flatten)]
-    pub display: crate::cli::DisplayArgs,
+    pub display: crate::config::DisplayArgs,
     /// What the central view shows at start: the model, or the reference element's shape
     /// functions and quadrature points.
     #[arg(long, value_enum)]

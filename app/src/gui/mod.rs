@@ -166,7 +166,7 @@ impl HoxApp {
             app.set_camera(preset);
         }
         if args.lesson.is_some() || args.lesson_file.is_some() {
-            let lesson = crate::cli::lesson::load(args.lesson.as_deref(), args.lesson_file.as_deref())
+            let lesson = crate::config::load_lesson(args.lesson.as_deref(), args.lesson_file.as_deref())
                 .map_err(|e| format!("{e:#}"))?;
             app.open_lesson(lesson);
         }
@@ -183,7 +183,7 @@ impl HoxApp {
     /// configuration, and `--compare` (alone: the default pair; with values: exactly two
     /// configurations). Nothing given keeps the saved ones. Errors name the option.
     fn start_configurations(&mut self, args: &AppArgs) -> Result<(), String> {
-        let o = crate::cli::overrides(&args.mesh, Some(&args.physics)).merged(&args.display.overrides);
+        let o = crate::config::overrides(&args.mesh, Some(&args.physics)).merged(&args.display.overrides);
         let specs: Vec<&String> = args.compare.iter().filter(|s| !s.trim().is_empty()).collect();
         let wants_pair = !args.compare.is_empty();
         if o.iter().next().is_none() && specs.is_empty() {
@@ -196,7 +196,7 @@ impl HoxApp {
             0 => vec![o],
             2 => specs
                 .iter()
-                .map(|s| crate::cli::parse_compare(s, &o).map_err(|e| format!("{e:#}")))
+                .map(|s| crate::config::parse_compare(s, &o).map_err(|e| format!("{e:#}")))
                 .collect::<Result<Vec<_>, _>>()?,
             n => return Err(format!("--compare with values needs exactly two configurations for the app, got {n}")),
         };

@@ -1,7 +1,7 @@
-//! The command line's scene parameters, made from the parameter table
-//! ([`hox_scenes::params::PARAMS`]): one flag per entry shown on the command line (`--KEY VALUE`,
-//! or a switch such as `--no-stability-guard`), parsed by the entry's kind; the range is checked
-//! when the scene is validated, and an error names the option.
+//! The scene parameters on the command line (the headless commands' and `hox app`'s), made from
+//! the parameter table ([`hox_scenes::params::PARAMS`]): one flag per entry shown on the command
+//! line (`--KEY VALUE`, or a switch such as `--no-stability-guard`), parsed by the entry's kind;
+//! the range is checked when the scene is validated, and an error names the option.
 
 use clap::{Arg, ArgAction, ArgMatches, Command, FromArgMatches};
 use hox_scenes::SceneOverrides;
@@ -21,7 +21,7 @@ pub struct PhysicsArgs {
 }
 
 /// The display parameters (`--tessellation --colour-max-m --quadrature-points`), for the
-/// commands that draw (`hox record`).
+/// commands that draw (`hox record`, `hox app`).
 #[derive(Clone, Debug, Default)]
 pub struct DisplayArgs {
     pub overrides: SceneOverrides,
