@@ -1,7 +1,7 @@
 //! The configuration both front ends take from the command line: the scene parameter flags
 //! (mesh, physics, display: [`params`]) and the overrides they give, a `--compare` value on top
 //! of them, and a lesson by name or file. The headless commands (`cli`) and the app (`gui`) read
-//! it; it reads neither (the room order in docs/ARCHITECTURE.md, kept by `app/tests/rooms.rs`).
+//! it; it reads neither (the room order in docs/ARCHITECTURE.md, kept by `tests/tests/rooms.rs`).
 
 use anyhow::{Context, Result};
 use hox_scenes::SceneOverrides;

@@ -20,7 +20,7 @@
 //!
 //! The app's modules ("rooms") use each other in one order, `colour`, `output` → `config` →
 //! `display` → `recording` → `cli`, `gui` → `main` (docs/ARCHITECTURE.md, kept by
-//! `app/tests/rooms.rs`): `cli` and `gui` share what both need through `config` and never
+//! `tests/tests/rooms.rs`): `cli` and `gui` share what both need through `config` and never
 //! use each other, so only this file knows both.
 //!
 //! Errors are printed as one clear message on stderr with a non-zero exit.

@@ -2,7 +2,7 @@
 //! (`--solver vbd|newton`) an implicit solver on the same beams.
 
 use anyhow::{Result, bail};
-use hox_sim::solver::{Method, Sweep};
+use hox_sim::solver::Sweep;
 
 pub fn bench(frames: usize, threads: &[usize], only: &str, sweeps: &[String], solver: &str) -> Result<()> {
     let method = hox_scenes::bench::solver::parse_solver(solver)?;

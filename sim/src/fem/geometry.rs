@@ -151,13 +151,22 @@ fn element_scale(positions: &[Vec3], nodes: &[u32]) -> f64 {
 /// node), evaluated as `I + Σ_i (x_i − X_i) ⊗ ∇_X N_i` (equal, since `Σ_i X_i ⊗ ∇_X N_i = I`):
 /// computing from displacements avoids cancellation, so small strains keep their relative
 /// accuracy and an element at rest has exactly `F = I` and zero energy. The one place `F` is
-/// computed outside the specialised sweep ([`crate::xpbd::kernels`], which forms the same sum in
-/// registers).
+/// computed for gathered nodes ([`deformation_gradient_from`] the one sum).
 #[inline]
 pub fn deformation_gradient(x: &[Vec3], rest: &[Vec3], grads: &[Vec3]) -> Matrix3<f64> {
+    deformation_gradient_from(x.iter().zip(rest).zip(grads).map(|((xi, ri), g)| (xi - ri, g)))
+}
+
+/// `F = I + Σ_i u_i ⊗ ∇_X N_i` from each node's displacement `u_i = x_i − X_i` and material
+/// gradient, in the order given: [`deformation_gradient`]'s sum for nodes reached through an
+/// index (the display fields, `crate::measure::field`). The specialised sweeps, which hold
+/// their nodes in registers or lanes, form it once each in their own layout
+/// (`crate::xpbd::kernels`, VBD's `F_q` cache).
+#[inline]
+pub fn deformation_gradient_from<'g>(nodes: impl IntoIterator<Item = (Vec3, &'g Vec3)>) -> Matrix3<f64> {
     let mut f = Matrix3::identity();
-    for ((xi, ri), g) in x.iter().zip(rest).zip(grads) {
-        f += (xi - ri) * g.transpose();
+    for (u, g) in nodes {
+        f += u * g.transpose();
     }
     f
 }

@@ -40,12 +40,12 @@ use nalgebra::{SMatrix, Vector3};
 mod testing;
 
 pub use crate::math::lane;
-mod psd;
-pub mod tangent;
 pub mod neo_hookean;
+mod psd;
 pub mod stable_neo_hookean;
 pub mod stable_neo_hookean_log;
 pub mod stvk;
+pub mod tangent;
 
 pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
 pub use psd::{project_psd, project_psd3};

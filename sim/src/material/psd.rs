@@ -4,7 +4,7 @@
 //! (Teran, Sifakis, Irving & Fedkiw 2005, "Robust quasistatic finite elements and flesh
 //! simulation", §4: clamp the negative eigenvalues).
 
-use super::{Mat3, Mat9};
+use super::Mat9;
 use nalgebra::{Matrix3, SymmetricEigen};
 
 /// The nearest (Frobenius) positive semi-definite matrix to the symmetric part of `m`, written
@@ -68,4 +68,3 @@ pub fn project_psd3(m: &Matrix3<f64>) -> Matrix3<f64> {
     }
     project_psd3_general(m)
 }
-

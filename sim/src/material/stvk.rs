@@ -25,8 +25,10 @@
 //! λ tr(E) is added to the diagonal of S only, so a non-finite tr(E) leaves the off-diagonal
 //! (shear) stress as 2μE; a NaN or infinite entry of F otherwise propagates into ψ and P.
 
+use super::{
+    FastLaw, HyperelasticModel, Lame, Mat3, Mat9, NodeVisit, NodeVisitKernel, SplitTerm, dpdf_from_directional,
+};
 use crate::math::lane::{Lane, M3, Scalar, from_mat3, to_mat3, tr_mat_mul};
-use super::{FastLaw, HyperelasticModel, Lame, Mat3, Mat9, NodeVisit, NodeVisitKernel, SplitTerm, dpdf_from_directional};
 use nalgebra::Vector3;
 
 /// E = ½(H + Hᵀ + HᵀH), H = F − I (Green–Lagrange).

@@ -55,10 +55,7 @@ fn names_round_trip() {
     let names: Vec<&str> = MaterialModel::ALL.iter().map(|m| m.name()).collect();
     assert_eq!(names[..4], ["stvk", "snh", "snh-log", "nh"]);
     assert_eq!(MaterialModel::from_name(" SNH-Log "), Some(MaterialModel::StableNeoHookeanLog));
-    assert_eq!(
-        MaterialModel::from_name("stable Neo-Hookean with log term"),
-        Some(MaterialModel::StableNeoHookeanLog)
-    );
+    assert_eq!(MaterialModel::from_name("stable Neo-Hookean with log term"), Some(MaterialModel::StableNeoHookeanLog));
     assert_eq!(MaterialModel::from_name(" StVK "), Some(MaterialModel::StVenantKirchhoff));
     assert_eq!(MaterialModel::from_name("NH"), Some(MaterialModel::NeoHookean));
     assert_eq!(MaterialModel::from_name("Snh"), Some(MaterialModel::StableNeoHookean));

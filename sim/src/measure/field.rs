@@ -24,7 +24,7 @@
 //! ([`crate::material`]).
 
 use crate::Vec3;
-use crate::fem::geometry::jacobian;
+use crate::fem::geometry::{deformation_gradient_from, jacobian};
 use crate::material::Material;
 use crate::measure::surface::Surface;
 use crate::mesh::Mesh;
@@ -211,11 +211,8 @@ impl SurfaceGradients {
     /// The deformation gradient of sample `s` at node positions `x` (rest positions `rest`).
     fn deformation_gradient(&self, s: usize, x: &[Vec3], rest: &[Vec3]) -> Matrix3<f64> {
         let (a, b) = (self.sample_nodes[s] as usize, self.sample_nodes[s + 1] as usize);
-        let mut f = Matrix3::identity();
-        for (&n, g) in self.nodes[a..b].iter().zip(&self.grad_in_material[a..b]) {
-            f += (x[n as usize] - rest[n as usize]) * g.transpose();
-        }
-        f
+        let nodes = self.nodes[a..b].iter().map(|&n| x[n as usize] - rest[n as usize]);
+        deformation_gradient_from(nodes.zip(&self.grad_in_material[a..b]))
     }
 
     /// Every deformation gradient of vertex `v` (one per element meeting there).

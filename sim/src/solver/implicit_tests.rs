@@ -7,6 +7,10 @@ use crate::effect::{Attachment, Clamp, ContactPlane, Damping, EffectState, Gravi
 use crate::element::ElementType;
 use crate::material::MaterialModel;
 
+use crate::Vec3;
+use crate::effect::Effect;
+use crate::material::Material;
+use crate::mesh::Mesh;
 fn implicit(method: Method, frames_per_second: f64) -> SolverSettings {
     SolverSettings { method, frames_per_second, ..SolverSettings::default() }
 }

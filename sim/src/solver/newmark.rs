@@ -196,11 +196,11 @@ impl Newmark {
 
 #[cfg(test)]
 mod tests {
-    use crate::solver::tests::{G, clamped_at_x0, one_cell_cantilever};
     use super::*;
     use crate::effect::{Clamp, Damping, Effect, Gravity};
     use crate::element::ElementType;
     use crate::material::{Material, MaterialModel};
+    use crate::solver::tests::{G, clamped_at_x0, one_cell_cantilever};
 
     fn et(name: &str) -> ElementType {
         ElementType::from_name(name).unwrap()

@@ -151,15 +151,8 @@ pub(crate) fn minimise(
         counters.solver_iterations += 1;
         if refactor {
             // the exact Hessian where it is positive definite, else the projected one
-            let exact = pattern.assemble_and_factor(
-                model.mesh,
-                model.geometry,
-                model.material,
-                x,
-                model.diagonal,
-                false,
-                SEQ,
-            );
+            let exact =
+                pattern.assemble_and_factor(model.mesh, model.geometry, model.material, x, model.diagonal, false, SEQ);
             if exact.is_err() {
                 pattern
                     .assemble_and_factor(model.mesh, model.geometry, model.material, x, model.diagonal, true, SEQ)

@@ -49,4 +49,3 @@ impl Potential<'_> {
         (e, reactions.sqrt())
     }
 }
-

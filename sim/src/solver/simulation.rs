@@ -8,9 +8,9 @@ use super::error::{SimError, SolverCounters};
 use super::method::Method;
 use super::nan_guard::{BadElement, ORIGIN_STATE};
 use super::registry;
-use super::residual::{self, StaticResidual};
+use super::residual::{StaticResidual, static_residual};
 use super::settings::{SolverSettings, Sweep};
-use super::stability::{self, GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
+use super::stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
 use super::step::{Hooks, StepInput, StepSolver};
 use super::xpbd::Xpbd;
 use crate::Vec3;
@@ -169,6 +169,12 @@ impl Simulation {
         self.solver.as_any().downcast_ref::<Xpbd>().map_or(0, |x| x.num_constraints())
     }
 
+    /// The XPBD solver's state, when it is the one running (tests of its schedule).
+    #[cfg(test)]
+    pub(crate) fn xpbd_solver(&self) -> Option<&Xpbd> {
+        self.solver.as_any().downcast_ref::<Xpbd>()
+    }
+
     /// A few words on the solver's work for a status line ("xpbd, 1,200 constraints").
     pub fn work_summary(&self) -> String {
         self.solver.work_summary(&self.settings, &self.counters)
@@ -197,7 +203,7 @@ impl Simulation {
             &self.positions,
             &mut grad,
         );
-        residual::static_residual(&grad, &self.masses_kg, self.body_acceleration_m_s2(), |i| self.inv_mass[i] > 0.0)
+        static_residual(&grad, &self.masses_kg, self.body_acceleration_m_s2(), |i| self.inv_mass[i] > 0.0)
     }
 
     /// Adds an effect to the running simulation (pinning the nodes it positions); refused when
@@ -604,7 +610,6 @@ impl Simulation {
     }
 }
 
-
 /// Refuses effects `method` cannot honour, naming the first one and the methods that can.
 pub(crate) fn check_effects<'e>(
     method: Method,
@@ -624,4 +629,3 @@ pub(crate) fn check_effects<'e>(
     }
     Ok(())
 }
-

@@ -96,4 +96,3 @@ pub(crate) trait StepSolver: Send {
         &[]
     }
 }
-

@@ -6,6 +6,12 @@ use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 use crate::xpbd::constraint::Formulation;
 use nalgebra::DMatrix;
 
+use crate::Vec3;
+use crate::effect::Effect;
+use crate::fem::geometry::precompute;
+use crate::fem::mass::lumped_masses_kg;
+use crate::material::Material;
+use crate::mesh::Mesh;
 pub(super) const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 
 fn cantilever(et: ElementType) -> Mesh {
@@ -341,7 +347,7 @@ fn slab_sweep_is_bitwise_the_same_on_one_and_two_threads() {
             for _ in 0..3 {
                 sim.step_frame().unwrap();
             }
-            let part = sim.solver.as_xpbd().unwrap().partitions[0].1.as_ref().expect("a partition");
+            let part = sim.xpbd_solver().unwrap().partitions[0].1.as_ref().expect("a partition");
             assert_eq!(part.slabs.len(), crate::xpbd::kernels::MIN_SLABS);
             let counts: Vec<usize> = part.slabs.iter().map(|s| s.len()).collect();
             assert_eq!(counts.iter().sum::<usize>(), sim.mesh().num_elements());

@@ -38,8 +38,7 @@ fn find_line(bytes: &[u8], needle: &[u8]) -> Option<usize> {
 
 pub(super) fn parse_ascii(bytes: &[u8], file: &str) -> Result<RawMsh, GmshError> {
     let mut raw = RawMsh::default();
-    let err =
-        |line: usize, message: String| GmshError::Parse { file: file.into(), at: format!(":{line}"), message };
+    let err = |line: usize, message: String| GmshError::Parse { file: file.into(), at: format!(":{line}"), message };
     if let Some((body, first)) = section(bytes, "Nodes", file)? {
         let text = String::from_utf8_lossy(body);
         let mut lines = text.lines().enumerate().map(|(k, l)| (first + k, l.trim())).filter(|(_, l)| !l.is_empty());
@@ -65,8 +64,7 @@ pub(super) fn parse_ascii(bytes: &[u8], file: &str) -> Result<RawMsh, GmshError>
     if let Some((body, first)) = section(bytes, "Elements", file)? {
         let text = String::from_utf8_lossy(body);
         let mut lines = text.lines().enumerate().map(|(k, l)| (first + k, l.trim())).filter(|(_, l)| !l.is_empty());
-        let (count_line, count) =
-            lines.next().ok_or_else(|| err(first, "$Elements has no element count".into()))?;
+        let (count_line, count) = lines.next().ok_or_else(|| err(first, "$Elements has no element count".into()))?;
         let count: usize = count.parse().map_err(|_| err(count_line, format!("bad element count \"{count}\"")))?;
         for (line, l) in lines {
             let bad =
@@ -136,10 +134,8 @@ pub(super) fn parse_binary(bytes: &[u8], file: &str) -> Result<RawMsh, GmshError
     // the header line is followed by the integer 1 written in the file's byte order
     let (format_body, _) = section(bytes, "MeshFormat", file)?.ok_or_else(|| err("no $MeshFormat"))?;
     let nl = format_body.iter().position(|&c| c == b'\n').ok_or_else(|| err("truncated $MeshFormat"))?;
-    let one: [u8; 4] = format_body
-        .get(nl + 1..nl + 5)
-        .and_then(|s| s.try_into().ok())
-        .ok_or_else(|| err("truncated $MeshFormat"))?;
+    let one: [u8; 4] =
+        format_body.get(nl + 1..nl + 5).and_then(|s| s.try_into().ok()).ok_or_else(|| err("truncated $MeshFormat"))?;
     let swap = match i32::from_ne_bytes(one) {
         1 => false,
         x if x.swap_bytes() == 1 => true,
@@ -177,10 +173,8 @@ pub(super) fn parse_binary(bytes: &[u8], file: &str) -> Result<RawMsh, GmshError
             for _ in 0..following {
                 let tag = c.i32().ok_or_else(truncated)?;
                 let tags: Vec<i32> = (0..ntags).map(|_| c.i32()).collect::<Option<_>>().ok_or_else(truncated)?;
-                let nodes: Vec<u64> = (0..nodes_per)
-                    .map(|_| c.i32().map(|t| t as u64))
-                    .collect::<Option<_>>()
-                    .ok_or_else(truncated)?;
+                let nodes: Vec<u64> =
+                    (0..nodes_per).map(|_| c.i32().map(|t| t as u64)).collect::<Option<_>>().ok_or_else(truncated)?;
                 raw.elements.push(RawElement {
                     tag: tag as u64,
                     gmsh_type: gmsh_type as u32,

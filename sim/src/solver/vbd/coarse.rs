@@ -26,15 +26,15 @@
 //!
 //! The coarse matrix is `Uᵀ H U` assembled element by element, never the fine `H`.
 
-use crate::solver::potential::Potential;
-use crate::solver::settings::SolverSettings;
-use crate::solver::step::StepInput;
 use crate::Vec3;
 use crate::effect::NodeSpring;
 use crate::fem::energy::for_each_element;
 use crate::fem::geometry::deformation_gradient;
 use crate::material::tangent::{contract_left, contract_right};
 use crate::mesh::Mesh;
+use crate::solver::potential::Potential;
+use crate::solver::settings::SolverSettings;
+use crate::solver::step::StepInput;
 use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
 
 /// Cells per axis for a box of extents `ext_m`: near-cubic cells, at least one across every
@@ -353,12 +353,12 @@ fn dot(a: &[Vec3], b: &[Vec3]) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use crate::solver::tests::{G, beam, clamped_at_x0};
-    use crate::solver::{Simulation, SolverSettings};
     use super::*;
     use crate::effect::{Clamp, Effect, Gravity};
     use crate::element::ElementType;
     use crate::material::{Material, MaterialModel};
+    use crate::solver::tests::{G, beam, clamped_at_x0};
+    use crate::solver::{Simulation, SolverSettings};
 
     impl CoarseSpace {
         fn node_position(&self, j: usize) -> Vec3 {
@@ -430,15 +430,15 @@ mod tests {
             let effects: Vec<Box<dyn Effect>> =
                 vec![Box::new(Gravity::new(G)), Box::new(Clamp { nodes: clamped.clone() })];
             let sim = Simulation::new(mesh, material, settings, effects).unwrap();
-            let mut inv_mass = sim.inv_mass.clone();
+            let mut inv_mass = sim.inv_mass().to_vec();
             clamped.iter().for_each(|&i| inv_mass[i as usize] = 0.0);
             let s = StepInput {
-                mesh: &sim.mesh,
-                geometry: &sim.geometry,
-                material: &sim.material,
-                masses_kg: &sim.masses_kg,
+                mesh: sim.mesh(),
+                geometry: sim.geometry(),
+                material: sim.material(),
+                masses_kg: sim.masses_kg(),
                 inv_mass: &inv_mass,
-                prev_positions: &sim.mesh.rest_positions,
+                prev_positions: &sim.mesh().rest_positions,
                 body_acceleration: Vec3::zeros(),
                 h: 1.0 / 60.0,
                 settings: &settings,
@@ -446,14 +446,14 @@ mod tests {
             };
             // the inertial target: a small bend plus a node-to-node ripple; x starts at rest
             let y: Vec<Vec3> = sim
-                .mesh
+                .mesh()
                 .rest_positions
                 .iter()
                 .enumerate()
                 .map(|(i, p)| p + Vec3::new(0.0, 0.0, 1e-6 * p.x * p.x + 1e-8 * (i % 3) as f64 * p.x))
                 .collect();
-            let mut x = sim.mesh.rest_positions.clone();
-            let mut c = CoarseSpace::new(&sim.mesh, 16);
+            let mut x = sim.mesh().rest_positions.clone();
+            let mut c = CoarseSpace::new(sim.mesh(), 16);
             c.begin_step(&s, &x, &[]);
             let energy = |x: &[Vec3]| {
                 let w = 0.5 / (s.h * s.h);
@@ -466,7 +466,10 @@ mod tests {
             let (after, g_after) = (energy(&x), c.coarse_gradient(&s, &x, &y));
             assert!(after < before, "{et}: G rose from {before:.6e} to {after:.6e}");
             assert!(g_after < 1e-6 * g_before, "{et}: coarse gradient {g_before:.3e} -> {g_after:.3e}");
-            assert!(clamped.iter().all(|&i| x[i as usize] == sim.mesh.rest_positions[i as usize]), "held nodes moved");
+            assert!(
+                clamped.iter().all(|&i| x[i as usize] == sim.mesh().rest_positions[i as usize]),
+                "held nodes moved"
+            );
         }
     }
 }

@@ -4,12 +4,11 @@
 //! AVX2 + FMA paths and their one runtime check ([`Fused`]).
 
 use crate::Vec3;
+use crate::fem::energy::element_grads;
 use crate::fem::geometry::BlockGeometry;
-use crate::material::{Lame, Material, NodeVisit, NodeVisitKernel, project_psd3};
+use crate::material::{Material, NodeVisitKernel};
 use crate::math::shared::SharedMut;
 use crate::mesh::Mesh;
-use crate::mesh::adjacency::NodeIncidence;
-use nalgebra::Matrix3;
 
 /// What a node visit reads of each element, lane-major ([`NodeVisit`]): per block, the points
 /// in chunks of `width` (4 where the element has several points, one AVX2 register per chunk; 1
@@ -133,7 +132,7 @@ pub(super) unsafe fn add_outer_any<const FMA: bool>(width: usize, f: &mut [f64],
 /// Whether the CPU has AVX2 and FMA: the sweep's node updates and `F_q` refreshes are then
 /// compiled for them (four-lane `F_q` moves in one fused instruction per entry).
 #[derive(Clone, Copy)]
-pub(super) struct Fused(bool);
+pub(super) struct Fused(pub(super) bool);
 
 impl Fused {
     pub(super) fn detect() -> Self {
@@ -160,7 +159,12 @@ pub(super) struct RefreshInput<'a> {
 /// # Safety
 /// [`add_outer`]'s.
 #[inline(always)]
-pub(super) unsafe fn refresh_element<const FMA: bool>(input: &RefreshInput<'_>, e: usize, nodes: &[u32], out: &mut [f64]) {
+pub(super) unsafe fn refresh_element<const FMA: bool>(
+    input: &RefreshInput<'_>,
+    e: usize,
+    nodes: &[u32],
+    out: &mut [f64],
+) {
     let w = input.lanes.width;
     out.fill(0.0);
     for k in 0..input.lanes.chunks {
@@ -329,4 +333,3 @@ impl Snapshots {
         }
     }
 }
-

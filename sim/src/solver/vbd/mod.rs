@@ -49,25 +49,22 @@
 //! per node-element visit, half of them the StVK law.
 
 use super::error::SolverCounters;
-use super::nan_guard::{BadElement, ORIGIN_VBD};
+use super::nan_guard::BadElement;
 use super::settings::{SolverSettings, VbdInit};
 use super::step::{Hooks, StepInput, StepSolver};
 use coarse::{CoarseSpace, coarse_cells};
-use lanes::{Fused, PointLanes, Snapshots};
+use lanes::{Fused, LaneView, PointLanes, Snapshots};
 use node::NodeUpdate;
 
 mod coarse;
 mod lanes;
 mod node;
 use crate::Vec3;
-use crate::effect::{ImplicitRole, NodeSpring};
-use crate::fem::energy::element_grads;
+use crate::effect::ImplicitRole;
 use crate::fem::geometry::BlockGeometry;
-use crate::material::{Lame, Material, NodeVisit, NodeVisitKernel, project_psd3};
+use crate::math::shared::SharedMut;
 use crate::mesh::Mesh;
 use crate::mesh::adjacency::{NodeIncidence, colour_nodes};
-use crate::math::shared::SharedMut;
-use nalgebra::Matrix3;
 
 /// Fewest nodes per parallel task within a colour.
 const MIN_NODES_PER_TASK: usize = 16;

@@ -2,12 +2,14 @@
 //! the elements holding it, the springs and the inertia term, and the 3×3 Newton step
 //! `x_i ← x_i + H_i⁻¹ f_i` by a hand-written Cholesky ([`solve_spd3`]).
 
+use super::lanes::{Fused, LaneView, add_outer_any};
 use crate::Vec3;
-use crate::fem::geometry::BlockGeometry;
-use crate::material::{Lame, Material, NodeVisit, NodeVisitKernel, project_psd3};
+use crate::effect::NodeSpring;
+use crate::material::{Lame, NodeVisit, project_psd3};
 use crate::math::shared::SharedMut;
-use crate::mesh::Mesh;
 use crate::mesh::adjacency::NodeIncidence;
+use crate::solver::nan_guard::{BadElement, ORIGIN_VBD};
+use crate::solver::step::StepInput;
 use nalgebra::Matrix3;
 
 /// What a node update reads.
@@ -29,7 +31,12 @@ impl NodeUpdate<'_> {
     /// # Safety
     /// No other thread may access node `i` or the `F_q` of an element holding it meanwhile
     /// (nodes of one colour share no element).
-    pub(super) unsafe fn step(&self, i: usize, positions: SharedMut<Vec3>, lanes: &[LaneView<'_>]) -> Result<bool, BadElement> {
+    pub(super) unsafe fn step(
+        &self,
+        i: usize,
+        positions: SharedMut<Vec3>,
+        lanes: &[LaneView<'_>],
+    ) -> Result<bool, BadElement> {
         #[cfg(target_arch = "x86_64")]
         if self.fused.0 {
             // SAFETY: the CPU has AVX2 and FMA (detected); the caller's promise
@@ -131,7 +138,12 @@ pub(super) fn solve_spd3(h: &Matrix3<f64>, f: &Vec3) -> Option<Vec3> {
 /// No other thread may access the `F_q` of an element holding node `i` meanwhile; with `FMA`,
 /// the CPU has AVX2 and FMA.
 #[inline(always)]
-pub(super) unsafe fn carry_points<const FMA: bool>(incidence: &NodeIncidence, i: usize, d: Vec3, lanes: &[LaneView<'_>]) {
+pub(super) unsafe fn carry_points<const FMA: bool>(
+    incidence: &NodeIncidence,
+    i: usize,
+    d: Vec3,
+    lanes: &[LaneView<'_>],
+) {
     for inc in incidence.of(i) {
         let (b, e, a) = (inc.block as usize, inc.element as usize, inc.local as usize);
         let l = &lanes[b];
@@ -141,4 +153,3 @@ pub(super) unsafe fn carry_points<const FMA: bool>(incidence: &NodeIncidence, i:
         unsafe { add_outer_any::<FMA>(l.geometry.width, fq, &d, l.geometry.node_grads(e, a)) };
     }
 }
-

@@ -1,3 +1,5 @@
+use super::lanes::LaneView;
+use super::node::{carry_points, solve_spd3};
 use super::*;
 use crate::element::ElementType;
 use crate::fem::geometry::{deformation_gradient, precompute};
@@ -6,6 +8,9 @@ use crate::fem::geometry::{deformation_gradient, precompute};
 ///
 /// # Safety
 /// [`carry_points`]'s; `fused` from [`Fused::detect`].
+use crate::fem::energy::element_grads;
+use crate::material::Material;
+use nalgebra::Matrix3;
 unsafe fn carry_on_this_cpu(fused: Fused, incidence: &NodeIncidence, i: usize, d: Vec3, lanes: &[LaneView<'_>]) {
     #[cfg(target_arch = "x86_64")]
     if fused.0 {
@@ -66,8 +71,7 @@ fn carried_point_gradients_match_recomputed_ones_for_every_element_type() {
             .map(|(i, p)| p + Vec3::new(0.003 * (i % 5) as f64, 0.002 * (i % 3) as f64, -0.004 * (i % 2) as f64))
             .collect();
         let fused = Fused::detect();
-        let material =
-            Material::new(crate::material::MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
+        let material = Material::new(crate::material::MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
         let mut cached = PointLanes::new(&mesh, &geometry);
         cached.refresh(&mesh, &x, fused);
         for (k, i) in (0..mesh.num_nodes()).step_by(3).enumerate() {

@@ -5,13 +5,13 @@
 //! [`crate::xpbd::constraint`], element by element: gather, project, check, scatter.
 
 use super::Xpbd;
-use crate::solver::error::SolverCounters;
-use crate::solver::nan_guard::{BadElement, non_finite_node};
-use crate::solver::step::StepInput;
 use crate::Vec3;
 use crate::fem::energy::{element_grads, gather};
 use crate::fem::geometry::BlockGeometry;
 use crate::material::Material;
+use crate::solver::error::SolverCounters;
+use crate::solver::nan_guard::{BadElement, non_finite_node};
+use crate::solver::step::StepInput;
 use crate::xpbd::constraint::{Formulation, NodeScratch, project_energy_constraint, project_split_constraints};
 
 impl Xpbd {

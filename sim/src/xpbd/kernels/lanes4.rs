@@ -11,9 +11,9 @@
 
 use super::{AnyMaterial, Multipliers, NonFiniteElement, Positions, Stvk};
 use crate::Vec3;
-pub use crate::math::f64x4::{F64x4, available};
 use crate::material::{Mat3, stvk};
-use crate::math::lane::{Lane, M3};
+pub use crate::math::f64x4::{F64x4, available};
+use crate::math::lane::M3;
 use std::arch::x86_64::*;
 
 /// A 3-vector of lanes.

@@ -234,8 +234,8 @@ fn sweep_colours_of(
 #[test]
 fn the_sweeps_stvk_is_the_materials_point_law_bit_for_bit() {
     use crate::material::Mat3;
-    use crate::math::lane::{Scalar, from_mat3, to_mat3};
     use crate::material::stvk::energy_and_pk1;
+    use crate::math::lane::{Scalar, from_mat3, to_mat3};
     let law = Stvk { mu_pa: 1.1e6, lambda_pa: 2.3e6 };
     let mut seed = 0x2545_f491_4f6c_dd1d_u64;
     let mut next = || {
