@@ -1,0 +1,88 @@
+use super::*;
+
+#[test]
+fn every_entry_is_complete_and_its_keys_unique() {
+    let mut keys = std::collections::HashSet::new();
+    let mut paths = std::collections::HashSet::new();
+    for p in PARAMS {
+        assert!(!p.key.is_empty() && !p.file_key.is_empty() && !p.label.is_empty() && !p.help.is_empty(), "{p:?}");
+        assert!(keys.insert(p.key), "key {} twice", p.key);
+        assert!(paths.insert(p.file_path()), "file key {} twice", p.file_path());
+        // the default is valid and round-trips through Value, TOML and text
+        let d = Params::default();
+        let v = (p.get)(&d);
+        p.kind.check(&v).unwrap_or_else(|e| panic!("{}: default {v}: {e}", p.key));
+        let mut q = d.clone();
+        assert!((p.set)(&mut q, v.clone()), "{}", p.key);
+        assert_eq!(q, d);
+        if let Some(t) = v.to_toml() {
+            assert_eq!(p.kind.from_toml(&t).as_ref(), Ok(&v), "{}", p.key);
+        }
+        if !matches!(p.kind, Kind::Point) {
+            assert_eq!(p.kind.parse(&v.to_string()).as_ref(), Ok(&v), "{}", p.key);
+        }
+    }
+}
+
+#[test]
+fn overrides_set_by_text_name_the_key_and_check_the_range() {
+    let mut o = SceneOverrides::default();
+    o.set_text("youngs", "6e6").unwrap();
+    o.set_text("grid", "16x4x4").unwrap();
+    o.set_text("quadrature", "default").unwrap();
+    o.set_text("guard", "off").unwrap();
+    assert_eq!(o.youngs_modulus_pa, Some(6e6));
+    assert_eq!(o.grid, Some([16, 4, 4]));
+    assert_eq!(o.quadrature_degree, Some(None));
+    assert_eq!(o.stability_guard, Some(false));
+    let e = o.set_text("youngz", "1").unwrap_err();
+    assert!(e.contains("'youngz'") && e.contains("did you mean 'youngs'"), "{e}");
+    let e = o.set_text("grid", "-4x2x2").unwrap_err();
+    assert!(e.starts_with("grid:"), "{e}");
+    let e = o.set_text("refine", "9").unwrap_err();
+    assert!(e.starts_with("refine = 9"), "{e}");
+    let e = o.set_text("poisson", "0.5").unwrap_err();
+    assert!(e.contains("< 0.5"), "{e}");
+}
+
+#[test]
+fn a_change_invalidates_what_its_entry_says() {
+    let a = Params::default();
+    let mut b = a.clone();
+    assert_eq!(a.invalidated_by(&b), Invalidates::Nothing);
+    b.substeps = 10;
+    assert_eq!(a.invalidated_by(&b), Invalidates::Settings);
+    b.youngs_modulus_pa = 1e7;
+    assert_eq!(a.invalidated_by(&b), Invalidates::Material);
+    b.element = "q2".into();
+    assert_eq!(a.invalidated_by(&b), Invalidates::Mesh);
+    assert_eq!(a.changed_keys(&b), ["element", "youngs", "substeps"]);
+}
+
+#[test]
+fn the_size_of_a_refined_box_is_estimated_before_building_it() {
+    let mut p = Params::default();
+    assert_eq!(box_elements(&p), Some(160));
+    p.refine = 3;
+    assert_eq!(box_elements(&p), Some(81_920));
+    assert!(check_box_size(&p).is_ok());
+    p.refine = 5;
+    let e = check_box_size(&p).unwrap_err();
+    assert!(e.contains("5,242,880 elements") && e.contains("GB"), "{e}");
+    p.refine = 0;
+    p.grid = [64, 64, 64];
+    p.element = "p1".into();
+    assert_eq!(box_elements(&p), Some(1_310_720));
+    assert!(check_box_size(&p).is_ok());
+    p.split = "six".into();
+    p.refine = 1;
+    assert!(check_box_size(&p).unwrap_err().contains("12,582,912 elements"));
+    assert!(check_grid_size(&p).is_ok(), "reported on the refinement, not the grid");
+    // high order reaches the memory limit first, and unrefined it is the grid's
+    p.element = "p3".into();
+    p.split = "five".into();
+    p.refine = 0;
+    let e = check_grid_size(&p).unwrap_err();
+    assert!(e.contains("1,310,720 elements") && e.contains("GB"), "{e}");
+    assert!(check_refine_size(&p).is_ok());
+}
