@@ -16,6 +16,14 @@
 //!
 //! **Adding a parameter** is one entry in the `params!` invocation below plus the code that uses
 //! the value (e.g. `SolverSettings`); nothing else lists parameters.
+//!
+//! This file holds the table and the public surface made from it; the rest of the folder: the
+//! meta-types `kind` (type and range, group, surfaces, invalidation) and `value` (untyped values
+//! and their conversion to the typed fields, the choices' types), `param` (one entry), `options`
+//! (the choices' option lists), `applies` (when an entry applies), `size` (the box's size limits)
+//! and `suggest` (did-you-mean). A choice's text is parsed into its typed field (e.g.
+//! [`MaterialModel`]) where it enters: a scene file, a command-line flag, a `--compare` key, the
+//! app's menu or its persisted settings.
 
 use serde::{Deserialize, Serialize};
 
@@ -33,7 +41,15 @@ pub use applies::{is_implicit, is_tetrahedral, is_vbd, is_xpbd};
 pub use kind::{EVERYWHERE, FILE_ONLY, Group, Invalidates, Kind, Surfaces};
 pub use param::Param;
 pub use size::{MAX_BOX_BYTES, MAX_BOX_ELEMENTS, box_bytes, box_elements, thousands};
-pub use value::{ParamType, Value};
+pub use value::{Choice, ParamType, Value};
+
+use hox_sim::element::ElementType;
+use hox_sim::material::MaterialModel;
+use hox_sim::measure::field::Field;
+use hox_sim::mesh::structured::TetSplit;
+use hox_sim::solver::{Method, Sweep, VbdInit};
+use hox_sim::xpbd::constraint::Formulation;
+use value::as_text;
 
 use applies::is_newton;
 use options::*;
@@ -44,13 +60,13 @@ use size::{check_grid_size, check_refine_size};
 
 /// Defines [`Params`], [`SceneOverrides`] and [`PARAMS`] from one list.
 macro_rules! params {
-    ($( $(#[doc = $doc:literal])* $field:ident : $ty:ty = $default:expr => { $($def:tt)* } )*) => {
+    ($( $(#[$attr:meta])* $field:ident : $ty:ty = $default:expr => { $($def:tt)* } )*) => {
         /// Every parameter's value (see the module docs); a scene's resolved configuration and
         /// the app's live controls. Persisted by the app (missing fields take their defaults).
         #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
         #[serde(default)]
         pub struct Params {
-            $( $(#[doc = $doc])* pub $field: $ty, )*
+            $( $(#[$attr])* pub $field: $ty, )*
         }
 
         impl Default for Params {
@@ -87,14 +103,16 @@ macro_rules! params {
 }
 
 params! {
-    /// Element type of a box mesh: a registered element type's name ([`hox_sim::element::ElementType::all`]).
-    element: String = "p2".into() => {
+    /// Element type of a box mesh: a registered element type ([`ElementType::all`]).
+    #[serde(with = "as_text")]
+    element: ElementType = ElementType::from_name("p2").expect("P2 is registered") => {
         key: "element", group: Group::Mesh, file_key: "element", label: "Element",
         help: "The element type: its shape (tetrahedron, hexahedron, prism, pyramid) and polynomial order; `hox elements` describes each.",
         kind: Kind::Choice(element_options), invalidates: Invalidates::Mesh, required: true, box_only: true, ..BASE
     }
     /// `five` (unbiased) or `six` (biased) tetrahedra per cell.
-    split: String = "five".into() => {
+    #[serde(with = "as_text")]
+    split: TetSplit = TetSplit::Five => {
         key: "split", group: Group::Mesh, file_key: "split", label: "Tet split",
         help: "How each hexahedral cell is cut into tetrahedra: five (unbiased, alternating) or six (biased along one diagonal).",
         kind: Kind::Choice(split_options), invalidates: Invalidates::Mesh, box_only: true, applies: Some(is_tetrahedral), ..BASE
@@ -125,8 +143,9 @@ params! {
         help: "The box mesh's upper corner, metres; beyond the lower corner in every direction.",
         kind: Kind::Point, invalidates: Invalidates::Mesh, surfaces: FILE_ONLY, required: true, box_only: true, ..BASE
     }
-    /// A registered material model's name ([`hox_sim::material::MaterialModel::ALL`]).
-    material: String = "stvk".into() => {
+    /// A registered material model ([`MaterialModel::ALL`]).
+    #[serde(with = "as_text")]
+    material: MaterialModel = MaterialModel::StVenantKirchhoff => {
         key: "material", group: Group::Material, file_key: "model", label: "Model",
         help: "The hyperelastic energy model; stvk (Saint-Venant–Kirchhoff) is the paper's.",
         kind: Kind::Choice(material_options), invalidates: Invalidates::Material, required: true, ..BASE
@@ -152,8 +171,9 @@ params! {
         kind: Kind::Number { min: 0.0, min_inclusive: false, max: f64::INFINITY, max_inclusive: false, soft: None },
         invalidates: Invalidates::Material, required: true, ..BASE
     }
-    /// xpbd | vbd | newton ([`hox_sim::solver::Method`]).
-    method: String = "xpbd".into() => {
+    /// xpbd | vbd | newton.
+    #[serde(with = "as_text")]
+    method: Method = Method::Xpbd => {
         key: "solver", group: Group::Solver, file_key: "method", label: "Solver",
         help: "xpbd: the paper's extended position-based dynamics (substeps × iterations); vbd: vertex block descent on implicit Euler (Chen et al. 2024); newton: implicit Euler solved by Newton's method to --newton-tolerance (sparse Cholesky). Contact needs xpbd or vbd.",
         kind: Kind::Choice(method_options), ..BASE
@@ -183,7 +203,8 @@ params! {
         kind: Kind::Whole { min: 0, max: 256, soft_max: 128 }, applies: Some(is_vbd), ..BASE
     }
     /// Where a VBD step starts: adaptive | inertia | previous.
-    vbd_init: String = "adaptive".into() => {
+    #[serde(with = "as_text")]
+    vbd_init: VbdInit = VbdInit::Adaptive => {
         key: "vbd-init", group: Group::Solver, file_key: "vbd_init", label: "VBD start",
         help: "Where a VBD step starts: adaptive (the paper's: the last step's acceleration along gravity, so a body at rest stays at rest), inertia (the inertial prediction) or previous (the last position).",
         kind: Kind::Choice(vbd_init_options), applies: Some(is_vbd), ..BASE
@@ -195,7 +216,8 @@ params! {
         kind: Kind::Number { min: 0.0, min_inclusive: false, max: 1.0, max_inclusive: false, soft: None }, applies: Some(is_newton), ..BASE
     }
     /// energy | split.
-    formulation: String = "energy".into() => {
+    #[serde(with = "as_text")]
+    formulation: Formulation = Formulation::Energy => {
         key: "formulation", group: Group::Solver, file_key: "formulation", label: "Formulation",
         help: "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.",
         kind: Kind::Choice(formulation_options), applies: Some(is_xpbd), ..BASE
@@ -232,7 +254,8 @@ params! {
         ..BASE
     }
     /// colour | element: the order of XPBD's Gauss–Seidel sweep.
-    sweep: String = "colour".into() => {
+    #[serde(with = "as_text")]
+    sweep: Sweep = Sweep::Colour => {
         key: "sweep", group: Group::Solver, file_key: "sweep", label: "Sweep",
         help: "Order of XPBD's constraint sweep. colour (default): colour by colour, four elements per AVX2 register, on every thread (RAYON_NUM_THREADS sets how many), the same result on any thread count; element: element after element in mesh order on one thread (the order of the paper's figures and of hox's results before the colour sweep became the default).",
         kind: Kind::Choice(sweep_options), applies: Some(is_xpbd), ..BASE
@@ -273,7 +296,8 @@ params! {
     }
     /// The fields the surface is coloured by, comma-separated; the first is drawn
     /// ([`hox_sim::measure::field::Field`]).
-    field: String = "displacement".into() => {
+    #[serde(with = "as_text")]
+    field: Vec<Field> = vec![Field::Displacement] => {
         key: "field", group: Group::Display, file_key: "field", label: "Colour by",
         help: "What the surface is coloured by: displacement (|u|, m), von-mises (stress, Pa), strain (equivalent Green–Lagrange strain), det-f (volume ratio), energy-density (J/m³) or error (|u − u_ref| against the reference field, m), evaluated at each element's own points. `hox record` records every field listed (comma-separated or --field repeated), each in its own 3D view; the app draws the first.",
         kind: Kind::Choices(field_options), invalidates: Invalidates::Nothing, ..BASE
@@ -392,9 +416,9 @@ impl Params {
     pub fn box_label(&self) -> String {
         let [x, y, z] = self.grid;
         let tets = is_tetrahedral(self);
-        let mut s = format!("{} {x}×{y}×{z}", self.element.to_uppercase());
+        let mut s = format!("{} {x}×{y}×{z}", self.element.name().to_uppercase());
         if tets {
-            s += &format!(" {}", self.split);
+            s += &format!(" {}", self.split.name());
             if self.refine > 0 {
                 s += &format!(" r{}", self.refine);
             }

@@ -2,7 +2,6 @@
 //! ([`MAX_BOX_ELEMENTS`], [`MAX_BOX_BYTES`]) and the checks the grid and refinement entries make;
 //! [`thousands`] writes the counts.
 
-use hox_sim::element::ElementType;
 use hox_sim::mesh::structured::TetSplit;
 
 use super::Params;
@@ -19,9 +18,9 @@ pub const MAX_BOX_BYTES: u64 = 8_000_000_000;
 
 /// Elements a box mesh of `p` would have (without building it).
 pub fn box_elements(p: &Params) -> Option<u64> {
-    let e = ElementType::from_name(&p.element)?;
+    let e = p.element;
     let cells: u64 = p.grid.iter().map(|&c| c as u64).product();
-    let split = if is_tetrahedral(p) { TetSplit::from_name(&p.split)? } else { TetSplit::default() };
+    let split = if is_tetrahedral(p) { p.split } else { TetSplit::default() };
     let per_cell = hox_sim::mesh::structured::elements_per_cell(e.shape(), split) as u64;
     let refine = u32::try_from(p.refine).ok().filter(|r| *r <= 20)?;
     Some(cells.saturating_mul(per_cell).saturating_mul(8u64.saturating_pow(refine)))
@@ -32,7 +31,7 @@ pub fn box_elements(p: &Params) -> Option<u64> {
 /// node (about one per element for these meshes, more for high order) positions, velocities,
 /// previous positions, rest positions, masses and the solver's scratch.
 pub fn box_bytes(p: &Params) -> Option<u64> {
-    let e = ElementType::from_name(&p.element)?;
+    let e = p.element;
     let nodes = e.num_nodes() as u64;
     let qp = hox_sim::fem::quadrature::rule(e.shape(), p.quadrature_degree.unwrap_or(e.default_quadrature_degree()))
         .map(|r| r.len() as u64)
@@ -51,7 +50,7 @@ pub(super) fn check_box_size(p: &Params) -> Result<(), String> {
     let [x, y, z] = p.grid;
     Err(format!(
         "{} {x}×{y}×{z}{} would be {} elements and take about {:.1} GB; at most {} elements and {:.0} GB",
-        p.element.to_uppercase(),
+        p.element.name().to_uppercase(),
         if p.refine > 0 { format!(" refined {} time(s)", p.refine) } else { String::new() },
         thousands(elements),
         bytes as f64 / 1e9,

@@ -54,7 +54,7 @@ fn a_change_invalidates_what_its_entry_says() {
     assert_eq!(a.invalidated_by(&b), Invalidates::Settings);
     b.youngs_modulus_pa = 1e7;
     assert_eq!(a.invalidated_by(&b), Invalidates::Material);
-    b.element = "q2".into();
+    b.element = ElementType::from_name("q2").unwrap();
     assert_eq!(a.invalidated_by(&b), Invalidates::Mesh);
     assert_eq!(a.changed_keys(&b), ["element", "youngs", "substeps"]);
 }
@@ -71,18 +71,43 @@ fn the_size_of_a_refined_box_is_estimated_before_building_it() {
     assert!(e.contains("5,242,880 elements") && e.contains("GB"), "{e}");
     p.refine = 0;
     p.grid = [64, 64, 64];
-    p.element = "p1".into();
+    p.element = ElementType::from_name("p1").unwrap();
     assert_eq!(box_elements(&p), Some(1_310_720));
     assert!(check_box_size(&p).is_ok());
-    p.split = "six".into();
+    p.split = TetSplit::Six;
     p.refine = 1;
     assert!(check_box_size(&p).unwrap_err().contains("12,582,912 elements"));
     assert!(check_grid_size(&p).is_ok(), "reported on the refinement, not the grid");
     // high order reaches the memory limit first, and unrefined it is the grid's
-    p.element = "p3".into();
-    p.split = "five".into();
+    p.element = ElementType::from_name("p3").unwrap();
+    p.split = TetSplit::Five;
     p.refine = 0;
     let e = check_grid_size(&p).unwrap_err();
     assert!(e.contains("1,310,720 elements") && e.contains("GB"), "{e}");
     assert!(check_refine_size(&p).is_ok());
+}
+
+#[test]
+fn the_typed_choices_persist_by_name_and_an_unknown_name_is_refused() {
+    let p = Params {
+        element: ElementType::from_name("q2").unwrap(),
+        method: Method::Vbd,
+        field: vec![Field::Strain, Field::VonMises],
+        ..Params::default()
+    };
+    let json = serde_json::to_value(&p).unwrap();
+    assert!(json["element"] == "q2" && json["method"] == "vbd" && json["field"] == "strain,von-mises", "{json}");
+    assert_eq!(serde_json::from_value::<Params>(json).unwrap(), p);
+    let e = serde_json::from_str::<Params>(r#"{"element": "p7"}"#).unwrap_err().to_string();
+    assert!(e.contains("unknown option 'p7'"), "{e}");
+    // what a choice's text check passes, its typed field takes
+    for param in PARAMS.iter().filter(|p| matches!(p.kind, Kind::Choice(_))) {
+        let Kind::Choice(options) = param.kind else { unreachable!() };
+        for (name, _) in options() {
+            let mut q = Params::default();
+            assert!((param.set)(&mut q, Value::Text(name.into())), "{} {name}", param.key);
+            assert_eq!((param.get)(&q), Value::Text(name.into()));
+        }
+        assert!(!(param.set)(&mut Params::default(), Value::Text("no-such-thing".into())), "{}", param.key);
+    }
 }

@@ -13,10 +13,9 @@ pub(crate) use validate::invalid_in;
 
 use hox_sim::Vec3;
 use hox_sim::io::gmsh::ImportedMesh;
-use hox_sim::material::{Material, MaterialError, MaterialModel};
+use hox_sim::material::{Material, MaterialError};
 use hox_sim::mesh::structured::BoxMeshSpec;
-use hox_sim::solver::{Method, NewtonSettings, SolverSettings, Sweep, VbdInit, VbdSettings};
-use hox_sim::xpbd::constraint::Formulation;
+use hox_sim::solver::{NewtonSettings, SolverSettings, VbdSettings};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -125,9 +124,7 @@ impl Scene {
     }
 
     pub(crate) fn material_of(p: &Params) -> Result<Material, MaterialError> {
-        // the model's name was checked against the table's choices
-        let model = MaterialModel::from_name(&p.material).unwrap_or(MaterialModel::StVenantKirchhoff);
-        Material::new(model, p.youngs_modulus_pa, p.poisson_ratio, p.density_kg_m3)
+        Material::new(p.material, p.youngs_modulus_pa, p.poisson_ratio, p.density_kg_m3)
     }
 
     /// The solver settings the parameters describe.
@@ -137,18 +134,17 @@ impl Scene {
             substeps: p.substeps,
             iterations: p.iterations,
             frames_per_second: p.frames_per_second,
-            formulation: Formulation::from_name(&p.formulation).unwrap_or(Formulation::Energy),
+            formulation: p.formulation,
             quadrature_degree: p.quadrature_degree,
-            sweep: Sweep::from_name(&p.sweep).unwrap_or_default(),
+            sweep: p.sweep,
             stability_guard: p.stability_guard,
-            // the names were checked against the table's choices
-            method: Method::from_name(&p.method).unwrap_or_default(),
+            method: p.method,
             steps_per_frame: p.steps_per_frame,
             vbd: VbdSettings {
                 iterations: p.vbd_iterations,
                 chebyshev_rho: p.chebyshev_rho,
                 coarse_cells: p.vbd_coarse_cells,
-                init: VbdInit::from_name(&p.vbd_init).unwrap_or_default(),
+                init: p.vbd_init,
             },
             newton: NewtonSettings { tolerance: p.newton_tolerance, ..Default::default() },
         }

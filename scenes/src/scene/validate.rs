@@ -4,7 +4,7 @@
 
 use hox_sim::Vec3;
 use hox_sim::element::ElementType;
-use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec};
 use hox_sim::xpbd::constraint::Formulation;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -68,8 +68,7 @@ impl Scene {
                 }
             }
         }
-        let formulation = Formulation::from_name(&params.formulation).unwrap_or(Formulation::Energy);
-        if formulation == Formulation::Split && material.split_stiffness_pa().iter().any(|k| !(*k > 0.0)) {
+        if params.formulation == Formulation::Split && material.split_stiffness_pa().iter().any(|k| !(*k > 0.0)) {
             return Err(invalid(
                 "material.poisson_ratio",
                 params.poisson_ratio.to_string(),
@@ -131,11 +130,7 @@ fn mesh_of(
         })?;
         return Ok(SceneMesh::File { path, imported: Arc::new(imported) });
     }
-    // the ranges and choices were checked against the parameter table
-    let element_type = ElementType::from_name(&p.element)
-        .ok_or_else(|| invalid("mesh.element", format!("{:?}", p.element), "unknown element type"))?;
-    let split = TetSplit::from_name(&p.split)
-        .ok_or_else(|| invalid("mesh.split", format!("{:?}", p.split), "expected \"five\" or \"six\""))?;
+    // the ranges were checked against the parameter table, the choices parsed when read
     for d in 0..3 {
         if p.box_max_m[d] <= p.box_min_m[d] {
             return Err(invalid(
@@ -147,8 +142,8 @@ fn mesh_of(
     }
     Ok(SceneMesh::Box(BoxMeshSpec {
         grid: BoxGrid { min_m: Vec3::from(p.box_min_m), max_m: Vec3::from(p.box_max_m), cells: p.grid },
-        element_type,
-        split,
+        element_type: p.element,
+        split: p.split,
         refine: p.refine,
     }))
 }
