@@ -23,7 +23,8 @@
 //! (the choices' option lists), `applies` (when an entry applies), `size` (the box's size limits)
 //! and `suggest` (did-you-mean). A choice's text is parsed into its typed field (e.g.
 //! [`MaterialModel`]) where it enters: a scene file, a command-line flag, a `--compare` key, the
-//! app's menu or its persisted settings.
+//! app's menu or its persisted settings. The solver entries' defaults are sim's
+//! ([`SolverSettings::default`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -47,7 +48,7 @@ use hox_sim::element::ElementType;
 use hox_sim::material::MaterialModel;
 use hox_sim::measure::field::Field;
 use hox_sim::mesh::structured::TetSplit;
-use hox_sim::solver::{Method, Sweep, VbdInit};
+use hox_sim::solver::{Method, SolverSettings, Sweep, VbdInit, VbdSettings};
 use hox_sim::xpbd::constraint::Formulation;
 use value::as_text;
 
@@ -57,6 +58,12 @@ use param::BASE;
 #[cfg(test)]
 use size::check_box_size;
 use size::{check_grid_size, check_refine_size};
+
+/// sim's solver defaults: the solver entries' defaults are these, written once in
+/// [`SolverSettings::default`].
+fn solver() -> SolverSettings {
+    SolverSettings::default()
+}
 
 /// Defines [`Params`], [`SceneOverrides`] and [`PARAMS`] from one list.
 macro_rules! params {
@@ -173,81 +180,82 @@ params! {
     }
     /// xpbd | vbd | newton.
     #[serde(with = "as_text")]
-    method: Method = Method::Xpbd => {
+    method: Method = solver().method => {
         key: "solver", group: Group::Solver, file_key: "method", label: "Solver",
         help: "xpbd: the paper's extended position-based dynamics (substeps × iterations); vbd: vertex block descent on implicit Euler (Chen et al. 2024); newton: implicit Euler solved by Newton's method to --newton-tolerance (sparse Cholesky). Contact needs xpbd or vbd.",
         kind: Kind::Choice(method_options), ..BASE
     }
     /// Implicit steps per frame (VBD, Newton).
-    steps_per_frame: u32 = 1 => {
+    steps_per_frame: u32 = solver().steps_per_frame => {
         key: "steps", group: Group::Solver, file_key: "steps_per_frame", label: "Steps per frame",
         help: "Implicit Euler steps per frame for vbd and newton (XPBD takes --substeps); more steps, less numerical damping.",
         kind: Kind::Whole { min: 1, max: 10_000, soft_max: 20 }, applies: Some(is_implicit), ..BASE
     }
     /// VBD sweeps per step.
-    vbd_iterations: u32 = 10 => {
+    vbd_iterations: u32 = solver().vbd.iterations => {
         key: "vbd-iterations", group: Group::Solver, file_key: "vbd_iterations", label: "VBD iterations",
         help: "Vertex block descent sweeps over the node colours per step.",
         kind: Kind::Whole { min: 1, max: 100_000, soft_max: 200 }, applies: Some(is_vbd), ..BASE
     }
     /// Chebyshev acceleration's ρ for VBD (0: off).
-    chebyshev_rho: f64 = 0.9 => {
+    chebyshev_rho: f64 = solver().vbd.chebyshev_rho => {
         key: "chebyshev-rho", group: Group::Solver, file_key: "chebyshev_rho", label: "Chebyshev ρ",
         help: "Chebyshev acceleration of the VBD sweeps, its spectral radius estimate in [0, 1) (0: off; 0.9 halves the sweeps to settle the bending beam; 0.95 can diverge at few sweeps).",
-        kind: Kind::Number { min: 0.0, min_inclusive: true, max: 1.0, max_inclusive: false, soft: None }, applies: Some(is_vbd), ..BASE
+        kind: Kind::Number { min: 0.0, min_inclusive: true, max: VbdSettings::CHEBYSHEV_RHO_BELOW, max_inclusive: false, soft: None },
+        applies: Some(is_vbd), ..BASE
     }
     /// VBD's two-level correction: about how many coarse cells (0: off).
-    vbd_coarse_cells: u32 = 32 => {
+    vbd_coarse_cells: u32 = solver().vbd.coarse_cells => {
         key: "vbd-coarse-cells", group: Group::Solver, file_key: "vbd_coarse_cells", label: "VBD coarse cells",
         help: "VBD's two-level correction: before its sweeps each step solves for the smooth part of the motion on a coarse grid of about this many trilinear cells over the body (0: off, the paper's VBD alone). The sweeps barely move smooth error such as a beam's slow bending; with the correction Gmsh's P2 beam settles in 122 frames (as Newton) instead of 707.",
-        kind: Kind::Whole { min: 0, max: 256, soft_max: 128 }, applies: Some(is_vbd), ..BASE
+        kind: Kind::Whole { min: 0, max: VbdSettings::MAX_COARSE_CELLS as u64, soft_max: 128 }, applies: Some(is_vbd), ..BASE
     }
     /// Where a VBD step starts: adaptive | inertia | previous.
     #[serde(with = "as_text")]
-    vbd_init: VbdInit = VbdInit::Adaptive => {
+    vbd_init: VbdInit = solver().vbd.init => {
         key: "vbd-init", group: Group::Solver, file_key: "vbd_init", label: "VBD start",
         help: "Where a VBD step starts: adaptive (the paper's: the last step's acceleration along gravity, so a body at rest stays at rest), inertia (the inertial prediction) or previous (the last position).",
         kind: Kind::Choice(vbd_init_options), applies: Some(is_vbd), ..BASE
     }
     /// Newton's tolerance per step, relative to the load.
-    newton_tolerance: f64 = 1e-6 => {
+    newton_tolerance: f64 = solver().newton.tolerance => {
         key: "newton-tolerance", group: Group::Solver, file_key: "newton_tolerance", label: "Newton tolerance",
         help: "A Newton step has converged when its unbalanced force is at most this fraction of the load (the body force, or the reactions if larger), as `hox static` measures it; in (0, 1).",
         kind: Kind::Number { min: 0.0, min_inclusive: false, max: 1.0, max_inclusive: false, soft: None }, applies: Some(is_newton), ..BASE
     }
     /// energy | split.
     #[serde(with = "as_text")]
-    formulation: Formulation = Formulation::Energy => {
+    formulation: Formulation = solver().formulation => {
         key: "formulation", group: Group::Solver, file_key: "formulation", label: "Formulation",
         help: "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.",
         kind: Kind::Choice(formulation_options), applies: Some(is_xpbd), ..BASE
     }
     /// None: each element type's default degree.
-    quadrature_degree: Option<usize> = None => {
+    quadrature_degree: Option<usize> = solver().quadrature_degree => {
         key: "quadrature", group: Group::Solver, file_key: "quadrature_degree", label: "Quadrature",
         help: "Degree of polynomials the element quadrature integrates exactly (default: the element's own).",
         kind: Kind::Degree { max: 21 }, ..BASE
     }
     /// XPBD substeps per frame.
-    substeps: u32 = 50 => {
+    substeps: u32 = solver().substeps => {
         key: "substeps", group: Group::Solver, file_key: "substeps", label: "Substeps",
         help: "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.",
         kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 500 }, applies: Some(is_xpbd), ..BASE
     }
     /// Constraint sweeps per substep.
-    iterations: u32 = 1 => {
+    iterations: u32 = solver().iterations => {
         key: "iterations", group: Group::Solver, file_key: "iterations", label: "Iterations",
         help: "Constraint sweeps per substep (the paper: 1).",
         kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 20 }, applies: Some(is_xpbd), ..BASE
     }
     /// More substeps where the stiffest element needs them (`hox_sim::solver::stability`).
-    stability_guard: bool = true => {
+    stability_guard: bool = solver().stability_guard => {
         key: "guard", group: Group::Solver, file_key: "stability_guard", label: "Stability guard",
         help: "More substeps when the stiffest element needs them (when h·ω_max would exceed 3, enough for h·ω_max ≤ 1; just below 3 your substeps are kept); off: exactly the substeps asked for, which may blow up (docs/STABILITY.md).",
         kind: Kind::Flag, switch: Some(("no-stability-guard", false)), applies: Some(is_xpbd), ..BASE
     }
     /// Simulated frames per second; each frame is one time step.
-    frames_per_second: f64 = 60.0 => {
+    frames_per_second: f64 = solver().frames_per_second => {
         key: "fps", group: Group::Solver, file_key: "frames_per_second", label: "Frames per second",
         help: "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.",
         kind: Kind::Number { min: 0.0, min_inclusive: false, max: f64::INFINITY, max_inclusive: false, soft: Some((10.0, 240.0)) },
@@ -255,7 +263,7 @@ params! {
     }
     /// colour | element: the order of XPBD's Gauss–Seidel sweep.
     #[serde(with = "as_text")]
-    sweep: Sweep = Sweep::Colour => {
+    sweep: Sweep = solver().sweep => {
         key: "sweep", group: Group::Solver, file_key: "sweep", label: "Sweep",
         help: "Order of XPBD's constraint sweep. colour (default): colour by colour, four elements per AVX2 register, on every thread (RAYON_NUM_THREADS sets how many), the same result on any thread count; element: element after element in mesh order on one thread (the order of the paper's figures and of hox's results before the colour sweep became the default).",
         kind: Kind::Choice(sweep_options), applies: Some(is_xpbd), ..BASE

@@ -111,3 +111,20 @@ fn the_typed_choices_persist_by_name_and_an_unknown_name_is_refused() {
         assert!(!(param.set)(&mut Params::default(), Value::Text("no-such-thing".into())), "{}", param.key);
     }
 }
+
+#[test]
+fn the_solver_entries_default_to_sims_settings() {
+    let (p, s) = (Params::default(), SolverSettings::default());
+    assert_eq!(
+        (p.method, p.substeps, p.iterations, p.sweep, p.formulation),
+        (s.method, s.substeps, s.iterations, s.sweep, s.formulation)
+    );
+    assert_eq!(
+        (p.vbd_iterations, p.chebyshev_rho, p.vbd_coarse_cells, p.vbd_init),
+        (s.vbd.iterations, s.vbd.chebyshev_rho, s.vbd.coarse_cells, s.vbd.init)
+    );
+    let mut o = SceneOverrides::default();
+    assert!(o.set_text("vbd-coarse-cells", &VbdSettings::MAX_COARSE_CELLS.to_string()).is_ok());
+    assert!(o.set_text("vbd-coarse-cells", &(VbdSettings::MAX_COARSE_CELLS + 1).to_string()).is_err());
+    assert!(o.set_text("chebyshev-rho", "1").unwrap_err().contains("< 1"));
+}
