@@ -13,7 +13,7 @@ pub(crate) use validate::invalid_in;
 
 use hox_sim::Vec3;
 use hox_sim::io::gmsh::ImportedMesh;
-use hox_sim::material::{Material, MaterialError};
+use hox_sim::material::Material;
 use hox_sim::mesh::structured::BoxMeshSpec;
 use hox_sim::solver::{NewtonSettings, SolverSettings, VbdSettings};
 use std::path::{Path, PathBuf};
@@ -36,8 +36,8 @@ pub struct Drive {
 }
 
 /// A validated scene: its file (every parameter once, in `file.params`) and its mesh source.
-/// The material and solver settings are derived from the parameters ([`Scene::material`],
-/// [`Scene::settings`]).
+/// The material is built from the parameters once, when the scene is validated
+/// ([`Scene::material`]); the solver settings are derived from them ([`Scene::settings`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// Where the scene came from (a file path or `builtin:NAME`), for error messages.
@@ -46,6 +46,9 @@ pub struct Scene {
     pub base_dir: Option<PathBuf>,
     pub file: SceneFile,
     pub mesh: SceneMesh,
+    /// The material `file.params` describe, built (and so checked by [`Material::new`]) once by
+    /// [`Scene::validate`].
+    material: Material,
 }
 /// Where a scene's mesh comes from.
 #[derive(Clone, Debug, PartialEq)]
@@ -118,13 +121,9 @@ impl Scene {
         self.mesh.as_box().is_some()
     }
 
-    /// The material the parameters describe.
+    /// The material the parameters describe (built when the scene was validated).
     pub fn material(&self) -> Material {
-        Scene::material_of(&self.file.params).expect("checked when the scene was validated")
-    }
-
-    pub(crate) fn material_of(p: &Params) -> Result<Material, MaterialError> {
-        Material::new(p.material, p.youngs_modulus_pa, p.poisson_ratio, p.density_kg_m3)
+        self.material
     }
 
     /// The solver settings the parameters describe.

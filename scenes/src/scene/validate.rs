@@ -4,6 +4,7 @@
 
 use hox_sim::Vec3;
 use hox_sim::element::ElementType;
+use hox_sim::material::Material;
 use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec};
 use hox_sim::xpbd::constraint::Formulation;
 use std::path::{Path, PathBuf};
@@ -41,17 +42,13 @@ impl Scene {
             p.check(params).map_err(|reason| invalid(&p.file_path(), (p.get)(params).to_string(), &reason))?;
         }
         let mesh = mesh_of(&file, source, base_dir.as_deref(), cached, &invalid)?;
-        let material = Scene::material_of(params).map_err(|e| {
-            use hox_sim::material::MaterialError as E;
-            let (key, value) = match &e {
-                E::YoungsModulus { .. } | E::NonFiniteLame { .. } => {
-                    ("material.youngs_modulus_pa", params.youngs_modulus_pa)
-                }
-                E::PoissonRatio { .. } => ("material.poisson_ratio", params.poisson_ratio),
-                E::Density { .. } => ("material.density_kg_m3", params.density_kg_m3),
-            };
-            invalid(key, value.to_string(), &e.to_string())
-        })?;
+        // E, ν and ρ were range-checked against the table just now; what the material's own
+        // check can still refuse is the pair (E, ν) overflowing μ or λ, reported on E
+        let material =
+            Material::new(params.material, params.youngs_modulus_pa, params.poisson_ratio, params.density_kg_m3)
+                .map_err(|e| {
+                    invalid("material.youngs_modulus_pa", params.youngs_modulus_pa.to_string(), &e.to_string())
+                })?;
         if let Some(d) = params.quadrature_degree {
             let types: Vec<ElementType> = match &mesh {
                 SceneMesh::Box(b) => vec![b.element_type],
@@ -88,7 +85,7 @@ impl Scene {
                 return Err(invalid(&format!("probes[{k}].name"), format!("{:?}", p.name), "is used twice"));
             }
         }
-        Ok(Scene { source: source.to_string(), base_dir, file, mesh })
+        Ok(Scene { source: source.to_string(), base_dir, file, mesh, material })
     }
 }
 
