@@ -54,11 +54,9 @@ pub fn side_by_side_offsets(first: &Mesh, count: usize, axis: LayoutAxis) -> Vec
         .collect()
 }
 
-/// The fields a configuration's `[display] field` lists (the first is the one drawn; unknown
-/// names were refused when the scene was validated).
+/// The fields a configuration's `[display] field` lists (the first is the one drawn).
 pub fn fields(params: &hox_scenes::Params) -> Vec<Field> {
-    let listed: Vec<Field> = params.field.split(',').filter_map(|n| Field::from_name(n.trim())).collect();
-    if listed.is_empty() { vec![Field::Displacement] } else { listed }
+    if params.field.is_empty() { vec![Field::Displacement] } else { params.field.clone() }
 }
 
 /// The colour scale of `field` every configuration shares, from the first one's display
@@ -222,7 +220,7 @@ mod tests {
         assert!(field_scale(Some(mesh), &p, Field::Displacement).range().automatic);
         p.colour_max_m = 0.1;
         p.colour_max = 2e5;
-        p.field = "strain,von-mises".into();
+        p.field = vec![Field::Strain, Field::VonMises];
         assert_eq!(field_scale(Some(mesh), &p, Field::Displacement).range().max, 0.1);
         assert_eq!(fields(&p), [Field::Strain, Field::VonMises]);
         // the fixed top belongs to the first non-metre field listed; the others stay automatic

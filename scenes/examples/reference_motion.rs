@@ -22,7 +22,7 @@ const TOLERANCE: f64 = 1e-10;
 
 fn motion(h_secs: f64, secs: f64) -> Result<(Motion, Vec<[f64; 3]>, f64, u64), Box<dyn std::error::Error>> {
     let scene = hox_scenes::by_name("bending")?.with_overrides(&SceneOverrides {
-        element: Some("q2".into()),
+        element: hox_sim::element::ElementType::from_name("q2"),
         grid: Some(GRID),
         ..Default::default()
     })?;

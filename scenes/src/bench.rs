@@ -23,6 +23,7 @@ pub mod solver;
 
 use crate::params::SceneOverrides;
 use crate::{Instance, SceneError};
+use hox_sim::element::ElementType;
 use hox_sim::measure::median;
 use hox_sim::solver::{Simulation, Sweep};
 use std::time::Instant;
@@ -81,11 +82,16 @@ pub fn bending_beam(case: &BenchCase, sweep: Sweep) -> Result<Simulation, SceneE
 /// [`bending_beam`], solved by `method` if given (else the scene's own solver).
 fn beam(case: &BenchCase, sweep: Sweep, method: Option<hox_sim::solver::Method>) -> Result<Simulation, SceneError> {
     let overrides = SceneOverrides {
-        element: Some(case.element.to_string()),
+        element: Some(ElementType::from_name(case.element).ok_or_else(|| SceneError::Invalid {
+            source_name: "bench".into(),
+            key: "element".into(),
+            value: case.element.into(),
+            reason: format!("is not a registered element type ({})", ElementType::names()),
+        })?),
         grid: Some(case.grid),
         refine: Some(case.refine),
-        sweep: Some(sweep.name().to_string()),
-        method: method.map(|m| m.name().to_string()),
+        sweep: Some(sweep),
+        method,
         ..SceneOverrides::default()
     };
     Ok(Instance::new(crate::by_name("bending")?.with_overrides(&overrides)?)?.sim)

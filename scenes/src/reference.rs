@@ -37,6 +37,7 @@ pub use field::ReferenceField;
 use crate::scene::EffectSpec;
 use crate::{Scene, SceneError, SceneOverrides};
 use hox_sim::Vec3;
+use hox_sim::element::ElementType;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -342,7 +343,7 @@ pub fn compute_with(scene: &Scene, finest_cells: usize, progress: Progress<'_>) 
     let mut finest_field = None;
     for (k, grid) in grids.iter().enumerate() {
         let o = SceneOverrides {
-            element: Some("q2".into()),
+            element: ElementType::from_name("q2"),
             grid: Some(*grid),
             quadrature_degree: Some(None),
             ..Default::default()
@@ -577,7 +578,7 @@ impl Lookup {
         let p = scene.params();
         let grid = levels(p.box_min_m, p.box_max_m, self.finest_cells)[2];
         let o = SceneOverrides {
-            element: Some("q2".into()),
+            element: ElementType::from_name("q2"),
             grid: Some(grid),
             quadrature_degree: Some(None),
             ..Default::default()

@@ -1,5 +1,7 @@
 use super::*;
 use crate::scene::EffectSpec;
+use hox_sim::solver::Sweep;
+use hox_sim::xpbd::constraint::Formulation;
 
 #[test]
 fn every_scene_file_in_assets_is_registered_and_parses() {
@@ -116,6 +118,11 @@ fn bad_scene_files_give_errors_naming_the_file_key_and_value() {
         let err = Scene::from_toml(&text, "my_scene.toml").unwrap_err().to_string();
         assert!(err.contains("my_scene.toml") && err.contains(needle), "expected '{needle}' in: {err}");
     }
+    // a choice's name is parsed when the file is read, with the reason the range check gives
+    let err = Scene::from_toml(&bending_text().replace("element = \"p2\"", "element = \"P2\""), "my_scene.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("mesh.element = P2: Element must be one of p1, p2"), "{err}");
 }
 
 #[test]
@@ -135,7 +142,7 @@ fn a_probe_outside_the_body_and_a_clamp_selecting_nothing_are_errors() {
 fn overrides_change_the_scene_and_are_validated() {
     let s = by_name("bending").unwrap();
     let o = SceneOverrides {
-        element: Some("p1".into()),
+        element: hox_sim::element::ElementType::from_name("p1"),
         grid: Some([16, 4, 4]),
         youngs_modulus_pa: Some(1e6),
         ..Default::default()
@@ -146,7 +153,7 @@ fn overrides_change_the_scene_and_are_validated() {
     let bad = SceneOverrides { poisson_ratio: Some(0.7), ..Default::default() };
     assert!(s.with_overrides(&bad).unwrap_err().to_string().contains("Poisson"));
     let split_negative =
-        SceneOverrides { formulation: Some("split".into()), poisson_ratio: Some(-0.2), ..Default::default() };
+        SceneOverrides { formulation: Some(Formulation::Split), poisson_ratio: Some(-0.2), ..Default::default() };
     assert!(s.with_overrides(&split_negative).unwrap_err().to_string().contains("split formulation"));
 }
 
@@ -237,8 +244,8 @@ fn xpbd_positions_are_bitwise_those_before_the_solver_room() {
     let fast_path = false;
     let fingerprint = |formulation: &str, parallel: bool| {
         let o = SceneOverrides {
-            formulation: Some(formulation.into()),
-            sweep: Some(if parallel { "colour" } else { "element" }.into()),
+            formulation: Formulation::from_name(formulation),
+            sweep: Some(if parallel { Sweep::Colour } else { Sweep::Element }),
             ..SceneOverrides::default()
         };
         let mut instance =

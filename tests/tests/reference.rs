@@ -34,7 +34,9 @@ fn reproduce(scene: Option<&str>, level: &str) {
         let grid: Vec<usize> = reference["grid"].as_str().unwrap().split('x').map(|v| v.parse().unwrap()).collect();
         let scene = scene
             .with_overrides(&SceneOverrides {
-                element: Some(reference["element"].as_str().unwrap().into()),
+                element: Some(
+                    hox_sim::element::ElementType::from_name(reference["element"].as_str().unwrap()).unwrap(),
+                ),
                 grid: Some([grid[0], grid[1], grid[2]]),
                 ..Default::default()
             })

@@ -56,12 +56,12 @@ fn the_parameter_table_offers_exactly_the_registered_element_types_and_material_
 fn bending(element: ElementType, material: MaterialModel, parallel: bool, formulation: Formulation) -> Scene {
     let base = hox_scenes::by_name("bending").unwrap();
     let overrides = SceneOverrides {
-        element: Some(element.name().into()),
-        material: Some(material.name().into()),
+        element: Some(element),
+        material: Some(material),
         grid: Some([2, 1, 1]),
         substeps: Some(10),
-        sweep: Some(if parallel { "colour" } else { "element" }.into()),
-        formulation: Some(formulation.name().into()),
+        sweep: Some(if parallel { hox_sim::solver::Sweep::Colour } else { hox_sim::solver::Sweep::Element }),
+        formulation: Some(formulation),
         ..SceneOverrides::default()
     };
     base.with_overrides(&overrides).unwrap_or_else(|e| panic!("{element} {material}: {e}"))

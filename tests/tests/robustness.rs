@@ -910,7 +910,10 @@ fn ten_thousand_frames_of_the_undamped_bending_scene_do_not_gain_energy() {
     for formulation in ["energy", "split"] {
         let scene = hox_scenes::by_name("bending")
             .unwrap()
-            .with_overrides(&hox_scenes::SceneOverrides { formulation: Some(formulation.into()), ..Default::default() })
+            .with_overrides(&hox_scenes::SceneOverrides {
+                formulation: Some(hox_sim::xpbd::constraint::Formulation::from_name(formulation).unwrap()),
+                ..Default::default()
+            })
             .unwrap();
         let mut instance = hox_scenes::Instance::new(scene).unwrap();
         let clock = std::time::Instant::now();

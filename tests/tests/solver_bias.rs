@@ -26,7 +26,7 @@ fn p2_160_at_70_substeps_settles_within_one_percent_of_the_static_solution() {
             let s = scene
                 .with_overrides(&SceneOverrides {
                     substeps: Some(substeps),
-                    formulation: Some(formulation.into()),
+                    formulation: Some(hox_sim::xpbd::constraint::Formulation::from_name(formulation).unwrap()),
                     ..Default::default()
                 })
                 .unwrap();

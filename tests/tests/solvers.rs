@@ -24,7 +24,12 @@ static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 /// The largest probe distance between a settled run and the static solution, relative to the
 /// largest static probe displacement; and the run's report.
 fn settle_against_static(scene: &Scene, solver: &str) -> (f64, hox_scenes::RunReport) {
-    let scene = scene.with_overrides(&SceneOverrides { method: Some(solver.into()), ..Default::default() }).unwrap();
+    let scene = scene
+        .with_overrides(&SceneOverrides {
+            method: Some(hox_sim::solver::Method::from_name(solver).unwrap()),
+            ..Default::default()
+        })
+        .unwrap();
     let mesh = scene.build_mesh().unwrap();
     let statics = hox_scenes::solve_static(&scene, &mesh, 1e-10, 1, &mut |_, _, _| {}).unwrap();
     let mut instance = Instance::new(scene).unwrap();
@@ -46,8 +51,7 @@ fn newton_and_vbd_settle_within_0_1_percent_of_static_on_the_paper_scenes() {
     for name in ["bending", "tension", "torsion"] {
         let base = hox_scenes::by_name(name).unwrap();
         for et in hox_sim::element::ElementType::all() {
-            let scene =
-                base.with_overrides(&SceneOverrides { element: Some(et.name().into()), ..Default::default() }).unwrap();
+            let scene = base.with_overrides(&SceneOverrides { element: Some(et), ..Default::default() }).unwrap();
             for solver in ["newton", "vbd"] {
                 let (err, report) = settle_against_static(&scene, solver);
                 eprintln!(

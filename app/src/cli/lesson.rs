@@ -74,7 +74,7 @@ pub fn step_markdown(lesson: &Lesson, k: usize, outcome: Option<&[Measured]>) ->
 fn scene_label(scene: &hox_scenes::Scene) -> String {
     let p = scene.params();
     let mut label = if scene.is_box() {
-        format!("{} {}×{}×{}", p.element.to_uppercase(), p.grid[0], p.grid[1], p.grid[2])
+        format!("{} {}×{}×{}", p.element.name().to_uppercase(), p.grid[0], p.grid[1], p.grid[2])
     } else {
         scene.mesh.element_names()
     };

@@ -1,7 +1,8 @@
 //! The scene parameters on the command line (the headless commands' and `hox app`'s), made from
 //! the parameter table ([`hox_scenes::params::PARAMS`]): one flag per entry shown on the command
-//! line (`--KEY VALUE`, or a switch such as `--no-stability-guard`), parsed by the entry's kind;
-//! the range is checked when the scene is validated, and an error names the option.
+//! line (`--KEY VALUE`, or a switch such as `--no-stability-guard`), parsed by the entry's kind
+//! (a choice into its option); the range is checked when the scene is validated, and an error
+//! names the option.
 
 use clap::{Arg, ArgAction, ArgMatches, Command, FromArgMatches};
 use hox_scenes::SceneOverrides;
@@ -55,15 +56,26 @@ pub fn arg(p: &'static Param) -> Arg {
             .value_name(value_name(p))
             .help(format!("{} [{}]", p.help, p.kind.expected()))
             .action(ArgAction::Append)
-            .value_parser(move |s: &str| p.kind.parse(s)),
+            .value_parser(move |s: &str| parse(p, s)),
         None => Arg::new(p.key)
             .long(p.key)
             .value_name(value_name(p))
             .help(format!("{} [{}{unit}]", p.help, p.kind.expected()))
             // `--grid -4x2x2` and `--refine -1` reach the parser, which names the option
             .allow_hyphen_values(true)
-            .value_parser(move |s: &str| p.kind.parse(s)),
+            .value_parser(move |s: &str| parse(p, s)),
     }
+}
+
+/// A flag's value: a choice's name is parsed into its option here (the overrides hold the typed
+/// value), so an unknown name is refused with the entry's reason (`Element must be one of …`);
+/// the other ranges are checked when the scene is validated.
+fn parse(p: &'static Param, text: &str) -> Result<Value, String> {
+    let v = p.kind.parse(text)?;
+    if matches!(p.kind, Kind::Choice(_) | Kind::Choices(_)) {
+        p.check_value(&v)?;
+    }
+    Ok(v)
 }
 
 fn augment(mut cmd: Command, groups: &'static [Group]) -> Command {

@@ -31,13 +31,13 @@ mod tests {
     fn round_trip_and_invalidation() {
         let scene = hox_scenes::by_name("bending").unwrap();
         let c = from_scene(&scene);
-        assert_eq!((c.element.as_str(), c.grid, c.substeps), ("p2", [8, 2, 2], 50));
+        assert_eq!((c.element.name(), c.grid, c.substeps), ("p2", [8, 2, 2], 50));
         let again = from_scene(&resolve(&c, &scene).unwrap());
         assert_eq!(again, c);
         let mut e = c.clone();
         e.youngs_modulus_pa = 1e7;
         assert_eq!(c.invalidated_by(&e), Invalidates::Material);
-        e.element = "q2".into();
+        e.element = hox_sim::element::ElementType::from_name("q2").unwrap();
         assert_eq!(c.invalidated_by(&e), Invalidates::Mesh);
         let mut s = c.clone();
         s.substeps = 10;
@@ -67,7 +67,7 @@ mod tests {
         c.youngs_modulus_pa = -1.0;
         assert!(resolve(&c, &scene).unwrap_err().to_lowercase().contains("young"));
         let mut c = from_scene(&scene);
-        c.element = "p7".into();
-        assert!(resolve(&c, &scene).is_err());
+        c.grid = [0, 2, 2];
+        assert!(resolve(&c, &scene).unwrap_err().contains("Grid"));
     }
 }

@@ -113,10 +113,8 @@ impl HoxApp {
         self.compare = self.sessions.len() > 1;
         self.active = 0;
         self.show_reference_element = step.reference_element;
-        if step.reference_element
-            && let Some(et) = hox_sim::element::ElementType::from_name(&step.configurations[0].params().element)
-        {
-            self.reference_element.set_element(et);
+        if step.reference_element {
+            self.reference_element.set_element(step.configurations[0].params().element);
         }
         self.rebuilt();
         let preset = step

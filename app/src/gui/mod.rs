@@ -253,12 +253,18 @@ impl HoxApp {
             let first = &self.sessions[0];
             let mut c = first.config.clone();
             let is_box = first.base.is_box();
-            if is_box && c.element == "p2" {
-                c.element = "p1".into();
-                c.refine = 1;
-            } else if is_box && c.element == "p1" {
-                c.element = "p2".into();
-                c.refine = 0;
+            // P2 is compared with P1 refined once (the same nodes), and P1 with P2
+            let other = match c.element.name() {
+                "p2" => Some(("p1", 1)),
+                "p1" => Some(("p2", 0)),
+                _ => None,
+            };
+            if is_box
+                && let Some((name, refine)) = other
+                && let Some(element) = hox_sim::element::ElementType::from_name(name)
+            {
+                c.element = element;
+                c.refine = refine;
             }
             let second = Session::new(first.base.clone(), c.clone())
                 .or_else(|_| Session::new(first.base.clone(), first.config.clone()));
@@ -266,7 +272,7 @@ impl HoxApp {
                 Ok(s) => {
                     // P1 first, so the pair reads "P1 vs P2" left to right
                     self.sessions.push(s);
-                    if self.sessions[1].config.element == "p1" {
+                    if self.sessions[1].config.element.name() == "p1" {
                         self.sessions.swap(0, 1);
                     }
                     self.compare = true;
@@ -294,7 +300,7 @@ impl HoxApp {
     pub fn set_field(&mut self, field: hox_sim::measure::field::Field) {
         for k in 0..self.sessions.len() {
             let mut c = self.sessions[k].config.clone();
-            c.field = field.name().to_string();
+            c.field = vec![field];
             if let Err(e) = self.sessions[k].apply(c) {
                 self.refusal = Some(("field".into(), e));
             }

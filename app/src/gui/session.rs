@@ -442,7 +442,7 @@ mod tests {
         assert_eq!(s.apply(c.clone()), Ok(Invalidates::Material));
         assert_eq!(s.instance.sim.positions, moved, "a material change keeps the state");
         assert_eq!(s.instance.sim.material().youngs_modulus_pa, c.youngs_modulus_pa);
-        c.element = "q2".into();
+        c.element = hox_sim::element::ElementType::from_name("q2").unwrap();
         c.grid = [4, 1, 1];
         assert_eq!(s.apply(c), Ok(Invalidates::Mesh));
         assert_eq!(s.instance.sim.mesh().num_nodes(), 9 * 3 * 3);
@@ -467,7 +467,7 @@ mod tests {
         assert!(other.reference_motion().is_none(), "a damped beam moves otherwise");
         let element = bending();
         let mut c = element.config.clone();
-        c.element = "q2".into();
+        c.element = hox_sim::element::ElementType::from_name("q2").unwrap();
         let mut element = element;
         element.apply(c).unwrap();
         assert!(element.reference_motion().is_some(), "another mesh of the same beam is compared with it");

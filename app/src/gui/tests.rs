@@ -107,11 +107,11 @@ fn compare_mode_links_controls_and_shows_both_errors() {
     app.apply("youngs", c);
     assert!(app.sessions.iter().all(|s| s.instance.sim.material().youngs_modulus_pa == 6e6));
     let mut c = app.sessions[0].config.clone();
-    c.element = "p3".into();
+    c.element = hox_sim::element::ElementType::from_name("p3").unwrap();
     c.refine = 0;
     app.apply("element", c);
-    assert_eq!(app.sessions[0].config.element, "p3");
-    assert_eq!(app.sessions[1].config.element, "p2");
+    assert_eq!(app.sessions[0].config.element.name(), "p3");
+    assert_eq!(app.sessions[1].config.element.name(), "p2");
     h.run_steps(2);
     assert!(status_count(&h) == 2);
 }
@@ -331,10 +331,10 @@ fn the_colour_field_switches_and_its_range_follows() {
     // the "Colour by" menu of the Display section (below the visible part of the panel here)
     let app = h.state_mut();
     let mut c = app.sessions[0].config.clone();
-    c.field = "von-mises".into();
+    c.field = vec![Field::VonMises];
     app.apply("field", c);
     h.run_steps(2);
-    assert_eq!(h.state().sessions[0].config.field, "von-mises");
+    assert_eq!(h.state().sessions[0].config.field, [Field::VonMises]);
     h.state_mut().step(20);
     h.run_steps(2);
     let r = h.state().viewport.colour_range().unwrap();
@@ -471,7 +471,7 @@ fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
     h.key_press(egui::Key::ArrowRight);
     h.run_steps(3);
     h.get_by_label_contains("Step 2 of 3: Does high order help?");
-    assert!(h.state().sessions.iter().all(|s| s.config.element == "p2"));
+    assert!(h.state().sessions.iter().all(|s| s.config.element.name() == "p2"));
     assert!(h.query_by_label_contains("Answer:").is_none(), "a new step hides its answer");
     h.key_press(egui::Key::ArrowLeft);
     h.run_steps(3);

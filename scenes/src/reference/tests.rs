@@ -10,8 +10,12 @@ fn the_physics_key_ignores_mesh_solver_and_damping_but_not_the_material() {
     let b = by_name("bending").unwrap();
     let key = physics_key(&b);
     let same = [
-        SceneOverrides { element: Some("q1".into()), grid: Some([4, 1, 1]), ..Default::default() },
-        SceneOverrides { method: Some("newton".into()), substeps: Some(7), ..Default::default() },
+        SceneOverrides {
+            element: hox_sim::element::ElementType::from_name("q1"),
+            grid: Some([4, 1, 1]),
+            ..Default::default()
+        },
+        SceneOverrides { method: Some(hox_sim::solver::Method::Newton), substeps: Some(7), ..Default::default() },
         SceneOverrides { damping_per_sec: Some(3.0), quadrature_degree: Some(Some(2)), ..Default::default() },
     ];
     for o in same {
@@ -21,7 +25,7 @@ fn the_physics_key_ignores_mesh_solver_and_damping_but_not_the_material() {
         SceneOverrides { poisson_ratio: Some(0.49), ..Default::default() },
         SceneOverrides { youngs_modulus_pa: Some(1e6), ..Default::default() },
         SceneOverrides { density_kg_m3: Some(500.0), ..Default::default() },
-        SceneOverrides { material: Some("snh".into()), ..Default::default() },
+        SceneOverrides { material: hox_sim::material::MaterialModel::from_name("snh"), ..Default::default() },
     ];
     for o in other {
         assert_ne!(physics_key(&with(&b, o.clone())), key, "{o:?}");
@@ -36,7 +40,14 @@ fn the_committed_reference_is_offered_only_for_the_physics_it_was_solved_for() {
     assert_eq!((r.origin, r.mesh.as_str()), (Origin::Committed, "Q2 32×8×8"));
     assert!((r.probes["tip"][2] + 0.3199).abs() < 1e-3, "{:?}", r.probes);
     // another mesh or solver of the same beam: the same reference
-    let p1 = with(&b, SceneOverrides { element: Some("p1".into()), grid: Some([16, 4, 4]), ..Default::default() });
+    let p1 = with(
+        &b,
+        SceneOverrides {
+            element: hox_sim::element::ElementType::from_name("p1"),
+            grid: Some([16, 4, 4]),
+            ..Default::default()
+        },
+    );
     assert_eq!(committed(&p1).unwrap(), Some(r.clone()));
     let nu = with(&b, SceneOverrides { poisson_ratio: Some(0.49), ..Default::default() });
     assert_eq!(committed(&nu).unwrap(), None);

@@ -115,7 +115,8 @@ struct RawSceneFile {
 
 impl SceneFile {
     /// Parses a scene file's text: the layout, then each `[mesh]`, `[material]`, `[solver]`,
-    /// `[effect]` and `[display]` key through its entry in the parameter table (type checked here, range when validated).
+    /// `[effect]` and `[display]` key through its entry in the parameter table (type and choice
+    /// checked here, range when validated).
     pub fn parse(text: &str, source: &str) -> Result<SceneFile, SceneError> {
         let raw: RawSceneFile = toml::from_str(text)
             .map_err(|e| SceneError::Parse { source_name: source.to_string(), message: e.to_string() })?;
@@ -149,7 +150,13 @@ impl SceneFile {
                     invalid(&path, value.to_string(), &format!("unknown key (expected one of {})", known.join(", ")))
                 })?;
                 let v = param.kind.from_toml(value).map_err(|reason| invalid(&path, value.to_string(), &reason))?;
-                (param.set)(&mut file.params, v);
+                // a choice's name (or a number out of its field's range) is parsed into the typed
+                // field here, the one place the file's text becomes a value
+                if !(param.set)(&mut file.params, v.clone()) {
+                    let reason =
+                        param.check_value(&v).err().unwrap_or_else(|| format!("must be {}", param.kind.expected()));
+                    return Err(invalid(&path, v.to_string(), &reason));
+                }
                 file.given.insert(param.key);
             }
         }

@@ -13,10 +13,9 @@ pub(crate) use validate::invalid_in;
 
 use hox_sim::Vec3;
 use hox_sim::io::gmsh::ImportedMesh;
-use hox_sim::material::{Material, MaterialError, MaterialModel};
+use hox_sim::material::Material;
 use hox_sim::mesh::structured::BoxMeshSpec;
-use hox_sim::solver::{Method, NewtonSettings, SolverSettings, Sweep, VbdInit, VbdSettings};
-use hox_sim::xpbd::constraint::Formulation;
+use hox_sim::solver::{NewtonSettings, SolverSettings, VbdSettings};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -37,8 +36,8 @@ pub struct Drive {
 }
 
 /// A validated scene: its file (every parameter once, in `file.params`) and its mesh source.
-/// The material and solver settings are derived from the parameters ([`Scene::material`],
-/// [`Scene::settings`]).
+/// The material is built from the parameters once, when the scene is validated
+/// ([`Scene::material`]); the solver settings are derived from them ([`Scene::settings`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// Where the scene came from (a file path or `builtin:NAME`), for error messages.
@@ -47,6 +46,9 @@ pub struct Scene {
     pub base_dir: Option<PathBuf>,
     pub file: SceneFile,
     pub mesh: SceneMesh,
+    /// The material `file.params` describe, built (and so checked by [`Material::new`]) once by
+    /// [`Scene::validate`].
+    material: Material,
 }
 /// Where a scene's mesh comes from.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,15 +121,9 @@ impl Scene {
         self.mesh.as_box().is_some()
     }
 
-    /// The material the parameters describe.
+    /// The material the parameters describe (built when the scene was validated).
     pub fn material(&self) -> Material {
-        Scene::material_of(&self.file.params).expect("checked when the scene was validated")
-    }
-
-    pub(crate) fn material_of(p: &Params) -> Result<Material, MaterialError> {
-        // the model's name was checked against the table's choices
-        let model = MaterialModel::from_name(&p.material).unwrap_or(MaterialModel::StVenantKirchhoff);
-        Material::new(model, p.youngs_modulus_pa, p.poisson_ratio, p.density_kg_m3)
+        self.material
     }
 
     /// The solver settings the parameters describe.
@@ -137,18 +133,17 @@ impl Scene {
             substeps: p.substeps,
             iterations: p.iterations,
             frames_per_second: p.frames_per_second,
-            formulation: Formulation::from_name(&p.formulation).unwrap_or(Formulation::Energy),
+            formulation: p.formulation,
             quadrature_degree: p.quadrature_degree,
-            sweep: Sweep::from_name(&p.sweep).unwrap_or_default(),
+            sweep: p.sweep,
             stability_guard: p.stability_guard,
-            // the names were checked against the table's choices
-            method: Method::from_name(&p.method).unwrap_or_default(),
+            method: p.method,
             steps_per_frame: p.steps_per_frame,
             vbd: VbdSettings {
                 iterations: p.vbd_iterations,
                 chebyshev_rho: p.chebyshev_rho,
                 coarse_cells: p.vbd_coarse_cells,
-                init: VbdInit::from_name(&p.vbd_init).unwrap_or_default(),
+                init: p.vbd_init,
             },
             newton: NewtonSettings { tolerance: p.newton_tolerance, ..Default::default() },
         }

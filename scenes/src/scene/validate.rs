@@ -4,7 +4,8 @@
 
 use hox_sim::Vec3;
 use hox_sim::element::ElementType;
-use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+use hox_sim::material::Material;
+use hox_sim::mesh::structured::{BoxGrid, BoxMeshSpec};
 use hox_sim::xpbd::constraint::Formulation;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -41,17 +42,13 @@ impl Scene {
             p.check(params).map_err(|reason| invalid(&p.file_path(), (p.get)(params).to_string(), &reason))?;
         }
         let mesh = mesh_of(&file, source, base_dir.as_deref(), cached, &invalid)?;
-        let material = Scene::material_of(params).map_err(|e| {
-            use hox_sim::material::MaterialError as E;
-            let (key, value) = match &e {
-                E::YoungsModulus { .. } | E::NonFiniteLame { .. } => {
-                    ("material.youngs_modulus_pa", params.youngs_modulus_pa)
-                }
-                E::PoissonRatio { .. } => ("material.poisson_ratio", params.poisson_ratio),
-                E::Density { .. } => ("material.density_kg_m3", params.density_kg_m3),
-            };
-            invalid(key, value.to_string(), &e.to_string())
-        })?;
+        // E, ν and ρ were range-checked against the table just now; what the material's own
+        // check can still refuse is the pair (E, ν) overflowing μ or λ, reported on E
+        let material =
+            Material::new(params.material, params.youngs_modulus_pa, params.poisson_ratio, params.density_kg_m3)
+                .map_err(|e| {
+                    invalid("material.youngs_modulus_pa", params.youngs_modulus_pa.to_string(), &e.to_string())
+                })?;
         if let Some(d) = params.quadrature_degree {
             let types: Vec<ElementType> = match &mesh {
                 SceneMesh::Box(b) => vec![b.element_type],
@@ -68,8 +65,7 @@ impl Scene {
                 }
             }
         }
-        let formulation = Formulation::from_name(&params.formulation).unwrap_or(Formulation::Energy);
-        if formulation == Formulation::Split && material.split_stiffness_pa().iter().any(|k| !(*k > 0.0)) {
+        if params.formulation == Formulation::Split && material.split_stiffness_pa().iter().any(|k| !(*k > 0.0)) {
             return Err(invalid(
                 "material.poisson_ratio",
                 params.poisson_ratio.to_string(),
@@ -89,7 +85,7 @@ impl Scene {
                 return Err(invalid(&format!("probes[{k}].name"), format!("{:?}", p.name), "is used twice"));
             }
         }
-        Ok(Scene { source: source.to_string(), base_dir, file, mesh })
+        Ok(Scene { source: source.to_string(), base_dir, file, mesh, material })
     }
 }
 
@@ -131,11 +127,7 @@ fn mesh_of(
         })?;
         return Ok(SceneMesh::File { path, imported: Arc::new(imported) });
     }
-    // the ranges and choices were checked against the parameter table
-    let element_type = ElementType::from_name(&p.element)
-        .ok_or_else(|| invalid("mesh.element", format!("{:?}", p.element), "unknown element type"))?;
-    let split = TetSplit::from_name(&p.split)
-        .ok_or_else(|| invalid("mesh.split", format!("{:?}", p.split), "expected \"five\" or \"six\""))?;
+    // the ranges were checked against the parameter table, the choices parsed when read
     for d in 0..3 {
         if p.box_max_m[d] <= p.box_min_m[d] {
             return Err(invalid(
@@ -147,8 +139,8 @@ fn mesh_of(
     }
     Ok(SceneMesh::Box(BoxMeshSpec {
         grid: BoxGrid { min_m: Vec3::from(p.box_min_m), max_m: Vec3::from(p.box_max_m), cells: p.grid },
-        element_type,
-        split,
+        element_type: p.element,
+        split: p.split,
         refine: p.refine,
     }))
 }

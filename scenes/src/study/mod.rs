@@ -52,9 +52,10 @@ impl StudyConfig {
     /// The scene overrides that build this configuration's mesh.
     pub fn overrides(&self) -> SceneOverrides {
         SceneOverrides {
-            element: Some(self.element.into()),
+            // the study's own element names, all registered
+            element: ElementType::from_name(self.element),
             grid: Some(self.grid),
-            split: Some(self.split.name().into()),
+            split: Some(self.split),
             refine: Some(self.refine),
             ..Default::default()
         }
@@ -208,7 +209,7 @@ pub fn study_one(
     // the settled state, timed
     progress(&format!("{scene_name} {label}: XPBD at 50 substeps, all threads"));
     let mut parallel_scene = scene.clone();
-    parallel_scene.file.params.sweep = "colour".into();
+    parallel_scene.file.params.sweep = hox_sim::solver::Sweep::Colour;
     let mut parallel = Instance::new(parallel_scene)?;
     parallel.sim.warm_start(&instance.sim.positions, instance.sim.time_secs());
     let all_threads = run(&mut parallel, RunMode::Seconds(1.0), &mut |_, _| {})?.ms_per_frame;

@@ -26,6 +26,7 @@ use super::motion::{Motion, MotionMetrics, reference_motion};
 use super::{StudyConfig, probe_distance, probes_of, reference, settled_probes};
 use crate::{Instance, RunMode, SceneError, SceneOverrides, run_observed};
 use hox_sim::mesh::structured::TetSplit;
+use hox_sim::solver::Method;
 use std::time::Instant;
 
 /// XPBD's grid of (substeps, iterations) per frame: equal sweep budgets of 50 and 100.
@@ -61,21 +62,24 @@ impl SolverChoice {
         }
     }
     pub fn method(&self) -> &'static str {
+        self.solver().name()
+    }
+    fn solver(&self) -> Method {
         match self {
-            SolverChoice::Xpbd { .. } => "xpbd",
-            SolverChoice::Vbd => "vbd",
-            SolverChoice::Newton => "newton",
+            SolverChoice::Xpbd { .. } => Method::Xpbd,
+            SolverChoice::Vbd => Method::Vbd,
+            SolverChoice::Newton => Method::Newton,
         }
     }
     fn overrides(&self) -> SceneOverrides {
         match *self {
             SolverChoice::Xpbd { substeps, iterations } => SceneOverrides {
-                method: Some("xpbd".into()),
+                method: Some(Method::Xpbd),
                 substeps: Some(substeps),
                 iterations: Some(iterations),
                 ..Default::default()
             },
-            other => SceneOverrides { method: Some(other.method().into()), ..Default::default() },
+            other => SceneOverrides { method: Some(other.solver()), ..Default::default() },
         }
     }
 }

@@ -86,6 +86,8 @@ pub struct VbdSettings {
 impl VbdSettings {
     /// The coarse grid's largest cell count: its dense matrix of `3 × nodes` rows stays small.
     pub const MAX_COARSE_CELLS: u32 = 256;
+    /// The Chebyshev `ρ` lies in `[0, CHEBYSHEV_RHO_BELOW)`: at 1 the acceleration diverges.
+    pub const CHEBYSHEV_RHO_BELOW: f64 = 1.0;
 }
 
 /// Where vertex block descent starts a step (Chen et al. 2024, §3.5).
@@ -184,7 +186,7 @@ impl SolverSettings {
                 self.vbd.coarse_cells
             ));
         }
-        if !(0.0..1.0).contains(&self.vbd.chebyshev_rho) {
+        if !(0.0..VbdSettings::CHEBYSHEV_RHO_BELOW).contains(&self.vbd.chebyshev_rho) {
             return bad(format!("the Chebyshev ρ must be in [0, 1), got {}", self.vbd.chebyshev_rho));
         }
         if !(self.newton.tolerance > 0.0 && self.newton.tolerance < 1.0) {
