@@ -282,7 +282,7 @@ impl Settler {
     /// Adds the scene's settle damping to `instance` and starts counting.
     pub fn start(instance: &mut Instance, cap_secs: f64) -> Result<Settler, SceneError> {
         let params = instance.scene.params();
-        let damping = if crate::params::is_vbd(params) {
+        let damping = if params.method.reads_parameter("vbd_settle_damping_per_sec") {
             params.vbd_settle_damping_per_sec
         } else {
             params.settle_damping_per_sec

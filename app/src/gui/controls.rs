@@ -301,7 +301,7 @@ fn choice_shown(entries: &[(String, String)], name: &str) -> String {
 fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
     let k = app.active;
     let config = app.sessions[k].config.clone();
-    let enabled = p.applies.is_none_or(|f| f(&config));
+    let enabled = p.applies_to(&config);
     let text = p.label_with_unit();
     let get = |c: &Config| (p.get)(c);
     let set = |c: &mut Config, v: Value| {

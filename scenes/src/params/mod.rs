@@ -38,7 +38,7 @@ mod suggest;
 mod tests;
 mod value;
 
-pub use applies::{is_implicit, is_tetrahedral, is_vbd, is_xpbd};
+pub use applies::is_tetrahedral;
 pub use kind::{EVERYWHERE, FILE_ONLY, Group, Invalidates, Kind, Surfaces};
 pub use param::Param;
 pub use size::{MAX_BOX_BYTES, MAX_BOX_ELEMENTS, box_bytes, box_elements, thousands};
@@ -52,7 +52,6 @@ use hox_sim::solver::{Method, SolverSettings, Sweep, VbdInit, VbdSettings};
 use hox_sim::xpbd::constraint::Formulation;
 use value::as_text;
 
-use applies::is_newton;
 use options::*;
 use param::BASE;
 #[cfg(test)]
@@ -189,46 +188,46 @@ params! {
     steps_per_frame: u32 = solver().steps_per_frame => {
         key: "steps", group: Group::Solver, file_key: "steps_per_frame", label: "Steps per frame",
         help: "Implicit Euler steps per frame for vbd and newton (XPBD takes --substeps); more steps, less numerical damping.",
-        kind: Kind::Whole { min: 1, max: 10_000, soft_max: 20 }, applies: Some(is_implicit), ..BASE
+        kind: Kind::Whole { min: 1, max: 10_000, soft_max: 20 }, ..BASE
     }
     /// VBD sweeps per step.
     vbd_iterations: u32 = solver().vbd.iterations => {
         key: "vbd-iterations", group: Group::Solver, file_key: "vbd_iterations", label: "VBD iterations",
         help: "Vertex block descent sweeps over the node colours per step.",
-        kind: Kind::Whole { min: 1, max: 100_000, soft_max: 200 }, applies: Some(is_vbd), ..BASE
+        kind: Kind::Whole { min: 1, max: 100_000, soft_max: 200 }, ..BASE
     }
     /// Chebyshev acceleration's ρ for VBD (0: off).
     chebyshev_rho: f64 = solver().vbd.chebyshev_rho => {
         key: "chebyshev-rho", group: Group::Solver, file_key: "chebyshev_rho", label: "Chebyshev ρ",
         help: "Chebyshev acceleration of the VBD sweeps, its spectral radius estimate in [0, 1) (0: off; 0.9 halves the sweeps to settle the bending beam; 0.95 can diverge at few sweeps).",
         kind: Kind::Number { min: 0.0, min_inclusive: true, max: VbdSettings::CHEBYSHEV_RHO_BELOW, max_inclusive: false, soft: None },
-        applies: Some(is_vbd), ..BASE
+        ..BASE
     }
     /// VBD's two-level correction: about how many coarse cells (0: off).
     vbd_coarse_cells: u32 = solver().vbd.coarse_cells => {
         key: "vbd-coarse-cells", group: Group::Solver, file_key: "vbd_coarse_cells", label: "VBD coarse cells",
         help: "VBD's two-level correction: before its sweeps each step solves for the smooth part of the motion on a coarse grid of about this many trilinear cells over the body (0: off, the paper's VBD alone). The sweeps barely move smooth error such as a beam's slow bending; with the correction Gmsh's P2 beam settles in 122 frames (as Newton) instead of 707.",
-        kind: Kind::Whole { min: 0, max: VbdSettings::MAX_COARSE_CELLS as u64, soft_max: 128 }, applies: Some(is_vbd), ..BASE
+        kind: Kind::Whole { min: 0, max: VbdSettings::MAX_COARSE_CELLS as u64, soft_max: 128 }, ..BASE
     }
     /// Where a VBD step starts: adaptive | inertia | previous.
     #[serde(with = "as_text")]
     vbd_init: VbdInit = solver().vbd.init => {
         key: "vbd-init", group: Group::Solver, file_key: "vbd_init", label: "VBD start",
         help: "Where a VBD step starts: adaptive (the paper's: the last step's acceleration along gravity, so a body at rest stays at rest), inertia (the inertial prediction) or previous (the last position).",
-        kind: Kind::Choice(vbd_init_options), applies: Some(is_vbd), ..BASE
+        kind: Kind::Choice(vbd_init_options), ..BASE
     }
     /// Newton's tolerance per step, relative to the load.
     newton_tolerance: f64 = solver().newton.tolerance => {
         key: "newton-tolerance", group: Group::Solver, file_key: "newton_tolerance", label: "Newton tolerance",
         help: "A Newton step has converged when its unbalanced force is at most this fraction of the load (the body force, or the reactions if larger), as `hox static` measures it; in (0, 1).",
-        kind: Kind::Number { min: 0.0, min_inclusive: false, max: 1.0, max_inclusive: false, soft: None }, applies: Some(is_newton), ..BASE
+        kind: Kind::Number { min: 0.0, min_inclusive: false, max: 1.0, max_inclusive: false, soft: None }, ..BASE
     }
     /// energy | split.
     #[serde(with = "as_text")]
     formulation: Formulation = solver().formulation => {
         key: "formulation", group: Group::Solver, file_key: "formulation", label: "Formulation",
         help: "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.",
-        kind: Kind::Choice(formulation_options), applies: Some(is_xpbd), ..BASE
+        kind: Kind::Choice(formulation_options), ..BASE
     }
     /// None: each element type's default degree.
     quadrature_degree: Option<usize> = solver().quadrature_degree => {
@@ -240,19 +239,19 @@ params! {
     substeps: u32 = solver().substeps => {
         key: "substeps", group: Group::Solver, file_key: "substeps", label: "Substeps",
         help: "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.",
-        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 500 }, applies: Some(is_xpbd), ..BASE
+        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 500 }, ..BASE
     }
     /// Constraint sweeps per substep.
     iterations: u32 = solver().iterations => {
         key: "iterations", group: Group::Solver, file_key: "iterations", label: "Iterations",
         help: "Constraint sweeps per substep (the paper: 1).",
-        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 20 }, applies: Some(is_xpbd), ..BASE
+        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 20 }, ..BASE
     }
     /// More substeps where the stiffest element needs them (`hox_sim::solver::stability`).
     stability_guard: bool = solver().stability_guard => {
         key: "guard", group: Group::Solver, file_key: "stability_guard", label: "Stability guard",
         help: "More substeps when the stiffest element needs them (when h·ω_max would exceed 3, enough for h·ω_max ≤ 1; just below 3 your substeps are kept); off: exactly the substeps asked for, which may blow up (docs/STABILITY.md).",
-        kind: Kind::Flag, switch: Some(("no-stability-guard", false)), applies: Some(is_xpbd), ..BASE
+        kind: Kind::Flag, switch: Some(("no-stability-guard", false)), ..BASE
     }
     /// Simulated frames per second; each frame is one time step.
     frames_per_second: f64 = solver().frames_per_second => {
@@ -266,7 +265,7 @@ params! {
     sweep: Sweep = solver().sweep => {
         key: "sweep", group: Group::Solver, file_key: "sweep", label: "Sweep",
         help: "Order of XPBD's constraint sweep. colour (default): colour by colour, four elements per AVX2 register, on every thread (RAYON_NUM_THREADS sets how many), the same result on any thread count; element: element after element in mesh order on one thread (the order of the paper's figures and of hox's results before the colour sweep became the default).",
-        kind: Kind::Choice(sweep_options), applies: Some(is_xpbd), ..BASE
+        kind: Kind::Choice(sweep_options), ..BASE
     }
     /// Default run length, seconds.
     duration_secs: f64 = 3.0 => {
@@ -287,7 +286,7 @@ params! {
         key: "vbd-settle-damping", group: Group::Solver, file_key: "vbd_settle_damping_per_sec", label: "VBD settle damping", unit: "1/s",
         help: "Velocity damping rate a run to rest (--settle) adds when the solver is vbd, per second, in place of the settle damping. With the coarse correction (vbd_coarse_cells > 0) VBD's steps are near converged and the 10/s that settles XPBD and Newton fastest does so too (Gmsh's P2 1,471 beam: 122 frames, as Newton); without it the few sweeps per step leave the slow bending modes only part of their stiffness and 2/s settles fastest (707 frames against 2,200 at 10/s).",
         kind: Kind::Number { min: 0.0, min_inclusive: true, max: f64::INFINITY, max_inclusive: false, soft: None },
-        applies: Some(is_vbd), invalidates: Invalidates::Nothing, surfaces: FILE_ONLY, ..BASE
+        invalidates: Invalidates::Nothing, surfaces: FILE_ONLY, ..BASE
     }
     /// Velocity damping of every node, 1/s (0: none).
     damping_per_sec: f64 = 0.0 => {

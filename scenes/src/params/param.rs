@@ -31,6 +31,8 @@ pub struct Param {
     pub switch: Option<(&'static str, bool)>,
     /// Whether it applies to a configuration (the app greys it out where not; e.g. the tet
     /// split for hexahedra). None: always.
+    /// (A solver's own parameter also needs the configuration's solver to read it:
+    /// [`Param::applies_to`].)
     pub applies: Option<fn(&Params) -> bool>,
     /// A check that needs the whole configuration (e.g. the size of a refined mesh).
     pub check_with: Option<fn(&Params) -> Result<(), String>>,
@@ -48,6 +50,12 @@ impl std::fmt::Debug for Param {
 }
 
 impl Param {
+    /// Whether it applies to the configuration `p`: its own predicate, and for a solver's own
+    /// parameter, the configuration's solver reads it ([`super::applies::solver_reads`]).
+    pub fn applies_to(&self, p: &Params) -> bool {
+        self.applies.is_none_or(|f| f(p)) && super::applies::solver_reads(p.method, self.file_key)
+    }
+
     /// `material.youngs_modulus_pa`.
     pub fn file_path(&self) -> String {
         format!("{}.{}", self.group.section(), self.file_key)

@@ -128,3 +128,27 @@ fn the_solver_entries_default_to_sims_settings() {
     assert!(o.set_text("vbd-coarse-cells", &(VbdSettings::MAX_COARSE_CELLS + 1).to_string()).is_err());
     assert!(o.set_text("chebyshev-rho", "1").unwrap_err().contains("< 1"));
 }
+
+/// Every parameter a solver's entry names is a table entry of the solver group, and each such
+/// entry applies to exactly the solvers that list it (the app greys it out for the others).
+#[test]
+fn solver_parameters_apply_to_the_solvers_that_read_them() {
+    use hox_sim::solver::{METHODS, Method};
+    for info in METHODS {
+        for key in info.parameters {
+            let entry = PARAMS.iter().find(|p| p.file_key == *key);
+            let entry = entry.unwrap_or_else(|| panic!("{}: no table entry with the file key {key}", info.name));
+            assert_eq!(entry.group, Group::Solver, "{key}");
+        }
+    }
+    let mut p = Params::default();
+    for method in Method::ALL {
+        p.method = method;
+        let applies = |file_key: &str| PARAMS.iter().find(|e| e.file_key == file_key).unwrap().applies_to(&p);
+        assert_eq!(applies("substeps"), method == Method::Xpbd, "{method}");
+        assert_eq!(applies("vbd_iterations"), method == Method::Vbd, "{method}");
+        assert_eq!(applies("newton_tolerance"), method == Method::Newton, "{method}");
+        assert_eq!(applies("steps_per_frame"), method.is_implicit(), "{method}");
+        assert!(applies("frames_per_second") && applies("quadrature_degree"), "{method}");
+    }
+}

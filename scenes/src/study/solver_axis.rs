@@ -38,12 +38,12 @@ pub const TARGET_ERROR_PCT: f64 = 1.0;
 /// The frame budget of real time at 60 frames per second, ms.
 pub const REAL_TIME_MS: f64 = 1000.0 / 60.0;
 
-/// One solver at one setting.
+/// One solver at one setting: XPBD at a grid point of substeps × iterations, or an implicit
+/// solver of the registry ([`Method::ALL`]) at its defaults.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SolverChoice {
     Xpbd { substeps: u32, iterations: u32 },
-    Vbd,
-    Newton,
+    Implicit(Method),
 }
 
 impl SolverChoice {
@@ -51,14 +51,13 @@ impl SolverChoice {
     pub fn all() -> Vec<SolverChoice> {
         let mut v: Vec<SolverChoice> =
             XPBD_GRID.iter().map(|&(substeps, iterations)| SolverChoice::Xpbd { substeps, iterations }).collect();
-        v.extend([SolverChoice::Vbd, SolverChoice::Newton]);
+        v.extend(Method::ALL.into_iter().filter(|m| m.is_implicit()).map(SolverChoice::Implicit));
         v
     }
     pub fn label(&self) -> String {
         match self {
             SolverChoice::Xpbd { substeps, iterations } => format!("xpbd {substeps}x{iterations}"),
-            SolverChoice::Vbd => "vbd".into(),
-            SolverChoice::Newton => "newton".into(),
+            SolverChoice::Implicit(m) => m.name().into(),
         }
     }
     pub fn method(&self) -> &'static str {
@@ -67,8 +66,7 @@ impl SolverChoice {
     fn solver(&self) -> Method {
         match self {
             SolverChoice::Xpbd { .. } => Method::Xpbd,
-            SolverChoice::Vbd => Method::Vbd,
-            SolverChoice::Newton => Method::Newton,
+            SolverChoice::Implicit(m) => *m,
         }
     }
     fn overrides(&self) -> SceneOverrides {
@@ -239,7 +237,7 @@ fn config_rows(
         let frames = report.frames.max(1) as f64;
         row.sweeps_per_frame = match choice {
             SolverChoice::Xpbd { iterations, .. } => (settling.sim.substeps_per_frame() * iterations) as f64,
-            SolverChoice::Vbd | SolverChoice::Newton => counters.solver_iterations as f64 / frames,
+            SolverChoice::Implicit(_) => counters.solver_iterations as f64 / frames,
         };
         if let SolverChoice::Xpbd { substeps, iterations } = choice
             && settling.sim.substeps_per_frame() != substeps
