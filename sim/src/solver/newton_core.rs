@@ -18,9 +18,10 @@
 //!   the residual falls; below `t = 1e-8` the step is refused: with a reused factor the factor
 //!   is refreshed and the iteration retried, with a fresh one the method stops.
 //! - **Convergence:** the free residual `‖∇Φ‖ ≤ tolerance · load`, the load as in
-//!   [`super::StaticResidual`] (the body force, or the reactions if larger); or a step that
-//!   moves no coordinate by more than `1e-12` of the body's size (stalled: converged for a time
-//!   step, whose start may already be the minimiser; the static solver asks for the tolerance).
+//!   [`super::StaticResidual`] (the body force, or the reactions if larger); or a full step
+//!   (`t = 1`) that moves no coordinate by more than `1e-12` of the body's size and no longer
+//!   reduces the residual 4× (stalled at round-off: converged for a time step, whose start may
+//!   already be the minimiser; the static solver asks for the tolerance).
 //! - **Bits:** the factorisation and solves run on one thread (`Par::Seq`) and the element
 //!   Hessians are summed in a fixed order, so results do not depend on the thread count.
 //! - **Settings:** tolerance, iteration limit and refactoring from [`super::NewtonSettings`].
@@ -64,7 +65,8 @@ pub(crate) struct HessianModel<'a> {
 pub(crate) enum Outcome {
     /// The residual reached the tolerance.
     Converged { residual: f64 },
-    /// A step moved no coordinate by more than `1e-12` of the body's size.
+    /// A full step moved no coordinate by more than `1e-12` of the body's size and no longer
+    /// reduced the residual (round-off).
     Stalled { residual: f64 },
     /// The iteration limit was reached, or the line search failed with a fresh factor; `x` holds
     /// the last accepted iterate.
@@ -198,12 +200,15 @@ pub(crate) fn minimise(
         }
         x.copy_from_slice(&scratch.trial);
         std::mem::swap(&mut scratch.grad, &mut scratch.trial_grad);
-        let moved = step.iter().fold(0.0f64, |m, v| m.max(v.abs())) * t;
-        if moved <= 1e-12 * body_size {
-            let residual = norm(&scratch.grad) / load_scale(body_force_n, reactions);
+        // a full step that moves nothing and no longer reduces the residual: the iterate is the
+        // minimiser to round-off (a step the line search cut short, or one that still reduces
+        // the residual, says nothing of the kind)
+        let moved = step.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let new_norm = norm(&scratch.grad);
+        if t == 1.0 && moved <= 1e-12 * body_size && new_norm > SLOW_RATIO * old_norm {
+            let residual = new_norm / load_scale(body_force_n, reactions);
             return Ok(Outcome::Stalled { residual });
         }
-        let new_norm = norm(&scratch.grad);
         refactor = settings.refactor_every_iteration || t < 1.0 || new_norm > SLOW_RATIO * old_norm;
     }
     if let Some(node) = first_non_finite(x, &scratch.grad) {
