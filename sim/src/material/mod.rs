@@ -187,7 +187,7 @@ impl MaterialModel {
     /// [`HyperelasticModel`]), its `pub mod NAME;` line above, and one entry here,
     /// `MaterialModel(&NAME::Struct),`. Everything else reads the registry:
     /// [`MaterialModel::from_name`], the scene file's `material.model`, `--material`, the app's
-    /// menu and their help texts (the parameter table's choices, `scenes/src/params.rs`), the
+    /// menu and their help texts (the parameter table's choices, `scenes/src/params/`), the
     /// kernels (through the law) and the tests: the `every_registered_model_*` tests below
     /// check it against finite differences, and `tests/tests/registries.rs` runs it through a
     /// scene with every element type. (A named constant such as

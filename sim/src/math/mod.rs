@@ -8,7 +8,7 @@ pub mod lane;
 pub mod shared;
 
 #[cfg(target_arch = "x86_64")]
-pub mod f64x4;
+pub(crate) mod f64x4;
 
 /// A 3×3 matrix of f64 (deformation gradients, stresses).
 pub type Mat3 = nalgebra::Matrix3<f64>;

@@ -58,6 +58,15 @@ pub(super) fn first_non_finite_position(x: &[Vec3]) -> Option<usize> {
     x.iter().position(|p| !p.iter().all(|c| c.is_finite()))
 }
 
+/// An implicit solver's check of the positions it is handed: the first non-finite one names an
+/// element holding it, as bad input ([`ORIGIN_INPUT`]).
+pub(super) fn check_input(mesh: &crate::mesh::Mesh, positions: &[Vec3]) -> Result<(), BadElement> {
+    match first_non_finite_position(positions) {
+        Some(i) => Err(BadElement::at_node(mesh, i, ORIGIN_INPUT)),
+        None => Ok(()),
+    }
+}
+
 /// The first node of an element whose gathered position `x` is not finite.
 #[inline]
 pub(super) fn non_finite_node(x: &[Vec3], nodes: &[u32]) -> Option<u32> {

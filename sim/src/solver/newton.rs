@@ -88,9 +88,7 @@ impl StepSolver for Newton {
     ) -> Result<(), BadElement> {
         let settings = s.settings.newton;
         let bad = |node: usize| BadElement::at_node(s.mesh, node, ORIGIN_NEWTON);
-        if let Some(i) = super::nan_guard::first_non_finite_position(positions) {
-            return Err(BadElement::at_node(s.mesh, i, super::nan_guard::ORIGIN_INPUT));
-        }
+        super::nan_guard::check_input(s.mesh, positions)?;
         if self.pattern.is_none() || self.made_for != (s.model_version, s.h) {
             let pattern = SparsePattern::new(s.mesh, |i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?;
             self.pattern = Some(pattern);

@@ -156,9 +156,7 @@ impl StepSolver for Vbd {
         counters: &mut SolverCounters,
     ) -> Result<(), BadElement> {
         let h = s.h;
-        if let Some(i) = super::nan_guard::first_non_finite_position(positions) {
-            return Err(BadElement::at_node(s.mesh, i, super::nan_guard::ORIGIN_INPUT));
-        }
+        super::nan_guard::check_input(s.mesh, positions)?;
         self.y.clear();
         self.y.extend_from_slice(positions);
         // the initial guess
