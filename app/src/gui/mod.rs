@@ -92,6 +92,9 @@ pub struct HoxApp {
     pub presenter: bool,
     /// An interface scale to apply at the next frame.
     zoom_wanted: Option<f32>,
+    /// On the first frame that knows the monitor's size: shrink a window larger than the screen
+    /// (a geometry saved on a larger screen, or a --size too large) to fit it.
+    fit_to_screen: bool,
     /// The first start offers the lessons.
     pub offer_lessons: bool,
 }
@@ -147,7 +150,10 @@ impl HoxApp {
             background: None,
             lesson: None,
             presenter: false,
-            zoom_wanted: None,
+            // an ordinary start is at the ordinary scale, whatever egui's saved memory holds
+            // from a presenter-mode session (issue #35: its 1.6 leaked into the next start)
+            zoom_wanted: Some(1.0),
+            fit_to_screen: true,
             // the very first start (no saved settings) offers the lessons
             offer_lessons: saved.is_none()
                 && !args.fresh

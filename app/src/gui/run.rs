@@ -52,6 +52,11 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
         "hox",
         options,
         Box::new(|cc| {
+            // egui's saved memory may hold presenter mode's scale: an ordinary start is at scale
+            // 1 before any size is asked for in points (issue #35: `--size 1600x900` after a
+            // presenter session opened a 2560×1440 window)
+            let zoom = if args.presenter { super::lesson::PRESENTER_ZOOM } else { 1.0 };
+            cc.egui_ctx.set_zoom_factor(zoom);
             // eframe restores the last window geometry before this point; an explicit --size or
             // --fresh asks for the given (or default) size instead
             if args.size.is_some() || args.fresh {

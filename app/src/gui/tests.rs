@@ -510,3 +510,22 @@ fn lessons_play_their_seconds_are_listed_and_offered_at_first_start() {
         HoxApp::new(&args::parse_for_test(&["--lesson-file", bad.to_str().unwrap()]), None).err().unwrap_or_default();
     assert!(err.contains("hox-bad-lesson") && err.contains("a.poisson"), "{err}");
 }
+
+/// Issue #35, symptom 3: presenter mode's scale leaked into the next ordinary start (egui keeps
+/// its zoom in the memory it saves). A new, ordinary app on the same egui memory is at scale 1;
+/// a window larger than the screen is shrunk to fit it.
+#[test]
+fn presenter_scale_does_not_leak_into_the_next_start() {
+    let mut h = harness(args::parse_for_test(&["--lesson", "mesh-bias", "--presenter"]));
+    h.run_steps(2);
+    assert_eq!(h.ctx.zoom_factor(), super::lesson::PRESENTER_ZOOM);
+    // the next start: a new app, egui's memory (and so the zoom) restored as it was saved
+    *h.state_mut() = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap();
+    h.run_steps(2);
+    assert_eq!(h.ctx.zoom_factor(), 1.0, "an ordinary start is at the ordinary scale");
+    assert!(!h.state().presenter);
+    // 2560×1440 on a 1600×900 screen is shrunk to fit; a window that fits is left alone
+    let fitted = window::fitted_inner_size(egui::vec2(2560.0, 1440.0), egui::vec2(1600.0, 900.0)).unwrap();
+    assert!(fitted.x <= 1600.0 && fitted.y <= 900.0, "{fitted:?}");
+    assert_eq!(window::fitted_inner_size(egui::vec2(1400.0, 800.0), egui::vec2(1920.0, 1080.0)), None);
+}

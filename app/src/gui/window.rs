@@ -21,7 +21,25 @@ impl Screenshot {
     }
 }
 
+/// The inner size, in points, of a window of `inner` points that fits on a monitor of `monitor`
+/// points (with room for the window's decorations), or None when it already fits.
+pub(super) fn fitted_inner_size(inner: egui::Vec2, monitor: egui::Vec2) -> Option<egui::Vec2> {
+    // title bar and borders, and a panel the desktop may keep
+    let room = egui::vec2(monitor.x - 16.0, monitor.y - 64.0).max(egui::vec2(320.0, 240.0));
+    (inner.x > room.x || inner.y > room.y).then(|| inner.min(room))
+}
+
 impl HoxApp {
+    /// Shrinks the window to the screen once the monitor's size is known ([`fitted_inner_size`]).
+    fn fit_window_to_screen(&mut self, ctx: &egui::Context) {
+        let (monitor, inner) = ctx.input(|i| (i.viewport().monitor_size, i.viewport().inner_rect));
+        let (Some(monitor), Some(inner)) = (monitor, inner) else { return };
+        self.fit_to_screen = false;
+        if let Some(size) = fitted_inner_size(inner.size(), monitor) {
+            ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(size));
+        }
+    }
+
     fn status_line_ui(&self, ui: &mut egui::Ui) {
         ui.horizontal_wrapped(|ui| {
             for (k, s) in self.sessions.iter().enumerate() {
@@ -93,6 +111,9 @@ impl HoxApp {
         self.lesson_shortcuts(&ctx);
         if let Some(z) = self.zoom_wanted.take() {
             ctx.set_zoom_factor(z);
+        }
+        if self.fit_to_screen {
+            self.fit_window_to_screen(&ctx);
         }
         // Simulated time follows egui's clock (the window's: wall time between frames; the
         // headless tests': exactly their step), never the wall clock read here, so a test plays
