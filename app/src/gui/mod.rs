@@ -95,6 +95,9 @@ pub struct HoxApp {
     /// On the first frame that knows the monitor's size: shrink a window larger than the screen
     /// (a geometry saved on a larger screen, or a --size too large) to fit it.
     fit_to_screen: bool,
+    /// Frames to wait before fitting (the scale set at the start takes a frame to reach eframe's
+    /// report of the monitor and window sizes).
+    fit_to_screen_in_frames: u8,
     /// The first start offers the lessons.
     pub offer_lessons: bool,
 }
@@ -154,6 +157,7 @@ impl HoxApp {
             // from a presenter-mode session (issue #35: its 1.6 leaked into the next start)
             zoom_wanted: Some(1.0),
             fit_to_screen: true,
+            fit_to_screen_in_frames: 3,
             // the very first start (no saved settings) offers the lessons
             offer_lessons: saved.is_none()
                 && !args.fresh

@@ -44,6 +44,10 @@ pub struct Persisted {
     pub show_reference_element: bool,
     pub rerun_url: String,
     pub rerun_file: String,
+    /// The app was in presenter mode when it closed: the window geometry eframe saved is the
+    /// projector's, in presenter mode's points, and an ordinary start does not reuse it.
+    #[serde(default)]
+    pub presenter_at_exit: bool,
 }
 
 impl Persisted {
@@ -72,6 +76,7 @@ impl HoxApp {
             show_reference_element: self.show_reference_element,
             rerun_url: self.rerun_url.clone(),
             rerun_file: self.rerun_file.clone(),
+            presenter_at_exit: self.presenter,
         }
     }
 }

@@ -76,6 +76,12 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
             let software = renderer.as_deref().is_some_and(is_software_renderer);
             cc.egui_ctx.tessellation_options_mut(|o| o.feathering = !software);
             let saved = cc.storage.and_then(Persisted::load);
+            // the window geometry eframe restored is in presenter mode's points when the last run
+            // ended in it: the start opens at the given (or default) size instead, fitted to the
+            // screen on its first frames (issue #35)
+            if saved.as_ref().is_some_and(|s| s.presenter_at_exit) && args.size.is_none() {
+                cc.egui_ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(egui::vec2(w, h)));
+            }
             match HoxApp::new(&args, saved) {
                 Ok(mut app) => {
                     app.renderer = renderer;

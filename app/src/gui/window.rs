@@ -21,8 +21,8 @@ impl Screenshot {
     }
 }
 
-/// The inner size, in points, of a window of `inner` points that fits on a monitor of `monitor`
-/// points (with room for the window's decorations), or None when it already fits.
+/// The inner size of a window of size `inner` that fits on a monitor of size `monitor` (both in
+/// the same points, with room for the window's decorations), or None when it already fits.
 pub(super) fn fitted_inner_size(inner: egui::Vec2, monitor: egui::Vec2) -> Option<egui::Vec2> {
     // title bar and borders, and a panel the desktop may keep
     let room = egui::vec2(monitor.x - 16.0, monitor.y - 64.0).max(egui::vec2(320.0, 240.0));
@@ -30,8 +30,14 @@ pub(super) fn fitted_inner_size(inner: egui::Vec2, monitor: egui::Vec2) -> Optio
 }
 
 impl HoxApp {
-    /// Shrinks the window to the screen once the monitor's size is known ([`fitted_inner_size`]).
+    /// Shrinks the window to the screen once the monitor's size is known ([`fitted_inner_size`]),
+    /// a few frames after the start: eframe reports the monitor and the window in the points of
+    /// the scale of an earlier frame, which the start's own scale may have just changed.
     fn fit_window_to_screen(&mut self, ctx: &egui::Context) {
+        if self.fit_to_screen_in_frames > 0 {
+            self.fit_to_screen_in_frames -= 1;
+            return;
+        }
         let (monitor, inner) = ctx.input(|i| (i.viewport().monitor_size, i.viewport().inner_rect));
         let (Some(monitor), Some(inner)) = (monitor, inner) else { return };
         self.fit_to_screen = false;
