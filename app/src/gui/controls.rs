@@ -122,7 +122,7 @@ fn link_ui(app: &mut HoxApp, ui: &mut egui::Ui, field: &str) {
 
 /// A numeric text field for parameter `p` that applies on Enter or focus loss; unparsable or
 /// refused values keep the previous value and show the reason.
-fn number_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
+fn number_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param, enabled: bool) {
     let field = p.key;
     let text = p.label_with_unit();
     let value = (p.get)(&app.sessions[app.active].config).to_string();
@@ -130,8 +130,12 @@ fn number_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
         let l = label(ui, &text, p.help);
         let key = format!("{}:{field}", app.active);
         let buffer = app.edits.entry(key.clone()).or_insert_with(|| value.clone());
-        let response =
-            ui.add(egui::TextEdit::singleline(buffer).desired_width(90.0)).labelled_by(l.id).on_hover_text(p.help);
+        // greyed like every other row when the configuration does not use it (a solver's own
+        // parameter under another solver: issue #35's "Chebyshev ρ" under XPBD)
+        let response = ui
+            .add_enabled(enabled, egui::TextEdit::singleline(buffer).desired_width(90.0))
+            .labelled_by(l.id)
+            .on_hover_text(p.help);
         let commit = response.lost_focus() || (response.has_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)));
         if commit {
             let typed = buffer.trim().to_string();
@@ -308,7 +312,7 @@ fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
         (p.set)(c, v);
     };
     match p.kind {
-        Kind::Number { soft: None, .. } => number_ui(app, ui, p),
+        Kind::Number { soft: None, .. } => number_ui(app, ui, p, enabled),
         // a list (the fields) is shown and chosen by its first entry: the app draws that one
         Kind::Choice(_) | Kind::Choices(_) => row_ui(app, ui, p.key, &text, p.help, get, set, |ui, v| {
             let Value::Text(name) = v else { return ui.label("?") };

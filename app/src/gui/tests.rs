@@ -529,3 +529,22 @@ fn presenter_scale_does_not_leak_into_the_next_start() {
     assert!(fitted.x <= 1600.0 && fitted.y <= 900.0, "{fitted:?}");
     assert_eq!(window::fitted_inner_size(egui::vec2(1400.0, 800.0), egui::vec2(1920.0, 1080.0)), None);
 }
+
+/// Issue #35, symptom 8: under XPBD the implicit solvers' typed fields (Chebyshev ρ, Newton
+/// tolerance) looked active; they are greyed as the sliders of the other solvers' rows are, and
+/// come back with their solver.
+#[test]
+fn another_solvers_typed_fields_are_greyed() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    let disabled = |h: &Harness<'_, HoxApp>, label: &str| h.get_by_label(label).accesskit_node().is_disabled();
+    assert!(disabled(&h, "Chebyshev ρ"), "Chebyshev ρ active under XPBD");
+    assert!(disabled(&h, "Newton tolerance"), "Newton tolerance active under XPBD");
+    assert!(!disabled(&h, "Young's modulus E (Pa)"), "a material field is always active");
+    let mut c = h.state().sessions[0].config.clone();
+    c.method = hox_sim::solver::Method::Newton;
+    h.state_mut().apply("solver", c);
+    h.run_steps(2);
+    assert!(!disabled(&h, "Newton tolerance"), "Newton's own field under Newton");
+    assert!(disabled(&h, "Chebyshev ρ"), "VBD's field under Newton");
+}
