@@ -548,3 +548,18 @@ fn another_solvers_typed_fields_are_greyed() {
     assert!(!disabled(&h, "Newton tolerance"), "Newton's own field under Newton");
     assert!(disabled(&h, "Chebyshev ρ"), "VBD's field under Newton");
 }
+
+/// Issue #35, symptom 8: paused, the status line said "0–1 fps" (the window repaints only on
+/// input); it says "paused", and the frame rate while playing.
+#[test]
+fn the_status_line_says_paused_instead_of_a_frame_rate() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(3);
+    assert!(!h.state().playback.playing);
+    h.get_by_label("paused");
+    assert!(h.query_by_label_contains(" fps").is_none(), "no frame rate while paused");
+    h.state_mut().playback.playing = true;
+    h.run_steps(3);
+    h.get_by_label_contains(" fps");
+    assert!(h.query_by_label("paused").is_none());
+}

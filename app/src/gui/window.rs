@@ -90,7 +90,14 @@ impl HoxApp {
                 }
                 ui.separator();
             }
-            ui.label(egui::RichText::new(format!("{:.0} fps", 1000.0 / self.times.ui_frame_ms.max(1e-3))).monospace())
+            // paused, the window repaints only on input: a frame rate then means nothing (issue
+            // #35: "0–1 fps" whenever paused)
+            let rate = if self.playback.playing || self.settling() {
+                format!("{:.0} fps", 1000.0 / self.times.ui_frame_ms.max(1e-3))
+            } else {
+                "paused".to_string()
+            };
+            ui.label(egui::RichText::new(rate).monospace())
                 .on_hover_text(format!("Displayed frames per second; view {:.1} ms and app {:.1} ms of CPU per frame (the 3D view's preparation and the app's whole frame). Renderer: {}.", self.viewport.render_ms, self.times.app_ms, self.renderer.as_deref().unwrap_or("none (no OpenGL: CPU rasteriser)")));
             if let Some(e) = self.viewport.gl_error() {
                 ui.colored_label(egui::Color32::from_rgb(255, 170, 60), format!("OpenGL view unavailable, drawn on the CPU: {e}"));
