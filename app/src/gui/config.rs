@@ -15,7 +15,22 @@ pub fn from_scene(scene: &Scene) -> Config {
 /// Validates `config` on `base`: the scene it gives, or the reason it is refused. A mesh file's
 /// scene takes no box parameters.
 pub fn resolve(config: &Config, base: &Scene) -> Result<Scene, String> {
-    base.with_overrides(&config.as_overrides(base.is_box())).map_err(|e| e.to_string())
+    base.with_overrides(&config.as_overrides(base.is_box())).map_err(|e| plain_words(&e))
+}
+
+/// A refusal in the words of the panel (issue #35: "builtin:bending: material.poisson_ratio
+/// (--poisson) = 0.5: …" read as internals): the control's label, the value and the reason.
+pub fn plain_words(e: &hox_scenes::SceneError) -> String {
+    match e {
+        hox_scenes::SceneError::Invalid { key, value, reason, .. } => {
+            let entry = hox_scenes::params::PARAMS.iter().find(|p| key.starts_with(&p.file_path()));
+            match entry {
+                Some(p) => format!("{} = {value}: {reason}", p.label),
+                None => format!("{key} = {value}: {reason}"),
+            }
+        }
+        other => other.to_string(),
+    }
 }
 
 /// A short label, e.g. `P2 8×2×2 five`, or "mesh file".

@@ -90,6 +90,9 @@ fn a_bad_value_is_refused_with_the_reason_and_changes_nothing() {
     type_into(&mut h, "Poisson ratio ν", "0.5");
     let refusal = text(&h, "refused:");
     assert!(refusal.to_lowercase().contains("poisson"), "{refusal}");
+    // in the panel's words, not the scene file's internals (issue #35)
+    assert!(refusal.starts_with("refused: Poisson ratio ν = 0.5: "), "{refusal}");
+    assert!(!refusal.contains("builtin:") && !refusal.contains("material.poisson_ratio"), "{refusal}");
     assert_eq!(h.state().sessions[0].config.poisson_ratio, 0.35);
     assert_eq!(h.state().sessions[0].instance.sim.material().poisson_ratio, 0.35);
 }
