@@ -566,3 +566,15 @@ fn the_status_line_says_paused_instead_of_a_frame_rate() {
     h.get_by_label_contains(" fps");
     assert!(h.query_by_label("paused").is_none());
 }
+
+/// Issue #35, symptom 8: the labels above the bodies name A and B, as the status line and the
+/// controls' "Editing: A … B …" do.
+#[test]
+fn the_labels_above_the_bodies_name_a_and_b() {
+    let h = harness(AppArgs { compare: vec![String::new()], ..Default::default() });
+    let s = &h.state().sessions;
+    let a = viewport::body_label(0, &s[0].label(), "x");
+    let b = viewport::body_label(1, &s[1].label(), "y");
+    assert!(a.starts_with(&format!("A: {}", s[0].label())) && a.ends_with("\nx"), "{a}");
+    assert!(b.starts_with(&format!("B: {}", s[1].label())) && b.ends_with("\ny"), "{b}");
+}

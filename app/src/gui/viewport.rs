@@ -378,12 +378,11 @@ impl Viewport {
         }
         // labels above each body in compare mode
         if sessions.len() > 1 {
-            for (s, o) in sessions.iter().zip(offsets) {
+            for (k, (s, o)) in sessions.iter().zip(offsets).enumerate() {
                 let (lo, hi) = s.instance.sim.mesh().bounding_box();
                 let top = Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z) + o;
                 if let Some(p) = self.screen_position(top) {
-                    let mut text = s.label();
-                    text += &format!("\n{}", s.readout().short_text());
+                    let text = body_label(k, &s.label(), &s.readout().short_text());
                     painter.text(
                         p - egui::vec2(0.0, 14.0),
                         egui::Align2::CENTER_BOTTOM,
@@ -566,4 +565,11 @@ fn legend_ui(
     if let Some(n) = note {
         line(n, None);
     }
+}
+
+/// The label above configuration `k` in compare mode: its letter (the status line's and the
+/// controls' A and B, issue #35), its mesh, and its readout below.
+pub(super) fn body_label(k: usize, label: &str, readout: &str) -> String {
+    let letter = ["A", "B"].get(k).map_or(String::new(), |l| format!("{l}: "));
+    format!("{letter}{label}\n{readout}")
 }
