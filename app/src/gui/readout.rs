@@ -165,6 +165,8 @@ pub enum Readout {
     Moving { error_m: f64, error_pct: f64, amplitude_m: f64, period_secs: f64, drift_m: Option<f64> },
     /// Moving, but no full oscillation recorded yet.
     Starting,
+    /// Not run yet: at t = 0, the start state (issue #35: it read "moving").
+    NotStarted,
 }
 
 impl Readout {
@@ -187,6 +189,7 @@ impl Readout {
             Readout::Settled { error_m, error_pct, .. } => format!("settled error {} ({error_pct:.2} %)", m(error_m)),
             Readout::Moving { error_m, error_pct, .. } => format!("mean error {} ({error_pct:.2} %)", m(error_m)),
             Readout::Starting => "moving".into(),
+            Readout::NotStarted => "not started".into(),
         }
     }
 
@@ -200,6 +203,7 @@ impl Readout {
                 format!("mean error {} ({error_pct:.2} %), swinging ± {}", m(error_m), m(amplitude_m))
             }
             Readout::Starting => "moving".into(),
+            Readout::NotStarted => "not started".into(),
         }
     }
 
@@ -220,6 +224,7 @@ impl Readout {
                 m(amplitude_m)
             ),
             Readout::Starting => "moving: no full oscillation yet (Settle for the equilibrium)".into(),
+            Readout::NotStarted => "not started: t = 0 (Play, Step or Settle)".into(),
         }
     }
 }

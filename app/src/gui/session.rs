@@ -128,7 +128,7 @@ impl Session {
             settler: None,
             settle_outcome: None,
             driven_until_secs,
-            readout: Readout::Starting,
+            readout: Readout::NotStarted,
             ms_per_frame: 0.0,
             residual: f64::NAN,
             failure: None,
@@ -356,6 +356,9 @@ impl Session {
         let Some(first) = self.instance.probes.first() else {
             return Readout::NoReference("the scene has no probes".into());
         };
+        if self.instance.sim.time_secs() == 0.0 {
+            return Readout::NotStarted;
+        }
         let h = &self.history;
         let Some((mean, amplitude_m, period_secs, before)) = last_oscillation(&h.time_secs, &h.probe_m) else {
             return Readout::Starting;

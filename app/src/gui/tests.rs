@@ -578,3 +578,17 @@ fn the_labels_above_the_bodies_name_a_and_b() {
     assert!(a.starts_with(&format!("A: {}", s[0].label())) && a.ends_with("\nx"), "{a}");
     assert!(b.starts_with(&format!("B: {}", s[1].label())) && b.ends_with("\ny"), "{b}");
 }
+
+/// Issue #35, symptom 8: at t = 0 the readouts said "moving"; they say the run has not
+/// started, and "moving" once it has.
+#[test]
+fn a_beam_not_yet_run_is_not_called_moving() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(3);
+    let s = status(&h);
+    assert!(s.contains("not started") && !s.contains("moving"), "{s}");
+    h.state_mut().step(3);
+    h.run_steps(2);
+    let s = status(&h);
+    assert!(s.contains("moving") && !s.contains("not started"), "{s}");
+}
