@@ -22,7 +22,7 @@
 
 use super::error::{SimError, SolverCounters};
 use super::nan_guard::{BadElement, ORIGIN_NEWTON};
-use super::newton_core::{Failure, HessianModel, Objective, Outcome, Scratch, minimise};
+use super::newton_core::{Failure, HessianModel, Outcome, Scratch, minimise};
 use super::potential::Potential;
 use super::settings::SolverSettings;
 use super::simulation::Simulation;
@@ -45,14 +45,6 @@ pub struct Newmark {
     time_secs: f64,
     counters: SolverCounters,
     settings: SolverSettings,
-}
-
-struct HalfStep<'a>(Potential<'a>);
-
-impl Objective for HalfStep<'_> {
-    fn eval(&self, x: &[Vec3], grad: &mut [Vec3]) -> (f64, f64) {
-        self.0.eval(x, grad)
-    }
 }
 
 impl Newmark {
@@ -143,15 +135,10 @@ impl Newmark {
                 settings: &self.settings,
                 model_version: 0,
             };
-            let potential = HalfStep(Potential { input: &input, y: &y, springs: &[], w });
-            let mut diagonal = vec![0.0; pattern.free_dofs];
-            for (dof, &k) in pattern.dof_of.iter().enumerate() {
-                if k != usize::MAX {
-                    diagonal[k] = sim.masses_kg()[dof / 3] * w;
-                }
-            }
+            let potential = Potential { input: &input, y: &y, springs: &[], w };
+            let diagonal = potential.hessian_diagonal(pattern);
             let model = HessianModel { mesh, geometry: sim.geometry(), material: sim.material(), diagonal: &diagonal };
-            let body_force: f64 = sim.masses_kg().iter().map(|m| m * g.norm()).sum();
+            let body_force = potential.body_force_n();
             minimise(
                 &potential,
                 &model,

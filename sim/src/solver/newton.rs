@@ -105,21 +105,8 @@ impl StepSolver for Newton {
         let springs = hooks.springs();
         let w = 1.0 / (s.h * s.h);
         let potential = Potential { input: s, y: &self.y, springs: &springs, w };
-        let body_force: f64 = s.masses_kg.iter().map(|m| m * s.body_acceleration.norm()).sum();
-        let mut diagonal = vec![0.0; pattern.free_dofs];
-        for (dof, &k) in pattern.dof_of.iter().enumerate() {
-            if k != usize::MAX {
-                diagonal[k] = s.masses_kg[dof / 3] * w;
-            }
-        }
-        for sp in &springs {
-            for a in 0..3 {
-                let k = pattern.dof_of[3 * sp.node as usize + a];
-                if k != usize::MAX {
-                    diagonal[k] += sp.stiffness_n_per_m;
-                }
-            }
-        }
+        let body_force = potential.body_force_n();
+        let diagonal = potential.hessian_diagonal(pattern);
         let model = HessianModel { mesh: s.mesh, geometry: s.geometry, material: s.material, diagonal: &diagonal };
         let outcome = minimise(
             &potential,

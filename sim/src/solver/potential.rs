@@ -7,6 +7,7 @@
 //! reports instead. Newton's implicit Euler minimises it (`newton.rs`), VBD's coarse correction
 //! takes its gradient (`vbd/coarse.rs`).
 
+use super::sparse::SparsePattern;
 use super::step::StepInput;
 use crate::Vec3;
 use crate::effect::NodeSpring;
@@ -47,5 +48,32 @@ impl Potential<'_> {
             }
         }
         (e, reactions.sqrt())
+    }
+
+    /// The diagonal of `E`'s Hessian beyond the elastic part, one value per free degree of
+    /// freedom of `pattern`: `m_i/h²` plus the stiffness of every spring on the node.
+    pub fn hessian_diagonal(&self, pattern: &SparsePattern) -> Vec<f64> {
+        let s = self.input;
+        let mut d = vec![0.0; pattern.free_dofs];
+        for (dof, &k) in pattern.dof_of.iter().enumerate() {
+            if k != usize::MAX {
+                d[k] = s.masses_kg[dof / 3] * self.w;
+            }
+        }
+        for sp in self.springs {
+            for a in 0..3 {
+                let k = pattern.dof_of[3 * sp.node as usize + a];
+                if k != usize::MAX {
+                    d[k] += sp.stiffness_n_per_m;
+                }
+            }
+        }
+        d
+    }
+
+    /// The body force `Σ_i m_i |a|`, newtons: the load Newton's residual is measured against.
+    pub fn body_force_n(&self) -> f64 {
+        let s = self.input;
+        s.masses_kg.iter().map(|m| m * s.body_acceleration.norm()).sum()
     }
 }
