@@ -30,14 +30,15 @@
 //! else `$XDG_CACHE_HOME/hox` or `~/.cache/hox`, folder `references/`), so a configuration is
 //! solved once per machine.
 
+pub mod compute;
 pub mod field;
 
+pub use compute::{LEVELS, OnEstimate, Progress, compute_with, grids, level_scene, own_mesh, provisional};
 pub use field::ReferenceField;
 
 use crate::scene::EffectSpec;
-use crate::{Scene, SceneError, SceneOverrides};
+use crate::{Scene, SceneError};
 use hox_sim::Vec3;
-use hox_sim::element::ElementType;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -75,6 +76,17 @@ pub struct Reference {
     /// committed references, which hold probes only, until [`Lookup::with_field`] solves it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub field: Option<ReferenceField>,
+    /// A provisional estimate while finer levels are being solved ([`compute::provisional`]);
+    /// None for a finished reference.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refining: Option<Refining>,
+}
+
+/// How far a computed reference has got: levels solved of levels to solve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Refining {
+    pub levels_done: usize,
+    pub levels: usize,
 }
 
 impl Reference {
@@ -104,10 +116,15 @@ impl Reference {
 
     /// One line for a user: "static, Q2 32×8×8, ν = 0.49, ± 0.31 % (from three levels, observed order 1.6)".
     pub fn label(&self) -> String {
-        let what = match self.origin {
-            Origin::Committed => "static (committed)",
-            Origin::Computed => "static, computed",
-            Origin::OwnMesh => "static solution of this mesh",
+        let refining;
+        let what = match (self.origin, self.refining) {
+            (_, Some(r)) => {
+                refining = format!("provisional, levels 1–{} of {} solved, refining", r.levels_done, r.levels);
+                refining.as_str()
+            }
+            (Origin::Committed, None) => "static (committed)",
+            (Origin::Computed, None) => "static, computed",
+            (Origin::OwnMesh, None) => "static solution of this mesh",
         };
         let estimate = match self.estimated_error_pct() {
             Some(pct) => format!(", ± {pct:.2} % ({})", self.estimate),
@@ -127,6 +144,7 @@ impl Reference {
             "estimated_error_m": self.estimated_error_m,
             "estimated_error_pct": self.estimated_error_pct(),
             "estimate": self.estimate,
+            "provisional": self.refining.is_some(),
         })
     }
 }
@@ -218,7 +236,7 @@ pub fn committed(scene: &Scene) -> Result<Option<Reference>, SceneError> {
     for (k, (grid, text)) in levels.iter().enumerate() {
         let level = ["coarse", "medium", "fine"][k];
         let probes = parse_probes(text, &format!("assets/reference/{name}-{level}.json"))?;
-        solved.push((cell_size(scene, *grid), probes));
+        solved.push((compute::cell_size(scene, *grid), probes));
     }
     let (error_m, estimate) = mesh_error(&solved);
     let fine = levels[2].0;
@@ -230,13 +248,8 @@ pub fn committed(scene: &Scene) -> Result<Option<Reference>, SceneError> {
         estimate,
         poisson_ratio: scene.params().poisson_ratio,
         field: None,
+        refining: None,
     }))
-}
-
-/// Representative cell size of a grid on the scene's box: the largest cell extent, metres.
-fn cell_size(scene: &Scene, grid: [usize; 3]) -> f64 {
-    let p = scene.params();
-    (0..3).map(|d| (p.box_max_m[d] - p.box_min_m[d]) / grid[d] as f64).fold(0.0, f64::max)
 }
 
 /// The largest number of Q2 cells of a computed reference's finest level (the committed
@@ -314,119 +327,6 @@ pub fn mesh_error(levels: &[(f64, Probes)]) -> (f64, String) {
         Some(p) => (distance(&extrapolate(b, c, p), &c.1), format!("from three levels, observed order {p:.2}")),
         None => (d2, "the difference of the two finest levels; they do not yet converge monotonically".into()),
     }
-}
-
-/// Progress of a computation: (what is being done, overall fraction 0–1).
-pub type Progress<'p> = &'p mut dyn FnMut(&str, f64);
-
-/// Static tolerance and load steps of a computed reference: a residual of 1e-9 of the load is
-/// far below the mesh error (the committed ones went to 1e-10, which the twist scene's large
-/// rotation cannot always reach).
-const TOLERANCE: f64 = 1e-9;
-const LOAD_STEPS: usize = 10;
-
-/// Computes the reference of a box scene's physics on three Q2 levels ([`levels`] with
-/// [`FINEST_CELLS`]).
-pub fn compute(scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
-    compute_with(scene, FINEST_CELLS, progress)
-}
-
-/// [`compute`] with a finest level of about `finest_cells` cells.
-pub fn compute_with(scene: &Scene, finest_cells: usize, progress: Progress<'_>) -> Result<Reference, SceneError> {
-    let p = scene.params();
-    let [coarse, medium, fine] = levels(p.box_min_m, p.box_max_m, finest_cells);
-    let grids = [coarse, medium, fine.map(|n| 3 * n / 4), fine];
-    let cells: Vec<f64> = grids.iter().map(|g| (g[0] * g[1] * g[2]) as f64).collect();
-    let total: f64 = cells.iter().sum();
-    let mut done = 0.0;
-    let mut solved = Vec::new();
-    let mut finest_field = None;
-    for (k, grid) in grids.iter().enumerate() {
-        let o = SceneOverrides {
-            element: ElementType::from_name("q2"),
-            grid: Some(*grid),
-            quadrature_degree: Some(None),
-            ..Default::default()
-        };
-        let level = scene.with_overrides(&o)?;
-        let mesh = level.build_mesh()?;
-        let what = format!("reference: static Q2 {}×{}×{} ({} of 4)", grid[0], grid[1], grid[2], k + 1);
-        let solution = crate::solve_static(&level, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
-            progress(&what, (done + fraction * cells[k]) / total)
-        })?;
-        done += cells[k];
-        solved.push((cell_size(scene, *grid), probes_at(&level, &mesh, &solution.positions)?));
-        if k == grids.len() - 1 {
-            finest_field = ReferenceField::lattice(&mesh, &solution.positions, p.box_min_m, p.box_max_m, *grid);
-        }
-    }
-    let name = format!("Q2 {}×{}×{}", fine[0], fine[1], fine[2]);
-    let triplet = |i: usize, j: usize, k: usize| [solved[i].clone(), solved[j].clone(), solved[k].clone()];
-    // two extrapolations of the finest level, from the halving triplet and from the finest
-    // triplet: the second is the reference, their distance its uncertainty
-    let reference = match (observed_order(&triplet(0, 1, 3)), observed_order(&triplet(1, 2, 3))) {
-        (Some(p_halving), Some(p_finest)) => {
-            let by_halving = extrapolate(&solved[1], &solved[3], p_halving);
-            let by_finest = extrapolate(&solved[2], &solved[3], p_finest);
-            Reference {
-                origin: Origin::Computed,
-                estimated_error_m: Some(distance(&by_halving, &by_finest)),
-                probes: by_finest,
-                mesh: format!("{name} extrapolated"),
-                estimate: format!("Richardson from four levels, order {p_finest:.2}; {p_halving:.2} by halving"),
-                poisson_ratio: p.poisson_ratio,
-                field: finest_field,
-            }
-        }
-        _ => {
-            let (error_m, estimate) = mesh_error(&triplet(0, 1, 3));
-            Reference {
-                origin: Origin::Computed,
-                probes: solved[3].1.clone(),
-                mesh: name,
-                estimated_error_m: Some(error_m),
-                estimate,
-                poisson_ratio: p.poisson_ratio,
-                field: finest_field,
-            }
-        }
-    };
-    Ok(reference)
-}
-
-/// The displacement of every probe of `scene` at `positions` on `mesh`.
-fn probes_at(scene: &Scene, mesh: &hox_sim::mesh::Mesh, positions: &[Vec3]) -> Result<Probes, SceneError> {
-    scene
-        .file
-        .probes
-        .iter()
-        .map(|q| {
-            let probe = hox_sim::measure::probe::Probe::locate(mesh, &q.name, Vec3::from(q.point_m))
-                .map_err(|e| SceneError::Probe { source_name: scene.source.clone(), message: e.to_string() })?;
-            let u = probe.displacement(positions, &mesh.rest_positions);
-            Ok((q.name.clone(), [u.x, u.y, u.z]))
-        })
-        .collect()
-}
-
-/// The static solution of the scene's own mesh (a mesh file's scene).
-pub fn own_mesh(scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
-    let mesh = scene.build_mesh()?;
-    let solution = crate::solve_static(scene, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
-        progress("reference: static solution of this mesh", fraction)
-    })?;
-    let probes = probes_at(scene, &mesh, &solution.positions)?;
-    Ok(Reference {
-        origin: Origin::OwnMesh,
-        probes,
-        mesh: format!("{} ({} elements)", scene.mesh.element_names(), mesh.num_elements()),
-        estimated_error_m: None,
-        estimate: "measures the solver's error only, not the mesh's".into(),
-        poisson_ratio: scene.params().poisson_ratio,
-        field: Some(ReferenceField::Nodes {
-            displacements_m: solution.positions.iter().zip(&mesh.rest_positions).map(|(x, r)| (x - r).into()).collect(),
-        }),
-    })
 }
 
 /// Why a scene has no reference, if it has none: no probes, or contact (no static counterpart).
@@ -543,6 +443,33 @@ impl Lookup {
     /// The reference of `scene`: committed, cached, or computed now (and cached). Err when the
     /// scene has none ([`unavailable`]) or the static solve fails.
     pub fn for_scene(&self, scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
+        self.get(scene, false, progress, &mut |_| {})
+    }
+
+    /// The reference of `scene` (`with_field`: [`Lookup::with_field`], else
+    /// [`Lookup::for_scene`]), passing each provisional estimate of a computation to
+    /// `on_estimate` ([`compute_with`]) before the final reference is returned.
+    pub fn get(
+        &self,
+        scene: &Scene,
+        with_field: bool,
+        progress: Progress<'_>,
+        on_estimate: OnEstimate<'_>,
+    ) -> Result<Reference, SceneError> {
+        if with_field {
+            let reference = self.probes_only(scene, progress, on_estimate)?;
+            self.add_field(scene, reference, progress)
+        } else {
+            self.probes_only(scene, progress, on_estimate)
+        }
+    }
+
+    fn probes_only(
+        &self,
+        scene: &Scene,
+        progress: Progress<'_>,
+        on_estimate: OnEstimate<'_>,
+    ) -> Result<Reference, SceneError> {
         if let Some(why) = unavailable(scene) {
             return Err(SceneError::Simulation {
                 source_name: scene.source.clone(),
@@ -553,8 +480,11 @@ impl Lookup {
             return Ok(r);
         }
         let key = self.key(scene);
-        let reference =
-            if scene.is_box() { compute_with(scene, self.finest_cells, progress)? } else { own_mesh(scene, progress)? };
+        let reference = if scene.is_box() {
+            compute_with(scene, self.finest_cells, progress, on_estimate)?
+        } else {
+            own_mesh(scene, progress)?
+        };
         self.store(&key, &reference, scene.is_box());
         Ok(reference)
     }
@@ -567,7 +497,11 @@ impl Lookup {
     /// [`Lookup::for_scene`] with its displacement field: a committed reference (probes only)
     /// gets the field of one static Q2 solve on the finest level ([`levels`]), cached.
     pub fn with_field(&self, scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
-        let reference = self.for_scene(scene, progress)?;
+        self.get(scene, true, progress, &mut |_| {})
+    }
+
+    /// `reference` with its displacement field (solved once on the finest level if it has none).
+    fn add_field(&self, scene: &Scene, reference: Reference, progress: Progress<'_>) -> Result<Reference, SceneError> {
         if reference.field.is_some() || !scene.is_box() {
             return Ok(reference);
         }
@@ -577,17 +511,13 @@ impl Lookup {
         }
         let p = scene.params();
         let grid = levels(p.box_min_m, p.box_max_m, self.finest_cells)[2];
-        let o = SceneOverrides {
-            element: ElementType::from_name("q2"),
-            grid: Some(grid),
-            quadrature_degree: Some(None),
-            ..Default::default()
-        };
-        let level = scene.with_overrides(&o)?;
+        let level = level_scene(scene, grid)?;
         let mesh = level.build_mesh()?;
-        let what = format!("reference field: static Q2 {}×{}×{}", grid[0], grid[1], grid[2]);
+        let what = format!("computing reference field: static Q2 {}×{}×{}", grid[0], grid[1], grid[2]);
         let solution =
-            crate::solve_static(&level, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| progress(&what, fraction))?;
+            crate::solve_static(&level, &mesh, compute::TOLERANCE, compute::LOAD_STEPS, &mut |fraction, _, _| {
+                progress(&what, fraction)
+            })?;
         let field = ReferenceField::lattice(&mesh, &solution.positions, p.box_min_m, p.box_max_m, grid);
         let with = Reference { field, ..reference };
         self.store(&key, &with, true);

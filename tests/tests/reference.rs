@@ -88,3 +88,64 @@ fn the_medium_and_fine_torsion_references_are_reproduced_from_their_recipe() {
     reproduce(Some("torsion"), "medium");
     reproduce(Some("torsion"), "fine");
 }
+
+/// Issue #35's acceptance: with an empty cache, compare P1 refined once against P2 at ν = 0.49:
+/// a reference number comes from the three coarsest Q2 levels (396 of the 3,808 cells the
+/// recipe solves; about 3 s on the project's 2-core machine, docs/APP.md), and it agrees with
+/// the full recipe's value within its stated error; so does each estimate after it.
+/// The time is printed, not asserted (machines differ).
+#[test]
+#[ignore = "a minute and a half in release: CI runs it with --release --ignored"]
+fn the_first_reference_estimate_at_nu_0_49_holds_against_the_full_recipe() {
+    let p1 = hox_scenes::by_name("bending")
+        .unwrap()
+        .with_overrides(&SceneOverrides {
+            element: hox_sim::element::ElementType::from_name("p1"),
+            refine: Some(1),
+            poisson_ratio: Some(0.49),
+            ..Default::default()
+        })
+        .unwrap();
+    let lookup = hox_scenes::reference::Lookup { finest_cells: hox_scenes::reference::FINEST_CELLS, cache_dir: None };
+    let start = std::time::Instant::now();
+    let mut estimates = Vec::new();
+    let mut level_started = Vec::new();
+    let full = lookup
+        .get(
+            &p1,
+            false,
+            &mut |what, _| {
+                if level_started.last().is_none_or(|(w, _): &(String, f64)| w != what) {
+                    level_started.push((what.to_string(), start.elapsed().as_secs_f64()));
+                }
+            },
+            &mut |e| estimates.push((e.clone(), start.elapsed().as_secs_f64())),
+        )
+        .unwrap();
+    for (what, secs) in &level_started {
+        eprintln!("{secs:7.2} s  {what}");
+    }
+    assert_eq!(estimates.len(), 3);
+    let size = full.size_m();
+    for (e, secs) in &estimates {
+        let r = e.refining.unwrap();
+        let off = full.error_m(&e.probes.iter().map(|(n, u)| (n.clone(), *u)).collect::<Vec<_>>()).unwrap();
+        let stated = e.estimated_error_m.unwrap() + full.estimated_error_m.unwrap();
+        eprintln!(
+            "{secs:7.2} s  after level {} of {}: off the full recipe by {:.3} %, stated ± {:.3} % ({})",
+            r.levels_done,
+            r.levels,
+            100.0 * off / size,
+            100.0 * e.estimated_error_m.unwrap() / size,
+            e.estimate
+        );
+        assert!(off <= stated, "{}: {off:e} off the full recipe's value, stated {stated:e}", e.label());
+    }
+    eprintln!("{:7.2} s  final: {}", start.elapsed().as_secs_f64(), full.label());
+    // the first estimate came after the three coarsest levels: an eighth of the recipe's cells
+    let p = p1.params();
+    let grids = hox_scenes::reference::grids(p.box_min_m, p.box_max_m, lookup.finest_cells);
+    let cells: Vec<usize> = grids.iter().map(|g| g.iter().product()).collect();
+    assert_eq!(estimates[0].0.refining.unwrap().levels_done, 3);
+    assert!(8 * cells[..3].iter().sum::<usize>() < cells.iter().sum::<usize>(), "{cells:?}");
+}

@@ -22,14 +22,13 @@ pub enum When {
 #[derive(Args, Clone, Debug)]
 pub struct ReferenceArgs {
     /// The error is measured against the committed reference when the physics are a paper
-    /// scene's as built; otherwise against one computed with hox's static solver on four Q2
+    /// scene's as built; otherwise against one computed with hox's static solver on six Q2
     /// levels and extrapolated (a minute or more the first time, then cached in
     /// ~/.cache/hox/references or HOX_CACHE_DIR), or, for a mesh file, its own static solution.
     #[arg(long, value_enum, default_value_t = When::Auto)]
     pub reference: When,
-    /// Cells of the finest Q2 level of a computed reference (the three coarser levels have a
-    /// quarter, a half and three quarters as many per direction): more, a better reference at
-    /// more cost.
+    /// Cells of the finest Q2 level of a computed reference (the five coarser levels have ¼,
+    /// ⅜, ½, ⅝ and ¾ as many per direction): more, a better reference at more cost.
     #[arg(long, default_value_t = hox_scenes::reference::FINEST_CELLS)]
     pub reference_cells: usize,
 }

@@ -3,8 +3,10 @@
 //! the motion ([`Readout`]), never as an instantaneous value of a swinging body.
 //!
 //! - **Reference**: [`hox_scenes::reference`] — committed for a paper scene's own physics;
-//!   otherwise computed on three Q2 levels in a background thread (with progress; cached on
+//!   otherwise computed on six Q2 levels in a background thread (with progress; cached on
 //!   disk by what determines it) and replaced whenever the physics change (ν, E, ρ, model).
+//!   While it computes, each provisional estimate is used as it arrives, its error bar and
+//!   "refining (level k of 6)" on the labels (issue #35: "no reference" for minutes).
 //! - **Settled**: the body is at rest ([`hox_scenes::RestWatch`]: every node still for 30
 //!   frames, or residual and kinetic energy at the settle limits): the error of the probes now.
 //! - **Moving**: the mean of the first probe over its last full oscillation (from a turning
@@ -16,12 +18,11 @@ use hox_scenes::Scene;
 use hox_scenes::reference::Lookup;
 use hox_scenes::reference::Reference;
 use std::sync::{Arc, Mutex};
-use std::thread::JoinHandle;
 
 /// How the app finds references: the default (Q2 levels up to
 /// [`hox_scenes::reference::FINEST_CELLS`] cells, the disk cache); the UI tests use small levels
 /// and no disk cache, to stay quick in a debug build and leave the home folder alone.
-fn lookup() -> Lookup {
+pub(super) fn lookup() -> Lookup {
     if cfg!(test) { Lookup { finest_cells: 64, cache_dir: None } } else { Lookup::default() }
 }
 
@@ -29,11 +30,12 @@ fn lookup() -> Lookup {
 pub enum ReferenceState {
     /// The scene has none (contact, no probes); why.
     Unavailable(String),
-    /// Being computed in the background: what it is doing and how far (0–1).
+    /// Being computed in the background ([`Job`]), with the latest provisional estimate taken
+    /// in by [`ReferenceState::poll`].
     Computing {
         key: String,
-        progress: Arc<Mutex<(String, f64)>>,
-        handle: Option<JoinHandle<Result<Reference, String>>>,
+        job: Arc<Job>,
+        latest: Option<Arc<Reference>>,
     },
     Ready {
         key: String,
@@ -43,6 +45,77 @@ pub enum ReferenceState {
         key: String,
         message: String,
     },
+}
+
+/// A reference computation in the background, shared by every session that wants the same
+/// reference (the two configurations compared share their physics: issue #35, one computation
+/// instead of two at half speed each).
+#[derive(Default)]
+pub struct Job {
+    /// What is being done and how far, 0–1.
+    pub(super) progress: Mutex<(String, f64)>,
+    /// The latest provisional estimate.
+    pub(super) estimate: Mutex<Option<Arc<Reference>>>,
+    /// The outcome, once finished.
+    pub(super) result: Mutex<Option<Result<Arc<Reference>, String>>>,
+}
+
+impl Job {
+    fn finished(&self) -> bool {
+        self.result.lock().is_ok_and(|r| r.is_some())
+    }
+}
+
+/// Why a computation stopped: no session wanted it any more.
+struct Cancelled;
+
+/// The computations under way, by key.
+fn jobs() -> &'static Mutex<std::collections::HashMap<String, std::sync::Weak<Job>>> {
+    static JOBS: std::sync::OnceLock<Mutex<std::collections::HashMap<String, std::sync::Weak<Job>>>> =
+        std::sync::OnceLock::new();
+    JOBS.get_or_init(Default::default)
+}
+
+/// The computation of `key` under way, or a new one started in the background.
+fn job(lookup: Lookup, key: &str, scene: &Scene, with_field: bool) -> Arc<Job> {
+    let mut jobs = jobs().lock().unwrap_or_else(|e| e.into_inner());
+    jobs.retain(|_, j| j.strong_count() > 0);
+    if let Some(j) = jobs.get(key).and_then(std::sync::Weak::upgrade).filter(|j| !j.finished()) {
+        return j;
+    }
+    let job = Arc::new(Job { progress: Mutex::new(("computing reference".into(), 0.0)), ..Default::default() });
+    jobs.insert(key.to_string(), Arc::downgrade(&job));
+    // the thread holds the job weakly: once no session wants it, the next progress report
+    // stops the computation (issue #35: a class typing ν after ν had each computation slow
+    // the next); `resume_unwind` stops it without the panic hook's message
+    let (scene, weak) = (scene.clone(), Arc::downgrade(&job));
+    std::thread::spawn(move || {
+        let wanted = || weak.upgrade().unwrap_or_else(|| std::panic::resume_unwind(Box::new(Cancelled)));
+        let run = || {
+            let mut report = |what: &str, fraction: f64| {
+                if let Ok(mut p) = wanted().progress.lock() {
+                    *p = (what.to_string(), fraction);
+                }
+            };
+            let mut on_estimate = |r: &Reference| {
+                if let Ok(mut e) = wanted().estimate.lock() {
+                    *e = Some(Arc::new(r.clone()));
+                }
+            };
+            lookup.get(&scene, with_field, &mut report, &mut on_estimate).map(Arc::new).map_err(|e| e.to_string())
+        };
+        let result = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+            Ok(result) => result,
+            Err(payload) if payload.is::<Cancelled>() => return,
+            Err(_) => Err("the reference computation stopped unexpectedly".into()),
+        };
+        if let Some(job) = weak.upgrade()
+            && let Ok(mut r) = job.result.lock()
+        {
+            *r = Some(result);
+        }
+    });
+    job
 }
 
 /// The key of what is wanted: the reference, or (`with_field`, for the error field) the
@@ -67,18 +140,8 @@ impl ReferenceState {
             Ok(_) => {}
             Err(e) => return ReferenceState::Failed { key, message: e.to_string() },
         }
-        let progress = Arc::new(Mutex::new(("reference: starting".to_string(), 0.0)));
-        let (scene, shared) = (scene.clone(), progress.clone());
-        let handle = std::thread::spawn(move || {
-            let mut report = |what: &str, fraction: f64| {
-                if let Ok(mut p) = shared.lock() {
-                    *p = (what.to_string(), fraction);
-                }
-            };
-            if with_field { lookup.with_field(&scene, &mut report) } else { lookup.for_scene(&scene, &mut report) }
-                .map_err(|e| e.to_string())
-        });
-        ReferenceState::Computing { key, progress, handle: Some(handle) }
+        let job = job(lookup, &key, scene, with_field);
+        ReferenceState::Computing { key, job, latest: None }
     }
 
     fn key(&self) -> Option<&str> {
@@ -100,22 +163,30 @@ impl ReferenceState {
         let fits = key.as_deref() == Some(wanted_key(&lookup, scene, with_field).as_str())
             || (!with_field && key.as_deref() == Some(lookup.field_key(scene).as_str()));
         if !fits || unavailable.is_some() {
-            // a computation no longer wanted finishes in the background (and fills the cache)
+            // a computation no longer wanted by any session stops at its next progress report
             *self = ReferenceState::for_scene(scene, with_field);
         }
     }
 
-    /// Takes a finished background computation in (non-blocking); whether it did.
+    /// Takes a finished background computation, or a new provisional estimate, in
+    /// (non-blocking); whether it did.
     pub fn poll(&mut self) -> bool {
-        let ReferenceState::Computing { key, handle, .. } = self else { return false };
-        if !handle.as_ref().is_some_and(|h| h.is_finished()) {
-            return false;
-        }
+        let ReferenceState::Computing { key, job, latest } = self else { return false };
+        let result = job.result.lock().ok().and_then(|r| r.clone());
+        let Some(result) = result else {
+            let new = job.estimate.lock().ok().and_then(|e| e.clone());
+            return match new {
+                Some(r) if !latest.as_ref().is_some_and(|l| Arc::ptr_eq(l, &r)) => {
+                    *latest = Some(r);
+                    true
+                }
+                _ => false,
+            };
+        };
         let key = key.clone();
-        *self = match handle.take().map(|h| h.join()) {
-            Some(Ok(Ok(r))) => ReferenceState::Ready { key, reference: Arc::new(r) },
-            Some(Ok(Err(message))) => ReferenceState::Failed { key, message },
-            _ => ReferenceState::Failed { key, message: "the reference computation stopped unexpectedly".into() },
+        *self = match result {
+            Ok(reference) => ReferenceState::Ready { key, reference },
+            Err(message) => ReferenceState::Failed { key, message },
         };
         true
     }
@@ -123,30 +194,78 @@ impl ReferenceState {
     /// Waits for a background computation (tests).
     #[cfg(test)]
     pub fn wait(&mut self) {
-        if let ReferenceState::Computing { handle, .. } = self
-            && let Some(h) = handle.as_ref()
-        {
-            while !h.is_finished() {
+        if let ReferenceState::Computing { job, .. } = self {
+            while !job.finished() {
                 std::thread::sleep(std::time::Duration::from_millis(20));
             }
         }
         let _ = self.poll();
     }
 
+    /// The reference, or while one is computed its latest provisional estimate.
     pub fn reference(&self) -> Option<&Reference> {
         match self {
-            ReferenceState::Ready { reference, .. } => Some(reference),
+            ReferenceState::Ready { reference, .. } | ReferenceState::Computing { latest: Some(reference), .. } => {
+                Some(reference)
+            }
             _ => None,
         }
+    }
+
+    /// What the computation is doing ("computing reference, level 3 of 6 (static Q2 16×4×4)")
+    /// and how far it is overall, 0–1.
+    fn progress(&self) -> Option<(String, f64)> {
+        match self {
+            ReferenceState::Computing { job, .. } => job.progress.lock().ok().map(|p| p.clone()),
+            _ => None,
+        }
+    }
+
+    /// A few words for a body's label: "no reference", "computing reference, level 2 of 6",
+    /// or with a provisional estimate "reference |u_tip| = 0.2887 m ± 3.97 %, refining (level 4
+    /// of 6)"; None for a finished reference (the readout says the rest).
+    pub fn short_status(&self) -> Option<String> {
+        let level = |what: &str| what.split(" (").next().unwrap_or(what).replace("computing reference, ", "");
+        match self {
+            ReferenceState::Ready { .. } => None,
+            ReferenceState::Computing { latest: Some(r), .. } => {
+                let size = match r.probes.iter().next() {
+                    Some((name, u)) => format!("|u_{name}| = {:.4} m", hox_sim::Vec3::from(*u).norm()),
+                    None => String::new(),
+                };
+                Some(format!(
+                    "reference {size} ± {:.2} %, refining ({})",
+                    r.estimated_error_pct().unwrap_or(f64::NAN),
+                    level(&self.progress().unwrap_or_default().0)
+                ))
+            }
+            ReferenceState::Computing { .. } => {
+                Some(self.progress().map_or_else(|| "computing reference".into(), |(what, _)| level(&what)))
+                    .map(|l| if l.starts_with("level") { format!("computing reference, {l}") } else { l })
+            }
+            ReferenceState::Unavailable(_) | ReferenceState::Failed { .. } => Some("no reference".into()),
+        }
+    }
+
+    /// For the status line, while a provisional estimate is in use: "ref. ± 3.97 %, level 4 of 6".
+    pub fn provisional_brief(&self) -> Option<String> {
+        let ReferenceState::Computing { latest: Some(r), .. } = self else { return None };
+        let (what, _) = self.progress().unwrap_or_default();
+        let level = what.split(" (").next().unwrap_or(&what).replace("computing reference, ", "");
+        Some(format!("ref. ± {:.2} %, {level}", r.estimated_error_pct().unwrap_or(f64::NAN)))
     }
 
     /// One line: the reference's label, or what is being done, or why there is none.
     pub fn status(&self) -> String {
         match self {
             ReferenceState::Unavailable(why) => format!("no reference: {why}"),
-            ReferenceState::Computing { progress, .. } => {
-                let (what, fraction) = progress.lock().map(|p| p.clone()).unwrap_or_default();
-                format!("computing the reference for this configuration: {what}, {:.0} %", 100.0 * fraction)
+            ReferenceState::Computing { latest, .. } => {
+                let (what, fraction) = self.progress().unwrap_or_default();
+                let doing = format!("{what}, {:.0} %", 100.0 * fraction);
+                match latest {
+                    Some(r) => format!("reference: {}; {doing}", r.label()),
+                    None => doing,
+                }
             }
             ReferenceState::Ready { reference, .. } => format!("reference: {}", reference.label()),
             ReferenceState::Failed { message, .. } => format!("no reference: {message}"),
@@ -157,8 +276,9 @@ impl ReferenceState {
 /// The probe readout of a session.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Readout {
-    /// No reference (yet): the reference state's status line.
-    NoReference(String),
+    /// No reference (yet): a few words ([`ReferenceState::short_status`]) and the reference
+    /// state's status line.
+    NoReference { short: String, why: String },
     /// At rest: the error of every probe now, metres and % of the reference's size.
     Settled { error_m: f64, error_pct: f64, in_equilibrium: bool },
     /// Oscillating: the error of the first probe's mean over its last full oscillation.
@@ -185,7 +305,7 @@ impl Readout {
     pub fn error_text(&self) -> String {
         let m = |v: f64| crate::colour::format_value(v, "m");
         match *self {
-            Readout::NoReference(_) => "no reference".into(),
+            Readout::NoReference { ref short, .. } => short.clone(),
             Readout::Settled { error_m, error_pct, .. } => format!("settled error {} ({error_pct:.2} %)", m(error_m)),
             Readout::Moving { error_m, error_pct, .. } => format!("mean error {} ({error_pct:.2} %)", m(error_m)),
             Readout::Starting => "moving".into(),
@@ -197,7 +317,7 @@ impl Readout {
     pub fn short_text(&self) -> String {
         let m = |v: f64| crate::colour::format_value(v, "m");
         match *self {
-            Readout::NoReference(_) => "no reference".into(),
+            Readout::NoReference { ref short, .. } => short.clone(),
             Readout::Settled { error_m, error_pct, .. } => format!("settled: error {} ({error_pct:.2} %)", m(error_m)),
             Readout::Moving { error_m, error_pct, amplitude_m, .. } => {
                 format!("mean error {} ({error_pct:.2} %), swinging ± {}", m(error_m), m(amplitude_m))
@@ -211,7 +331,7 @@ impl Readout {
     pub fn text(&self) -> String {
         let m = crate::recording::format_metres;
         match *self {
-            Readout::NoReference(ref why) => why.clone(),
+            Readout::NoReference { ref why, .. } => why.clone(),
             Readout::Settled { error_m, error_pct, in_equilibrium } => format!(
                 "settled error {} m ({error_pct:.2} %){}",
                 m(error_m),

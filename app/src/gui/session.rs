@@ -329,10 +329,33 @@ impl Session {
     /// motion ([`Readout`]); while the reference is being computed, its progress.
     pub fn readout(&self) -> Readout {
         match (&self.readout, self.reference.reference()) {
-            (_, None) => Readout::NoReference(self.reference.status()),
+            (_, None) => self.no_reference(),
             // taken in since the last refresh (a test waiting on the computation)
-            (Readout::NoReference(_), Some(_)) => self.measure_readout(),
+            (Readout::NoReference { .. }, Some(_)) => self.measure_readout(),
             (r, Some(_)) => r.clone(),
+        }
+    }
+
+    /// While a provisional reference is in use, what it is: "reference ± 3.98 %, refining
+    /// (level 4 of 6)".
+    pub fn provisional_note(&self) -> Option<String> {
+        self.reference.reference().filter(|r| r.refining.is_some()).and(self.reference.short_status())
+    }
+
+    /// The readout under a body's label, and on a line of its own what the reference is while
+    /// it is still being refined.
+    pub fn readout_label(&self) -> String {
+        let readout = self.readout().short_text();
+        match self.provisional_note() {
+            Some(note) => format!("{readout}\n{note}"),
+            None => readout,
+        }
+    }
+
+    fn no_reference(&self) -> Readout {
+        Readout::NoReference {
+            short: self.reference.short_status().unwrap_or_else(|| "no reference".into()),
+            why: self.reference.status(),
         }
     }
 
@@ -342,7 +365,7 @@ impl Session {
 
     fn measure_readout(&self) -> Readout {
         let Some(r) = self.reference.reference() else {
-            return Readout::NoReference(self.reference.status());
+            return self.no_reference();
         };
         if self.rest.at_rest() {
             let now = self.instance.probe_displacements();
@@ -350,11 +373,11 @@ impl Session {
                 (Some(error_m), Some(error_pct)) => {
                     Readout::Settled { error_m, error_pct, in_equilibrium: self.rest.settled() }
                 }
-                _ => Readout::NoReference("the reference has none of this scene's probes".into()),
+                _ => no_reference("the reference has none of this scene's probes"),
             };
         }
         let Some(first) = self.instance.probes.first() else {
-            return Readout::NoReference("the scene has no probes".into());
+            return no_reference("the scene has no probes");
         };
         if self.instance.sim.time_secs() == 0.0 {
             return Readout::NotStarted;
@@ -372,10 +395,17 @@ impl Session {
                 period_secs,
                 drift_m: before.map(|b| (Vec3::from(mean) - Vec3::from(b)).norm()),
             },
-            _ => Readout::NoReference(format!("the reference has no probe '{}'", first.name)),
+            _ => no_reference(&format!("the reference has no probe '{}'", first.name)),
         }
     }
+}
 
+/// A readout without a reference, for `why`.
+fn no_reference(why: &str) -> Readout {
+    Readout::NoReference { short: "no reference".into(), why: format!("no reference: {why}") }
+}
+
+impl Session {
     /// Makes the simulation's mouse attachment match `drag`: replaced when the target moved,
     /// removed on release, untouched otherwise (no effect churn on the stepping path).
     fn sync_drag(&mut self) {

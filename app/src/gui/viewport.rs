@@ -382,7 +382,7 @@ impl Viewport {
                 let (lo, hi) = s.instance.sim.mesh().bounding_box();
                 let top = Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z) + o;
                 if let Some(p) = self.screen_position(top) {
-                    let text = body_label(k, &s.label(), &s.readout().short_text());
+                    let text = body_label(k, &s.label(), &s.readout_label());
                     painter.text(
                         p - egui::vec2(0.0, 14.0),
                         egui::Align2::CENTER_BOTTOM,

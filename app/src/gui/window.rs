@@ -61,6 +61,9 @@ impl HoxApp {
                     s.ms_per_frame,
                     s.readout().error_text()
                 );
+                if let Some(note) = s.reference.provisional_brief() {
+                    text += &format!(" ({note})");
+                }
                 if s.settler.is_some() {
                     text += " (settling…)";
                 }

@@ -1,5 +1,6 @@
 use super::*;
-use crate::by_name;
+use crate::{SceneOverrides, by_name};
+use hox_sim::mesh::structured::TetSplit;
 
 fn with(scene: &Scene, o: SceneOverrides) -> Scene {
     scene.with_overrides(&o).unwrap()
@@ -117,12 +118,34 @@ fn a_computed_reference_solves_three_levels_and_estimates_its_own_error() {
     let soft = with(&b, SceneOverrides { poisson_ratio: Some(0.3), ..Default::default() });
     let mut calls = 0;
     let mut last = 0.0;
-    let r = compute_with(&soft, 64, &mut |what, fraction| {
-        assert!(what.contains("Q2") && fraction >= last - 1e-12 && fraction <= 1.0 + 1e-12, "{what} {fraction}");
-        last = fraction;
-        calls += 1;
-    })
+    let mut estimates = Vec::new();
+    let r = compute_with(
+        &soft,
+        64,
+        &mut |what, fraction| {
+            assert!(what.contains("Q2") && fraction >= last - 1e-12 && fraction <= 1.0 + 1e-12, "{what} {fraction}");
+            assert!(what.starts_with("computing reference, level "), "{what}");
+            last = fraction;
+            calls += 1;
+        },
+        &mut |e| estimates.push(e.clone()),
+    )
     .unwrap();
+    // issue #35: a provisional estimate after the third level and each one after, each within
+    // its stated error of the final one
+    assert_eq!(estimates.len(), 3, "{estimates:?}");
+    for (k, e) in estimates.iter().enumerate() {
+        assert_eq!(e.refining, Some(Refining { levels_done: 3 + k, levels: 6 }));
+        assert!(
+            e.label().starts_with(&format!("provisional, levels 1–{} of 6 solved, refining", 3 + k)),
+            "{}",
+            e.label()
+        );
+        let stated = e.estimated_error_m.unwrap() + r.estimated_error_m.unwrap();
+        let off = distance(&e.probes, &r.probes);
+        assert!(off <= stated, "estimate {k}: {off:e} off the final, stated {stated:e} ({})", e.estimate);
+    }
+    assert_eq!(r.refining, None);
     assert!(calls > 3 && last > 0.99, "{calls} calls, last {last}");
     assert_eq!((r.origin, r.mesh.as_str(), r.poisson_ratio), (Origin::Computed, "Q2 12×4×4 extrapolated", 0.3));
     let tip = r.probes["tip"][2];
@@ -154,6 +177,45 @@ fn a_committed_reference_gets_its_field_on_request() {
     let field = with.field.expect("solved");
     let tip = field.lattice_at(&hox_sim::Vec3::from(b.file.probes[0].point_m)).z;
     assert!((tip / plain.probes["tip"][2] - 1.0).abs() < 0.05, "{tip} vs {:?}", plain.probes["tip"]);
+}
+
+/// Issue #35, symptom 1: compare P1 refined once against P2, type ν = 0.49 — A's readout said
+/// "cannot build the mesh: … refinement applies to tetrahedra only, not to q2" because the Q2
+/// levels inherited the configuration's refinement. A reference depends on the physics alone.
+#[test]
+fn a_refined_p1_gets_the_same_reference_as_p2() {
+    let b = by_name("bending").unwrap();
+    let nu = |element: &str, refine: usize, split: TetSplit| {
+        let o = SceneOverrides {
+            element: hox_sim::element::ElementType::from_name(element),
+            refine: Some(refine),
+            split: Some(split),
+            poisson_ratio: Some(0.49),
+            ..Default::default()
+        };
+        with(&b, o)
+    };
+    let lookup = Lookup { finest_cells: 64, cache_dir: None };
+    let (p1, p2) = (nu("p1", 1, TetSplit::Six), nu("p2", 0, TetSplit::Five));
+    assert_eq!(lookup.key(&p1), lookup.key(&p2));
+    let r = lookup.for_scene(&p1, &mut |_, _| {}).expect("the refined P1's reference");
+    assert_eq!((r.origin, r.poisson_ratio), (Origin::Computed, 0.49));
+    assert_eq!(lookup.known(&p2).unwrap(), Some(r));
+}
+
+#[test]
+fn the_levels_of_a_computed_reference_grow_and_start_small() {
+    assert_eq!(
+        grids([0.0; 3], [2.0, 0.5, 0.5], FINEST_CELLS),
+        vec![[8, 2, 2], [12, 3, 3], [16, 4, 4], [20, 5, 5], [24, 6, 6], [32, 8, 8]]
+    );
+    // the first provisional estimate needs the three coarsest: a fifth of the finest's cells
+    let g = grids([0.0; 3], [2.0, 0.5, 0.5], FINEST_CELLS);
+    let cells = |g: &[usize; 3]| g.iter().product::<usize>();
+    assert!(g[..3].iter().map(cells).sum::<usize>() * 5 < cells(&g[5]));
+    // a small box repeats no level
+    let small = grids([0.0; 3], [1.0, 1.0, 1.0], 8);
+    assert!(small.windows(2).all(|w| w[0] != w[1] && cells(&w[0]) < cells(&w[1])), "{small:?}");
 }
 
 #[test]

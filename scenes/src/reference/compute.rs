@@ -1,0 +1,268 @@
+//! Solving a reference: six static Q2 levels of the scene's box, coarse to fine, with a
+//! provisional estimate as soon as three are solved (issue #35: a class that changes ν gets a
+//! number with its error bar within seconds, refined in the background), and the static
+//! solution of a mesh file's own mesh.
+//!
+//! **Levels** ([`grids`]): a quarter, three eighths, a half, five eighths, three quarters and
+//! all of the finest grid's cells per direction ([`super::levels`]; bending: 8×2×2, 12×3×3,
+//! 16×4×4, 20×5×5, 24×6×6, 32×8×8). The eighths only serve the provisional estimates: three
+//! levels give one within seconds, four a tight one soon after (bending at ν = 0.49 on the
+//! project's 2-core machine: ± 4 % after 3 s, ± 0.1 % after 7 s, the final ± 0.05 % after
+//! 75 s; docs/APP.md). Each level is built from the physics alone ([`level_scene`]): Q2, the grid,
+//! no refinement, the element's own quadrature — whatever mesh, split, refinement or element
+//! the configuration uses.
+//!
+//! **Provisional estimates** ([`provisional`]), after every level from the third. From three
+//! levels `(h₁, u₁), (h₂, u₂), (h₃, u₃)`: the observed order `p` and Richardson's limit
+//! `u₃ + (u₃ − u₂) h₃ᵖ/(h₂ᵖ − h₃ᵖ)` (module docs of [`super`]); its stated uncertainty is
+//! Roache's grid convergence index of the finest level, `GCI = F_s |limit − u₃|` with the
+//! safety factor `F_s = 1.25` of a three-level study (Roache 1994, 1998): the whole correction
+//! and a quarter more, since coarse levels may not yet be in the asymptotic range. Without
+//! monotone convergence the finest level is the estimate and three times the larger of the last
+//! two differences its uncertainty (Roache's `F_s = 3` where no order is observed). From four levels or more, as the final reference: the finest
+//! extrapolated with the order of the last three, its uncertainty the distance to the
+//! extrapolation from the levels one and three steps coarser (with their order).
+//!
+//! **Final** (all five): the finest level extrapolated with the order of the three finest
+//! levels (½, ¾, 1), its uncertainty the distance to the extrapolation by the halving levels
+//! (¼, ½, 1): two independent estimates of the limit (unchanged from issue #20).
+
+use super::field::ReferenceField;
+use super::{Origin, Probes, Reference, Refining, distance, extrapolate, levels, mesh_error, observed_order};
+use crate::{Scene, SceneError, SceneOverrides};
+use hox_sim::Vec3;
+use hox_sim::element::ElementType;
+
+/// Progress of a computation: (what is being done, overall fraction 0–1).
+pub type Progress<'p> = &'p mut dyn FnMut(&str, f64);
+
+/// Receives each provisional reference while finer levels are solved ([`compute_with`]).
+pub type OnEstimate<'p> = &'p mut dyn FnMut(&Reference);
+
+/// Static tolerance and load steps of a computed reference: a residual of 1e-9 of the load is
+/// far below the mesh error (the committed ones went to 1e-10, which the twist scene's large
+/// rotation cannot always reach).
+pub(super) const TOLERANCE: f64 = 1e-9;
+pub(super) const LOAD_STEPS: usize = 10;
+
+/// Roache's safety factor of a grid convergence index from three levels.
+pub const SAFETY_FACTOR: f64 = 1.25;
+
+/// Roache's safety factor where no order of convergence can be observed.
+pub const UNCONVERGED_SAFETY_FACTOR: f64 = 3.0;
+
+/// How many levels a computed reference solves.
+pub const LEVELS: usize = 6;
+
+/// The scene of one reference level: the physics of `scene` on a Q2 box mesh of `grid` cells,
+/// with the element's own quadrature and no refinement, whatever the configuration's mesh
+/// (issue #35: a refined P1 passed its refinement on to the Q2 levels, which refused it).
+pub fn level_scene(scene: &Scene, grid: [usize; 3]) -> Result<Scene, SceneError> {
+    let o = SceneOverrides {
+        element: ElementType::from_name("q2"),
+        grid: Some(grid),
+        refine: Some(0),
+        quadrature_degree: Some(None),
+        ..Default::default()
+    };
+    scene.with_overrides(&o)
+}
+
+/// The six grids of a computed reference on a box (module docs), coarse to fine; a level
+/// that would repeat its coarser neighbour (a small box) is left out.
+pub fn grids(box_min_m: [f64; 3], box_max_m: [f64; 3], finest_cells: usize) -> Vec<[usize; 3]> {
+    let [quarter, half, fine] = levels(box_min_m, box_max_m, finest_cells);
+    let eighths = |k: usize| fine.map(|n| ((k * n + 4) / 8).max(1));
+    let mut out: Vec<[usize; 3]> = Vec::new();
+    for g in [quarter, eighths(3), half, eighths(5), fine.map(|n| 3 * n / 4), fine] {
+        if out.last() != Some(&g) {
+            out.push(g);
+        }
+    }
+    out
+}
+
+/// Representative cell size of a grid on the scene's box: the largest cell extent, metres.
+pub(super) fn cell_size(scene: &Scene, grid: [usize; 3]) -> f64 {
+    let p = scene.params();
+    (0..3).map(|d| (p.box_max_m[d] - p.box_min_m[d]) / grid[d] as f64).fold(0.0, f64::max)
+}
+
+fn grid_name(g: [usize; 3]) -> String {
+    format!("Q2 {}×{}×{}", g[0], g[1], g[2])
+}
+
+/// The provisional reference from the levels solved so far, `(cell size, probes)` coarse to
+/// fine (module docs); None before three.
+pub fn provisional(
+    solved: &[(f64, Probes)],
+    finest: [usize; 3],
+    levels: usize,
+    poisson_ratio: f64,
+) -> Option<Reference> {
+    let [.., b, c, d] = solved else { return None };
+    let order = |x: &(f64, Probes), y: &(f64, Probes)| observed_order(&[x.clone(), y.clone(), d.clone()]);
+    let extrapolated = format!("{} extrapolated", grid_name(finest));
+    let (probes, error_m, estimate, mesh) = match (solved.len(), order(b, c)) {
+        // four levels or more: two extrapolations of the finest, as the final reference
+        (4.., Some(p_last)) if order(&solved[solved.len() - 4], b).is_some() => {
+            let p_wide = order(&solved[solved.len() - 4], b).unwrap_or(p_last);
+            let (by_last, by_wide) = (extrapolate(c, d, p_last), extrapolate(b, d, p_wide));
+            let error_m = distance(&by_last, &by_wide);
+            (
+                by_last,
+                error_m,
+                format!("Richardson from the last four levels, order {p_last:.2}; {p_wide:.2} wider"),
+                extrapolated,
+            )
+        }
+        (_, Some(p)) => {
+            let limit = extrapolate(c, d, p);
+            let error_m = SAFETY_FACTOR * distance(&limit, &d.1);
+            (
+                limit,
+                error_m,
+                format!("Richardson from the last three levels, order {p:.2}; ± GCI, F_s = {SAFETY_FACTOR}"),
+                extrapolated,
+            )
+        }
+        (_, None) => (
+            d.1.clone(),
+            UNCONVERGED_SAFETY_FACTOR * distance(&b.1, &c.1).max(distance(&c.1, &d.1)),
+            format!(
+                "{UNCONVERGED_SAFETY_FACTOR} × the larger of the last two level differences; not yet converging monotonically"
+            ),
+            grid_name(finest),
+        ),
+    };
+    Some(Reference {
+        origin: Origin::Computed,
+        probes,
+        mesh,
+        estimated_error_m: Some(error_m),
+        estimate,
+        poisson_ratio,
+        field: None,
+        refining: Some(Refining { levels_done: solved.len(), levels }),
+    })
+}
+
+/// Computes the reference of a box scene's physics on [`LEVELS`] Q2 levels ([`grids`] with
+/// `finest_cells`), calling `on_estimate` with each provisional reference on the way.
+pub fn compute_with(
+    scene: &Scene,
+    finest_cells: usize,
+    progress: Progress<'_>,
+    on_estimate: OnEstimate<'_>,
+) -> Result<Reference, SceneError> {
+    let p = scene.params();
+    let grids = grids(p.box_min_m, p.box_max_m, finest_cells);
+    let cells: Vec<f64> = grids.iter().map(|g| (g[0] * g[1] * g[2]) as f64).collect();
+    let total: f64 = cells.iter().sum();
+    let mut done = 0.0;
+    let mut solved = Vec::new();
+    let mut finest_field = None;
+    let n = grids.len();
+    for (k, grid) in grids.iter().enumerate() {
+        let level = level_scene(scene, *grid)?;
+        let mesh = level.build_mesh()?;
+        let what = format!("computing reference, level {} of {n} (static {})", k + 1, grid_name(*grid));
+        let solution = crate::solve_static(&level, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
+            progress(&what, (done + fraction * cells[k]) / total)
+        })?;
+        done += cells[k];
+        solved.push((cell_size(scene, *grid), probes_at(&level, &mesh, &solution.positions)?));
+        if k + 1 == n {
+            finest_field = ReferenceField::lattice(&mesh, &solution.positions, p.box_min_m, p.box_max_m, *grid);
+        } else if let Some(r) = provisional(&solved, *grid, n, p.poisson_ratio) {
+            on_estimate(&r);
+        }
+    }
+    Ok(finish(&solved, &grids, p.poisson_ratio, finest_field))
+}
+
+/// The final reference from every level (module docs).
+fn finish(
+    solved: &[(f64, Probes)],
+    grids: &[[usize; 3]],
+    poisson_ratio: f64,
+    field: Option<ReferenceField>,
+) -> Reference {
+    let n = solved.len();
+    let fine = grids[n - 1];
+    // the halving levels: a half and a quarter as many cells per direction as the finest
+    let at = |g: [usize; 3]| grids.iter().position(|x| *x == g);
+    let (quarter, half) = (at(fine.map(|c| c / 4)), at(fine.map(|c| c / 2)));
+    let triplet = |i: usize, j: usize, k: usize| [solved[i].clone(), solved[j].clone(), solved[k].clone()];
+    let orders = match (quarter, half) {
+        (Some(q), Some(h)) if n >= 3 && h + 1 < n - 1 => {
+            observed_order(&triplet(q, h, n - 1)).zip(observed_order(&triplet(h, n - 2, n - 1))).map(|o| (o, h))
+        }
+        _ => None,
+    };
+    match orders {
+        Some(((p_halving, p_finest), h)) => {
+            let by_halving = extrapolate(&solved[h], &solved[n - 1], p_halving);
+            let by_finest = extrapolate(&solved[n - 2], &solved[n - 1], p_finest);
+            Reference {
+                origin: Origin::Computed,
+                estimated_error_m: Some(distance(&by_halving, &by_finest)),
+                probes: by_finest,
+                mesh: format!("{} extrapolated", grid_name(fine)),
+                estimate: format!("Richardson from four levels, order {p_finest:.2}; {p_halving:.2} by halving"),
+                poisson_ratio,
+                field,
+                refining: None,
+            }
+        }
+        None => {
+            let (error_m, estimate) = mesh_error(&solved[n.saturating_sub(3)..]);
+            Reference {
+                origin: Origin::Computed,
+                probes: solved[n - 1].1.clone(),
+                mesh: grid_name(fine),
+                estimated_error_m: Some(error_m),
+                estimate,
+                poisson_ratio,
+                field,
+                refining: None,
+            }
+        }
+    }
+}
+
+/// The displacement of every probe of `scene` at `positions` on `mesh`.
+pub(super) fn probes_at(scene: &Scene, mesh: &hox_sim::mesh::Mesh, positions: &[Vec3]) -> Result<Probes, SceneError> {
+    scene
+        .file
+        .probes
+        .iter()
+        .map(|q| {
+            let probe = hox_sim::measure::probe::Probe::locate(mesh, &q.name, Vec3::from(q.point_m))
+                .map_err(|e| SceneError::Probe { source_name: scene.source.clone(), message: e.to_string() })?;
+            let u = probe.displacement(positions, &mesh.rest_positions);
+            Ok((q.name.clone(), [u.x, u.y, u.z]))
+        })
+        .collect()
+}
+
+/// The static solution of the scene's own mesh (a mesh file's scene).
+pub fn own_mesh(scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
+    let mesh = scene.build_mesh()?;
+    let solution = crate::solve_static(scene, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
+        progress("computing reference: static solution of this mesh", fraction)
+    })?;
+    let probes = probes_at(scene, &mesh, &solution.positions)?;
+    Ok(Reference {
+        origin: Origin::OwnMesh,
+        probes,
+        mesh: format!("{} ({} elements)", scene.mesh.element_names(), mesh.num_elements()),
+        estimated_error_m: None,
+        estimate: "measures the solver's error only, not the mesh's".into(),
+        poisson_ratio: scene.params().poisson_ratio,
+        field: Some(ReferenceField::Nodes {
+            displacements_m: solution.positions.iter().zip(&mesh.rest_positions).map(|(x, r)| (x - r).into()).collect(),
+        }),
+        refining: None,
+    })
+}
