@@ -9,7 +9,10 @@
 use super::HoxApp;
 use super::session::Session;
 use eframe::egui;
-use hox_scenes::lesson::{Lesson, Measured, Run};
+use hox_scenes::lesson::{Lesson, Measure, Measured, Run};
+
+/// What the panel and the caption say while a step is prepared.
+const PREPARING: &str = "Preparing this step: building its meshes and solving what it needs…";
 
 /// Interface scale of presenter mode.
 pub const PRESENTER_ZOOM: f32 = 1.6;
@@ -26,20 +29,81 @@ pub struct LessonState {
     /// What each configuration's measurement is against, when it needs one of its own (the
     /// solver's error: the static solution of that mesh, solved when the step opens).
     own_references: Vec<Option<hox_scenes::reference::Reference>>,
+    /// The step being prepared in the background (meshes built, static solutions solved):
+    /// until it is ready the panel says so and shows no numbers (issue #35: the last step's
+    /// answer stayed 5–6 s with no sign of work).
+    preparing: Option<std::thread::JoinHandle<Prepared>>,
+}
+
+/// A step's configurations, built and (for a static step, or the solver's error) solved.
+struct Prepared {
+    sessions: Vec<Session>,
+    own_references: Vec<Option<hox_scenes::reference::Reference>>,
+    problem: Option<String>,
+}
+
+/// Builds step `step`'s configurations as the lesson runs them (`hox lesson`'s
+/// [`hox_scenes::lesson::StepRunner::start`]): a static step shows the static equilibrium, the
+/// solver's error is measured against each mesh's own static solution.
+fn prepare(step: &hox_scenes::lesson::Step) -> Prepared {
+    let mut sessions = Vec::new();
+    for scene in &step.configurations {
+        let session = hox_scenes::by_name(scene.name())
+            .map_err(|e| e.to_string())
+            .and_then(|base| Session::new(base, scene.params().clone()));
+        match session {
+            Ok(s) => sessions.push(s),
+            Err(problem) => {
+                return Prepared { sessions: Vec::new(), own_references: Vec::new(), problem: Some(problem) };
+            }
+        }
+    }
+    let own_references = step
+        .configurations
+        .iter()
+        .map(|scene| match step.measure {
+            Measure::SolverError => {
+                hox_scenes::lesson::reference_for(step.measure, scene, &mut |_, _| {}).ok().flatten()
+            }
+            _ => None,
+        })
+        .collect();
+    let mut problem = None;
+    for s in &mut sessions {
+        s.watch_min_det_f = step.measure == Measure::MinDetF;
+        if step.run == Run::Static
+            && let Err(e) = s.show_static_equilibrium()
+        {
+            problem = Some(e);
+        }
+        s.watch();
+    }
+    Prepared { sessions, own_references, problem }
 }
 
 impl LessonState {
-    /// The measurement of every session now, for the step on screen.
+    /// Whether the step on screen is still being prepared.
+    pub fn preparing(&self) -> bool {
+        self.preparing.is_some()
+    }
+
+    /// The measurement of every session now, for the step on screen: while a step plays or
+    /// settles, a settle-measured number is not yet the answer's and reads "settling…".
     pub fn measured(&self, sessions: &[Session]) -> Vec<Measured> {
-        let measure = self.lesson.steps[self.step].measure;
+        let step = &self.lesson.steps[self.step];
         sessions
             .iter()
             .enumerate()
             .map(|(k, s)| match &s.failure {
                 Some(f) => Measured { value: f64::INFINITY, text: format!("failed: {f}") },
+                None if step.run == Run::Settle && s.settle_outcome.is_none() => {
+                    Measured { value: f64::NAN, text: format!("settling… (t = {:.2} s)", s.instance.sim.time_secs()) }
+                }
                 None => {
                     let reference = self.own_references.get(k).and_then(Option::as_ref).or(s.reference.reference());
-                    hox_scenes::lesson::measure(measure, &s.instance, reference, s.ms_per_frame, f64::INFINITY)
+                    let mut ms = s.frame_ms.clone();
+                    let ms = if ms.is_empty() { f64::NAN } else { hox_scenes::median(&mut ms) };
+                    hox_scenes::lesson::measure(step.measure, &s.instance, reference, ms, s.min_det_f)
                 }
             })
             .collect()
@@ -47,7 +111,7 @@ impl LessonState {
 }
 
 impl HoxApp {
-    /// Opens `lesson` on its first step.
+    /// Opens `lesson` on its first step (prepared in the background: [`HoxApp::poll_lesson`]).
     pub fn open_lesson(&mut self, lesson: Lesson) {
         self.lesson = Some(LessonState {
             lesson,
@@ -56,60 +120,54 @@ impl HoxApp {
             play_until_secs: None,
             problem: None,
             own_references: Vec::new(),
+            preparing: None,
         });
         self.go_to_step(0);
     }
 
-    /// Sets up step `k` of the open lesson: its configurations (side by side when two), camera
-    /// and view, and starts it as it says (plays its seconds, settles, or shows the static
-    /// equilibrium).
+    /// Starts preparing step `k` of the open lesson in the background; the app pauses and the
+    /// panel says "preparing" until [`HoxApp::poll_lesson`] installs it.
     pub fn go_to_step(&mut self, k: usize) {
         let Some(state) = &mut self.lesson else { return };
         let k = k.min(state.lesson.steps.len() - 1);
         state.step = k;
         state.revealed = false;
         state.problem = None;
+        state.play_until_secs = None;
         let step = state.lesson.steps[k].clone();
-        let mut sessions = Vec::new();
-        for scene in &step.configurations {
-            let base = match hox_scenes::by_name(scene.name()) {
-                Ok(b) => b,
-                Err(e) => {
-                    state.problem = Some(e.to_string());
-                    return;
-                }
-            };
-            match Session::new(base, scene.params().clone()) {
-                Ok(s) => sessions.push(s),
-                Err(e) => {
-                    state.problem = Some(e);
-                    return;
-                }
-            }
+        // a step asked for while another is prepared replaces it (its thread's result is dropped)
+        state.preparing = Some(std::thread::spawn(move || prepare(&step)));
+        self.playback.playing = false;
+    }
+
+    /// Installs the step prepared in the background once it is ready (non-blocking; `wait`:
+    /// blocking, for the first step of `--lesson` and the tests); whether it did.
+    pub fn poll_lesson(&mut self, wait: bool) -> bool {
+        let Some(state) = &mut self.lesson else { return false };
+        if !wait && !state.preparing.as_ref().is_some_and(|h| h.is_finished()) {
+            return false;
         }
-        state.own_references = step
-            .configurations
-            .iter()
-            .map(|scene| match step.measure {
-                hox_scenes::lesson::Measure::SolverError => {
-                    hox_scenes::lesson::reference_for(step.measure, scene, &mut |_, _| {}).ok().flatten()
-                }
-                _ => None,
-            })
-            .collect();
-        if step.run == Run::Static {
-            for s in &mut sessions {
-                if let Err(e) = s.show_static_equilibrium() {
-                    state.problem = Some(e);
-                }
-            }
+        let Some(handle) = state.preparing.take() else { return false };
+        let prepared = match handle.join() {
+            Ok(p) => p,
+            Err(_) => Prepared {
+                sessions: Vec::new(),
+                own_references: Vec::new(),
+                problem: Some("preparing the step stopped unexpectedly".into()),
+            },
+        };
+        state.problem = prepared.problem;
+        if prepared.sessions.is_empty() {
+            return true;
         }
+        state.own_references = prepared.own_references;
+        let step = state.lesson.steps[state.step].clone();
         state.play_until_secs = match step.run {
             Run::Seconds(secs) => Some(secs),
             _ => None,
         };
         self.join_background();
-        self.sessions = sessions;
+        self.sessions = prepared.sessions;
         self.compare = self.sessions.len() > 1;
         self.active = 0;
         self.show_reference_element = step.reference_element;
@@ -124,9 +182,24 @@ impl HoxApp {
             .unwrap_or_default();
         self.set_camera(preset);
         self.playback.playing = step.run != Run::Static;
+        self.playback.frame_budget_secs = 0.0;
         if step.run == Run::Settle {
             self.settle();
         }
+        true
+    }
+
+    /// Whether the step on screen times its frames (their median is its measurement): its
+    /// configurations then step one after the other, as `hox lesson` steps them.
+    pub(super) fn lesson_times_frames(&self) -> bool {
+        self.lesson.as_ref().is_some_and(|l| l.lesson.steps[l.step].measure == Measure::MsPerFrame)
+    }
+
+    /// Frames left before a step that plays some seconds ends; None when none is playing.
+    pub(super) fn lesson_frames_left(&self, frame_secs: f64) -> Option<usize> {
+        let until = self.lesson.as_ref()?.play_until_secs?;
+        let t = self.sessions.first()?.instance.sim.time_secs();
+        Some(((until - t) / frame_secs - 1e-6).ceil().max(0.0) as usize)
     }
 
     /// The next (`+1`) or previous (`-1`) step.
@@ -141,7 +214,9 @@ impl HoxApp {
 
     /// Reveals the step's answer.
     pub fn reveal_answer(&mut self) {
-        if let Some(state) = &mut self.lesson {
+        if let Some(state) = &mut self.lesson
+            && !state.preparing()
+        {
             state.revealed = true;
         }
     }
@@ -210,16 +285,26 @@ pub fn lesson_panel_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.label(egui::RichText::new(format!("Question: {}", step.question)).strong());
     ui.add_space(6.0);
     ui.label(egui::RichText::new(step.measure.title()).underline());
-    for (k, (m, s)) in measured.iter().zip(&app.sessions).enumerate() {
-        ui.label(egui::RichText::new(format!("{} {}: {}", ["A", "B"][k.min(1)], s.label(), m.text)).monospace());
+    if state.preparing() {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            ui.label(PREPARING);
+        });
+    } else {
+        for (k, (m, s)) in measured.iter().zip(&app.sessions).enumerate() {
+            ui.label(egui::RichText::new(format!("{} {}: {}", ["A", "B"][k.min(1)], s.label(), m.text)).monospace());
+        }
     }
     if let Some(p) = &state.problem {
         ui.colored_label(egui::Color32::from_rgb(255, 120, 90), p);
     }
     ui.add_space(6.0);
-    let revealed = state.revealed;
+    // no answer while the step is prepared: the numbers it speaks of are not there yet
+    let (revealed, preparing) = (state.revealed, state.preparing());
     let (at, answer) = (state.step, step.answer.clone());
-    if revealed {
+    if preparing {
+        ui.label(egui::RichText::new("(the answer once the step is ready)").weak());
+    } else if revealed {
         ui.label(egui::RichText::new(format!("Answer: {answer}")).color(egui::Color32::from_rgb(250, 220, 120)));
     } else if ui.button("Reveal the answer (A)").clicked() {
         app.reveal_answer();
@@ -256,6 +341,10 @@ pub fn caption_ui(app: &HoxApp, ctx: &egui::Context) {
                         .color(egui::Color32::WHITE),
                 );
                 ui.label(egui::RichText::new(&step.question).color(egui::Color32::WHITE));
+                if state.preparing() {
+                    ui.label(egui::RichText::new(PREPARING).color(egui::Color32::from_rgb(250, 220, 120)));
+                    return;
+                }
                 for (k, m) in measured.iter().enumerate() {
                     ui.label(
                         egui::RichText::new(format!("{}: {}", ["A", "B"][k.min(1)], m.text))

@@ -179,6 +179,7 @@ impl HoxApp {
             let lesson = crate::config::load_lesson(args.lesson.as_deref(), args.lesson_file.as_deref())
                 .map_err(|e| format!("{e:#}"))?;
             app.open_lesson(lesson);
+            app.poll_lesson(true);
         }
         if args.presenter {
             app.set_presenter(true);
@@ -401,11 +402,17 @@ impl HoxApp {
         self.rebuilt();
     }
 
-    /// Advances every session by `frames` frames (in parallel in compare mode).
+    /// Advances every session by `frames` frames (in parallel in compare mode); a *Settle* that
+    /// ends on the way stops there, at rest (issue #35: the frames left ran on undamped).
     pub fn step(&mut self, frames: usize) {
         self.join_background();
+        let one_at_a_time = self.lesson_times_frames();
+        let settling = self.settling();
         for _ in 0..frames {
-            step_sessions(&mut self.sessions);
+            if settling && !self.settling() {
+                break;
+            }
+            step_sessions(&mut self.sessions, one_at_a_time);
             self.log_rerun();
             if let Some(m) = &mut self.measure {
                 m.sim_frames += 1;

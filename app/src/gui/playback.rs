@@ -47,9 +47,16 @@ impl HoxApp {
             return;
         }
         let mut sessions = std::mem::take(&mut self.sessions);
+        let one_at_a_time = self.lesson_times_frames();
         let handle = std::thread::spawn(move || {
+            let settling = |s: &[Session]| s.iter().any(|s| s.settler.is_some());
+            let was_settling = settling(&sessions);
             for _ in 0..frames {
-                step_sessions(&mut sessions);
+                // a settle that ends stops there, at rest (as [`HoxApp::step`])
+                if was_settling && !settling(&sessions) {
+                    break;
+                }
+                step_sessions(&mut sessions, one_at_a_time);
             }
             sessions
         });
@@ -141,17 +148,30 @@ impl HoxApp {
             self.step_or_defer(1);
             return;
         }
-        let frames = self.playback.frames_due(real_dt_secs, frame_secs);
+        let mut frames = self.playback.frames_due(real_dt_secs, frame_secs);
+        // a lesson step that plays some seconds ends on its last frame exactly, as `hox lesson`
+        if let Some(left) = self.lesson_frames_left(frame_secs) {
+            frames = frames.min(left);
+        }
         self.step_or_defer(frames);
     }
 }
 
-/// One frame of every session (in parallel in compare mode).
-pub(super) fn step_sessions(sessions: &mut [Session]) {
+/// One frame of every session: in parallel in compare mode, unless `one_at_a_time` (a lesson
+/// timing frames: each configuration then has the cores to itself, as in `hox lesson`). While a
+/// *Settle* is under way, a configuration that has settled waits at rest for the other (issue
+/// #35: it ran on undamped and read other numbers than `hox lesson`).
+pub(super) fn step_sessions(sessions: &mut [Session], one_at_a_time: bool) {
     use rayon::prelude::*;
-    if sessions.len() > 1 {
-        sessions.par_iter_mut().for_each(|s| s.step(1));
-    } else if let Some(s) = sessions.first_mut() {
-        s.step(1);
+    let settling = sessions.iter().any(|s| s.settler.is_some());
+    let step = |s: &mut Session| {
+        if !settling || s.settler.is_some() {
+            s.step(1);
+        }
+    };
+    if one_at_a_time || sessions.len() == 1 {
+        sessions.iter_mut().for_each(step);
+    } else {
+        sessions.par_iter_mut().for_each(step);
     }
 }

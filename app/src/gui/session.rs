@@ -78,6 +78,13 @@ pub struct Session {
     readout: Readout,
     /// Wall time of the last frames' stepping, exponentially averaged, milliseconds.
     pub ms_per_frame: f64,
+    /// Wall time of every frame stepped since the last reset (at most [`FRAME_MS_KEPT`]), ms: a
+    /// lesson's "ms per frame" is their median, as `hox lesson`'s.
+    pub frame_ms: Vec<f64>,
+    /// The smallest det F over every quadrature point since the last reset, when
+    /// `watch_min_det_f` (a lesson measuring it; each frame costs a pass over the elements).
+    pub min_det_f: f64,
+    pub watch_min_det_f: bool,
     /// The static residual at the last frame: the unbalanced force on the free nodes relative to
     /// the load ([`hox_sim::solver::StaticResidual`]).
     pub residual: f64,
@@ -130,6 +137,9 @@ impl Session {
             driven_until_secs,
             readout: Readout::NotStarted,
             ms_per_frame: 0.0,
+            frame_ms: Vec::new(),
+            min_det_f: f64::INFINITY,
+            watch_min_det_f: false,
             residual: f64::NAN,
             failure: None,
             drag: None,
@@ -250,8 +260,21 @@ impl Session {
         self.settle_outcome = None;
         self.rest = RestWatch::new(&self.instance);
         self.history = History::default();
+        self.frame_ms.clear();
+        self.min_det_f = f64::INFINITY;
+        self.watch();
         self.record();
         self.refresh_readout();
+    }
+
+    /// Takes the smallest det F in, when watched.
+    pub fn watch(&mut self) {
+        if self.watch_min_det_f {
+            let sim = &self.instance.sim;
+            if let Some(m) = hox_sim::measure::min_det_f(sim.mesh(), sim.geometry(), &sim.positions) {
+                self.min_det_f = self.min_det_f.min(m.det_f);
+            }
+        }
     }
 
     /// Steps `frames` frames (stopping at a failure).
@@ -265,11 +288,15 @@ impl Session {
             let result = self.instance.sim.step_frame();
             let ms = t0.elapsed().as_secs_f64() * 1e3;
             self.ms_per_frame = if self.ms_per_frame == 0.0 { ms } else { 0.9 * self.ms_per_frame + 0.1 * ms };
+            if self.frame_ms.len() < FRAME_MS_KEPT {
+                self.frame_ms.push(ms);
+            }
             if let Err(e) = result {
                 self.failure = Some(format!("{e} — press Reset (R)"));
                 self.settler = None;
                 break;
             }
+            self.watch();
             self.record();
             let driving = self.instance.sim.time_secs() < self.driven_until_secs || self.drag.is_some();
             self.rest.observe(&self.instance, driving);
@@ -399,6 +426,9 @@ impl Session {
         }
     }
 }
+
+/// How many frames' wall times a session keeps ([`Session::frame_ms`]).
+pub const FRAME_MS_KEPT: usize = 10_000;
 
 /// A readout without a reference, for `why`.
 fn no_reference(why: &str) -> Readout {

@@ -119,6 +119,13 @@ fn compare_mode_links_controls_and_shows_both_errors() {
     assert!(status_count(&h) == 2);
 }
 
+/// Waits until the lesson step asked for is prepared and installed.
+fn lesson_ready(h: &mut Harness<'_, HoxApp>) {
+    h.run_steps(1);
+    h.state_mut().poll_lesson(true);
+    h.run_steps(2);
+}
+
 fn status_count(h: &Harness<'_, HoxApp>) -> usize {
     h.query_all_by_label_contains("nodes,").count()
 }
@@ -476,12 +483,18 @@ fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
     h.run_steps(2);
     h.get_by_label_contains("Answer: B does");
     h.key_press(egui::Key::ArrowRight);
-    h.run_steps(3);
+    h.run_steps(1);
+    // issue #35: while the step is prepared the panel says so, with neither numbers nor answer
     h.get_by_label_contains("Step 2 of 3: Does high order help?");
+    if h.state().lesson.as_ref().unwrap().preparing() {
+        h.get_by_label_contains("Preparing this step");
+        assert!(h.query_by_label_contains("Answer: B does").is_none(), "the last step's answer is gone");
+    }
+    lesson_ready(&mut h);
     assert!(h.state().sessions.iter().all(|s| s.config.element.name() == "p2"));
     assert!(h.query_by_label_contains("Answer:").is_none(), "a new step hides its answer");
     h.key_press(egui::Key::ArrowLeft);
-    h.run_steps(3);
+    lesson_ready(&mut h);
     h.get_by_label_contains("Step 1 of 3");
     // presenter mode: no side panels; the caption carries the numbers
     h.key_press(egui::Key::P);
@@ -705,4 +718,71 @@ fn a_reference_no_longer_wanted_stops_computing() {
     std::thread::sleep(std::time::Duration::from_millis(200));
     assert!(readout::lookup().known(&at(0.47)).unwrap().is_none());
     assert!(readout::lookup().known(&at(0.46)).unwrap().is_some());
+}
+
+/// Plays the open lesson's step as the window would, frame by frame of egui's clock, until it
+/// pauses (its seconds played, or settled).
+fn play_step_to_its_end(app: &mut HoxApp) {
+    for _ in 0..200_000 {
+        if !app.playback.playing {
+            return;
+        }
+        app.advance(1.0 / 60.0);
+        app.join_background();
+        app.lesson_after_advance();
+    }
+    panic!("the step never ended");
+}
+
+/// Issue #35, symptom 4: lessons showed other numbers than `hox lesson` (why-high-order step 1
+/// stopped at 0.47–0.48 s instead of 0.45 s), and different ones each run. Every lesson, run
+/// twice in the app and once headlessly, shows the same numbers to the digits shown; a time per
+/// frame (the machine's) only has to be measured.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "every lesson three times: release only, run by .ci/run")]
+fn every_lesson_shows_the_same_numbers_in_the_app_as_headlessly() {
+    use hox_scenes::lesson::{Measure, Run};
+    for lesson in hox_scenes::lesson::registry().unwrap() {
+        let headless: Vec<Vec<String>> = lesson
+            .steps
+            .iter()
+            .map(|step| {
+                let (_, measured) = hox_scenes::lesson::run_step(step, &mut |_, _| {}).unwrap();
+                measured.into_iter().map(|m| m.text).collect()
+            })
+            .collect();
+        let mut runs = Vec::new();
+        for _ in 0..2 {
+            let mut app = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap();
+            app.open_lesson(lesson.clone());
+            let mut shown = Vec::new();
+            for (k, step) in lesson.steps.iter().enumerate() {
+                app.go_to_step(k);
+                assert!(app.lesson.as_ref().unwrap().preparing());
+                app.poll_lesson(true);
+                play_step_to_its_end(&mut app);
+                if let Run::Seconds(secs) = step.run {
+                    let t = app.sessions[0].instance.sim.time_secs();
+                    assert!((t - secs).abs() < 1e-9, "{} step {}: ended at {t} s, not {secs} s", lesson.name, k + 1);
+                }
+                let state = app.lesson.as_ref().unwrap();
+                shown.push(state.measured(&app.sessions).into_iter().map(|m| m.text).collect::<Vec<_>>());
+            }
+            runs.push(shown);
+        }
+        for (k, step) in lesson.steps.iter().enumerate() {
+            let what = format!("{} step {} ({})", lesson.name, k + 1, step.measure.name());
+            if step.measure == Measure::MsPerFrame {
+                for texts in [&runs[0][k], &runs[1][k], &headless[k]] {
+                    assert!(
+                        texts.iter().all(|t| t.ends_with("ms per frame") && !t.contains("NaN")),
+                        "{what}: {texts:?}"
+                    );
+                }
+                continue;
+            }
+            assert_eq!(runs[0][k], headless[k], "{what}: the app against hox lesson");
+            assert_eq!(runs[1][k], runs[0][k], "{what}: the app's second run against its first");
+        }
+    }
 }

@@ -123,6 +123,11 @@ impl HoxApp {
         if computing {
             ctx.request_repaint_after(std::time::Duration::from_millis(250));
         }
+        if self.lesson.as_ref().is_some_and(|l| l.preparing()) {
+            // a lesson step being prepared: look again soon
+            self.poll_lesson(false);
+            ctx.request_repaint_after(std::time::Duration::from_millis(50));
+        }
         self.shortcuts(&ctx);
         self.lesson_shortcuts(&ctx);
         if let Some(z) = self.zoom_wanted.take() {
