@@ -283,8 +283,11 @@ pub enum Readout {
     Settled { error_m: f64, error_pct: f64, in_equilibrium: bool },
     /// Oscillating: the error of the first probe's mean over its last full oscillation.
     Moving { error_m: f64, error_pct: f64, amplitude_m: f64, period_secs: f64, drift_m: Option<f64> },
-    /// Moving, but no full oscillation recorded yet.
-    Starting,
+    /// Moving, but no full oscillation recorded yet; `paused` mid-swing (issue #35: a paused
+    /// beam read "moving").
+    Starting { paused: bool },
+    /// The static equilibrium, solved and shown (a lesson's static step): its error.
+    Static { error_m: f64, error_pct: f64 },
     /// Not run yet: at t = 0, the start state (issue #35: it read "moving").
     NotStarted,
 }
@@ -295,7 +298,7 @@ impl Readout {
     /// means (or, with only one, the amplitude).
     pub fn error_with_uncertainty_m(&self) -> Option<(f64, f64)> {
         match *self {
-            Readout::Settled { error_m, .. } => Some((error_m, 0.0)),
+            Readout::Settled { error_m, .. } | Readout::Static { error_m, .. } => Some((error_m, 0.0)),
             Readout::Moving { error_m, amplitude_m, drift_m, .. } => Some((error_m, drift_m.unwrap_or(amplitude_m))),
             _ => None,
         }
@@ -307,8 +310,10 @@ impl Readout {
         match *self {
             Readout::NoReference { ref short, .. } => short.clone(),
             Readout::Settled { error_m, error_pct, .. } => format!("settled error {} ({error_pct:.2} %)", m(error_m)),
+            Readout::Static { error_m, error_pct } => format!("static, error {} ({error_pct:.2} %)", m(error_m)),
             Readout::Moving { error_m, error_pct, .. } => format!("mean error {} ({error_pct:.2} %)", m(error_m)),
-            Readout::Starting => "moving".into(),
+            Readout::Starting { paused: false } => "moving".into(),
+            Readout::Starting { paused: true } => "paused mid-swing".into(),
             Readout::NotStarted => "not started".into(),
         }
     }
@@ -319,10 +324,14 @@ impl Readout {
         match *self {
             Readout::NoReference { ref short, .. } => short.clone(),
             Readout::Settled { error_m, error_pct, .. } => format!("settled: error {} ({error_pct:.2} %)", m(error_m)),
+            Readout::Static { error_m, error_pct } => {
+                format!("static equilibrium: error {} ({error_pct:.2} %)", m(error_m))
+            }
             Readout::Moving { error_m, error_pct, amplitude_m, .. } => {
                 format!("mean error {} ({error_pct:.2} %), swinging ± {}", m(error_m), m(amplitude_m))
             }
-            Readout::Starting => "moving".into(),
+            Readout::Starting { paused: false } => "moving".into(),
+            Readout::Starting { paused: true } => "paused mid-swing".into(),
             Readout::NotStarted => "not started".into(),
         }
     }
@@ -343,7 +352,15 @@ impl Readout {
                 drift_m.map(|d| format!(" ± {}", m(d))).unwrap_or_default(),
                 m(amplitude_m)
             ),
-            Readout::Starting => "moving: no full oscillation yet (Settle for the equilibrium)".into(),
+            Readout::Static { error_m, error_pct } => {
+                format!("static equilibrium (solved, shown at rest): error {} m ({error_pct:.2} %)", m(error_m))
+            }
+            Readout::Starting { paused: false } => {
+                "moving: no full oscillation yet (Settle for the equilibrium)".into()
+            }
+            Readout::Starting { paused: true } => {
+                "paused mid-swing: no full oscillation yet (Play, or Settle for the equilibrium)".into()
+            }
             Readout::NotStarted => "not started: t = 0 (Play, Step or Settle)".into(),
         }
     }

@@ -85,6 +85,10 @@ pub struct Session {
     /// `watch_min_det_f` (a lesson measuring it; each frame costs a pass over the elements).
     pub min_det_f: f64,
     pub watch_min_det_f: bool,
+    /// The static equilibrium was solved and is shown, not stepped since.
+    pub shown_static: bool,
+    /// The app is paused (set by the app every frame): a swing not yet complete reads "paused".
+    pub paused: bool,
     /// The static residual at the last frame: the unbalanced force on the free nodes relative to
     /// the load ([`hox_sim::solver::StaticResidual`]).
     pub residual: f64,
@@ -140,6 +144,8 @@ impl Session {
             frame_ms: Vec::new(),
             min_det_f: f64::INFINITY,
             watch_min_det_f: false,
+            shown_static: false,
+            paused: true,
             residual: f64::NAN,
             failure: None,
             drag: None,
@@ -262,6 +268,7 @@ impl Session {
         self.history = History::default();
         self.frame_ms.clear();
         self.min_det_f = f64::INFINITY;
+        self.shown_static = false;
         self.watch();
         self.record();
         self.refresh_readout();
@@ -283,6 +290,7 @@ impl Session {
             return;
         }
         self.sync_drag();
+        self.shown_static &= frames == 0;
         for _ in 0..frames {
             let t0 = Instant::now();
             let result = self.instance.sim.step_frame();
@@ -333,6 +341,7 @@ impl Session {
             .map_err(|e| e.to_string())?;
         self.instance.sim.warm_start(&solution.positions, 0.0);
         self.history = History::default();
+        self.shown_static = true;
         self.record();
         self.residual = self.force_residual();
         self.refresh_readout();
@@ -359,6 +368,7 @@ impl Session {
             (_, None) => self.no_reference(),
             // taken in since the last refresh (a test waiting on the computation)
             (Readout::NoReference { .. }, Some(_)) => self.measure_readout(),
+            (Readout::Starting { .. }, Some(_)) => Readout::Starting { paused: self.paused },
             (r, Some(_)) => r.clone(),
         }
     }
@@ -394,6 +404,13 @@ impl Session {
         let Some(r) = self.reference.reference() else {
             return self.no_reference();
         };
+        if self.shown_static {
+            let now = self.instance.probe_displacements();
+            return match (r.error_m(&now), r.error_pct(&now)) {
+                (Some(error_m), Some(error_pct)) => Readout::Static { error_m, error_pct },
+                _ => no_reference("the reference has none of this scene's probes"),
+            };
+        }
         if self.rest.at_rest() {
             let now = self.instance.probe_displacements();
             return match (r.error_m(&now), r.error_pct(&now)) {
@@ -411,7 +428,7 @@ impl Session {
         }
         let h = &self.history;
         let Some((mean, amplitude_m, period_secs, before)) = last_oscillation(&h.time_secs, &h.probe_m) else {
-            return Readout::Starting;
+            return Readout::Starting { paused: self.paused };
         };
         let one = |u: [f64; 3]| vec![(first.name.clone(), u)];
         match (r.error_m(&one(mean)), r.error_pct(&one(mean))) {

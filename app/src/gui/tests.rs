@@ -606,8 +606,35 @@ fn a_beam_not_yet_run_is_not_called_moving() {
     assert!(s.contains("not started") && !s.contains("moving"), "{s}");
     h.state_mut().step(3);
     h.run_steps(2);
+    // stepped while paused: it is mid-swing, and says it is paused (it read "moving")
     let s = status(&h);
-    assert!(s.contains("moving") && !s.contains("not started"), "{s}");
+    assert!(s.contains("paused mid-swing") && !s.contains("not started") && !s.contains("moving"), "{s}");
+    h.state_mut().playback.playing = true;
+    h.run_steps(2);
+    let s = status(&h);
+    assert!(s.contains("moving") && !s.contains("paused mid-swing"), "{s}");
+}
+
+/// Issue #35, symptoms 6 and 8: the solver's effect on the motion is said where it is chosen;
+/// a lesson's static step reads "static equilibrium", not "moving" or "not started".
+#[test]
+fn the_solver_says_what_it_does_to_the_motion_and_a_static_step_says_static() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    h.get_by_label_contains("Keeps the motion");
+    let app = h.state_mut();
+    let mut c = app.sessions[0].config.clone();
+    c.method = hox_sim::solver::Method::Newton;
+    app.apply("solver", c);
+    h.run_steps(2);
+    h.get_by_label_contains("it damps the motion");
+    assert!(h.query_by_label_contains("Keeps the motion").is_none());
+    let mut h = harness(args::parse_for_test(&["--lesson", "mesh-bias"]));
+    h.run_steps(3);
+    for s in &h.state().sessions {
+        assert!(s.readout_label().starts_with("static equilibrium: error"), "{}", s.readout_label());
+    }
+    assert_eq!(h.query_all_by_label_contains("static, error").count(), 2, "both status lines say static");
 }
 
 /// Issue #35, symptoms 1–2: the default comparison (P1 refined once against P2) at ν = 0.49.

@@ -143,6 +143,10 @@ impl HoxApp {
         self.advance(if self.playback.last_clock_frame { clock_dt } else { 0.0 });
         self.lesson_after_advance();
         self.playback.last_clock_frame = true;
+        let paused = !self.playback.playing && !self.settling();
+        for s in &mut self.sessions {
+            s.paused = paused;
+        }
 
         // The panels are not filled: the window is cleared to the panel colour (`clear_color`), and
         // a software renderer pays per blended pixel for each fill (docs/APP.md).
