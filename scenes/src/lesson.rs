@@ -28,7 +28,7 @@
 //! accept are errors naming the file, the step and the key. [`run_step`] runs a step headlessly
 //! and measures it: the CLI's recordings, the app and the tests share it.
 
-use crate::params::{PARAMS, Value};
+use crate::params::{PARAMS, Param, Value};
 use crate::{Instance, Scene, SceneError, SceneOverrides};
 use serde::Deserialize;
 
@@ -597,6 +597,33 @@ pub fn shape_minimum(element: hox_sim::element::ElementType) -> f64 {
         }
     }
     lowest
+}
+
+impl Lesson {
+    /// The parameters its steps change: every key of the parameter table whose value differs
+    /// between any two configurations of the lesson (A and B, or one step and the next), in
+    /// the table's order (issue #35: the locking lesson never showed ν, its one parameter).
+    pub fn parameters_changed(&self) -> Vec<&'static Param> {
+        let scenes: Vec<&Scene> = self.steps.iter().flat_map(|s| &s.configurations).collect();
+        PARAMS
+            .iter()
+            .filter(|p| p.surfaces.app)
+            .filter(|p| scenes.windows(2).any(|w| (p.get)(w[0].params()) != (p.get)(w[1].params())))
+            .collect()
+    }
+
+    /// One line per configuration of step `k`: its values of [`Lesson::parameters_changed`],
+    /// "Element P1 · Poisson ratio ν 0.49".
+    pub fn step_parameters(&self, k: usize) -> Vec<String> {
+        let changed = self.parameters_changed();
+        self.steps[k]
+            .configurations
+            .iter()
+            .map(|scene| {
+                changed.iter().map(|p| format!("{} {}", p.label, parameter(scene, p.key))).collect::<Vec<_>>().join(" · ")
+            })
+            .collect()
+    }
 }
 
 /// The value of parameter `key` in `scene` as text (for captions): "p2", "0.49".

@@ -280,6 +280,9 @@ pub fn lesson_panel_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.label(egui::RichText::new(&state.lesson.goal).italics());
     ui.separator();
     ui.label(egui::RichText::new(format!("Step {} of {n}: {}", state.step + 1, step.title)).strong().size(18.0));
+    for (k, line) in state.lesson.step_parameters(state.step).iter().enumerate() {
+        ui.label(egui::RichText::new(format!("{}: {line}", ["A", "B"][k.min(1)])).monospace());
+    }
     ui.label(&step.text);
     ui.add_space(6.0);
     ui.label(egui::RichText::new(format!("Question: {}", step.question)).strong());
@@ -340,6 +343,13 @@ pub fn caption_ui(app: &HoxApp, ctx: &egui::Context) {
                         .strong()
                         .color(egui::Color32::WHITE),
                 );
+                for (k, line) in state.lesson.step_parameters(state.step).iter().enumerate() {
+                    ui.label(
+                        egui::RichText::new(format!("{}: {line}", ["A", "B"][k.min(1)]))
+                            .monospace()
+                            .color(egui::Color32::from_rgb(200, 200, 200)),
+                    );
+                }
                 ui.label(egui::RichText::new(&step.question).color(egui::Color32::WHITE));
                 if state.preparing() {
                     ui.label(egui::RichText::new(PREPARING).color(egui::Color32::from_rgb(250, 220, 120)));

@@ -471,6 +471,8 @@ fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
     let mut h = harness(args::parse_for_test(&["--lesson", "mesh-bias"]));
     h.run_steps(3);
     h.get_by_label_contains("Step 1 of 3: Five against six");
+    // the parameters the lesson's steps change (issue #35)
+    h.get_by_label_contains("A: Element p1 · Tet split five");
     h.get_by_label_contains("Question: Does either tip move sideways");
     let labels: Vec<String> = h.state().sessions.iter().map(|s| s.label()).collect();
     assert_eq!(labels, ["P1 8×2×2 five", "P1 8×2×2 six"]);
@@ -500,7 +502,7 @@ fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
     h.key_press(egui::Key::P);
     h.run_steps(3);
     assert!(h.state().presenter);
-    assert!(h.query_by_label_contains("Young's modulus").is_none(), "the controls are hidden");
+    assert!(h.query_by_label_contains("Compare two configurations").is_none(), "the controls are hidden");
     h.get_by_label_contains("Mesh bias — Five against six");
     h.get_by_label_contains("B: 0.027");
 }

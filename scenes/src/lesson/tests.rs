@@ -70,3 +70,17 @@ fn high_order_shape_functions_have_negative_lobes() {
     assert!((p("p2") + 0.125).abs() < 1e-3, "{}", p("p2"));
     assert!(p("p3") < -0.05, "{}", p("p3"));
 }
+
+/// Issue #35: a lesson shows the parameters its steps change (the locking lesson never showed
+/// ν, its one parameter).
+#[test]
+fn a_lesson_names_the_parameters_its_steps_change() {
+    let locking = registry().unwrap().into_iter().find(|l| l.name == "locking").unwrap();
+    let keys: Vec<&str> = locking.parameters_changed().iter().map(|p| p.key).collect();
+    assert!(keys.contains(&"poisson") && keys.contains(&"element") && keys.contains(&"grid"), "{keys:?}");
+    assert!(!keys.contains(&"youngs") && !keys.contains(&"substeps"), "{keys:?}");
+    let lines = locking.step_parameters(1);
+    assert_eq!(lines.len(), 2);
+    assert!(lines[0].contains("Poisson ratio ν 0.49") && lines[0].contains("p1"), "{lines:?}");
+    assert!(lines[1].contains("Poisson ratio ν 0.49") && lines[1].contains("p2"), "{lines:?}");
+}
