@@ -620,7 +620,11 @@ impl Lesson {
             .configurations
             .iter()
             .map(|scene| {
-                changed.iter().map(|p| format!("{} {}", p.label, parameter(scene, p.key))).collect::<Vec<_>>().join(" · ")
+                changed
+                    .iter()
+                    .map(|p| format!("{} {}", p.label, parameter(scene, p.key)))
+                    .collect::<Vec<_>>()
+                    .join(" · ")
             })
             .collect()
     }

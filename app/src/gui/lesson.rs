@@ -399,20 +399,25 @@ pub fn welcome_ui(app: &mut HoxApp, ctx: &egui::Context) {
         return;
     }
     let mut open = true;
-    egui::Window::new("Welcome to hox").collapsible(false).open(&mut open).show(ctx, |ui| {
-        ui.label("Start with a guided lesson, or explore freely (the Lessons menu has them all).");
-        if let Ok(all) = hox_scenes::lesson::registry() {
-            for l in all {
-                if ui.button(&l.title).on_hover_text(&l.goal).clicked() {
-                    app.open_lesson(l);
-                    app.offer_lessons = false;
+    // centred in the window, below the menu bar it used to cover (issue #35)
+    egui::Window::new("Welcome to hox")
+        .collapsible(false)
+        .anchor(egui::Align2::CENTER_CENTER, egui::vec2(0.0, 0.0))
+        .open(&mut open)
+        .show(ctx, |ui| {
+            ui.label("Start with a guided lesson, or explore freely (the Lessons menu has them all).");
+            if let Ok(all) = hox_scenes::lesson::registry() {
+                for l in all {
+                    if ui.button(&l.title).on_hover_text(&l.goal).clicked() {
+                        app.open_lesson(l);
+                        app.offer_lessons = false;
+                    }
                 }
             }
-        }
-        if ui.button("Explore freely").clicked() {
-            app.offer_lessons = false;
-        }
-    });
+            if ui.button("Explore freely").clicked() {
+                app.offer_lessons = false;
+            }
+        });
     if !open {
         app.offer_lessons = false;
     }

@@ -18,6 +18,7 @@
 mod args;
 pub mod config;
 pub mod controls;
+mod cost;
 pub mod gl_view;
 pub mod lesson;
 mod links;
@@ -63,6 +64,8 @@ pub struct HoxApp {
     /// The last refused change: control, reason, when.
     pub refusal: Option<(String, String)>,
     pub message: Option<String>,
+    /// A slow change waiting for the user's answer ([`cost`]).
+    pub pending_change: Option<cost::PendingChange>,
     pub show_reference_element: bool,
     pub reference_element: teach::ReferenceElementView,
     pub bottom_tab: plots::Tab,
@@ -132,6 +135,7 @@ impl HoxApp {
             playback: Playback::new(args.play, saved.as_ref().map_or(1.0, |s| s.time_scale)),
             refusal: None,
             message: None,
+            pending_change: None,
             show_reference_element: saved.as_ref().is_some_and(|s| s.show_reference_element),
             reference_element: teach::ReferenceElementView::default(),
             bottom_tab: plots::Tab::default(),
@@ -338,8 +342,18 @@ impl HoxApp {
     }
 
     /// Applies `new` to the active session and, in compare mode, the linked fields to the
-    /// other. A refusal keeps everything as it was and records the reason.
+    /// other; a change estimated too slow to play waits for the user's answer ([`cost`]). A
+    /// refusal keeps everything as it was and records the reason.
     pub fn apply(&mut self, control: &str, new: Config) {
+        if let Some(estimate) = self.too_slow(&new) {
+            self.pending_change = Some(cost::PendingChange { control: control.to_string(), config: new, estimate });
+            return;
+        }
+        self.apply_now(control, new);
+    }
+
+    /// [`HoxApp::apply`] without asking.
+    pub fn apply_now(&mut self, control: &str, new: Config) {
         let k = self.active;
         let old = self.sessions[k].config.clone();
         match self.sessions[k].apply(new.clone()) {

@@ -186,6 +186,9 @@ impl Session {
                 self.settler = None;
                 self.settle_outcome = None;
                 self.rest = RestWatch::new(&self.instance);
+                // the old mesh's frame time says nothing of the new one's
+                self.ms_per_frame = 0.0;
+                self.frame_ms.clear();
                 self.driven_until_secs = hox_scenes::driven_until_secs(&self.instance.scene.file.effects);
                 self.mesh_changed();
                 self.residual = self.force_residual();

@@ -815,3 +815,39 @@ fn every_lesson_shows_the_same_numbers_in_the_app_as_headlessly() {
         }
     }
 }
+
+/// Issue #35, symptom 7: refine 3 was accepted without a word and froze the window (13.6 s per
+/// frame; the next typed value was lost). A change estimated too slow to play asks first,
+/// keeping the current configuration until answered; a frame that is slow anyway pauses.
+#[test]
+fn a_change_too_slow_to_play_asks_first_and_a_slow_frame_pauses() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    // as measured on a machine where the P2 beam takes 5 ms per frame
+    h.state_mut().sessions[0].ms_per_frame = 5.0;
+    let app = h.state_mut();
+    let mut c = app.sessions[0].config.clone();
+    c.refine = 2;
+    app.apply("refine", c.clone());
+    assert!(app.pending_change.is_some(), "64 times the elements: asked first");
+    assert_eq!(app.sessions[0].instance.sim.mesh().num_elements(), 160, "nothing changed yet");
+    h.run_steps(2);
+    let question = text(&h, "elements, ");
+    assert!(question.contains("10240 elements") && question.contains("per frame"), "{question}");
+    h.get_by_label("Keep the current configuration").click();
+    h.run_steps(2);
+    assert!(h.state().pending_change.is_none());
+    assert_eq!(h.state().sessions[0].config.refine, 0);
+    h.state_mut().apply("refine", c);
+    h.run_steps(1);
+    h.get_by_label("Apply, paused").click();
+    h.run_steps(2);
+    assert_eq!(h.state().sessions[0].instance.sim.mesh().num_elements(), 10240);
+    assert!(!h.state().playback.playing);
+    // a frame slower than the limit pauses a playing app, saying why
+    h.state_mut().playback.playing = true;
+    h.state_mut().sessions[0].ms_per_frame = 2.0 * super::cost::SLOW_FRAME_MS;
+    h.run_steps(1);
+    assert!(!h.state().playback.playing, "paused");
+    assert!(h.state().message.as_deref().is_some_and(|m| m.starts_with("Paused: a frame takes")));
+}

@@ -142,6 +142,7 @@ impl HoxApp {
         let clock_dt = f64::from(ctx.input(|i| i.unstable_dt));
         self.advance(if self.playback.last_clock_frame { clock_dt } else { 0.0 });
         self.lesson_after_advance();
+        self.pause_if_slow();
         self.playback.last_clock_frame = true;
         let paused = !self.playback.playing && !self.settling();
         for s in &mut self.sessions {
@@ -179,6 +180,7 @@ impl HoxApp {
             self.show_reference_element = open;
         }
         controls::open_dialog_ui(self, &ctx);
+        super::cost::pending_change_ui(self, &ctx);
         egui::CentralPanel::no_frame().show(ui, |ui| {
             let offsets = self.offsets();
             self.viewport.ui(ui, &mut self.sessions, &offsets, &self.view, self.gl_available);

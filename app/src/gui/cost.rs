@@ -1,0 +1,121 @@
+//! Guard rails for expensive settings (issue #35: refine 3 gave 81,920 elements and 368
+//! substeps, 13.6 s per frame; the window ran at about 1 fps and the next typed value was lost).
+//!
+//! - **Before**: a change that rebuilds or re-tunes a configuration is estimated first. The
+//!   frame's work is `Σ elements × quadrature points × nodes per element` times the solver's
+//!   sweeps per frame (XPBD: substeps × iterations, with the stability guard's substeps; VBD:
+//!   steps × iterations; Newton: steps × [`NEWTON_ITERATIONS_GUESS`]); the new configuration's
+//!   time per frame is the current one's measured time scaled by the ratio of the two works.
+//!   Above [`SLOW_FRAME_MS`] the app asks first, saying the estimate and the frame rate it
+//!   means, and keeps the current configuration until the answer.
+//! - **After**: a frame that took more than [`SLOW_FRAME_MS`] pauses the app (a slow frame then
+//!   runs only on Step), so the window stays usable and typing is not lost.
+
+use super::HoxApp;
+use super::config::Config;
+use eframe::egui;
+use hox_sim::solver::{Method, Simulation};
+
+/// A frame slower than this (under 4 frames per second) is asked about and pauses the app.
+pub const SLOW_FRAME_MS: f64 = 250.0;
+
+/// Newton iterations per step assumed in the estimate.
+const NEWTON_ITERATIONS_GUESS: f64 = 5.0;
+
+/// A change held back until the user says: the control, the configuration, what it will cost.
+pub struct PendingChange {
+    pub control: String,
+    pub config: Config,
+    pub estimate: String,
+}
+
+/// The work of one frame of `sim`, in element–point–node visits (module docs).
+pub fn frame_work(sim: &Simulation) -> f64 {
+    let per_sweep: f64 = sim
+        .geometry()
+        .iter()
+        .zip(&sim.mesh().blocks)
+        .map(|(g, b)| (b.len() * g.points_per_element * g.nodes_per_element) as f64)
+        .sum();
+    let s = sim.settings();
+    let sweeps = match s.method {
+        Method::Xpbd => f64::from(sim.substeps_per_frame()) * f64::from(s.iterations.max(1)),
+        Method::Vbd => f64::from(s.steps_per_frame.max(1)) * f64::from(s.vbd.iterations.max(1)),
+        Method::Newton => f64::from(s.steps_per_frame.max(1)) * NEWTON_ITERATIONS_GUESS,
+    };
+    per_sweep * sweeps
+}
+
+/// The estimated time per frame of `candidate`, from `current`'s measured `current_ms`.
+pub fn estimated_ms(current: &Simulation, current_ms: f64, candidate: &Simulation) -> f64 {
+    current_ms * frame_work(candidate) / frame_work(current).max(1.0)
+}
+
+impl HoxApp {
+    /// Whether `new` for the active configuration would be slow: the estimate in words, or
+    /// None (cheap enough, not measurable yet, or not buildable: `apply` says why).
+    pub(super) fn too_slow(&self, new: &Config) -> Option<String> {
+        let s = &self.sessions[self.active];
+        if s.ms_per_frame <= 0.0 || s.config.invalidated_by(new) == super::config::Invalidates::Nothing {
+            return None;
+        }
+        let scene = super::config::resolve(new, &s.base).ok()?;
+        let candidate = hox_scenes::Instance::new(scene).ok()?;
+        let ms = estimated_ms(&s.instance.sim, s.ms_per_frame, &candidate.sim);
+        (ms > SLOW_FRAME_MS).then(|| {
+            format!(
+                "{} elements, {}: about {} per frame on this machine (now {:.1} ms), {}.",
+                candidate.sim.mesh().num_elements(),
+                candidate.sim.work_summary(),
+                if ms >= 1000.0 { format!("{:.1} s", ms / 1e3) } else { format!("{ms:.0} ms") },
+                s.ms_per_frame,
+                if ms >= 1000.0 {
+                    "under one frame per second".to_string()
+                } else {
+                    format!("about {:.0} frames per second", 1000.0 / ms)
+                }
+            )
+        })
+    }
+
+    /// After stepping: a frame slower than [`SLOW_FRAME_MS`] pauses the app, saying why.
+    pub(super) fn pause_if_slow(&mut self) {
+        let slowest = self.sessions.iter().map(|s| s.ms_per_frame).fold(0.0, f64::max);
+        if self.playback.playing && !self.settling() && slowest > SLOW_FRAME_MS {
+            self.playback.playing = false;
+            self.message = Some(format!(
+                "Paused: a frame takes {:.1} s, too slow to play (Step, S, advances one frame; fewer elements or substeps play).",
+                slowest / 1e3
+            ));
+        }
+    }
+}
+
+/// The question about a held-back change: apply it (paused) or keep the current one.
+pub fn pending_change_ui(app: &mut HoxApp, ctx: &egui::Context) {
+    let Some(pending) = &app.pending_change else { return };
+    let mut answer = None;
+    egui::Window::new("This change is slow")
+        .collapsible(false)
+        .anchor(egui::Align2::CENTER_CENTER, egui::vec2(0.0, 0.0))
+        .show(ctx, |ui| {
+            ui.label(format!("{}: {}", pending.control, pending.estimate));
+            ui.label("The window would stay usable (paused, Step advances a frame), but it would not play.");
+            ui.horizontal(|ui| {
+                if ui.button("Apply, paused").clicked() {
+                    answer = Some(true);
+                }
+                if ui.button("Keep the current configuration").clicked() {
+                    answer = Some(false);
+                }
+            });
+        });
+    if let Some(apply) = answer
+        && let Some(p) = app.pending_change.take()
+    {
+        if apply {
+            app.playback.playing = false;
+            app.apply_now(&p.control, p.config);
+        }
+    }
+}
