@@ -110,12 +110,12 @@ pub fn pending_change_ui(app: &mut HoxApp, ctx: &egui::Context) {
                 }
             });
         });
+    // either answer ends the question; only "apply" changes anything
     if let Some(apply) = answer
         && let Some(p) = app.pending_change.take()
+        && apply
     {
-        if apply {
-            app.playback.playing = false;
-            app.apply_now(&p.control, p.config);
-        }
+        app.playback.playing = false;
+        app.apply_now(&p.control, p.config);
     }
 }
