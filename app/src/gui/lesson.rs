@@ -326,47 +326,37 @@ pub fn lesson_panel_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     });
 }
 
-/// In presenter mode: the step's caption and numbers over the 3D view's top left corner.
-pub fn caption_ui(app: &HoxApp, ctx: &egui::Context) {
+/// In presenter mode: the step's caption and numbers in a panel below the 3D view (issue #35:
+/// laid over the view, the answer covered both bodies' labels at 1280×720).
+pub fn caption_ui(app: &HoxApp, ui: &mut egui::Ui) {
     let Some(state) = &app.lesson else { return };
     let step = &state.lesson.steps[state.step];
     let measured = state.measured(&app.sessions);
-    egui::Area::new(egui::Id::unique("lesson-caption")).fixed_pos(egui::pos2(12.0, 40.0)).show(ctx, |ui| {
-        egui::Frame::new()
-            .fill(egui::Color32::from_rgba_unmultiplied(0, 0, 0, 180))
-            .inner_margin(10.0)
-            .corner_radius(6.0)
-            .show(ui, |ui| {
-                ui.set_max_width(560.0);
-                ui.label(
-                    egui::RichText::new(format!("{} — {}", state.lesson.title, step.title))
-                        .strong()
-                        .color(egui::Color32::WHITE),
-                );
-                for (k, line) in state.lesson.step_parameters(state.step).iter().enumerate() {
-                    ui.label(
-                        egui::RichText::new(format!("{}: {line}", ["A", "B"][k.min(1)]))
-                            .monospace()
-                            .color(egui::Color32::from_rgb(200, 200, 200)),
-                    );
-                }
-                ui.label(egui::RichText::new(&step.question).color(egui::Color32::WHITE));
-                if state.preparing() {
-                    ui.label(egui::RichText::new(PREPARING).color(egui::Color32::from_rgb(250, 220, 120)));
-                    return;
-                }
-                for (k, m) in measured.iter().enumerate() {
-                    ui.label(
-                        egui::RichText::new(format!("{}: {}", ["A", "B"][k.min(1)], m.text))
-                            .monospace()
-                            .color(egui::Color32::from_rgb(250, 220, 120)),
-                    );
-                }
-                if state.revealed {
-                    ui.label(egui::RichText::new(&step.answer).color(egui::Color32::from_rgb(180, 230, 255)));
-                }
-            });
-    });
+    ui.label(
+        egui::RichText::new(format!("{} — {}", state.lesson.title, step.title)).strong().color(egui::Color32::WHITE),
+    );
+    for (k, line) in state.lesson.step_parameters(state.step).iter().enumerate() {
+        ui.label(
+            egui::RichText::new(format!("{}: {line}", ["A", "B"][k.min(1)]))
+                .monospace()
+                .color(egui::Color32::from_rgb(200, 200, 200)),
+        );
+    }
+    ui.label(egui::RichText::new(&step.question).color(egui::Color32::WHITE));
+    if state.preparing() {
+        ui.label(egui::RichText::new(PREPARING).color(egui::Color32::from_rgb(250, 220, 120)));
+        return;
+    }
+    for (k, m) in measured.iter().enumerate() {
+        ui.label(
+            egui::RichText::new(format!("{}: {}", ["A", "B"][k.min(1)], m.text))
+                .monospace()
+                .color(egui::Color32::from_rgb(250, 220, 120)),
+        );
+    }
+    if state.revealed {
+        ui.label(egui::RichText::new(&step.answer).color(egui::Color32::from_rgb(180, 230, 255)));
+    }
 }
 
 /// The Lessons menu: every built-in lesson.

@@ -222,21 +222,21 @@ impl ReferenceState {
     }
 
     /// A few words for a body's label: "no reference", "computing reference, level 2 of 6",
-    /// or with a provisional estimate "reference |u_tip| = 0.2887 m ± 3.97 %, refining (level 4
-    /// of 6)"; None for a finished reference (the readout says the rest).
+    /// or with a provisional estimate "reference 0.2887 m ± 3.97 % (refining, 4 of 6)" (the
+    /// first probe's displacement); None for a finished reference (the readout says the rest).
     pub fn short_status(&self) -> Option<String> {
         let level = |what: &str| what.split(" (").next().unwrap_or(what).replace("computing reference, ", "");
         match self {
             ReferenceState::Ready { .. } => None,
             ReferenceState::Computing { latest: Some(r), .. } => {
                 let size = match r.probes.iter().next() {
-                    Some((name, u)) => format!("|u_{name}| = {:.4} m", hox_sim::Vec3::from(*u).norm()),
+                    Some((_, u)) => format!("{:.4} m", hox_sim::Vec3::from(*u).norm()),
                     None => String::new(),
                 };
                 Some(format!(
-                    "reference {size} ± {:.2} %, refining ({})",
+                    "reference {size} ± {:.2} % (refining, {})",
                     r.estimated_error_pct().unwrap_or(f64::NAN),
-                    level(&self.progress().unwrap_or_default().0)
+                    level(&self.progress().unwrap_or_default().0).replace("level ", "")
                 ))
             }
             ReferenceState::Computing { .. } => {

@@ -617,6 +617,16 @@ fn a_beam_not_yet_run_is_not_called_moving() {
     assert!(s.contains("moving") && !s.contains("paused mid-swing"), "{s}");
 }
 
+/// Switches configuration A to Newton; the note under the solver says it damps the motion.
+fn choose_newton_for_a(h: &mut Harness<'_, HoxApp>) {
+    let app = h.state_mut();
+    let mut c = app.sessions[0].config.clone();
+    c.method = hox_sim::solver::Method::Newton;
+    app.apply("solver", c);
+    h.run_steps(2);
+    h.get_by_label_contains("it damps the motion");
+}
+
 /// Issue #35, symptoms 6 and 8: the solver's effect on the motion is said where it is chosen;
 /// a lesson's static step reads "static equilibrium", not "moving" or "not started".
 #[test]
@@ -624,12 +634,7 @@ fn the_solver_says_what_it_does_to_the_motion_and_a_static_step_says_static() {
     let mut h = harness(AppArgs::default());
     h.run_steps(2);
     h.get_by_label_contains("Keeps the motion");
-    let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
-    c.method = hox_sim::solver::Method::Newton;
-    app.apply("solver", c);
-    h.run_steps(2);
-    h.get_by_label_contains("it damps the motion");
+    choose_newton_for_a(&mut h);
     assert!(h.query_by_label_contains("Keeps the motion").is_none());
     let mut h = harness(args::parse_for_test(&["--lesson", "mesh-bias"]));
     h.run_steps(3);
@@ -712,7 +717,7 @@ fn a_provisional_reference_is_used_and_labelled_while_it_refines() {
     assert!(!state.poll(), "once");
     assert_eq!(state.provisional_brief().as_deref(), Some("ref. ± 4.00 %, level 4 of 6"));
     assert_eq!(state.reference(), Some(&estimate));
-    assert_eq!(state.short_status().as_deref(), Some("reference |u_tip| = 0.2500 m ± 4.00 %, refining (level 4 of 6)"));
+    assert_eq!(state.short_status().as_deref(), Some("reference 0.2500 m ± 4.00 % (refining, 4 of 6)"));
     assert!(
         state.status().starts_with("reference: provisional, levels 1–3 of 6 solved, refining"),
         "{}",
@@ -850,4 +855,110 @@ fn a_change_too_slow_to_play_asks_first_and_a_slow_frame_pauses() {
     h.run_steps(1);
     assert!(!h.state().playback.playing, "paused");
     assert!(h.state().message.as_deref().is_some_and(|m| m.starts_with("Paused: a frame takes")));
+}
+
+/// The drawn labels, legend and bodies of the view: every label inside the view, clear of the
+/// legend, the other label and both bodies; every body inside the view (issue #35, symptom 5).
+fn assert_layout_fits(h: &Harness<'_, HoxApp>, what: &str) {
+    let d = &h.state().viewport.drawn;
+    let view = d.view.expect("the view was drawn");
+    let legend = d.legend.expect("the legend was drawn");
+    assert!(view.contains_rect(legend), "{what}: legend {legend:?} outside the view {view:?}");
+    for (k, body) in d.bodies.iter().enumerate() {
+        assert!(view.expand(1.0).contains_rect(*body), "{what}: body {k} {body:?} leaves the view {view:?}");
+        assert!(!body.intersects(legend), "{what}: body {k} {body:?} under the legend {legend:?}");
+    }
+    for (k, label) in d.labels.iter().enumerate() {
+        assert!(view.contains_rect(*label), "{what}: label {k} {label:?} leaves the view {view:?}");
+        assert!(!label.intersects(legend), "{what}: label {k} {label:?} on the legend {legend:?}");
+        for (j, other) in d.labels.iter().chain(&d.bodies).enumerate() {
+            assert!(j == k || !label.intersects(*other), "{what}: label {k} {label:?} on {other:?}");
+        }
+    }
+}
+
+fn harness_sized(args: AppArgs, size: egui::Vec2) -> Harness<'static, HoxApp> {
+    let app = HoxApp::new(&AppArgs { fresh: true, ..args }, None).expect("the app starts");
+    Harness::builder()
+        .with_size(size)
+        .allow_missing_glyphs()
+        .with_step_dt(1.0 / 60.0)
+        .build_ui_state(|ui, app: &mut HoxApp| app.ui_all(ui), app)
+}
+
+/// Plays until the app pauses (a settle ends, a lesson step ends), as the window would.
+fn play_until_paused(h: &mut Harness<'_, HoxApp>) {
+    for _ in 0..2_000 {
+        if !h.state().playback.playing {
+            return;
+        }
+        h.run_steps(1);
+    }
+    panic!("still playing");
+}
+
+/// Issue #35's scenario, the session a teacher runs, at a projector's 1280×720 and at
+/// 1920×1080: compare P1 refined once against P2, type ν, settle, switch solver, a lesson
+/// stepped forward and back with its answer, presenter mode on and off, a restart. At every
+/// stage the readouts say what they are and nothing drawn overlaps.
+#[test]
+fn a_classroom_session_at_projector_and_full_hd_sizes() {
+    for size in [egui::vec2(1280.0, 720.0), egui::vec2(1920.0, 1080.0)] {
+        let at = |what: &str| format!("{}×{}: {what}", size.x, size.y);
+        let mut h = harness_sized(AppArgs { compare: vec![String::new()], ..Default::default() }, size);
+        h.run_steps(3);
+        assert_layout_fits(&h, &at("start"));
+        assert_eq!(h.state().viewport.drawn.labels.len(), 2, "{}", at("both bodies labelled"));
+        // ν typed: both say what the reference is doing, never "no reference"
+        type_into(&mut h, "Poisson ratio ν", "0.45");
+        for s in &h.state().sessions {
+            assert!(!s.readout_label().contains("no reference"), "{}: {}", at("ν typed"), s.readout_label());
+        }
+        for k in 0..2 {
+            h.state_mut().sessions[k].reference.wait();
+        }
+        // settle: both read their settled error, the app pauses
+        h.state_mut().settle();
+        play_until_paused(&mut h);
+        h.run_steps(2);
+        for s in &h.state().sessions {
+            assert!(s.readout_label().starts_with("settled: error"), "{}: {}", at("settled"), s.readout_label());
+        }
+        assert_layout_fits(&h, &at("settled"));
+        // another solver for A: said under the solver what it does to the motion
+        choose_newton_for_a(&mut h);
+        // a lesson, forward and back, with its answer
+        let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "locking").unwrap();
+        h.state_mut().open_lesson(lesson);
+        lesson_ready(&mut h);
+        h.get_by_label_contains("A: Element p1 · Grid 8x2x2 · Poisson ratio ν 0.3");
+        assert_layout_fits(&h, &at("lesson step 1"));
+        h.key_press(egui::Key::ArrowRight);
+        lesson_ready(&mut h);
+        h.get_by_label_contains("Step 2 of 3");
+        assert_eq!(h.query_all_by_label_contains("Poisson ratio ν 0.49").count(), 2, "A and B at ν = 0.49");
+        h.key_press(egui::Key::A);
+        h.run_steps(2);
+        h.get_by_label_contains("Answer:");
+        assert_layout_fits(&h, &at("lesson step 2, answered"));
+        h.key_press(egui::Key::ArrowLeft);
+        lesson_ready(&mut h);
+        h.get_by_label_contains("Step 1 of 3");
+        // presenter mode: the caption below the view, the labels short, nothing overlapping
+        h.key_press(egui::Key::P);
+        h.run_steps(3);
+        h.key_press(egui::Key::A);
+        h.run_steps(3);
+        assert!(h.state().presenter);
+        assert_layout_fits(&h, &at("presenter, answered"));
+        h.key_press(egui::Key::P);
+        h.run_steps(3);
+        assert_eq!(h.ctx.zoom_factor(), 1.0, "{}", at("presenter off"));
+        assert_layout_fits(&h, &at("presenter off"));
+        // the next day: a new app on the same egui memory starts at the ordinary scale
+        *h.state_mut() = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap();
+        h.run_steps(3);
+        assert_eq!(h.ctx.zoom_factor(), 1.0);
+        assert_layout_fits(&h, &at("restart"));
+    }
 }

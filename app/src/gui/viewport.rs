@@ -120,7 +120,32 @@ pub struct Viewport {
     /// The camera was framed before the view had a size (at start): framed again on the first
     /// frame drawn, for the view's real proportions.
     framed_blind: bool,
+    /// The view's proportions the camera was framed for, and whether the user has moved the
+    /// camera since: an unmoved camera is framed again when the view changes shape (a panel
+    /// opening, another window size; issue #35: bodies clipped at the view's edges).
+    framed_aspect: f32,
+    user_moved: bool,
+    /// Where the last frame drew the legend, the bodies' labels and the bodies (their current
+    /// extent), in points: the UI tests check that none overlaps another or leaves the view.
+    pub drawn: Drawn,
+    /// Labels name the bodies only (presenter mode: its caption carries the numbers).
+    pub short_labels: bool,
 }
+
+/// Rectangles drawn in the view at the last frame ([`Viewport::drawn`]).
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(not(test), allow(dead_code))]
+pub struct Drawn {
+    pub view: Option<egui::Rect>,
+    pub legend: Option<egui::Rect>,
+    pub labels: Vec<egui::Rect>,
+    pub bodies: Vec<egui::Rect>,
+}
+
+/// The legend's column at the view's right (its panel and margins), points.
+const LEGEND_COLUMN: f32 = 172.0;
+/// Room above the bodies for their labels in compare mode (three lines), points.
+const LABEL_ROOM: f32 = 64.0;
 
 impl Viewport {
     pub fn new(camera: Option<Camera>) -> Viewport {
@@ -139,6 +164,10 @@ impl Viewport {
             last_frames: Vec::new(),
             preset: ViewPreset::default(),
             framed_blind: false,
+            framed_aspect: 0.0,
+            user_moved: false,
+            drawn: Drawn::default(),
+            short_labels: false,
         }
     }
 
@@ -153,10 +182,24 @@ impl Viewport {
         if lo.x.is_finite() {
             let (yaw, pitch) = self.preset.yaw_pitch();
             let r = self.last_rect;
-            let aspect = if r.is_positive() { r.width() / r.height() } else { super::raster::DEFAULT_ASPECT };
-            self.camera = Camera::framing_from(f32s(&lo), f32s(&hi), yaw, pitch, aspect);
+            if r.is_positive() {
+                // the bodies in the part of the view the legend (right) and the labels (top)
+                // leave free
+                let label_room = if sessions.len() > 1 { LABEL_ROOM } else { 0.0 };
+                let free = egui::vec2(
+                    (r.width() - LEGEND_COLUMN).max(0.4 * r.width()),
+                    (r.height() - label_room).max(0.6 * r.height()),
+                );
+                self.camera = Camera::framing_from(f32s(&lo), f32s(&hi), yaw, pitch, free.x / free.y);
+                self.camera.distance *= r.height() / free.y;
+                self.camera.pan(-(r.width() - free.x) / 2.0, (r.height() - free.y) / 2.0, r.height());
+                self.framed_aspect = r.width() / r.height();
+            } else {
+                self.camera = Camera::framing_from(f32s(&lo), f32s(&hi), yaw, pitch, super::raster::DEFAULT_ASPECT);
+            }
             self.framed_blind = !r.is_positive();
         }
+        self.user_moved = false;
         self.fitted = true;
     }
 
@@ -209,7 +252,8 @@ impl Viewport {
         let (rect, response) =
             ui.allocate_exact_size(ui.available_size().max(egui::vec2(64.0, 64.0)), egui::Sense::click_and_drag());
         self.last_rect = rect;
-        if self.framed_blind {
+        let reshaped = (rect.width() / rect.height() / self.framed_aspect.max(1e-3) - 1.0).abs() > 0.03;
+        if self.framed_blind || (!self.user_moved && reshaped) {
             self.reset_camera(sessions, offsets);
         }
         let ppp = ui.ctx().pixels_per_point();
@@ -228,6 +272,7 @@ impl Viewport {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
             if scroll != 0.0 {
                 self.camera.zoom((scroll * 0.002).exp());
+                self.user_moved = true;
             }
         }
         if response.double_clicked() {
@@ -255,13 +300,20 @@ impl Viewport {
                         sessions[k].drag = Some(Drag { node, target_m: target });
                     }
                 }
-                _ if shift => self.camera.pan(delta.x, delta.y, rect.height()),
-                _ => self.camera.orbit(delta.x, delta.y),
+                _ if shift => {
+                    self.camera.pan(delta.x, delta.y, rect.height());
+                    self.user_moved = true;
+                }
+                _ => {
+                    self.camera.orbit(delta.x, delta.y);
+                    self.user_moved = true;
+                }
             }
         }
         if response.dragged_by(egui::PointerButton::Secondary) || response.dragged_by(egui::PointerButton::Middle) {
             let delta = response.drag_delta();
             self.camera.pan(delta.x, delta.y, rect.height());
+            self.user_moved = true;
         }
         if (response.drag_stopped() || !ui.input(|i| i.pointer.primary_down()))
             && let Some((k, _, _)) = self.dragging.take()
@@ -376,23 +428,51 @@ impl Viewport {
             self.cpu_view(&painter, rect, w, h, scale, &overlay);
             self.render_ms = started.elapsed().as_secs_f64() * 1e3;
         }
-        // labels above each body in compare mode
+        // where each body is now, and its label in compare mode: above it, or below it where
+        // that would cover the legend, another label or leave the view (issue #35)
+        let legend = legend_rect(rect);
+        let mut drawn = Drawn { view: Some(rect), legend: Some(legend), ..Default::default() };
+        for (s, o) in sessions.iter().zip(offsets) {
+            drawn.bodies.push(self.screen_extent(&s.instance.sim.positions, o).unwrap_or(egui::Rect::NOTHING));
+        }
         if sessions.len() > 1 {
-            for (k, (s, o)) in sessions.iter().zip(offsets).enumerate() {
-                let (lo, hi) = s.instance.sim.mesh().bounding_box();
-                let top = Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z) + o;
-                if let Some(p) = self.screen_position(top) {
-                    let text = body_label(k, &s.label(), &s.readout_label());
-                    painter.text(
-                        p - egui::vec2(0.0, 14.0),
-                        egui::Align2::CENTER_BOTTOM,
-                        text,
-                        egui::FontId::proportional(14.0),
-                        egui::Color32::WHITE,
-                    );
+            for (k, s) in sessions.iter().enumerate() {
+                let body = drawn.bodies[k];
+                if !body.is_positive() {
+                    continue;
                 }
+                let text = if self.short_labels {
+                    format!("{}: {}", ["A", "B"][k.min(1)], s.label())
+                } else {
+                    body_label(k, &s.label(), &s.readout_label())
+                };
+                let galley = painter.layout_no_wrap(text, egui::FontId::proportional(14.0), egui::Color32::WHITE);
+                let size = galley.size();
+                let place = |top_left: egui::Pos2| {
+                    let x = top_left.x.clamp(rect.min.x + 4.0, (rect.max.x - size.x - 4.0).max(rect.min.x + 4.0));
+                    egui::Rect::from_min_size(egui::pos2(x, top_left.y), size)
+                };
+                let above = place(egui::pos2(body.center().x - size.x / 2.0, body.min.y - 6.0 - size.y));
+                let below = place(egui::pos2(body.center().x - size.x / 2.0, body.max.y + 6.0));
+                let free = |r: &egui::Rect| {
+                    rect.contains_rect(*r)
+                        && !r.intersects(legend)
+                        && drawn.labels.iter().chain(&drawn.bodies).all(|l| !l.intersects(*r))
+                };
+                // neither: stacked in the view's top-left corner, under the labels already there
+                let stacked = egui::Rect::from_min_size(
+                    egui::pos2(
+                        rect.min.x + 4.0,
+                        drawn.labels.iter().map(|l| l.max.y + 4.0).fold(rect.min.y + 4.0, f32::max),
+                    ),
+                    size,
+                );
+                let at = [above, below, stacked].into_iter().find(free).unwrap_or(stacked);
+                painter.galley(at.min, galley, egui::Color32::WHITE);
+                drawn.labels.push(at);
             }
         }
+        self.drawn = drawn;
         let values: Vec<f64> = self.frames.iter().flat_map(|f| f.values.iter().copied()).collect();
         let note = sessions.first().and_then(|s| {
             (colours.field == Field::Error && !s.field_source.has_reference())
@@ -439,6 +519,24 @@ impl Viewport {
 
     /// Where the world point `p` was drawn in the last frame, in points (None if behind the
     /// camera or not drawn yet).
+    /// The screen rectangle of `positions` moved by `offset` (the corners of their box), points.
+    fn screen_extent(&self, positions: &[Vec3], offset: &Vec3) -> Option<egui::Rect> {
+        let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+        for p in positions {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let corners = (0..8).map(|k| {
+            Vec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            ) + offset
+        });
+        let points: Vec<egui::Pos2> = corners.map(|c| self.screen_position(c)).collect::<Option<_>>()?;
+        Some(egui::Rect::from_points(&points))
+    }
+
     pub fn screen_position(&self, p: Vec3) -> Option<egui::Pos2> {
         let s = self.image.project(f32s(&p))?;
         let r = self.last_rect;
@@ -484,6 +582,18 @@ impl Viewport {
     }
 }
 
+/// Where the legend is drawn in a view `rect`: its top-right corner.
+fn legend_rect(rect: egui::Rect) -> egui::Rect {
+    let shorter = 130.0 - legend_bar_height(rect);
+    egui::Rect::from_min_size(rect.right_top() + egui::vec2(-166.0, 6.0), egui::vec2(160.0, 236.0 - shorter))
+}
+
+/// The colour bar's height: 130 points, less in a low view (presenter mode at 1280×720), so the
+/// legend stays inside it.
+fn legend_bar_height(rect: egui::Rect) -> f32 {
+    (rect.height() - 118.0).clamp(40.0, 130.0)
+}
+
 /// The legend in the viewport's top-right corner, on a dark panel: the field and its unit,
 /// whether the range is automatic or fixed, the colour bar with ticks in the unit, the share of
 /// the surface beyond a fixed range (drawn in the saturation colours), why a field has no value
@@ -500,7 +610,7 @@ fn legend_ui(
     let mono = egui::FontId::monospace(11.0);
     let white = egui::Color32::WHITE;
     let (over, under) = colours.saturation(values);
-    let panel = egui::Rect::from_min_size(rect.right_top() + egui::vec2(-166.0, 6.0), egui::vec2(160.0, 236.0));
+    let panel = legend_rect(rect);
     painter.rect_filled(panel, 4.0, egui::Color32::from_rgba_unmultiplied(0, 0, 0, 150));
     painter.text(
         panel.left_top() + egui::vec2(6.0, 4.0),
@@ -516,7 +626,8 @@ fn legend_ui(
         if colours.automatic { "automatic range" } else { "fixed range" }
     );
     painter.text(panel.left_top() + egui::vec2(6.0, 20.0), egui::Align2::LEFT_TOP, mode, mono.clone(), white);
-    let bar = egui::Rect::from_min_size(panel.left_top() + egui::vec2(10.0, 52.0), egui::vec2(16.0, 130.0));
+    let bar =
+        egui::Rect::from_min_size(panel.left_top() + egui::vec2(10.0, 52.0), egui::vec2(16.0, legend_bar_height(rect)));
     let swatch = |y: f32, c: [u8; 3], text: String| {
         let r = egui::Rect::from_min_size(egui::pos2(bar.min.x, y), egui::vec2(bar.width(), 10.0));
         painter.rect_filled(r, 0.0, egui::Color32::from_rgb(c[0], c[1], c[2]));

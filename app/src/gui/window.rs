@@ -154,7 +154,10 @@ impl HoxApp {
         let frame = egui::Frame::side_top_panel(ui.style()).fill(egui::Color32::TRANSPARENT);
         egui::Panel::top("menu").frame(frame).show(ui, |ui| controls::menu_bar_ui(self, ui));
         egui::Panel::bottom("status").frame(frame).show(ui, |ui| self.status_line_ui(ui));
-        // presenter mode: the 3D view fills the window, the lesson's caption over it
+        // presenter mode: the 3D view fills the window, the lesson's caption in a panel below it
+        if self.presenter && self.lesson.is_some() {
+            egui::Panel::bottom("caption").frame(frame).show(ui, |ui| super::lesson::caption_ui(self, ui));
+        }
         if !self.presenter {
             egui::Panel::bottom("plots")
                 .frame(frame)
@@ -182,12 +185,10 @@ impl HoxApp {
         controls::open_dialog_ui(self, &ctx);
         super::cost::pending_change_ui(self, &ctx);
         egui::CentralPanel::no_frame().show(ui, |ui| {
+            self.viewport.short_labels = self.presenter && self.lesson.is_some();
             let offsets = self.offsets();
             self.viewport.ui(ui, &mut self.sessions, &offsets, &self.view, self.gl_available);
         });
-        if self.presenter {
-            super::lesson::caption_ui(self, &ctx);
-        }
         if self.playback.playing || self.sessions.iter().any(|s| s.drag.is_some()) {
             ctx.request_repaint();
         }
