@@ -58,11 +58,13 @@ pub fn step_markdown(lesson: &Lesson, k: usize, outcome: Option<&[Measured]>) ->
         step.question
     );
     for (j, scene) in step.configurations.iter().enumerate() {
+        // while the step runs its measurement is not yet known: said in words (issue #35: the
+        // stock viewer showed "probe u_z = …")
         let what = match outcome.and_then(|o| o.get(j)) {
             Some(m) => m.text.clone(),
-            None => "…".into(),
+            None => "measured when the step ends".into(),
         };
-        text += &format!("- **{}** {}: {} = {what}\n", ["A", "B"][j.min(1)], scene_label(scene), step.measure.title());
+        text += &format!("- **{}** {}: {}: {what}\n", ["A", "B"][j.min(1)], scene_label(scene), step.measure.title());
     }
     if outcome.is_some() {
         text += &format!("\n**Answer:** {}\n", step.answer);
@@ -101,7 +103,8 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
         None => None,
     };
     if let Some(rec) = &rec {
-        blueprint().send(rec, bp::BlueprintActivation { make_active: true, make_default: true })?;
+        blueprint(&lesson).send(rec, bp::BlueprintActivation { make_active: true, make_default: true })?;
+        name_series(rec, &lesson)?;
         rec.log_static(
             "lesson/goal",
             &rerun::TextDocument::from_markdown(format!("# {}\n\n{}", lesson.title, lesson.goal)),
@@ -198,10 +201,7 @@ fn record_step(
         recorder.log_frame(rec, &instances, &vec![0.0; instances.len()])?;
         for (j, m) in runner.measured().iter().enumerate() {
             if m.value.is_finite() {
-                rec.log(
-                    format!("lesson/measure/step_{}/{}", k + 1, ["a", "b"][j.min(1)]),
-                    &rerun::Scalars::single(m.value),
-                )?;
+                rec.log(measure_path(step, k, j), &rerun::Scalars::single(m.value))?;
             }
         }
         Ok(())
@@ -239,17 +239,64 @@ fn record_step(
     Ok(measured)
 }
 
-/// The lesson recording's layout: the 3D view large, the step's text and the measurement beside.
-fn blueprint() -> bp::Blueprint {
+/// The folder of a measurement's series: one per unit, so that one chart never mixes metres and
+/// milliseconds (issue #35).
+fn unit_folder(measure: hox_scenes::lesson::Measure) -> &'static str {
+    match measure.unit() {
+        "" => "number",
+        unit => unit,
+    }
+}
+
+/// Where configuration `j`'s measurement of step `k` is logged.
+fn measure_path(step: &Step, k: usize, j: usize) -> String {
+    format!("lesson/measure/{}/step_{}/{}", unit_folder(step.measure), k + 1, ["a", "b"][j.min(1)])
+}
+
+/// Names each step's measurement series with its configuration, what it is and its unit
+/// ("step 1 A: probe u_z (m)"), once, as static data.
+fn name_series(rec: &rerun::RecordingStream, lesson: &Lesson) -> Result<()> {
+    for (k, step) in lesson.steps.iter().enumerate() {
+        for j in 0..step.configurations.len() {
+            let unit = step.measure.unit();
+            let name = format!(
+                "step {} {}: {}{}",
+                k + 1,
+                ["A", "B"][j.min(1)],
+                step.measure.title(),
+                if unit.is_empty() { String::new() } else { format!(" ({unit})") }
+            );
+            rec.log_static(measure_path(step, k, j), &rerun::SeriesLines::new().with_names([name]))?;
+        }
+    }
+    Ok(())
+}
+
+/// The lesson recording's layout: the 3D view large, the step's text and the measurements
+/// beside, one chart per unit.
+fn blueprint(lesson: &Lesson) -> bp::Blueprint {
     let view3d = bp::Spatial3DView::new("3D").with_origin("world").with_contents(["+ world/**"]);
     let text = bp::TextDocumentView::new("Step").with_origin("lesson/step").with_contents(["+ lesson/step"]);
     let goal = bp::TextDocumentView::new("Lesson").with_origin("lesson/goal").with_contents(["+ lesson/goal"]);
-    let measure = bp::TimeSeriesView::new("Measurement (A, B per step)")
-        .with_origin("lesson/measure")
-        .with_contents(["+ lesson/measure/**"]);
+    let mut units: Vec<&str> = lesson.steps.iter().map(|s| unit_folder(s.measure)).collect();
+    units.dedup();
+    units.sort_unstable();
+    units.dedup();
+    let mut column: Vec<bp::ContainerLike> = vec![goal.into(), text.into()];
+    let mut shares = vec![0.7, 2.2];
+    for unit in &units {
+        let title = if *unit == "number" { "Measurement".to_string() } else { format!("Measurement ({unit})") };
+        column.push(
+            bp::TimeSeriesView::new(title)
+                .with_origin(format!("lesson/measure/{unit}"))
+                .with_contents([format!("+ lesson/measure/{unit}/**")])
+                .into(),
+        );
+        shares.push(1.0 / units.len() as f32);
+    }
     let root = bp::Horizontal::new([
         bp::ContainerLike::from(view3d),
-        bp::Vertical::new([goal.into(), text.into(), measure.into()]).with_row_shares([0.7, 2.2, 1.0]).into(),
+        bp::Vertical::new(column).with_row_shares(shares).into(),
     ])
     .with_column_shares([0.62, 0.38]);
     crate::recording::blueprint_of(root)
