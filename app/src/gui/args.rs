@@ -45,6 +45,9 @@ pub struct AppArgs {
     /// Open on a built-in lesson (`hox lessons` lists them).
     #[arg(long, conflicts_with = "lesson_file")]
     pub lesson: Option<String>,
+    /// Open the lesson on this step (1 is the first): a class resuming where it stopped.
+    #[arg(long, value_name = "N")]
+    pub lesson_step: Option<usize>,
     /// Open on a lesson file of your own (TOML, docs/LESSONS.md).
     #[arg(long)]
     pub lesson_file: Option<PathBuf>,

@@ -182,7 +182,14 @@ impl HoxApp {
         if args.lesson.is_some() || args.lesson_file.is_some() {
             let lesson = crate::config::load_lesson(args.lesson.as_deref(), args.lesson_file.as_deref())
                 .map_err(|e| format!("{e:#}"))?;
+            let steps = lesson.steps.len();
             app.open_lesson(lesson);
+            if let Some(n) = args.lesson_step {
+                if !(1..=steps).contains(&n) {
+                    return Err(format!("--lesson-step {n}: the lesson has steps 1 to {steps}"));
+                }
+                app.go_to_step(n - 1);
+            }
             app.poll_lesson(true);
         }
         if args.presenter {

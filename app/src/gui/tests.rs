@@ -962,3 +962,16 @@ fn a_classroom_session_at_projector_and_full_hd_sizes() {
         assert_layout_fits(&h, &at("restart"));
     }
 }
+
+/// `--lesson-step N` opens a lesson on step N (a class resuming); a step the lesson does not
+/// have is refused naming the option.
+#[test]
+fn a_lesson_opens_on_the_step_asked_for() {
+    let h = harness(args::parse_for_test(&["--lesson", "why-high-order", "--lesson-step", "3"]));
+    let state = h.state().lesson.as_ref().unwrap();
+    assert_eq!((state.step, state.preparing()), (2, false));
+    let err = HoxApp::new(&args::parse_for_test(&["--lesson", "why-high-order", "--lesson-step", "9"]), None)
+        .err()
+        .unwrap_or_default();
+    assert!(err.contains("--lesson-step 9") && err.contains("steps 1 to 3"), "{err}");
+}
