@@ -5,7 +5,10 @@
 //!   frame's work is `Σ elements × quadrature points × nodes per element` times the solver's
 //!   sweeps per frame (XPBD: substeps × iterations, with the stability guard's substeps; VBD:
 //!   steps × iterations; Newton: steps × [`NEWTON_ITERATIONS_GUESS`]); the new configuration's
-//!   time per frame is the current one's measured time scaled by the ratio of the two works.
+//!   time per frame is the current one's measured time scaled by the ratio of the two works. A
+//!   change of solver settings is estimated on the current mesh (nothing is built: dragging the
+//!   substeps slider stays cheap); a new mesh is built to be counted; a new material is not
+//!   estimated (the slow-frame pause below catches a stiffer one's extra substeps).
 //!   Above [`SLOW_FRAME_MS`] the app asks first, saying the estimate and the frame rate it
 //!   means, and keeps the current configuration until the answer.
 //! - **After**: a frame that took more than [`SLOW_FRAME_MS`] pauses the app (a slow frame then
@@ -14,7 +17,7 @@
 use super::HoxApp;
 use super::config::Config;
 use eframe::egui;
-use hox_sim::solver::{Method, Simulation};
+use hox_sim::solver::{Method, Simulation, SolverSettings};
 
 /// A frame slower than this (under 4 frames per second) is asked about and pauses the app.
 pub const SLOW_FRAME_MS: f64 = 250.0;
@@ -29,21 +32,27 @@ pub struct PendingChange {
     pub estimate: String,
 }
 
-/// The work of one frame of `sim`, in element–point–node visits (module docs).
-pub fn frame_work(sim: &Simulation) -> f64 {
-    let per_sweep: f64 = sim
-        .geometry()
+/// Element–point–node visits of one sweep over `sim`'s elements.
+fn sweep_work(sim: &Simulation) -> f64 {
+    sim.geometry()
         .iter()
         .zip(&sim.mesh().blocks)
         .map(|(g, b)| (b.len() * g.points_per_element * g.nodes_per_element) as f64)
-        .sum();
-    let s = sim.settings();
-    let sweeps = match s.method {
-        Method::Xpbd => f64::from(sim.substeps_per_frame()) * f64::from(s.iterations.max(1)),
-        Method::Vbd => f64::from(s.steps_per_frame.max(1)) * f64::from(s.vbd.iterations.max(1)),
-        Method::Newton => f64::from(s.steps_per_frame.max(1)) * NEWTON_ITERATIONS_GUESS,
-    };
-    per_sweep * sweeps
+        .sum()
+}
+
+/// Sweeps per frame of `settings`, XPBD's with `substeps` (the stability guard's, if raised).
+fn sweeps(settings: &SolverSettings, substeps: u32) -> f64 {
+    match settings.method {
+        Method::Xpbd => f64::from(substeps.max(1)) * f64::from(settings.iterations.max(1)),
+        Method::Vbd => f64::from(settings.steps_per_frame.max(1)) * f64::from(settings.vbd.iterations.max(1)),
+        Method::Newton => f64::from(settings.steps_per_frame.max(1)) * NEWTON_ITERATIONS_GUESS,
+    }
+}
+
+/// The work of one frame of `sim`, in element–point–node visits (module docs).
+pub fn frame_work(sim: &Simulation) -> f64 {
+    sweep_work(sim) * sweeps(sim.settings(), sim.substeps_per_frame())
 }
 
 /// The estimated time per frame of `candidate`, from `current`'s measured `current_ms`.
@@ -51,22 +60,46 @@ pub fn estimated_ms(current: &Simulation, current_ms: f64, candidate: &Simulatio
     current_ms * frame_work(candidate) / frame_work(current).max(1.0)
 }
 
+/// The estimated time per frame of `current` run with `settings` instead (the same mesh, so
+/// nothing is built: dragging the substeps slider stays cheap); the stability guard keeps XPBD's
+/// substeps at least where it raised them.
+pub fn estimated_ms_with(current: &Simulation, current_ms: f64, settings: &SolverSettings) -> f64 {
+    let raised = current.substeps_per_frame() > current.settings().substeps;
+    let substeps = if settings.stability_guard && raised {
+        settings.substeps.max(current.substeps_per_frame())
+    } else {
+        settings.substeps
+    };
+    current_ms * sweeps(settings, substeps) / sweeps(current.settings(), current.substeps_per_frame()).max(1e-9)
+}
+
 impl HoxApp {
     /// Whether `new` for the active configuration would be slow: the estimate in words, or
     /// None (cheap enough, not measurable yet, or not buildable: `apply` says why).
     pub(super) fn too_slow(&self, new: &Config) -> Option<String> {
+        use super::config::Invalidates;
         let s = &self.sessions[self.active];
-        if s.ms_per_frame <= 0.0 || s.config.invalidated_by(new) == super::config::Invalidates::Nothing {
+        if s.ms_per_frame <= 0.0 {
             return None;
         }
-        let scene = super::config::resolve(new, &s.base).ok()?;
-        let candidate = hox_scenes::Instance::new(scene).ok()?;
-        let ms = estimated_ms(&s.instance.sim, s.ms_per_frame, &candidate.sim);
+        let scene = match s.config.invalidated_by(new) {
+            // a new material may raise the guard's substeps: a slow frame then pauses (below)
+            Invalidates::Nothing | Invalidates::Material => return None,
+            Invalidates::Settings | Invalidates::Mesh => super::config::resolve(new, &s.base).ok()?,
+        };
+        // the same mesh: estimated from the settings alone; a new mesh is built to be counted
+        let (ms, elements, work) = if s.config.invalidated_by(new) == Invalidates::Settings {
+            let settings = scene.settings();
+            let ms = estimated_ms_with(&s.instance.sim, s.ms_per_frame, &settings);
+            (ms, s.instance.sim.mesh().num_elements(), format!("{} solver", settings.method.name()))
+        } else {
+            let candidate = hox_scenes::Instance::new(scene).ok()?;
+            let ms = estimated_ms(&s.instance.sim, s.ms_per_frame, &candidate.sim);
+            (ms, candidate.sim.mesh().num_elements(), candidate.sim.work_summary())
+        };
         (ms > SLOW_FRAME_MS).then(|| {
             format!(
-                "{} elements, {}: about {} per frame on this machine (now {:.1} ms), {}.",
-                candidate.sim.mesh().num_elements(),
-                candidate.sim.work_summary(),
+                "{elements} elements, {work}: about {} per frame on this machine (now {:.1} ms), {}.",
                 if ms >= 1000.0 { format!("{:.1} s", ms / 1e3) } else { format!("{ms:.0} ms") },
                 s.ms_per_frame,
                 if ms >= 1000.0 {

@@ -247,14 +247,6 @@ impl ReferenceState {
         }
     }
 
-    /// For the status line, while a provisional estimate is in use: "ref. ± 3.97 %, level 4 of 6".
-    pub fn provisional_brief(&self) -> Option<String> {
-        let ReferenceState::Computing { latest: Some(r), .. } = self else { return None };
-        let (what, _) = self.progress().unwrap_or_default();
-        let level = what.split(" (").next().unwrap_or(&what).replace("computing reference, ", "");
-        Some(format!("ref. ± {:.2} %, {level}", r.estimated_error_pct().unwrap_or(f64::NAN)))
-    }
-
     /// One line: the reference's label, or what is being done, or why there is none.
     pub fn status(&self) -> String {
         match self {

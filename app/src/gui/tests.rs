@@ -672,7 +672,7 @@ fn a_refined_p1_and_p2_at_nu_0_49_both_get_a_reference() {
     }
     for line in h.query_all_by_label_contains("nodes,") {
         let line = line.accesskit_node().label().or_else(|| line.accesskit_node().value()).unwrap_or_default();
-        assert!(!line.contains("no reference") && line.contains("reference"), "{line}");
+        assert!(!line.contains("no reference"), "{line}");
     }
     for k in 0..2 {
         h.state_mut().sessions[k].reference.wait();
@@ -715,7 +715,6 @@ fn a_provisional_reference_is_used_and_labelled_while_it_refines() {
     *job.estimate.lock().unwrap() = Some(Arc::new(estimate.clone()));
     assert!(state.poll(), "a new estimate is taken in");
     assert!(!state.poll(), "once");
-    assert_eq!(state.provisional_brief().as_deref(), Some("ref. ± 4.00 %, level 4 of 6"));
     assert_eq!(state.reference(), Some(&estimate));
     assert_eq!(state.short_status().as_deref(), Some("reference 0.2500 m ± 4.00 % (refining, 4 of 6)"));
     assert!(
@@ -849,6 +848,15 @@ fn a_change_too_slow_to_play_asks_first_and_a_slow_frame_pauses() {
     h.run_steps(2);
     assert_eq!(h.state().sessions[0].instance.sim.mesh().num_elements(), 10240);
     assert!(!h.state().playback.playing);
+    // a solver setting is estimated on the current mesh: 100 times the substeps of a 5 ms frame
+    h.state_mut().pending_change = None;
+    h.state_mut().sessions[0].ms_per_frame = 5.0;
+    let app = h.state_mut();
+    let mut c = app.sessions[0].config.clone();
+    c.substeps = 100 * app.sessions[0].instance.sim.substeps_per_frame();
+    app.apply("substeps", c);
+    assert!(app.pending_change.as_ref().is_some_and(|p| p.estimate.contains("xpbd solver")), "asked first");
+    h.state_mut().pending_change = None;
     // a frame slower than the limit pauses a playing app, saying why
     h.state_mut().playback.playing = true;
     h.state_mut().sessions[0].ms_per_frame = 2.0 * super::cost::SLOW_FRAME_MS;

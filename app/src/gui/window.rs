@@ -61,9 +61,6 @@ impl HoxApp {
                     s.ms_per_frame,
                     s.readout().error_text()
                 );
-                if let Some(note) = s.reference.provisional_brief() {
-                    text += &format!(" ({note})");
-                }
                 if s.settler.is_some() {
                     text += " (settling…)";
                 }
@@ -71,13 +68,15 @@ impl HoxApp {
                 if raised {
                     text += &format!(", {} substeps (guard)", sim.substeps_per_frame());
                 }
+                // the reference's state on hover: the line stays one line (the labels carry it)
                 let details = format!(
-                    "{} nodes, {} elements, {solver}, residual {:.1e}, t = {:.2} s\n{}",
+                    "{} nodes, {} elements, {solver}, residual {:.1e}, t = {:.2} s\n{}\n{}",
                     sim.mesh().num_nodes(),
                     sim.mesh().num_elements(),
                     s.residual,
                     sim.time_secs(),
-                    s.readout().text()
+                    s.readout().text(),
+                    s.reference.status()
                 );
                 let label = ui.label(egui::RichText::new(text).monospace()).on_hover_text(details);
                 if raised {
