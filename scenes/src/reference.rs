@@ -9,8 +9,9 @@
 //!   medium levels as below.
 //! - **computed**: any other physics on a box mesh (another ν, E, ρ or model, a scene file's own
 //!   loads). hox's static solver ([`crate::solve_static`]) on triquadratic hexahedra (Q2) at
-//!   four levels: the finest ([`levels`]; bending 32×8×8) and a quarter, a half and three
-//!   quarters as many cells per direction. The reference is the finest level extrapolated
+//!   six levels ([`compute`]): the finest ([`levels`]; bending 32×8×8) and ¼, ⅜, ½, ⅝ and ¾ as
+//!   many cells per direction, with provisional estimates on the way. The final reference uses
+//!   four of them (¼, ½, ¾, 1): it is the finest level extrapolated
 //!   (below) with the order the three finest levels show; its uncertainty is its distance from
 //!   the extrapolation by the halving levels (¼, ½, 1) — two independent estimates of the limit.
 //! - **own mesh**: a scene on a mesh file. The static solution of that same mesh: it measures

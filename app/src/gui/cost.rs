@@ -82,13 +82,14 @@ impl HoxApp {
         if s.ms_per_frame <= 0.0 {
             return None;
         }
-        let scene = match s.config.invalidated_by(new) {
+        let what = s.config.invalidated_by(new);
+        let scene = match what {
             // a new material may raise the guard's substeps: a slow frame then pauses (below)
             Invalidates::Nothing | Invalidates::Material => return None,
             Invalidates::Settings | Invalidates::Mesh => super::config::resolve(new, &s.base).ok()?,
         };
         // the same mesh: estimated from the settings alone; a new mesh is built to be counted
-        let (ms, elements, work) = if s.config.invalidated_by(new) == Invalidates::Settings {
+        let (ms, elements, work) = if what == Invalidates::Settings {
             let settings = scene.settings();
             let ms = estimated_ms_with(&s.instance.sim, s.ms_per_frame, &settings);
             (ms, s.instance.sim.mesh().num_elements(), format!("{} solver", settings.method.name()))

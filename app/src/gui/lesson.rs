@@ -82,6 +82,13 @@ fn prepare(step: &hox_scenes::lesson::Step) -> Prepared {
 }
 
 impl LessonState {
+    /// "A: Element p1 · Poisson ratio ν 0.49", a line per configuration of the step on screen:
+    /// the parameters the lesson's steps change.
+    fn parameter_lines(&self) -> Vec<String> {
+        let lines = self.lesson.step_parameters(self.step);
+        lines.iter().enumerate().map(|(k, line)| format!("{}: {line}", ["A", "B"][k.min(1)])).collect()
+    }
+
     /// Whether the step on screen is still being prepared.
     pub fn preparing(&self) -> bool {
         self.preparing.is_some()
@@ -101,8 +108,11 @@ impl LessonState {
                 }
                 None => {
                     let reference = self.own_references.get(k).and_then(Option::as_ref).or(s.reference.reference());
-                    let mut ms = s.frame_ms.clone();
-                    let ms = if ms.is_empty() { f64::NAN } else { hox_scenes::median(&mut ms) };
+                    // the median of the step's frames, only where it is the measure (drawn every frame)
+                    let ms = match step.measure {
+                        Measure::MsPerFrame if !s.frame_ms.is_empty() => hox_scenes::median(&mut s.frame_ms.clone()),
+                        _ => f64::NAN,
+                    };
                     hox_scenes::lesson::measure(step.measure, &s.instance, reference, ms, s.min_det_f)
                 }
             })
@@ -280,8 +290,8 @@ pub fn lesson_panel_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     ui.label(egui::RichText::new(&state.lesson.goal).italics());
     ui.separator();
     ui.label(egui::RichText::new(format!("Step {} of {n}: {}", state.step + 1, step.title)).strong().size(18.0));
-    for (k, line) in state.lesson.step_parameters(state.step).iter().enumerate() {
-        ui.label(egui::RichText::new(format!("{}: {line}", ["A", "B"][k.min(1)])).monospace());
+    for line in state.parameter_lines() {
+        ui.label(egui::RichText::new(line).monospace());
     }
     ui.label(&step.text);
     ui.add_space(6.0);
@@ -335,12 +345,8 @@ pub fn caption_ui(app: &HoxApp, ui: &mut egui::Ui) {
     ui.label(
         egui::RichText::new(format!("{} — {}", state.lesson.title, step.title)).strong().color(egui::Color32::WHITE),
     );
-    for (k, line) in state.lesson.step_parameters(state.step).iter().enumerate() {
-        ui.label(
-            egui::RichText::new(format!("{}: {line}", ["A", "B"][k.min(1)]))
-                .monospace()
-                .color(egui::Color32::from_rgb(200, 200, 200)),
-        );
+    for line in state.parameter_lines() {
+        ui.label(egui::RichText::new(line).monospace().color(egui::Color32::from_rgb(200, 200, 200)));
     }
     ui.label(egui::RichText::new(&step.question).color(egui::Color32::WHITE));
     if state.preparing() {

@@ -412,7 +412,7 @@ impl HoxApp {
 
     /// Whether a *Settle* is under way in any configuration.
     pub fn settling(&self) -> bool {
-        self.sessions.iter().any(|s| s.settler.is_some())
+        playback::any_settling(&self.sessions)
     }
 
     pub fn reset(&mut self) {

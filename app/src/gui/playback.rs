@@ -49,11 +49,10 @@ impl HoxApp {
         let mut sessions = std::mem::take(&mut self.sessions);
         let one_at_a_time = self.lesson_times_frames();
         let handle = std::thread::spawn(move || {
-            let settling = |s: &[Session]| s.iter().any(|s| s.settler.is_some());
-            let was_settling = settling(&sessions);
+            let was_settling = any_settling(&sessions);
             for _ in 0..frames {
                 // a settle that ends stops there, at rest (as [`HoxApp::step`])
-                if was_settling && !settling(&sessions) {
+                if was_settling && !any_settling(&sessions) {
                     break;
                 }
                 step_sessions(&mut sessions, one_at_a_time);
@@ -157,13 +156,18 @@ impl HoxApp {
     }
 }
 
+/// Whether a *Settle* is under way in any of `sessions`.
+pub(super) fn any_settling(sessions: &[Session]) -> bool {
+    sessions.iter().any(|s| s.settler.is_some())
+}
+
 /// One frame of every session: in parallel in compare mode, unless `one_at_a_time` (a lesson
 /// timing frames: each configuration then has the cores to itself, as in `hox lesson`). While a
 /// *Settle* is under way, a configuration that has settled waits at rest for the other (issue
 /// #35: it ran on undamped and read other numbers than `hox lesson`).
 pub(super) fn step_sessions(sessions: &mut [Session], one_at_a_time: bool) {
     use rayon::prelude::*;
-    let settling = sessions.iter().any(|s| s.settler.is_some());
+    let settling = any_settling(sessions);
     let step = |s: &mut Session| {
         if !settling || s.settler.is_some() {
             s.step(1);

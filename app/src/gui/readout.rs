@@ -285,6 +285,11 @@ pub enum Readout {
 }
 
 impl Readout {
+    /// No reference for this readout, for `why` ("the scene has no probes").
+    pub fn missing(why: &str) -> Readout {
+        Readout::NoReference { short: "no reference".into(), why: format!("no reference: {why}") }
+    }
+
     /// The error and its uncertainty, metres, where one can be stated: settled (no uncertainty
     /// beyond the solver's own), or moving with the drift between the last two oscillations'
     /// means (or, with only one, the amplitude).

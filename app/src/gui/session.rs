@@ -57,6 +57,9 @@ pub struct Drag {
 /// Compliance of the mouse attachment, m/N (stiff, but not rigid).
 const DRAG_COMPLIANCE_M_PER_N: f64 = 1e-6;
 
+/// How many frames' wall times a session keeps ([`Session::frame_ms`]).
+pub const FRAME_MS_KEPT: usize = 10_000;
+
 pub struct Session {
     pub base: Scene,
     pub config: Config,
@@ -368,7 +371,7 @@ impl Session {
     /// motion ([`Readout`]); while the reference is being computed, its progress.
     pub fn readout(&self) -> Readout {
         match (&self.readout, self.reference.reference()) {
-            (_, None) => self.no_reference(),
+            (_, None) => self.reference_pending(),
             // taken in since the last refresh (a test waiting on the computation)
             (Readout::NoReference { .. }, Some(_)) => self.measure_readout(),
             (Readout::Starting { .. }, Some(_)) => Readout::Starting { paused: self.paused },
@@ -392,7 +395,7 @@ impl Session {
         }
     }
 
-    fn no_reference(&self) -> Readout {
+    fn reference_pending(&self) -> Readout {
         Readout::NoReference {
             short: self.reference.short_status().unwrap_or_else(|| "no reference".into()),
             why: self.reference.status(),
@@ -405,13 +408,13 @@ impl Session {
 
     fn measure_readout(&self) -> Readout {
         let Some(r) = self.reference.reference() else {
-            return self.no_reference();
+            return self.reference_pending();
         };
         if self.shown_static {
             let now = self.instance.probe_displacements();
             return match (r.error_m(&now), r.error_pct(&now)) {
                 (Some(error_m), Some(error_pct)) => Readout::Static { error_m, error_pct },
-                _ => no_reference("the reference has none of this scene's probes"),
+                _ => Readout::missing("the reference has none of this scene's probes"),
             };
         }
         if self.rest.at_rest() {
@@ -420,11 +423,11 @@ impl Session {
                 (Some(error_m), Some(error_pct)) => {
                     Readout::Settled { error_m, error_pct, in_equilibrium: self.rest.settled() }
                 }
-                _ => no_reference("the reference has none of this scene's probes"),
+                _ => Readout::missing("the reference has none of this scene's probes"),
             };
         }
         let Some(first) = self.instance.probes.first() else {
-            return no_reference("the scene has no probes");
+            return Readout::missing("the scene has no probes");
         };
         if self.instance.sim.time_secs() == 0.0 {
             return Readout::NotStarted;
@@ -442,20 +445,9 @@ impl Session {
                 period_secs,
                 drift_m: before.map(|b| (Vec3::from(mean) - Vec3::from(b)).norm()),
             },
-            _ => no_reference(&format!("the reference has no probe '{}'", first.name)),
+            _ => Readout::missing(&format!("the reference has no probe '{}'", first.name)),
         }
     }
-}
-
-/// How many frames' wall times a session keeps ([`Session::frame_ms`]).
-pub const FRAME_MS_KEPT: usize = 10_000;
-
-/// A readout without a reference, for `why`.
-fn no_reference(why: &str) -> Readout {
-    Readout::NoReference { short: "no reference".into(), why: format!("no reference: {why}") }
-}
-
-impl Session {
     /// Makes the simulation's mouse attachment match `drag`: replaced when the target moved,
     /// removed on release, untouched otherwise (no effect churn on the stepping path).
     fn sync_drag(&mut self) {

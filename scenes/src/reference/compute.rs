@@ -103,10 +103,11 @@ pub fn provisional(
     let [.., b, c, d] = solved else { return None };
     let order = |x: &(f64, Probes), y: &(f64, Probes)| observed_order(&[x.clone(), y.clone(), d.clone()]);
     let extrapolated = format!("{} extrapolated", grid_name(finest));
-    let (probes, error_m, estimate, mesh) = match (solved.len(), order(b, c)) {
-        // four levels or more: two extrapolations of the finest, as the final reference
-        (4.., Some(p_last)) if order(&solved[solved.len() - 4], b).is_some() => {
-            let p_wide = order(&solved[solved.len() - 4], b).unwrap_or(p_last);
+    // four levels or more: the order from the levels one and three steps coarser too
+    let wide = solved.len().checked_sub(4).and_then(|k| order(&solved[k], b));
+    let (probes, error_m, estimate, mesh) = match (order(b, c), wide) {
+        // two extrapolations of the finest, as the final reference
+        (Some(p_last), Some(p_wide)) => {
             let (by_last, by_wide) = (extrapolate(c, d, p_last), extrapolate(b, d, p_wide));
             let error_m = distance(&by_last, &by_wide);
             (
@@ -116,7 +117,7 @@ pub fn provisional(
                 extrapolated,
             )
         }
-        (_, Some(p)) => {
+        (Some(p), None) => {
             let limit = extrapolate(c, d, p);
             let error_m = SAFETY_FACTOR * distance(&limit, &d.1);
             (
@@ -126,7 +127,7 @@ pub fn provisional(
                 extrapolated,
             )
         }
-        (_, None) => (
+        (None, _) => (
             d.1.clone(),
             UNCONVERGED_SAFETY_FACTOR * distance(&b.1, &c.1).max(distance(&c.1, &d.1)),
             format!(

@@ -110,7 +110,7 @@ fn the_levels_halve_the_cells_and_follow_the_box() {
     assert_eq!(levels([0.0; 3], [1.0, 1.0, 1.0], 8)[2], [4, 4, 4]);
 }
 
-/// A computed reference on small levels: it solves the scene at four Q2 levels, extrapolates,
+/// A computed reference on small levels: it solves the scene at six Q2 levels, extrapolates,
 /// and states an uncertainty.
 #[test]
 fn a_computed_reference_solves_three_levels_and_estimates_its_own_error() {
