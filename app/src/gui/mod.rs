@@ -179,6 +179,9 @@ impl HoxApp {
         if let Some(preset) = args.camera {
             app.set_camera(preset);
         }
+        if args.lesson_step.is_some() && args.lesson.is_none() && args.lesson_file.is_none() {
+            return Err("--lesson-step needs a lesson: --lesson NAME or --lesson-file FILE".into());
+        }
         if args.lesson.is_some() || args.lesson_file.is_some() {
             let lesson = crate::config::load_lesson(args.lesson.as_deref(), args.lesson_file.as_deref())
                 .map_err(|e| format!("{e:#}"))?;

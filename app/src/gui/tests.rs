@@ -992,4 +992,6 @@ fn a_lesson_opens_on_the_step_asked_for() {
         .err()
         .unwrap_or_default();
     assert!(err.contains("--lesson-step 9") && err.contains("steps 1 to 3"), "{err}");
+    let err = HoxApp::new(&args::parse_for_test(&["--lesson-step", "2"]), None).err().unwrap_or_default();
+    assert!(err.contains("--lesson-step needs a lesson"), "{err}");
 }
