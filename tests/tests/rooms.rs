@@ -22,7 +22,7 @@ const SIM: &[&[&str]] = &[
 
 /// The files of hox-sim's `solver/`, lowest first (`mod.rs`, the room's front, declares them).
 const SOLVER_FILES: &[&[&str]] = &[
-    &["method"],
+    &["method", "integrator"],
     &["error"],
     &["settings"],
     &["nan_guard"],
@@ -34,7 +34,6 @@ const SOLVER_FILES: &[&[&str]] = &[
     &["statics"],
     &["registry"],
     &["simulation"],
-    &["newmark"],
 ];
 
 /// hox-scenes' rooms, lowest first; `lib` (the registry of scenes, `Instance`, the front) last.

@@ -48,7 +48,7 @@ use hox_sim::element::ElementType;
 use hox_sim::material::MaterialModel;
 use hox_sim::measure::field::Field;
 use hox_sim::mesh::structured::TetSplit;
-use hox_sim::solver::{Method, SolverSettings, Sweep, VbdInit, VbdSettings};
+use hox_sim::solver::{Integrator, Method, SolverSettings, Sweep, VbdInit, VbdSettings};
 use hox_sim::xpbd::constraint::Formulation;
 use value::as_text;
 
@@ -187,8 +187,15 @@ params! {
     /// Implicit steps per frame (VBD, Newton).
     steps_per_frame: u32 = solver().steps_per_frame => {
         key: "steps", group: Group::Solver, file_key: "steps_per_frame", label: "Steps per frame",
-        help: "Implicit Euler steps per frame for vbd and newton (XPBD takes --substeps); more steps, less numerical damping.",
+        help: "Implicit steps per frame for vbd and newton (XPBD takes --substeps); more steps, less numerical damping and phase error.",
         kind: Kind::Whole { min: 1, max: 10_000, soft_max: 20 }, ..BASE
+    }
+    /// The implicit solvers' time integrator: euler | newmark | bdf2.
+    #[serde(with = "as_text")]
+    integrator: Integrator = solver().integrator => {
+        key: "integrator", group: Group::Solver, file_key: "integrator", label: "Integrator",
+        help: "Time integrator of vbd and newton (XPBD's substeps are its own): bdf2 (default: second order, keeps a swinging beam's motion and damps only the fast modes a frame cannot resolve, so a dragged node settles), newmark (average acceleration: conserves energy exactly, no numerical damping at all, so unresolved fast modes ring on) or euler (implicit Euler: first order, damps the motion, at one step per frame a beam loses half its swing in 2 s). docs/METHOD.md.",
+        kind: Kind::Choice(integrator_options), ..BASE
     }
     /// VBD sweeps per step.
     vbd_iterations: u32 = solver().vbd.iterations => {

@@ -1,10 +1,10 @@
 //! The options of the choice parameters (`element`, `split`, `material`, `solver`, `sweep`,
-//! `formulation`, `vbd-init`, `field`): each option's name and description, from sim's registries.
+//! `formulation`, `vbd-init`, `integrator`, `field`): each option's name and description, from sim's registries.
 
 use hox_sim::element::ElementType;
 use hox_sim::material::MaterialModel;
 use hox_sim::mesh::structured::TetSplit;
-use hox_sim::solver::{Method, Sweep, VbdInit};
+use hox_sim::solver::{Integrator, Method, Sweep, VbdInit};
 use hox_sim::xpbd::constraint::Formulation;
 
 pub(super) fn element_options() -> Vec<(&'static str, String)> {
@@ -54,4 +54,7 @@ pub(super) fn method_options() -> Vec<(&'static str, String)> {
 }
 pub(super) fn vbd_init_options() -> Vec<(&'static str, String)> {
     VbdInit::ALL.iter().map(|i| (i.name(), i.name().to_string())).collect()
+}
+pub(super) fn integrator_options() -> Vec<(&'static str, String)> {
+    Integrator::ALL.iter().map(|i| (i.name(), i.long_name().to_string())).collect()
 }

@@ -139,11 +139,13 @@ impl Scene {
             stability_guard: p.stability_guard,
             method: p.method,
             steps_per_frame: p.steps_per_frame,
+            integrator: p.integrator,
             vbd: VbdSettings {
                 iterations: p.vbd_iterations,
                 chebyshev_rho: p.chebyshev_rho,
                 coarse_cells: p.vbd_coarse_cells,
                 init: p.vbd_init,
+                ..VbdSettings::default()
             },
             newton: NewtonSettings { tolerance: p.newton_tolerance, ..Default::default() },
         }

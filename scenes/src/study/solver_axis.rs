@@ -26,7 +26,7 @@ use super::motion::{Motion, MotionMetrics, reference_motion};
 use super::{StudyConfig, probe_distance, probes_of, reference, settled_probes};
 use crate::{Instance, RunMode, SceneError, SceneOverrides, run_observed};
 use hox_sim::mesh::structured::TetSplit;
-use hox_sim::solver::Method;
+use hox_sim::solver::{Integrator, Method};
 use std::time::Instant;
 
 /// XPBD's grid of (substeps, iterations) per frame: equal sweep budgets of 50 and 100.
@@ -39,25 +39,29 @@ pub const TARGET_ERROR_PCT: f64 = 1.0;
 pub const REAL_TIME_MS: f64 = 1000.0 / 60.0;
 
 /// One solver at one setting: XPBD at a grid point of substeps × iterations, or an implicit
-/// solver of the registry ([`Method::ALL`]) at its defaults.
+/// solver of the registry ([`Method::ALL`]) at its defaults with one of the integrators
+/// ([`Integrator::ALL`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SolverChoice {
     Xpbd { substeps: u32, iterations: u32 },
-    Implicit(Method),
+    Implicit(Method, Integrator),
 }
 
 impl SolverChoice {
-    /// XPBD's grid, then VBD and Newton at their defaults.
+    /// XPBD's grid, then VBD and Newton at their defaults under each integrator.
     pub fn all() -> Vec<SolverChoice> {
         let mut v: Vec<SolverChoice> =
             XPBD_GRID.iter().map(|&(substeps, iterations)| SolverChoice::Xpbd { substeps, iterations }).collect();
-        v.extend(Method::ALL.into_iter().filter(|m| m.is_implicit()).map(SolverChoice::Implicit));
+        for m in Method::ALL.into_iter().filter(|m| m.is_implicit()) {
+            v.extend(Integrator::ALL.map(|i| SolverChoice::Implicit(m, i)));
+        }
         v
     }
+    /// "xpbd 50x1", "vbd bdf2", "newton newmark".
     pub fn label(&self) -> String {
         match self {
             SolverChoice::Xpbd { substeps, iterations } => format!("xpbd {substeps}x{iterations}"),
-            SolverChoice::Implicit(m) => m.name().into(),
+            SolverChoice::Implicit(m, i) => format!("{} {}", m.name(), i.name()),
         }
     }
     pub fn method(&self) -> &'static str {
@@ -66,7 +70,7 @@ impl SolverChoice {
     fn solver(&self) -> Method {
         match self {
             SolverChoice::Xpbd { .. } => Method::Xpbd,
-            SolverChoice::Implicit(m) => *m,
+            SolverChoice::Implicit(m, _) => *m,
         }
     }
     fn overrides(&self) -> SceneOverrides {
@@ -77,7 +81,9 @@ impl SolverChoice {
                 iterations: Some(iterations),
                 ..Default::default()
             },
-            other => SceneOverrides { method: Some(other.solver()), ..Default::default() },
+            SolverChoice::Implicit(m, i) => {
+                SceneOverrides { method: Some(m), integrator: Some(i), ..Default::default() }
+            }
         }
     }
 }
@@ -122,7 +128,8 @@ pub struct SolverRow {
     pub element: String,
     pub elements: usize,
     pub nodes: usize,
-    /// "xpbd 50x1", "vbd", "newton" (XPBD at the substeps it took, if the guard raised them).
+    /// "xpbd 50x1", "vbd bdf2", "newton newmark" (XPBD at the substeps it took, if the guard
+    /// raised them).
     pub solver: String,
     /// Element sweeps per frame: XPBD substeps × iterations, VBD steps × sweeps, Newton the mean
     /// iterations (each a factorisation or a back-substitution) per frame.
@@ -237,7 +244,7 @@ fn config_rows(
         let frames = report.frames.max(1) as f64;
         row.sweeps_per_frame = match choice {
             SolverChoice::Xpbd { iterations, .. } => (settling.sim.substeps_per_frame() * iterations) as f64,
-            SolverChoice::Implicit(_) => counters.solver_iterations as f64 / frames,
+            SolverChoice::Implicit(..) => counters.solver_iterations as f64 / frames,
         };
         if let SolverChoice::Xpbd { substeps, iterations } = choice
             && settling.sim.substeps_per_frame() != substeps
@@ -662,7 +669,19 @@ mod tests {
     #[test]
     fn the_grid_has_the_issues_budgets_and_every_solver() {
         let labels: Vec<String> = SolverChoice::all().iter().map(SolverChoice::label).collect();
-        for want in ["xpbd 50x1", "xpbd 25x2", "xpbd 10x5", "xpbd 100x1", "xpbd 50x2", "vbd", "newton"] {
+        for want in [
+            "xpbd 50x1",
+            "xpbd 25x2",
+            "xpbd 10x5",
+            "xpbd 100x1",
+            "xpbd 50x2",
+            "vbd euler",
+            "vbd newmark",
+            "vbd bdf2",
+            "newton euler",
+            "newton newmark",
+            "newton bdf2",
+        ] {
             assert!(labels.iter().any(|l| l == want), "{want} missing from {labels:?}");
         }
         let bending = solver_configurations("bending", false);

@@ -88,6 +88,7 @@ pub const INFO: [MethodInfo; 3] = [
         honours: &[ImplicitRole::Hooks, ImplicitRole::Projection, ImplicitRole::Potential],
         parameters: &[
             "steps_per_frame",
+            "integrator",
             "vbd_iterations",
             "chebyshev_rho",
             "vbd_coarse_cells",
@@ -104,7 +105,7 @@ pub const INFO: [MethodInfo; 3] = [
         long_name: "Newton (implicit Euler)",
         implicit: true,
         honours: &[ImplicitRole::Hooks, ImplicitRole::Potential],
-        parameters: &["steps_per_frame", "newton_tolerance"],
+        parameters: &["steps_per_frame", "integrator", "newton_tolerance"],
         step_word: "step",
         remedy: "more steps per frame, a softer material or stable Neo-Hookean",
         motion: "Implicit Euler solved to convergence, one step per frame: it damps the motion (the beam loses 55–62 % of its swing by 2 s; the dashed reference keeps swinging), not a fault. Its equilibrium is right: Settle shows it.",

@@ -11,7 +11,8 @@
 //! gathers each element's nodes, calls a pure kernel, and scatters the corrections back.
 //!
 //! Where things are, in the order each file reads only the ones before it (`tests/tests/rooms.rs`
-//! keeps it): `method.rs` (which solvers there are and what each is, [`Method`]); `error.rs`
+//! keeps it): `method.rs` (which solvers there are and what each is, [`Method`]) and
+//! `integrator.rs` (the implicit solvers' time integrators, [`Integrator`]); `error.rs`
 //! ([`SimError`], [`SolverCounters`]); `settings.rs` (what a run is asked to do,
 //! [`SolverSettings`]); `nan_guard.rs` (naming the element of a blow-up); `step.rs` (what a
 //! solver's step reads and the one trait every solver implements); `residual.rs` (the static
@@ -20,8 +21,7 @@
 //! (the one Newton's method with line search); the solvers `xpbd/`, `vbd/`, `newton.rs`;
 //! [`statics`] (the static equilibrium XPBD settles to, by the same Newton); `registry.rs` (the
 //! one match naming each solver's type); `simulation.rs` (the stateful [`Simulation`]: the step
-//! skeleton below, the NaN and stability guards); `newmark.rs` (the reference motion's
-//! integrator, driving a `Simulation` through its public interface).
+//! skeleton below, the NaN and stability guards).
 //!
 //! **NaN guard.** A kernel whose corrections come out non-finite is not scattered: the substep
 //! stops there with [`SimError::NonFinite`] naming that element (block and index), its bad node,
@@ -34,6 +34,8 @@
 //! state instead of painting garbage, and offers a reset. See `docs/STABILITY.md`.
 
 mod method;
+
+mod integrator;
 
 mod error;
 
@@ -65,16 +67,16 @@ mod registry;
 
 mod simulation;
 
-mod newmark;
-
 pub use error::{SimError, SolverCounters};
+pub use integrator::{INFO as INTEGRATORS, Integrator, IntegratorInfo};
 pub use method::{INFO as METHODS, Method, MethodInfo};
-pub use newmark::Newmark;
 pub use residual::StaticResidual;
 pub use settings::{NewtonSettings, SolverSettings, Sweep, VbdInit, VbdSettings};
 pub use simulation::{NODE_LOOP_MIN_NODES_PER_THREAD, Simulation};
 
 #[cfg(test)]
 mod implicit_tests;
+#[cfg(test)]
+mod integrator_tests;
 #[cfg(test)]
 mod tests;

@@ -42,7 +42,7 @@ use crate::mesh::Mesh;
 
 pub(crate) struct Newton {
     pattern: Option<SparsePattern>,
-    /// The model version and step the pattern and factor were made for.
+    /// The model version and inertia step the pattern and factor were made for.
     made_for: (u64, f64),
     y: Vec<Vec3>,
     scratch: Scratch,
@@ -89,21 +89,21 @@ impl StepSolver for Newton {
         let settings = s.settings.newton;
         let bad = |node: usize| BadElement::at_node(s.mesh, node, ORIGIN_NEWTON);
         super::nan_guard::check_input(s.mesh, positions)?;
-        if self.pattern.is_none() || self.made_for != (s.model_version, s.h) {
+        if self.pattern.is_none() || self.made_for != (s.model_version, s.inertia_h) {
             let pattern = SparsePattern::new(s.mesh, |i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?;
             self.pattern = Some(pattern);
-            self.made_for = (s.model_version, s.h);
+            self.made_for = (s.model_version, s.inertia_h);
         }
         let pattern = self.pattern.as_mut().expect("made above");
         self.y.clear();
         self.y.extend_from_slice(positions);
         for (i, x) in positions.iter_mut().enumerate() {
             if s.inv_mass[i] > 0.0 {
-                *x -= s.body_acceleration * (s.h * s.h);
+                *x -= s.body_acceleration * (s.inertia_h * s.inertia_h);
             }
         }
         let springs = hooks.springs();
-        let w = 1.0 / (s.h * s.h);
+        let w = 1.0 / (s.inertia_h * s.inertia_h);
         let potential = Potential { input: s, y: &self.y, springs: &springs, w };
         let body_force = potential.body_force_n();
         let diagonal = potential.hessian_diagonal(pattern);

@@ -1,7 +1,8 @@
 //! The one Newton's method of hox: it minimises a potential `Φ` over the free degrees of freedom
 //! for the static solver ([`super::statics`]: `Π(x) = Σ_e U_e(x) − Σ_i m_i a·x_i` at one load
-//! fraction), for Newton's implicit Euler (`newton.rs`: the incremental potential of
-//! [`super::potential`]) and so for the reference motion's Newmark steps (`newmark.rs`).
+//! fraction) and for the Newton solver's steps (`newton.rs`: the incremental potential of
+//! [`super::potential`] under any of the [`super::integrator`]s, the reference motion's Newmark
+//! steps among them).
 //!
 //! Each iteration solves `K Δ = −∇Φ` with `K = D + Σ_e Σ_q V_q Gᵀ ∂P/∂F G` (`D` a diagonal such
 //! as `M/h²` plus spring stiffnesses, none for statics; sparse Cholesky, `sparse.rs`) and

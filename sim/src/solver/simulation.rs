@@ -5,6 +5,7 @@
 //! [`super::registry::make`].
 
 use super::error::{SimError, SolverCounters};
+use super::integrator::{History, Integrator};
 use super::method::Method;
 use super::nan_guard::{BadElement, ORIGIN_STATE};
 use super::registry;
@@ -52,6 +53,8 @@ pub struct Simulation {
     masses_overridden: bool,
     /// Substeps per frame being taken (the requested ones or the guard's).
     substeps_per_frame: u32,
+    /// The implicit solvers' integrator history ([`super::integrator`]).
+    history: History,
 }
 
 impl Simulation {
@@ -92,6 +95,7 @@ impl Simulation {
             omega2_per_e_over_rho: None,
             masses_overridden: false,
             substeps_per_frame: settings.substeps,
+            history: History::default(),
         };
         for e in effects {
             sim.add_effect(e)?;
@@ -195,15 +199,15 @@ impl Simulation {
     /// free nodes (elastic force plus body force) relative to the load ([`StaticResidual`]).
     /// Forces of contact and of attachments are not counted.
     pub fn static_residual(&self) -> StaticResidual {
-        let mut grad = vec![Vec3::zeros(); self.positions.len()];
-        crate::fem::energy::total_energy_and_gradient(
-            &self.mesh,
-            &self.geometry,
-            &self.material,
-            &self.positions,
-            &mut grad,
-        );
+        let grad = self.elastic_gradient(&self.positions);
         static_residual(&grad, &self.masses_kg, self.body_acceleration_m_s2(), |i| self.inv_mass[i] > 0.0)
+    }
+
+    /// `∇U(x)`, the elastic energy's gradient at `x`.
+    fn elastic_gradient(&self, x: &[Vec3]) -> Vec<Vec3> {
+        let mut grad = vec![Vec3::zeros(); x.len()];
+        crate::fem::energy::total_energy_and_gradient(&self.mesh, &self.geometry, &self.material, x, &mut grad);
+        grad
     }
 
     /// Adds an effect to the running simulation (pinning the nodes it positions); refused when
@@ -313,6 +317,7 @@ impl Simulation {
         }
         if settings.method != self.settings.method {
             self.solver = registry::make(&self.mesh, &self.geometry, &settings);
+            self.history.clear();
         } else {
             self.solver.rebuild(&self.mesh, &self.geometry, &settings, geometry_changed);
         }
@@ -331,6 +336,7 @@ impl Simulation {
         self.substeps_in_frame = 0;
         self.failure = None;
         self.solver.reset_history(true, self.positions.len());
+        self.history.clear();
     }
 
     /// Back to the rest shape at t = 0.
@@ -343,6 +349,7 @@ impl Simulation {
         self.substeps_in_frame = 0;
         self.failure = None;
         self.solver.reset_history(false, self.positions.len());
+        self.history.clear();
     }
 
     /// The stability guard's findings: the fastest element mode, `h ω_max` with the requested
@@ -422,7 +429,12 @@ impl Simulation {
             return Err(e.clone());
         }
         let h = self.substep_dt_secs();
+        // the implicit solvers' integrator (XPBD's substeps are its own)
+        let integrator = self.integrator();
         self.solver.begin_step(&self.velocities);
+        if integrator != Integrator::Euler {
+            self.history.begin(integrator, h, &self.velocities);
+        }
         self.time_secs += h;
         self.counters.substeps += 1;
         self.substeps_in_frame += 1;
@@ -467,9 +479,38 @@ impl Simulation {
                 *x += v * h;
             }
         }
+        let inertia_h = if integrator == Integrator::Euler {
+            h
+        } else {
+            let start_gradient = self.history.needs_start_acceleration(integrator, h).then(|| {
+                let mut grad = self.elastic_gradient(&self.prev_positions);
+                for sp in self.effects.iter().filter_map(|e| e.spring()) {
+                    let i = sp.node as usize;
+                    grad[i] += (self.prev_positions[i] - sp.target_m) * sp.stiffness_n_per_m;
+                }
+                grad
+            });
+            self.history.predict(
+                integrator,
+                h,
+                &self.prev_positions,
+                &self.velocities,
+                &mut self.positions,
+                &self.inv_mass,
+                start_gradient.as_deref(),
+            )
+        };
         hook!(after_prediction);
         let body_acceleration = self.body_acceleration_m_s2();
         let mut hook_calls = 0;
+        let num_nodes = self.positions.len();
+        let (guess, projected) = match integrator {
+            Integrator::Euler => (None, None),
+            _ => {
+                let (guess, projected) = self.history.step_views(num_nodes);
+                (Some(guess).filter(|_| integrator == Integrator::Newmark), Some(projected))
+            }
+        };
         let input = StepInput {
             mesh: &self.mesh,
             geometry: &self.geometry,
@@ -479,6 +520,8 @@ impl Simulation {
             prev_positions: &self.prev_positions,
             body_acceleration,
             h,
+            inertia_h,
+            guess,
             settings: &self.settings,
             model_version: self.model_version,
         };
@@ -491,6 +534,7 @@ impl Simulation {
             time_secs: self.time_secs,
             h,
             calls: &mut hook_calls,
+            projected,
         };
         let solved = self.solver.solve_step(&input, &mut self.positions, &mut hooks, &mut self.counters);
         self.counters.effect_hook_calls += hook_calls;
@@ -498,7 +542,16 @@ impl Simulation {
             return Err(self.fail(bad));
         }
         let inv_h = 1.0 / h;
-        if chunks > 1 {
+        if integrator != Integrator::Euler {
+            self.history.update(
+                integrator,
+                h,
+                &self.prev_positions,
+                &self.positions,
+                &mut self.velocities,
+                &self.inv_mass,
+            );
+        } else if chunks > 1 {
             use rayon::prelude::*;
             self.velocities
                 .par_chunks_mut(c)
@@ -532,6 +585,12 @@ impl Simulation {
             Some(bad) => Err(self.fail(bad)),
             None => Ok(()),
         }
+    }
+
+    /// The time integrator the steps take: the settings' for the implicit solvers, implicit
+    /// Euler's update for XPBD (its substeps are its integrator).
+    pub fn integrator(&self) -> Integrator {
+        if self.settings.method.is_implicit() { self.settings.integrator } else { Integrator::Euler }
     }
 
     /// Kinetic energy `½ Σ m_i |v_i|²`, joules.

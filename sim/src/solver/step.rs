@@ -24,6 +24,13 @@ pub(crate) struct StepInput<'a> {
     pub body_acceleration: Vec3,
     /// The step, seconds.
     pub h: f64,
+    /// The inertia step `h̄` of the incremental potential's `m/(2h̄²)|x − y|²`, seconds: `h` for
+    /// implicit Euler, `h/2` for Newmark, `2h/3` for BDF2 ([`super::integrator`]). The
+    /// prediction `y` holds the body acceleration as `h̄² g`.
+    pub inertia_h: f64,
+    /// Newmark's guess of `x_{n+1}` (the motion with its last acceleration kept), where VBD's
+    /// adaptive start begins under it ([`super::integrator`]); None under the other schemes.
+    pub guess: Option<&'a [Vec3]>,
     pub settings: &'a SolverSettings,
     /// Changes whenever the pinned nodes, the masses or the material may have changed.
     pub model_version: u64,
@@ -39,12 +46,22 @@ pub(crate) struct Hooks<'a> {
     pub time_secs: f64,
     pub h: f64,
     pub calls: &'a mut u64,
+    /// Where the nodes a projection moved are marked (with a scratch copy of the positions), when
+    /// the integrator must know them ([`super::integrator`]: a projected node's velocity is
+    /// implicit Euler's, so a contact does not become an acceleration that bounces it back).
+    pub projected: Option<(&'a mut [bool], &'a mut Vec<Vec3>)>,
 }
 
 impl Hooks<'_> {
     /// Runs the effects' projections: every effect's (`only` = None, XPBD), or only those of
     /// one role (contact under VBD).
     pub fn after_projection(&mut self, positions: &mut [Vec3], only: Option<ImplicitRole>) {
+        let track =
+            self.projected.is_some() && self.effects.iter().any(|e| only.is_none_or(|role| e.implicit_role() == role));
+        if track && let Some((_, before)) = &mut self.projected {
+            before.clear();
+            before.extend_from_slice(positions);
+        }
         for e in self.effects.iter_mut() {
             if only.is_some_and(|role| e.implicit_role() != role) {
                 continue;
@@ -59,6 +76,11 @@ impl Hooks<'_> {
                 velocities: self.velocities,
                 inv_mass: self.inv_mass,
             });
+        }
+        if track && let Some((marks, before)) = &mut self.projected {
+            for ((m, x), b) in marks.iter_mut().zip(positions.iter()).zip(before.iter()) {
+                *m |= x != b;
+            }
         }
     }
 

@@ -175,7 +175,7 @@ impl CoarseSpace {
     fn make(&mut self, s: &StepInput<'_>, x: &[Vec3], springs: &[NodeSpring]) {
         let n = 3 * self.num_coarse;
         let mut a = DMatrix::<f64>::zeros(n, n);
-        let inv_h2_per_s2 = 1.0 / (s.h * s.h);
+        let inv_h2_per_s2 = 1.0 / (s.inertia_h * s.inertia_h);
         let free = |i: usize| s.inv_mass[i] > 0.0;
         let add_node_diag = |a: &mut DMatrix<f64>, i: usize, k: f64| {
             for &(cj, wj) in &self.corners[i] {
@@ -272,7 +272,7 @@ impl CoarseSpace {
     /// Starts a step: the coarse matrix is remade when it is [`REFRESH_STEPS`] old, when the
     /// last correction's line search found it far off, or when the model or the step changed.
     pub fn begin_step(&mut self, s: &StepInput<'_>, x: &[Vec3], springs: &[NodeSpring]) {
-        let made_for = (s.model_version, s.h);
+        let made_for = (s.model_version, s.inertia_h);
         if self.made_for != made_for || self.factor.is_none() || self.age >= REFRESH_STEPS {
             self.make(s, x, springs);
             self.made_for = made_for;
@@ -343,7 +343,7 @@ impl CoarseSpace {
 /// `∇G(x)` into `out`: Newton's [`Potential`] (zero on held nodes).
 fn potential_gradient(s: &StepInput<'_>, x: &[Vec3], y: &[Vec3], springs: &[NodeSpring], out: &mut Vec<Vec3>) {
     out.resize(x.len(), Vec3::zeros());
-    Potential { input: s, y, springs, w: 1.0 / (s.h * s.h) }.eval(x, out);
+    Potential { input: s, y, springs, w: 1.0 / (s.inertia_h * s.inertia_h) }.eval(x, out);
 }
 
 /// `Σ_i a_i · b_i` over the nodes `b` moves (held nodes have `b_i = 0`).
@@ -441,6 +441,8 @@ mod tests {
                 prev_positions: &sim.mesh().rest_positions,
                 body_acceleration: Vec3::zeros(),
                 h: 1.0 / 60.0,
+                inertia_h: 1.0 / 60.0,
+                guess: None,
                 settings: &settings,
                 model_version: 1,
             };
@@ -456,7 +458,7 @@ mod tests {
             let mut c = CoarseSpace::new(sim.mesh(), 16);
             c.begin_step(&s, &x, &[]);
             let energy = |x: &[Vec3]| {
-                let w = 0.5 / (s.h * s.h);
+                let w = 0.5 / (s.inertia_h * s.inertia_h);
                 crate::fem::energy::total_energy(s.mesh, s.geometry, s.material, x)
                     + x.iter().zip(&y).zip(s.masses_kg).map(|((a, b), m)| w * m * (a - b).norm_squared()).sum::<f64>()
             };

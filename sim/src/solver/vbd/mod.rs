@@ -18,10 +18,15 @@
 //! colour in parallel; each node reads only the others and writes only itself, so serial and
 //! parallel sweeps, on any thread count, give the same bits.
 //!
-//! - **Initialisation** (§3.5 of the paper, [`super::VbdInit`]): by default
-//!   `x⁰ = x_n + h v_n + h² ã ĝ` with `ã` the body's acceleration along gravity `ĝ` over the
-//!   last step clamped to `[0, |g|]`, so a body at rest in equilibrium starts — and stays —
-//!   exactly there: VBD's fixed point is the static equilibrium for any iteration count.
+//! - **Initialisation** (§3.5 of the paper, [`super::VbdInit`]): by default, under implicit
+//!   Euler, `x⁰ = x_n + h v_n + h² ã ĝ` with `ã` the body's acceleration along gravity `ĝ` over
+//!   the last step clamped to `[0, |g|]`, so a body at rest in equilibrium starts — and stays —
+//!   exactly there: VBD's fixed point is the static equilibrium for any iteration count (also
+//!   under BDF2). Under Newmark, the integrator's guess (the motion with its last acceleration
+//!   kept, at rest the same fixed point; [`super::step::StepInput::guess`]), and the step sweeps
+//!   on until converged ([`super::VbdSettings::tolerance`]): Newmark damps nothing, so the error
+//!   fixed sweeps leave feeds the next step's acceleration (10 sweeps blew the bending beam up
+//!   within a second).
 //! - **Acceleration** (§3.7): Chebyshev semi-iteration with spectral radius estimate `ρ`,
 //!   `x⁽ᵏ⁾ = ω_k (x̄⁽ᵏ⁾ − x⁽ᵏ⁻²⁾) + x⁽ᵏ⁻²⁾`, `ω_1 = 1`, `ω_2 = 2/(2 − ρ²)`,
 //!   `ω_k = 4/(4 − ρ² ω_{k−1})`; `ρ = 0.9` by default (measured: half the sweeps to settle the
@@ -50,6 +55,8 @@
 
 use super::error::SolverCounters;
 use super::nan_guard::BadElement;
+use super::potential::Potential;
+use super::residual::load_scale;
 use super::settings::{SolverSettings, VbdInit};
 use super::step::{Hooks, StepInput, StepSolver};
 use coarse::{CoarseSpace, coarse_cells};
@@ -60,7 +67,7 @@ mod coarse;
 mod lanes;
 mod node;
 use crate::Vec3;
-use crate::effect::ImplicitRole;
+use crate::effect::{ImplicitRole, NodeSpring};
 use crate::fem::geometry::BlockGeometry;
 use crate::math::shared::SharedMut;
 use crate::mesh::Mesh;
@@ -170,6 +177,7 @@ impl StepSolver for Vbd {
             *x = match s.settings.vbd.init {
                 VbdInit::Inertia => self.y[i],
                 VbdInit::Previous => xn,
+                VbdInit::Adaptive if s.guess.is_some() => s.guess.map_or(xn, |guess| guess[i]),
                 VbdInit::Adaptive if g_norm == 0.0 => xn + vn * h,
                 VbdInit::Adaptive if self.history < 2 => self.y[i],
                 VbdInit::Adaptive => {
@@ -186,68 +194,102 @@ impl StepSolver for Vbd {
             incidence: &self.incidence,
             y: &self.y,
             springs: &springs,
-            w: 1.0 / (h * h),
+            w: 1.0 / (s.inertia_h * s.inertia_h),
             lame: s.material.lame(),
             fused: self.fused,
         };
         let rho = s.settings.vbd.chebyshev_rho;
-        let mut omega = 1.0;
-        // the two-level correction: the smooth error the sweeps barely touch, first
-        if let Some(c) = &mut self.coarse {
-            c.begin_step(s, positions, &springs);
-            counters.coarse_corrections += u64::from(c.correct(s, positions, &self.y, &springs));
-        }
-        if rho > 0.0 {
-            self.prev_prev.clear();
-            self.prev_prev.extend_from_slice(positions);
-            self.prev_iter.clear();
-            self.prev_iter.extend_from_slice(positions);
-        }
-        // the initial guess (and the correction) moved the positions as a whole: F_q from them,
-        // then in step with each node move, each acceleration (F is affine in the positions, so
-        // it mixes as they do) and, after a projection moved the positions, from them again
+        // rounds of sweeps: one under a scheme that damps what the sweeps leave (implicit Euler,
+        // BDF2); under Newmark, which damps nothing, more until the step has converged
+        let converge = s.settings.integrator.info().needs_converged_steps;
+        let rounds = if converge { MAX_ROUNDS } else { 1 };
+        let mut grad = Vec::new();
         let mut stale = true;
-        for k in 1..=s.settings.vbd.iterations {
-            if stale {
-                self.lanes.refresh(s.mesh, positions, self.fused);
+        for round in 0..rounds {
+            // the two-level correction: the smooth error the sweeps barely touch, first
+            if let Some(c) = &mut self.coarse {
+                if round == 0 {
+                    c.begin_step(s, positions, &springs);
+                }
+                let corrected = c.correct(s, positions, &self.y, &springs);
+                counters.coarse_corrections += u64::from(corrected && round == 0);
+                stale |= corrected;
             }
-            if rho > 0.0 && k == 1 {
-                self.f_snapshots.start(&self.lanes);
-            }
-            let lanes = LaneView::of(&mut self.lanes, s.material);
-            for colour in &self.colours {
-                counters.node_updates +=
-                    sweep_colour(&update, colour, positions, &lanes, s.settings.sweep.is_colour())?;
-            }
+            let mut omega = 1.0;
             if rho > 0.0 {
-                omega = match k {
-                    1 => 1.0,
-                    2 => 2.0 / (2.0 - rho * rho),
-                    _ => 4.0 / (4.0 - rho * rho * omega),
-                };
-                let mix = k >= 2 && omega > 1.0;
-                if mix {
-                    for (i, x) in positions.iter_mut().enumerate() {
-                        if s.inv_mass[i] > 0.0 {
-                            *x = (*x - self.prev_prev[i]) * omega + self.prev_prev[i];
+                self.prev_prev.clear();
+                self.prev_prev.extend_from_slice(positions);
+                self.prev_iter.clear();
+                self.prev_iter.extend_from_slice(positions);
+            }
+            // the initial guess (and the correction) moved the positions as a whole: F_q from them,
+            // then in step with each node move, each acceleration (F is affine in the positions, so
+            // it mixes as they do) and, after a projection moved the positions, from them again
+            for k in 1..=s.settings.vbd.iterations {
+                if stale {
+                    self.lanes.refresh(s.mesh, positions, self.fused);
+                }
+                if rho > 0.0 && k == 1 {
+                    self.f_snapshots.start(&self.lanes);
+                }
+                let lanes = LaneView::of(&mut self.lanes, s.material);
+                for colour in &self.colours {
+                    counters.node_updates +=
+                        sweep_colour(&update, colour, positions, &lanes, s.settings.sweep.is_colour())?;
+                }
+                if rho > 0.0 {
+                    omega = match k {
+                        1 => 1.0,
+                        2 => 2.0 / (2.0 - rho * rho),
+                        _ => 4.0 / (4.0 - rho * rho * omega),
+                    };
+                    let mix = k >= 2 && omega > 1.0;
+                    if mix {
+                        for (i, x) in positions.iter_mut().enumerate() {
+                            if s.inv_mass[i] > 0.0 {
+                                *x = (*x - self.prev_prev[i]) * omega + self.prev_prev[i];
+                            }
                         }
                     }
+                    std::mem::swap(&mut self.prev_prev, &mut self.prev_iter);
+                    self.prev_iter.copy_from_slice(positions);
+                    self.f_snapshots.advance(&mut self.lanes, mix.then_some(omega));
                 }
-                std::mem::swap(&mut self.prev_prev, &mut self.prev_iter);
-                self.prev_iter.copy_from_slice(positions);
-                self.f_snapshots.advance(&mut self.lanes, mix.then_some(omega));
+                let projections = *hooks.calls;
+                hooks.after_projection(positions, Some(ImplicitRole::Projection));
+                stale = *hooks.calls != projections;
+                #[cfg(test)]
+                if !stale {
+                    self.lanes.assert_in_step_with(s.mesh, positions);
+                }
+                counters.solver_iterations += 1;
             }
-            let projections = *hooks.calls;
-            hooks.after_projection(positions, Some(ImplicitRole::Projection));
-            stale = *hooks.calls != projections;
-            #[cfg(test)]
-            if !stale {
-                self.lanes.assert_in_step_with(s.mesh, positions);
+            if !converge {
+                break;
             }
-            counters.solver_iterations += 1;
+            let residual = relative_residual(s, positions, &self.y, &springs, &mut grad);
+            if residual <= s.settings.vbd.tolerance {
+                break;
+            }
+            if round + 1 == rounds {
+                counters.unconverged_steps += 1;
+            }
         }
         Ok(())
     }
+}
+
+/// The most rounds of sweeps a step takes where it must converge (Newmark).
+const MAX_ROUNDS: u32 = 20;
+
+/// The free residual of the step's incremental potential over the load (as Newton measures it).
+fn relative_residual(s: &StepInput<'_>, x: &[Vec3], y: &[Vec3], springs: &[NodeSpring], grad: &mut Vec<Vec3>) -> f64 {
+    grad.clear();
+    grad.resize(x.len(), Vec3::zeros());
+    let potential = Potential { input: s, y, springs, w: 1.0 / (s.inertia_h * s.inertia_h) };
+    let (_, reactions) = potential.eval(x, grad);
+    let norm = grad.iter().map(|g| g.norm_squared()).sum::<f64>().sqrt();
+    norm / load_scale(potential.body_force_n(), reactions)
 }
 
 /// Updates the free nodes of one colour; returns how many moved.
