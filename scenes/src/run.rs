@@ -68,8 +68,11 @@ pub struct RunReport {
     pub residual_rel: f64,
     /// Wall-clock time of the whole run (stepping and checks), seconds.
     pub wall_secs: f64,
-    /// Implicit steps that reached their iteration limit (Newton).
+    /// Implicit steps that reached their iteration limit (Newton; VBD under Newmark).
     pub unconverged_steps: u64,
+    /// Implicit steps the step watch rejected and took again in halves (a node moved more than
+    /// the body's size against the body's mean motion).
+    pub rejected_steps: u64,
     pub kinetic_energy_j: f64,
     pub elastic_energy_j: f64,
     /// The solver that ran ("xpbd", "vbd", "newton").
@@ -186,6 +189,7 @@ pub fn run_observed(
         residual_rel: instance.sim.static_residual().relative,
         wall_secs: started.elapsed().as_secs_f64(),
         unconverged_steps: instance.sim.counters().unconverged_steps,
+        rejected_steps: instance.sim.counters().rejected_steps,
         kinetic_energy_j: instance.sim.kinetic_energy_j(),
         elastic_energy_j: instance.sim.elastic_energy_j(),
         solver: instance.sim.method().name().to_string(),

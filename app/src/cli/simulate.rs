@@ -113,8 +113,14 @@ pub fn simulate(
     }
     if report.unconverged_steps > 0 {
         eprintln!(
-            "warning: {} Newton steps reached their iteration limit before the tolerance",
-            report.unconverged_steps
+            "warning: {} {} steps reached their iteration limit before the tolerance",
+            report.unconverged_steps, report.solver
+        );
+    }
+    if report.rejected_steps > 0 {
+        eprintln!(
+            "warning: the step watch rejected {} {} steps (a node moved more than the body's size, or the step was left far from solved) and took them again in halves",
+            report.rejected_steps, report.solver
         );
     }
     Ok(())

@@ -45,6 +45,29 @@ pub enum SimError {
         substep: u64,
         time_secs: f64,
     },
+    #[error(
+        "the {solver} simulation diverged at frame {frame} (t = {time_secs:.6} s): in one {} node {node} moved {moved_m:.3e} m against the body's mean motion, more than the body's size ({size_m:.3e} m), and {} halvings of the step (down to {h_secs:.3e} s) did not help; the last sound state is kept — reset, or use {}",
+        step_word(solver),
+        halvings,
+        remedy(solver)
+    )]
+    Diverged {
+        solver: &'static str,
+        /// The node that moved most against the body's mean motion (global index).
+        node: usize,
+        moved_m: f64,
+        size_m: f64,
+        frame: u64,
+        time_secs: f64,
+        /// How many times the step was halved, and the shortest step tried.
+        halvings: u32,
+        h_secs: f64,
+    },
+    #[error(
+        "the {solver} simulation could not solve its step at frame {frame} (t = {time_secs:.6} s): the unbalanced force stayed above a tenth of the load, and {halvings} halvings of the step (down to {h_secs:.3e} s) did not help; the last sound state is kept — reset, or use {}",
+        remedy(solver)
+    )]
+    Unsolved { solver: &'static str, frame: u64, time_secs: f64, halvings: u32, h_secs: f64 },
 }
 
 /// Counters of the work done, for tests and the status line.
@@ -61,8 +84,11 @@ pub struct SolverCounters {
     pub coarse_corrections: u64,
     /// Newton's numeric factorisations of the stiffness.
     pub factorizations: u64,
-    /// Newton steps that reached their iteration limit before the tolerance.
+    /// Newton steps that reached their iteration limit before the tolerance (VBD's under Newmark
+    /// that reached its most rounds of sweeps).
     pub unconverged_steps: u64,
+    /// Steps the step watch rejected and took again in halves ([`super::Simulation`]).
+    pub rejected_steps: u64,
 }
 
 /// What the NaN guard calls a step of `solver` ("substep" for XPBD, "step" for the implicit ones).

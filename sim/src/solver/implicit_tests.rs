@@ -349,3 +349,43 @@ fn the_coarse_correction_settles_a_stiff_beam_in_a_fraction_of_the_frames() {
     assert_eq!(corrections, with as u64, "one correction per step");
     assert!(3 * with < without, "{with} frames with the coarse correction, {without} without");
 }
+
+/// Finite but absurd is stopped as a NaN is (issue #36): a projection that throws a node ten
+/// body sizes each time it runs (a broken effect) moves it by more than the body's size in every
+/// step the watch tries, down to `h/2^MAX_HALVINGS`, so the run stops naming the solver and the
+/// node, keeps the state the step started from and refuses to step until reset;
+/// `rejected_steps` counts the tries.
+#[test]
+fn a_node_thrown_across_the_body_stops_the_implicit_run_naming_it() {
+    struct Thrower(u32);
+    impl Effect for Thrower {
+        fn name(&self) -> &'static str {
+            "thrower"
+        }
+        fn implicit_role(&self) -> crate::effect::ImplicitRole {
+            crate::effect::ImplicitRole::Projection
+        }
+        fn after_projection(&mut self, s: &mut EffectState<'_>) {
+            s.positions[self.0 as usize].z += 10.0;
+        }
+    }
+    let mesh = beam(ElementType::from_name("p1").unwrap(), [2, 1, 1]);
+    let material = Material::new(MaterialModel::StableNeoHookean, 1.0e5, 0.3, 1000.0).unwrap();
+    let clamped = clamped_at_x0(&mesh);
+    let node = mesh.num_nodes() as u32 - 1;
+    let mut sim =
+        Simulation::new(mesh.clone(), material, implicit(Method::Vbd, 60.0), cantilever_effects(&clamped, 0.0))
+            .unwrap();
+    sim.step_frame().unwrap();
+    let before = sim.positions.clone();
+    sim.add_effect(Box::new(Thrower(node))).unwrap();
+    let err = sim.step_frame().unwrap_err().to_string();
+    assert!(err.starts_with("the vbd simulation diverged"), "{err}");
+    assert!(err.contains(&format!("node {node} moved")) && err.contains("6 halvings"), "{err}");
+    assert_eq!(sim.counters().rejected_steps, 7, "one rejection per depth, 1 to 1/64");
+    assert_eq!(sim.positions, before, "the state the step started from is kept");
+    assert!(sim.step_frame().is_err());
+    sim.reset();
+    sim.remove_effects_named("thrower");
+    sim.step_frame().unwrap();
+}

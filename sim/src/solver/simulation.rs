@@ -55,7 +55,12 @@ pub struct Simulation {
     substeps_per_frame: u32,
     /// The implicit solvers' integrator history ([`super::integrator`]).
     history: History,
+    /// The rest shape's bounding-box diagonal: the step watch's bound, m.
+    body_size_m: f64,
 }
+
+/// The most times the step watch halves a rejected step ([`Simulation`]): down to 1/16.
+pub const MAX_HALVINGS: u32 = 6;
 
 impl Simulation {
     /// Validates the mesh and settings, precomputes geometry and masses, pins the nodes the
@@ -96,7 +101,9 @@ impl Simulation {
             masses_overridden: false,
             substeps_per_frame: settings.substeps,
             history: History::default(),
+            body_size_m: 0.0,
         };
+        sim.body_size_m = super::newton_core::body_size_m(&sim.mesh.rest_positions);
         for e in effects {
             sim.add_effect(e)?;
         }
@@ -429,6 +436,70 @@ impl Simulation {
             return Err(e.clone());
         }
         let h = self.substep_dt_secs();
+        if self.settings.method.is_implicit() { self.watched_step(h, 0) } else { self.advance(h) }
+    }
+
+    /// An implicit step of `h` under the step watch: a step in which a free node moves, against
+    /// the free nodes' mean motion, by more than the body's size, or which the solver left far
+    /// from solved ([`StepSolver::last_step_failed`]), is rejected — the state goes back to its
+    /// start — and taken again as two steps of `h/2`, down to `h/2^`[`MAX_HALVINGS`]; past that
+    /// the run stops with [`SimError::Diverged`] naming the node (or [`SimError::Unsolved`]),
+    /// keeping the last sound state.
+    fn watched_step(&mut self, h: f64, halvings: u32) -> Result<(), SimError> {
+        let start = (self.positions.clone(), self.velocities.clone(), self.time_secs, self.substeps_in_frame);
+        self.advance(h)?;
+        let excess = self.step_excess(&start.0);
+        let failed = self.solver.last_step_failed();
+        if excess.is_none() && !failed {
+            return Ok(());
+        }
+        (self.positions, self.velocities, self.time_secs, self.substeps_in_frame) = start;
+        self.prev_positions.copy_from_slice(&self.positions);
+        self.history.clear();
+        self.solver.reset_history(false, self.positions.len());
+        self.counters.rejected_steps += 1;
+        if halvings == MAX_HALVINGS {
+            let err = match excess {
+                Some((node, moved_m)) => SimError::Diverged {
+                    solver: self.settings.method.name(),
+                    node,
+                    moved_m,
+                    size_m: self.body_size_m,
+                    frame: self.frames + 1,
+                    time_secs: self.time_secs + h,
+                    halvings,
+                    h_secs: h,
+                },
+                None => SimError::Unsolved {
+                    solver: self.settings.method.name(),
+                    frame: self.frames + 1,
+                    time_secs: self.time_secs + h,
+                    halvings,
+                    h_secs: h,
+                },
+            };
+            self.failure = Some(err.clone());
+            return Err(err);
+        }
+        self.watched_step(0.5 * h, halvings + 1)?;
+        self.watched_step(0.5 * h, halvings + 1)
+    }
+
+    /// The free node that moved most in the step from `start` against the free nodes' mean
+    /// motion, and how far, when that is more than the body's size.
+    fn step_excess(&self, start: &[Vec3]) -> Option<(usize, f64)> {
+        let free = |i: &usize| self.inv_mass[*i] > 0.0;
+        let n = (0..start.len()).filter(free).count().max(1) as f64;
+        let mean = (0..start.len()).filter(free).map(|i| self.positions[i] - start[i]).sum::<Vec3>() / n;
+        let (node, moved) = (0..start.len())
+            .filter(free)
+            .map(|i| (i, (self.positions[i] - start[i] - mean).norm()))
+            .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+        (moved > self.body_size_m).then_some((node, moved))
+    }
+
+    /// One step of `h` (a substep of XPBD, a step of the implicit solvers).
+    fn advance(&mut self, h: f64) -> Result<(), SimError> {
         // the implicit solvers' integrator (XPBD's substeps are its own)
         let integrator = self.integrator();
         self.solver.begin_step(&self.velocities);

@@ -113,6 +113,11 @@ pub(crate) trait StepSolver: Send {
     fn as_any_mut(&mut self) -> &mut dyn std::any::Any;
     /// A few words on the work it does, for a status line ("xpbd, 1,200 constraints").
     fn work_summary(&self, settings: &SolverSettings, counters: &SolverCounters) -> String;
+    /// Whether the last step ended far from solved (VBD: a residual above a tenth of the load
+    /// after its recovery rounds): the step watch rejects it and takes it again in halves.
+    fn last_step_failed(&self) -> bool {
+        false
+    }
     /// The relative residual of each iteration of the last step (Newton; for tests).
     fn last_step_residuals(&self) -> &[f64] {
         &[]

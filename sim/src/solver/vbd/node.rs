@@ -1,6 +1,7 @@
 //! One VBD node update ([`NodeUpdate`]): the node's force and positive-definite block summed over
 //! the elements holding it, the springs and the inertia term, and the 3×3 Newton step
-//! `x_i ← x_i + H_i⁻¹ f_i` by a hand-written Cholesky ([`solve_spd3`]).
+//! `x_i ← x_i + t H_i⁻¹ f_i` by a hand-written Cholesky ([`solve_spd3`]), `t` halved from 1
+//! until the node's share of the potential does not rise (at most [`MAX_BACKTRACKS`] times).
 
 use super::lanes::{Fused, LaneView, add_outer_any};
 use crate::Vec3;
@@ -21,6 +22,8 @@ pub(super) struct NodeUpdate<'a> {
     pub(super) w: f64,
     pub(super) lame: Lame,
     pub(super) fused: Fused,
+    /// Backtrack each node step on the node's potential (VBD's recovery rounds).
+    pub(super) line_search: bool,
 }
 
 impl NodeUpdate<'_> {
@@ -102,14 +105,73 @@ impl NodeUpdate<'_> {
         let Some(d) = solve_spd3(&h, &f) else {
             return Err(BadElement::at_node(s.mesh, i, ORIGIN_VBD));
         };
-        // SAFETY: the caller's promise
-        unsafe {
-            positions.write(i, xi + d);
-            carry_points::<FMA>(self.incidence, i, d, lanes);
+        if !self.line_search {
+            // SAFETY: the caller's promise
+            unsafe {
+                positions.write(i, xi + d);
+                carry_points::<FMA>(self.incidence, i, d, lanes);
+            }
+            return Ok(true);
         }
-        Ok(true)
+        // the step, backtracked until the node's potential does not rise (a full Newton step on
+        // the projected block overshot near incompressibility: ν = 0.499 under torsion blew up)
+        // SAFETY: the caller's promise
+        let before = unsafe { self.local_energy(i, xi, lanes) };
+        let mut t = 1.0;
+        let mut moved = Vec3::zeros();
+        for _ in 0..=MAX_BACKTRACKS {
+            let step = d * t - moved;
+            // SAFETY: the caller's promise
+            unsafe { carry_points::<FMA>(self.incidence, i, step, lanes) };
+            moved += step;
+            // SAFETY: the caller's promise
+            let after = unsafe { self.local_energy(i, xi + moved, lanes) };
+            if after <= before {
+                // SAFETY: the caller's promise
+                unsafe { positions.write(i, xi + moved) };
+                return Ok(true);
+            }
+            t *= 0.5;
+        }
+        // no decrease along the step (round-off at a minimum): the node stays
+        // SAFETY: the caller's promise
+        unsafe { carry_points::<FMA>(self.incidence, i, -moved, lanes) };
+        Ok(false)
+    }
+
+    /// The node's share of the incremental potential at `xi`, with the `F_q` the lanes hold:
+    /// `m_i/(2h̄²)|x_i − y_i|² + Σ_{e ∋ i} Σ_q V_q ψ(F_q) + Σ_k k_k/2 |x_i − t_k|²`.
+    ///
+    /// # Safety
+    /// As [`NodeUpdate::step`].
+    #[inline(always)]
+    unsafe fn local_energy(&self, i: usize, xi: Vec3, lanes: &[LaneView<'_>]) -> f64 {
+        let s = self.input;
+        let law = s.material.model.law();
+        let mut e = 0.5 * s.masses_kg[i] * self.w * (xi - self.y[i]).norm_squared();
+        for inc in self.incidence.of(i) {
+            let (b, el) = (inc.block as usize, inc.element as usize);
+            let l = &lanes[b];
+            // SAFETY: an element holding node i
+            let fq = unsafe { l.f_mut(el) };
+            let g = &l.geometry;
+            let visit = NodeVisit { width: g.width, f: fq, grads: g.node_grads(el, 0), volumes: g.volumes(el) };
+            for (p, &v) in visit.volumes.iter().enumerate() {
+                if v != 0.0 {
+                    let (f, _, _) = visit.point(p / g.width, p % g.width);
+                    e += v * law.energy_density(self.lame, &f);
+                }
+            }
+        }
+        for sp in self.springs.iter().filter(|sp| sp.node as usize == i) {
+            e += 0.5 * sp.stiffness_n_per_m * (xi - sp.target_m).norm_squared();
+        }
+        e
     }
 }
+
+/// The most halvings of a node's step ([`NodeUpdate::step`]).
+const MAX_BACKTRACKS: u32 = 10;
 
 /// `H⁻¹ f` for a symmetric positive definite 3 × 3 `H` by its Cholesky factor `L Lᵀ` (lower
 /// triangle read); `None` when `H` is not positive definite or the result not finite.
