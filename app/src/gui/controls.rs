@@ -361,16 +361,26 @@ fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
         Kind::Point => {}
     }
     if p.key == "solver" {
-        solver_motion_ui(ui, config.method);
+        solver_motion_ui(ui, config.method, config.integrator);
     }
 }
 
-/// Under the solver: what it does to the motion (issue #35: the implicit solvers' beam lost
-/// half its swing each period with nothing on screen saying why).
-pub(super) fn solver_motion_ui(ui: &mut egui::Ui, method: hox_sim::solver::Method) {
+/// Under the solver: what it and, for the implicit ones, their integrator do to the motion
+/// (issue #35: the implicit solvers' beam lost half its swing each period with nothing on screen
+/// saying why); in amber where the motion is damped (implicit Euler).
+pub(super) fn solver_motion_ui(
+    ui: &mut egui::Ui,
+    method: hox_sim::solver::Method,
+    integrator: hox_sim::solver::Integrator,
+) {
     let info = method.info();
-    let colour = if info.implicit { egui::Color32::from_rgb(250, 200, 120) } else { ui.visuals().weak_text_color() };
+    let damps = info.implicit && integrator == hox_sim::solver::Integrator::Euler;
+    let colour = if damps { egui::Color32::from_rgb(250, 200, 120) } else { ui.visuals().weak_text_color() };
     ui.label(egui::RichText::new(info.motion).small().color(colour));
+    if info.implicit {
+        let i = integrator.info();
+        ui.label(egui::RichText::new(format!("{}: {}", i.long_name, i.motion)).small().color(colour));
+    }
 }
 
 /// *Settle* (E): run to rest with the settle damping, as `hox simulate --settle` does.

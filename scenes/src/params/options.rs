@@ -46,7 +46,7 @@ pub(super) fn method_options() -> Vec<(&'static str, String)> {
             let long = match m {
                 Method::Xpbd => "XPBD (the paper's)",
                 Method::Vbd => "VBD (vertex block descent)",
-                Method::Newton => "Newton (implicit Euler)",
+                Method::Newton => "Newton (implicit step)",
             };
             (m.name(), long.to_string())
         })

@@ -3,7 +3,8 @@
 //! The reference (`assets/reference/bending-motion.json`, made by
 //! `cargo run --release -p hox-scenes --example reference_motion`, recipe in
 //! `assets/reference/README.md`) is the tip probe's displacement every 1/60 s over 3 s on Q2
-//! 16×4×4, integrated by Newmark's average-acceleration rule ([`hox_sim::solver::Newmark`],
+//! 16×4×4, integrated by Newmark's average-acceleration rule (the Newton solver with
+//! [`hox_sim::solver::Integrator::Newmark`],
 //! energy-conserving) with a step converged against its half.
 //!
 //! Two numbers summarise a motion `u_z(t)` released from rest (a turning point at t = 0):

@@ -36,9 +36,9 @@ pub enum Method {
     /// Extended position-based dynamics with small steps (the paper's).
     #[default]
     Xpbd,
-    /// Vertex block descent on implicit Euler's incremental potential.
+    /// Vertex block descent on the implicit step's incremental potential.
     Vbd,
-    /// Newton's method on implicit Euler's incremental potential (sparse Cholesky).
+    /// Newton's method on the implicit step's incremental potential (sparse Cholesky).
     Newton,
 }
 
@@ -97,18 +97,18 @@ pub const INFO: [MethodInfo; 3] = [
         ],
         step_word: "step",
         remedy: "more steps per frame, a softer material or stable Neo-Hookean",
-        motion: "Implicit Euler, one step per frame: it damps the motion (the beam loses 55–62 % of its swing by 2 s; the dashed reference keeps swinging), not a fault. Its equilibrium is right: Settle shows it.",
+        motion: "Sweeps the implicit step's potential; the motion is its integrator's (below). Its equilibrium is right: Settle shows it.",
     },
     MethodInfo {
         method: Method::Newton,
         name: "newton",
-        long_name: "Newton (implicit Euler)",
+        long_name: "Newton (implicit step)",
         implicit: true,
         honours: &[ImplicitRole::Hooks, ImplicitRole::Potential],
         parameters: &["steps_per_frame", "integrator", "newton_tolerance"],
         step_word: "step",
         remedy: "more steps per frame, a softer material or stable Neo-Hookean",
-        motion: "Implicit Euler solved to convergence, one step per frame: it damps the motion (the beam loses 55–62 % of its swing by 2 s; the dashed reference keeps swinging), not a fault. Its equilibrium is right: Settle shows it.",
+        motion: "Solves the implicit step to convergence; the motion is its integrator's (below). Its equilibrium is right: Settle shows it.",
     },
 ];
 
