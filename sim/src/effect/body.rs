@@ -27,6 +27,9 @@ impl Effect for Gravity {
     fn body_acceleration_m_s2(&self) -> Vec3 {
         self.acceleration_m_s2
     }
+    fn does_no_work(&self) -> bool {
+        true
+    }
     fn before_prediction(&mut self, s: &mut EffectState<'_>) {
         let dv = self.acceleration_m_s2 * s.dt_secs;
         for (v, w) in s.velocities.iter_mut().zip(s.inv_mass) {
@@ -53,6 +56,9 @@ impl Effect for Damping {
     }
     fn implicit_role(&self) -> super::ImplicitRole {
         super::ImplicitRole::Hooks
+    }
+    fn does_no_work(&self) -> bool {
+        true
     }
     fn after_velocity_update(&mut self, s: &mut EffectState<'_>) {
         let factor = (-self.rate_per_sec * s.dt_secs).exp();

@@ -15,6 +15,9 @@ impl Effect for Clamp {
     fn name(&self) -> &'static str {
         "clamp"
     }
+    fn does_no_work(&self) -> bool {
+        true
+    }
     fn implicit_role(&self) -> super::ImplicitRole {
         super::ImplicitRole::Hooks
     }

@@ -95,6 +95,12 @@ pub trait Effect: Send + Sync {
     fn body_acceleration_m_s2(&self) -> Vec3 {
         Vec3::zeros()
     }
+    /// Whether the effect does no work the simulation's energy does not count: gravity (a
+    /// potential the energy holds), clamps (held nodes do not move) and damping (takes energy
+    /// out). The step watch checks that the energy does not grow only when every effect says so.
+    fn does_no_work(&self) -> bool {
+        false
+    }
     /// The spring this effect is, for the implicit solvers ([`ImplicitRole::Potential`]).
     fn spring(&self) -> Option<NodeSpring> {
         None

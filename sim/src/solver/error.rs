@@ -64,10 +64,18 @@ pub enum SimError {
         h_secs: f64,
     },
     #[error(
-        "the {solver} simulation could not solve its step at frame {frame} (t = {time_secs:.6} s): the unbalanced force stayed above a tenth of the load, and {halvings} halvings of the step (down to {h_secs:.3e} s) did not help; the last sound state is kept — reset, or use {}",
+        "the {solver} simulation could not take its step at frame {frame} (t = {time_secs:.6} s): {why}, and {halvings} halvings of the step (down to {h_secs:.3e} s) did not help; the last sound state is kept — reset, or use {}",
         remedy(solver)
     )]
-    Unsolved { solver: &'static str, frame: u64, time_secs: f64, halvings: u32, h_secs: f64 },
+    Unsolved {
+        solver: &'static str,
+        frame: u64,
+        time_secs: f64,
+        /// What the step watch found: the unbalanced force left, or the energy gained.
+        why: String,
+        halvings: u32,
+        h_secs: f64,
+    },
 }
 
 /// Counters of the work done, for tests and the status line.

@@ -59,8 +59,13 @@ pub struct Simulation {
     body_size_m: f64,
 }
 
-/// The most times the step watch halves a rejected step ([`Simulation`]): down to 1/16.
+/// The most times the step watch halves a rejected step ([`Simulation`]): down to 1/64.
 pub const MAX_HALVINGS: u32 = 6;
+
+/// The most a step may raise the mechanical energy of a body whose effects do no work, as a
+/// fraction of the energy's scale ([`Simulation`]'s step watch): Newmark's own drift on a
+/// nonlinear body is far below it, implicit Euler and BDF2 only lower the energy.
+const ENERGY_GROWTH: f64 = 1e-2;
 
 impl Simulation {
     /// Validates the mesh and settings, precomputes geometry and masses, pins the nodes the
@@ -440,17 +445,26 @@ impl Simulation {
     }
 
     /// An implicit step of `h` under the step watch: a step in which a free node moves, against
-    /// the free nodes' mean motion, by more than the body's size, or which the solver left far
-    /// from solved ([`StepSolver::last_step_failed`]), is rejected — the state goes back to its
+    /// the free nodes' mean motion, by more than the body's size, which the solver left far
+    /// from solved ([`StepSolver::last_step_failed`]), or which raised the mechanical energy by
+    /// more than [`ENERGY_GROWTH`] of its scale while no effect does work
+    /// ([`Effect::does_no_work`]), is rejected — the state goes back to its
     /// start — and taken again as two steps of `h/2`, down to `h/2^`[`MAX_HALVINGS`]; past that
     /// the run stops with [`SimError::Diverged`] naming the node (or [`SimError::Unsolved`]),
     /// keeping the last sound state.
     fn watched_step(&mut self, h: f64, halvings: u32) -> Result<(), SimError> {
         let start = (self.positions.clone(), self.velocities.clone(), self.time_secs, self.substeps_in_frame);
+        let watch_energy = self.effects.iter().all(|e| e.does_no_work());
+        let energy_before = watch_energy.then(|| self.mechanical_energy_j());
         self.advance(h)?;
         let excess = self.step_excess(&start.0);
         let failed = self.solver.last_step_failed();
-        if excess.is_none() && !failed {
+        let gained = energy_before.and_then(|(total, scale)| {
+            let (after, scale_after) = self.mechanical_energy_j();
+            let growth = (after - total) / scale.max(scale_after).max(f64::MIN_POSITIVE);
+            (growth > ENERGY_GROWTH).then_some(growth)
+        });
+        if excess.is_none() && !failed && gained.is_none() {
             return Ok(());
         }
         (self.positions, self.velocities, self.time_secs, self.substeps_in_frame) = start;
@@ -474,6 +488,13 @@ impl Simulation {
                     solver: self.settings.method.name(),
                     frame: self.frames + 1,
                     time_secs: self.time_secs + h,
+                    why: match gained {
+                        Some(growth) => format!(
+                            "the step raised the energy of a body no effect does work on by {:.1} % of its scale",
+                            100.0 * growth
+                        ),
+                        None => "the unbalanced force stayed above a tenth of the load".into(),
+                    },
                     halvings,
                     h_secs: h,
                 },
@@ -483,6 +504,18 @@ impl Simulation {
         }
         self.watched_step(0.5 * h, halvings + 1)?;
         self.watched_step(0.5 * h, halvings + 1)
+    }
+
+    /// The mechanical energy `K + U − Σ m_i g·(x_i − X_i)` (free nodes), J, and its scale
+    /// `K + U + |V_g|`, for the step watch.
+    fn mechanical_energy_j(&self) -> (f64, f64) {
+        let g = self.body_acceleration_m_s2();
+        let gravity: f64 = (0..self.positions.len())
+            .filter(|&i| self.inv_mass[i] > 0.0)
+            .map(|i| -self.masses_kg[i] * g.dot(&(self.positions[i] - self.mesh.rest_positions[i])))
+            .sum();
+        let (kinetic, elastic) = (self.kinetic_energy_j(), self.elastic_energy_j());
+        (kinetic + elastic + gravity, kinetic + elastic + gravity.abs())
     }
 
     /// The free node that moved most in the step from `start` against the free nodes' mean
