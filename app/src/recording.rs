@@ -141,7 +141,8 @@ pub fn configuration_markdown(instance: &Instance) -> String {
     text
 }
 
-/// A short label for an instance, e.g. `p2 160` (element type and count).
+/// A short label for an instance, e.g. `p2 160` (element type and count; an implicit solver
+/// and its integrator follow: `p2 160 newton bdf2`).
 pub fn config_label(instance: &Instance) -> String {
     let mesh = instance.sim.mesh();
     let types: Vec<&str> = mesh.blocks.iter().map(|b| b.element_type.name()).collect();
@@ -149,7 +150,12 @@ pub fn config_label(instance: &Instance) -> String {
     // the default solver (XPBD, the paper's) is unnamed (the labels of earlier recordings stay
     // as they were)
     let method = instance.sim.method();
-    if method == hox_sim::solver::Method::default() { label } else { format!("{label} {method}") }
+    if method == hox_sim::solver::Method::default() {
+        label
+    } else {
+        // an implicit solver with its integrator (issue #36): `p2 160 newton bdf2`
+        format!("{label} {method} {}", instance.sim.integrator())
+    }
 }
 
 /// Line colours of the configurations in the charts, in order (Tableau 10).

@@ -417,3 +417,36 @@ fn simulate_and_static_report_the_reference_of_the_physics_at_hand() {
     let none = json(&["simulate", "--scene", "bending", "--seconds", "0.1", "--reference", "none", "--json"]);
     assert!(none["reference"].is_null() && none["error_m"].is_null());
 }
+
+/// Issue #36: the bad-input cases with every solver and integrator, and a bad integrator named.
+#[test]
+fn bad_input_is_a_clear_error_under_every_solver_and_integrator() {
+    fails_with(&["simulate", "--scene", "bending", "--integrator", "verlet"], "verlet");
+    for solver in ["xpbd", "vbd", "newton"] {
+        for integrator in ["euler", "newmark", "bdf2"] {
+            let run = |extra: &[&str], needle: &str| {
+                let mut args = vec![
+                    "simulate",
+                    "--scene",
+                    "bending",
+                    "--seconds",
+                    "0.05",
+                    "--solver",
+                    solver,
+                    "--integrator",
+                    integrator,
+                ];
+                args.extend_from_slice(extra);
+                fails_with(&args, needle);
+            };
+            run(&["--poisson", "0.5"], "Poisson ratio");
+            run(&["--youngs", "nan"], "Young's modulus");
+            run(&["--density", "-1"], "density");
+            run(&["--fps", "inf"], "frames_per_second");
+            run(&["--steps", "0"], "steps");
+            run(&["--vbd-iterations", "0"], "vbd");
+            run(&["--newton-tolerance", "nan"], "newton");
+        }
+    }
+    fails_with(&["simulate", "--scene", "drop", "--solver", "newton", "--seconds", "0.05"], "contact");
+}

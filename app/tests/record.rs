@@ -276,16 +276,31 @@ fn a_refused_record_option_names_the_problem_without_an_empty_prefix() {
 }
 
 #[test]
-fn an_implicit_solvers_recording_is_labelled_with_its_solver() {
+fn an_implicit_solvers_recording_is_labelled_with_its_solver_and_integrator() {
     let file = temp("newton.rrd");
     let f = file.to_str().unwrap();
     let summary =
         ok_json(&["record", "--scene", "bending", "--seconds", "0.05", "--solver", "newton", "--out", f, "--json"]);
     let entities: Vec<&str> =
         summary["configurations"].as_array().unwrap().iter().map(|c| c["entity"].as_str().unwrap()).collect();
-    assert_eq!(entities, ["world/p2_160_newton"]);
+    assert_eq!(entities, ["world/p2_160_newton_bdf2"]);
     let checked = ok_json(&["inspect", f, "--expect-frames", "4", "--json"]);
-    assert_eq!(checked["configurations"], serde_json::json!(["p2_160_newton"]));
+    assert_eq!(checked["configurations"], serde_json::json!(["p2_160_newton_bdf2"]));
+    let summary = ok_json(&[
+        "record",
+        "--scene",
+        "bending",
+        "--seconds",
+        "0.05",
+        "--solver",
+        "vbd",
+        "--integrator",
+        "newmark",
+        "--out",
+        f,
+        "--json",
+    ]);
+    assert_eq!(summary["configurations"][0]["entity"], "world/p2_160_vbd_newmark");
 }
 
 /// Issue #21: `hox lessons --json` lists at least eight lessons; every one records headlessly
