@@ -26,4 +26,4 @@ shot classroom-1280-lesson 1280x720 5 --lesson why-high-order
 # presenter mode: the caption below the view, short labels, the lesson's parameters
 shot classroom-1280-presenter 1280x720 4 --lesson locking --presenter
 # Full HD: Newton against XPBD, the solver's effect on the motion said under it
-shot classroom-1920-newton 1920x1080 5 --compare element=p1,refine=1,solver=newton --compare element=p2 --play
+shot classroom-1920-newton 1920x1080 5 --compare element=p1,refine=1,solver=newton,integrator=euler --compare element=p2 --play
