@@ -181,7 +181,7 @@ params! {
     #[serde(with = "as_text")]
     method: Method = solver().method => {
         key: "solver", group: Group::Solver, file_key: "method", label: "Solver",
-        help: "xpbd: the paper's extended position-based dynamics (substeps × iterations); vbd: vertex block descent on implicit Euler (Chen et al. 2024); newton: implicit Euler solved by Newton's method to --newton-tolerance (sparse Cholesky). Contact needs xpbd or vbd.",
+        help: "xpbd: the paper's extended position-based dynamics (substeps × iterations); vbd: vertex block descent on an implicit step (Chen et al. 2024); newton: the implicit step solved by Newton's method to --newton-tolerance (sparse Cholesky); the implicit step's scheme is --integrator. Contact needs xpbd or vbd.",
         kind: Kind::Choice(method_options), ..BASE
     }
     /// Implicit steps per frame (VBD, Newton).
