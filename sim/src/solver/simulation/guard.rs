@@ -1,0 +1,152 @@
+//! The guards of a [`Simulation`]'s step: the **step watch** of the implicit solvers (a step that
+//! throws a node further than the body's size, that the solver left far from solved, or that
+//! raised the energy of a body no effect does work on, is taken again in halves and, failing
+//! that, stops the run naming the solver and node; docs/STABILITY.md) and the **NaN guard**'s
+//! check and roll-back to the last finite state (module doc of [`super::super`]).
+
+use super::super::error::SimError;
+use super::super::nan_guard::{BadElement, ORIGIN_STATE};
+use super::Simulation;
+use crate::Vec3;
+
+/// The most times the step watch halves a rejected step ([`Simulation`]): down to 1/64.
+pub const MAX_HALVINGS: u32 = 6;
+
+/// The most a step may raise the mechanical energy of a body whose effects do no work, as a
+/// fraction of the energy's scale ([`Simulation`]'s step watch): Newmark's own drift on a
+/// nonlinear body is far below it, implicit Euler and BDF2 only lower the energy.
+const ENERGY_GROWTH: f64 = 1e-2;
+
+impl Simulation {
+    /// An implicit step of `h` under the step watch: a step in which a free node moves, against
+    /// the free nodes' mean motion, by more than the body's size, which the solver left far
+    /// from solved ([`StepSolver::last_step_failed`]), or which raised the mechanical energy by
+    /// more than [`ENERGY_GROWTH`] of its scale while no effect does work
+    /// ([`Effect::does_no_work`]), is rejected — the state goes back to its
+    /// start — and taken again as two steps of `h/2`, down to `h/2^`[`MAX_HALVINGS`]; past that
+    /// the run stops with [`SimError::Diverged`] naming the node (or [`SimError::Unsolved`]),
+    /// keeping the last sound state.
+    pub(super) fn watched_step(&mut self, h: f64, halvings: u32) -> Result<(), SimError> {
+        let start = (self.positions.clone(), self.velocities.clone(), self.time_secs, self.substeps_in_frame);
+        let watch_energy = self.effects.iter().all(|e| e.does_no_work());
+        let energy_before = watch_energy.then(|| self.mechanical_energy_j());
+        self.advance(h)?;
+        let excess = self.step_excess(&start.0);
+        let failed = self.solver.last_step_failed();
+        let gained = energy_before.and_then(|(total, scale)| {
+            let (after, scale_after) = self.mechanical_energy_j();
+            let growth = (after - total) / scale.max(scale_after).max(f64::MIN_POSITIVE);
+            (growth > ENERGY_GROWTH).then_some(growth)
+        });
+        if excess.is_none() && !failed && gained.is_none() {
+            return Ok(());
+        }
+        (self.positions, self.velocities, self.time_secs, self.substeps_in_frame) = start;
+        self.prev_positions.copy_from_slice(&self.positions);
+        self.history.clear();
+        self.solver.reset_history(false, self.positions.len());
+        self.counters.rejected_steps += 1;
+        if halvings == MAX_HALVINGS {
+            let err = match excess {
+                Some((node, moved_m)) => SimError::Diverged {
+                    solver: self.settings.method.name(),
+                    node,
+                    moved_m,
+                    size_m: self.body_size_m,
+                    frame: self.frames + 1,
+                    time_secs: self.time_secs + h,
+                    halvings,
+                    h_secs: h,
+                },
+                None => SimError::Unsolved {
+                    solver: self.settings.method.name(),
+                    frame: self.frames + 1,
+                    time_secs: self.time_secs + h,
+                    why: match gained {
+                        Some(growth) => format!(
+                            "the step raised the energy of a body no effect does work on by {:.1} % of its scale",
+                            100.0 * growth
+                        ),
+                        None => "the unbalanced force stayed above a tenth of the load".into(),
+                    },
+                    halvings,
+                    h_secs: h,
+                },
+            };
+            self.failure = Some(err.clone());
+            return Err(err);
+        }
+        self.watched_step(0.5 * h, halvings + 1)?;
+        self.watched_step(0.5 * h, halvings + 1)
+    }
+
+    /// The mechanical energy `K + U − Σ m_i g·(x_i − X_i)` (free nodes), J, and its scale
+    /// `K + U + |V_g|`, for the step watch.
+    fn mechanical_energy_j(&self) -> (f64, f64) {
+        let g = self.body_acceleration_m_s2();
+        let gravity: f64 = (0..self.positions.len())
+            .filter(|&i| self.inv_mass[i] > 0.0)
+            .map(|i| -self.masses_kg[i] * g.dot(&(self.positions[i] - self.mesh.rest_positions[i])))
+            .sum();
+        let (kinetic, elastic) = (self.kinetic_energy_j(), self.elastic_energy_j());
+        (kinetic + elastic + gravity, kinetic + elastic + gravity.abs())
+    }
+
+    /// The free node that moved most in the step from `start` against the free nodes' mean
+    /// motion, and how far, when that is more than the body's size.
+    fn step_excess(&self, start: &[Vec3]) -> Option<(usize, f64)> {
+        let free = |i: &usize| self.inv_mass[*i] > 0.0;
+        let n = (0..start.len()).filter(free).count().max(1) as f64;
+        let mean = (0..start.len()).filter(free).map(|i| self.positions[i] - start[i]).sum::<Vec3>() / n;
+        let (node, moved) = (0..start.len())
+            .filter(free)
+            .map(|i| (i, (self.positions[i] - start[i] - mean).norm()))
+            .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+        (moved > self.body_size_m).then_some((node, moved))
+    }
+}
+
+impl Simulation {
+    // The NaN guard (module doc of `solver`).
+    /// The first node whose position or velocity is not finite, with an element holding it.
+    pub(crate) fn first_non_finite(&self) -> Option<BadElement> {
+        let node = self
+            .positions
+            .iter()
+            .zip(&self.velocities)
+            .position(|(x, v)| !(x.iter().chain(v.iter()).all(|c| c.is_finite())))?;
+        Some(BadElement::at_node(&self.mesh, node, ORIGIN_STATE))
+    }
+
+    /// Builds the NaN guard's error, puts the state back to the last finite positions (the
+    /// start of this substep, else the rest shape) at rest, and stops the simulation until reset.
+    pub(crate) fn fail(&mut self, bad: BadElement) -> SimError {
+        let err = SimError::NonFinite {
+            solver: self.settings.method.name(),
+            block: bad.block,
+            element: bad.element,
+            element_type: self
+                .mesh
+                .blocks
+                .get(bad.block)
+                .map(|b| b.element_type.to_string())
+                .unwrap_or_else(|| "none".into()),
+            node: bad.node as usize,
+            origin: bad.origin,
+            frame: self.frames + 1,
+            substep_in_frame: self.substeps_in_frame,
+            substeps_per_frame: self.substeps_per_frame,
+            substep: self.counters.substeps,
+            time_secs: self.time_secs,
+        };
+        let last = if self.prev_positions.iter().all(|x| x.iter().all(|c| c.is_finite())) {
+            &self.prev_positions
+        } else {
+            &self.mesh.rest_positions
+        };
+        self.positions.clone_from(last);
+        self.velocities.iter_mut().for_each(|v| *v = Vec3::zeros());
+        self.failure = Some(err.clone());
+        err
+    }
+}
