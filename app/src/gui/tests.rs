@@ -617,14 +617,19 @@ fn a_beam_not_yet_run_is_not_called_moving() {
     assert!(s.contains("moving") && !s.contains("paused mid-swing"), "{s}");
 }
 
+/// Changes configuration A's `key` as a user's control would, and draws two frames.
+fn change_a(h: &mut Harness<'_, HoxApp>, key: &str, change: impl FnOnce(&mut crate::gui::config::Config)) {
+    let app = h.state_mut();
+    let mut c = app.sessions[0].config.clone();
+    change(&mut c);
+    app.apply(key, c);
+    h.run_steps(2);
+}
+
 /// Switches configuration A to Newton; the notes under the solver say the motion is its
 /// integrator's, and what the default integrator (BDF2) does to it.
 fn choose_newton_for_a(h: &mut Harness<'_, HoxApp>) {
-    let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
-    c.method = hox_sim::solver::Method::Newton;
-    app.apply("solver", c);
-    h.run_steps(2);
+    change_a(h, "solver", |c| c.method = hox_sim::solver::Method::Newton);
     h.get_by_label_contains("the motion is its integrator's");
     h.get_by_label_contains("BDF2 (backward differentiation): Second order");
 }
@@ -639,11 +644,7 @@ fn the_solver_says_what_it_does_to_the_motion_and_a_static_step_says_static() {
     choose_newton_for_a(&mut h);
     assert!(h.query_by_label_contains("Keeps the motion").is_none());
     // issue #36: implicit Euler, chosen, says it damps
-    let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
-    c.integrator = hox_sim::solver::Integrator::Euler;
-    app.apply("integrator", c);
-    h.run_steps(2);
+    change_a(&mut h, "integrator", |c| c.integrator = hox_sim::solver::Integrator::Euler);
     h.get_by_label_contains("implicit Euler: First order; damps every mode");
     let mut h = harness(args::parse_for_test(&["--lesson", "mesh-bias"]));
     h.run_steps(3);
