@@ -36,6 +36,13 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// List the solvers and the implicit solvers' integrators: what each is, the parameters it
+    /// reads and what it does to the motion.
+    Solvers {
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
     /// Build a scene's mesh and print its element and node counts and volume.
     Mesh {
         #[command(flatten)]
@@ -164,6 +171,7 @@ pub fn run(command: Command) -> Result<()> {
     match command {
         Command::Elements { json } => list::elements(json),
         Command::Scenes { json } => list::scenes(json),
+        Command::Solvers { json } => list::solvers(json),
         Command::Mesh { scene, mesh, json } => mesh::mesh_command(&scene, &mesh, json),
         Command::Simulate { scene, mesh, physics, seconds, settle, vtk, reference, json } => {
             simulate::simulate(&scene, &mesh, &physics, seconds, settle, &vtk, &reference, json)

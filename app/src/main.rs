@@ -3,6 +3,7 @@
 //!
 //! - `hox elements` lists the element types: nodes, faces, default quadrature;
 //! - `hox scenes` lists the built-in scenes;
+//! - `hox solvers` lists the solvers and the implicit solvers' integrators;
 //! - `hox mesh` builds a scene's mesh and prints its element and node counts and volume;
 //! - `hox static` solves a scene's static equilibrium (Newton, load stepping) and prints the
 //!   probe displacements;

@@ -28,6 +28,24 @@ fn elements_lists_all_seven_types_as_json() {
     assert_eq!(rows[0]["quadrature_points"], 1, "P1 uses one point, as in the paper");
 }
 
+/// `hox solvers` reads the registries: every solver and integrator with its entry, and each
+/// solver named there is accepted by `--solver`.
+#[test]
+fn solvers_lists_every_solver_and_integrator_of_the_registries() {
+    let all = json(&["solvers", "--json"]);
+    let solvers = all["solvers"].as_array().unwrap();
+    assert_eq!(solvers.len(), hox_sim::solver::Method::ALL.len());
+    assert_eq!(all["integrators"].as_array().unwrap().len(), hox_sim::solver::Integrator::ALL.len());
+    for s in solvers {
+        let name = s["name"].as_str().unwrap();
+        assert!(!s["long_name"].as_str().unwrap().is_empty() && !s["motion"].as_str().unwrap().is_empty());
+        let out = hox(&["simulate", "--scene", "bending", "--seconds", "0.05", "--solver", name]);
+        assert!(out.status.success(), "--solver {name}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    let text = hox(&["solvers"]);
+    assert!(text.status.success() && String::from_utf8_lossy(&text.stdout).contains("newmark"));
+}
+
 #[test]
 fn mesh_prints_the_papers_counts() {
     let m = json(&["mesh", "--scene", "bending", "--element", "p1", "--grid", "16x4x4", "--split", "five", "--json"]);

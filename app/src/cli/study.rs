@@ -42,7 +42,7 @@ pub fn study(quick: bool, out: &std::path::Path) -> Result<()> {
     ];
     for scene in hox_scenes::PAPER_SCENES {
         if solvers.iter().any(|r| r.scene == scene) {
-            files.push((format!("pareto-{scene}.svg"), solver_axis::pareto_svg(&solvers, scene)));
+            files.push((format!("pareto-{scene}.svg"), hox_scenes::study::pareto::pareto_svg(&solvers, scene)));
         }
     }
     for (name, text) in files {

@@ -3,8 +3,9 @@
 //!
 //! - **Before**: a change that rebuilds or re-tunes a configuration is estimated first. The
 //!   frame's work is `Σ elements × quadrature points × nodes per element` times the solver's
-//!   sweeps per frame (XPBD: substeps × iterations, with the stability guard's substeps; VBD:
-//!   steps × iterations; Newton: steps × [`NEWTON_ITERATIONS_GUESS`]); the new configuration's
+//!   sweeps per frame (the solver's steps — XPBD's substeps, with the stability guard's — times
+//!   its registry entry's [`MethodInfo::sweeps_per_step`]: XPBD's iterations, VBD's, or a
+//!   Newton-type solver's usual iterations); the new configuration's
 //!   time per frame is the current one's measured time scaled by the ratio of the two works. A
 //!   change of solver settings is estimated on the current mesh (nothing is built: dragging the
 //!   substeps slider stays cheap); a new mesh is built to be counted; a new material is not
@@ -17,13 +18,12 @@
 use super::HoxApp;
 use super::config::Config;
 use eframe::egui;
-use hox_sim::solver::{Method, Simulation, SolverSettings};
+#[cfg(doc)]
+use hox_sim::solver::MethodInfo;
+use hox_sim::solver::{Simulation, SolverSettings, SweepsPerStep};
 
 /// A frame slower than this (under 4 frames per second) is asked about and pauses the app.
 pub const SLOW_FRAME_MS: f64 = 250.0;
-
-/// Newton iterations per step assumed in the estimate.
-const NEWTON_ITERATIONS_GUESS: f64 = 5.0;
 
 /// A change held back until the user says: the control, the configuration, what it will cost.
 pub struct PendingChange {
@@ -43,11 +43,14 @@ fn sweep_work(sim: &Simulation) -> f64 {
 
 /// Sweeps per frame of `settings`, XPBD's with `substeps` (the stability guard's, if raised).
 fn sweeps(settings: &SolverSettings, substeps: u32) -> f64 {
-    match settings.method {
-        Method::Xpbd => f64::from(substeps.max(1)) * f64::from(settings.iterations.max(1)),
-        Method::Vbd => f64::from(settings.steps_per_frame.max(1)) * f64::from(settings.vbd.iterations.max(1)),
-        Method::Newton => f64::from(settings.steps_per_frame.max(1)) * NEWTON_ITERATIONS_GUESS,
-    }
+    let info = settings.method.info();
+    let steps = if info.implicit { settings.steps_per_frame } else { substeps };
+    let per_step = match info.sweeps_per_step {
+        SweepsPerStep::Iterations => f64::from(settings.iterations.max(1)),
+        SweepsPerStep::VbdIterations => f64::from(settings.vbd.iterations.max(1)),
+        SweepsPerStep::About(n) => n,
+    };
+    f64::from(steps.max(1)) * per_step
 }
 
 /// The work of one frame of `sim`, in element–point–node visits (module docs).

@@ -84,9 +84,9 @@ pub struct SolverBenchRow {
     pub us_per_node_update: Option<f64>,
     /// VBD: [`Self::us_per_node_update`] / [`Self::elements_per_free_node`].
     pub us_per_element_visit: Option<f64>,
-    /// Newton: summed frame time / summed iterations.
+    /// A Newton-type solver (one that updates no node): summed frame time / summed iterations.
     pub ms_per_iteration: Option<f64>,
-    /// Newton: summed frame time / summed factorisations.
+    /// A Newton-type solver: summed frame time / summed factorisations.
     pub ms_per_factorization: Option<f64>,
     /// ms per frame on one thread over this row's, measured side by side (None without a
     /// one-thread row of the same case).
@@ -97,9 +97,9 @@ impl SolverBenchRow {
     /// The progress line printed as each row is measured, e.g.
     /// `P2 8x2x2 vbd on 1 thread(s): 20.61 ms/frame, 4.82 µs/node update`.
     pub fn progress_line(&self) -> String {
-        let per = match self.method {
-            Method::Newton => self.ms_per_iteration.map_or(String::new(), |x| format!(", {x:.3} ms/iteration")),
-            _ => self.us_per_node_update.map_or(String::new(), |x| format!(", {x:.2} µs/node update")),
+        let per = match self.us_per_node_update {
+            Some(x) => format!(", {x:.2} µs/node update"),
+            None => self.ms_per_iteration.map_or(String::new(), |x| format!(", {x:.3} ms/iteration")),
         };
         format!(
             "{} {} on {} thread(s): {:.2} ms/frame{per}",
@@ -200,7 +200,8 @@ fn row(case: &BenchCase, method: Method, threads: usize, sim: &Simulation, timed
     let (elements_per_free_node, free_nodes) = free_node_incidence(sim);
     let (iterations, steps, updates, factorizations) =
         (total(|f| f.iterations), total(|f| f.steps), total(|f| f.node_updates), total(|f| f.factorizations));
-    let newton_per = |count: u64| (method == Method::Newton && count > 0).then(|| total_ms / count as f64);
+    // a solver that updates no node (a Newton-type one) is measured per iteration and factorisation
+    let newton_per = |count: u64| (updates == 0 && count > 0).then(|| total_ms / count as f64);
     let mut per_update: Vec<f64> =
         timed.iter().filter(|f| f.node_updates > 0).map(|f| f.ms * 1e3 / f.node_updates as f64).collect();
     let us_per_node_update = (!per_update.is_empty()).then(|| median(&mut per_update));
@@ -261,12 +262,12 @@ fn speedup(r: &SolverBenchRow) -> String {
     }
 }
 
-/// The table `hox bench --solver` prints: per case, one row per thread count. Newton's rows get
-/// the iteration and factorisation columns, the others (VBD) the node-update columns; one table
-/// each.
+/// The table `hox bench --solver` prints: per case, one row per thread count. Newton-type rows (no
+/// node updates) get the iteration and factorisation columns, the others (VBD) the node-update
+/// columns; one table each.
 pub fn markdown(rows: &[SolverBenchRow]) -> String {
     let (newton, sweeps): (Vec<&SolverBenchRow>, Vec<&SolverBenchRow>) =
-        rows.iter().partition(|r| r.method == Method::Newton);
+        rows.iter().partition(|r| r.node_updates_per_frame == 0.0);
     let mut s = String::new();
     if !sweeps.is_empty() {
         s.push_str(

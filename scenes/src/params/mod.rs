@@ -45,7 +45,7 @@ pub use size::{MAX_BOX_BYTES, MAX_BOX_ELEMENTS, box_bytes, box_elements, thousan
 pub use value::{Choice, ParamType, Value};
 
 use hox_sim::element::ElementType;
-use hox_sim::material::MaterialModel;
+use hox_sim::material::{DENSITY_KG_M3, MaterialModel, POISSON_RATIO, YOUNGS_MODULUS_PA};
 use hox_sim::measure::field::Field;
 use hox_sim::mesh::structured::TetSplit;
 use hox_sim::solver::{Integrator, Method, SolverSettings, Sweep, VbdInit, VbdSettings};
@@ -160,41 +160,41 @@ params! {
     youngs_modulus_pa: f64 = 3e6 => {
         key: "youngs", group: Group::Material, file_key: "youngs_modulus_pa", label: "Young's modulus E", unit: "Pa",
         help: "Stiffness in pascals, > 0 (rubber ~1e6, the paper's beam 3e6).",
-        kind: Kind::Number { min: 0.0, min_inclusive: false, max: f64::INFINITY, max_inclusive: false, soft: None },
+        kind: Kind::Number { min: YOUNGS_MODULUS_PA.min, min_inclusive: false, max: YOUNGS_MODULUS_PA.max, max_inclusive: false, soft: None },
         invalidates: Invalidates::Material, required: true, ..BASE
     }
     /// Poisson ratio.
     poisson_ratio: f64 = 0.35 => {
         key: "poisson", group: Group::Material, file_key: "poisson_ratio", label: "Poisson ratio ν",
         help: "Lateral contraction, between −1 and 0.5 (exclusive); near 0.5 is nearly incompressible.",
-        kind: Kind::Number { min: -1.0, min_inclusive: false, max: 0.5, max_inclusive: false, soft: None },
+        kind: Kind::Number { min: POISSON_RATIO.min, min_inclusive: false, max: POISSON_RATIO.max, max_inclusive: false, soft: None },
         invalidates: Invalidates::Material, required: true, ..BASE
     }
     /// Density, kg/m³.
     density_kg_m3: f64 = 1000.0 => {
         key: "density", group: Group::Material, file_key: "density_kg_m3", label: "Density ρ", unit: "kg/m³",
         help: "Mass per volume in kg/m³, > 0 (water 1000).",
-        kind: Kind::Number { min: 0.0, min_inclusive: false, max: f64::INFINITY, max_inclusive: false, soft: None },
+        kind: Kind::Number { min: DENSITY_KG_M3.min, min_inclusive: false, max: DENSITY_KG_M3.max, max_inclusive: false, soft: None },
         invalidates: Invalidates::Material, required: true, ..BASE
     }
-    /// xpbd | vbd | newton.
+    /// A solver of the registry ([`Method::ALL`]).
     #[serde(with = "as_text")]
     method: Method = solver().method => {
         key: "solver", group: Group::Solver, file_key: "method", label: "Solver",
-        help: "xpbd: the paper's extended position-based dynamics (substeps × iterations); vbd: vertex block descent on an implicit step (Chen et al. 2024); newton: the implicit step solved by Newton's method to --newton-tolerance (sparse Cholesky); the implicit step's scheme is --integrator. Contact needs xpbd or vbd.",
+        help: "The solver moving the free nodes (`hox solvers` describes each): xpbd is the paper's extended position-based dynamics (substeps × iterations); the others are implicit, solving each step's incremental potential, whose scheme is --integrator (vbd: vertex block descent, Chen et al. 2024; the Newton-type ones to --newton-tolerance). A solver that cannot honour a scene's effect (contact) refuses it by name.",
         kind: Kind::Choice(method_options), ..BASE
     }
-    /// Implicit steps per frame (VBD, Newton).
+    /// Implicit steps per frame (the implicit solvers).
     steps_per_frame: u32 = solver().steps_per_frame => {
         key: "steps", group: Group::Solver, file_key: "steps_per_frame", label: "Steps per frame",
-        help: "Implicit steps per frame for vbd and newton (XPBD takes --substeps); more steps, less numerical damping and phase error.",
+        help: "Steps per frame of the implicit solvers (XPBD takes --substeps); more steps, less numerical damping and phase error.",
         kind: Kind::Whole { min: 1, max: 10_000, soft_max: 20 }, ..BASE
     }
     /// The implicit solvers' time integrator: euler | newmark | bdf2.
     #[serde(with = "as_text")]
     integrator: Integrator = solver().integrator => {
         key: "integrator", group: Group::Solver, file_key: "integrator", label: "Integrator",
-        help: "Time integrator of vbd and newton (XPBD's substeps are its own): bdf2 (default: second order, keeps a swinging beam's motion and damps only the fast modes a frame cannot resolve, so a dragged node settles), newmark (average acceleration: conserves energy exactly, no numerical damping at all, so unresolved fast modes ring on) or euler (implicit Euler: first order, damps the motion, at one step per frame a beam loses half its swing in 2 s). docs/METHOD.md.",
+        help: "Time integrator of the implicit solvers (XPBD's substeps are its own): bdf2 (default: second order, keeps a swinging beam's motion and damps only the fast modes a frame cannot resolve, so a dragged node settles), newmark (average acceleration: conserves energy exactly, no numerical damping at all, so unresolved fast modes ring on) or euler (implicit Euler: first order, damps the motion, at one step per frame a beam loses half its swing in 2 s). docs/METHOD.md.",
         kind: Kind::Choice(integrator_options), ..BASE
     }
     /// VBD sweeps per step.

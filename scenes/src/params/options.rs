@@ -40,17 +40,7 @@ pub(super) fn field_options() -> Vec<(&'static str, String)> {
 }
 
 pub(super) fn method_options() -> Vec<(&'static str, String)> {
-    Method::ALL
-        .iter()
-        .map(|m| {
-            let long = match m {
-                Method::Xpbd => "XPBD (the paper's)",
-                Method::Vbd => "VBD (vertex block descent)",
-                Method::Newton => "Newton (implicit step)",
-            };
-            (m.name(), long.to_string())
-        })
-        .collect()
+    Method::ALL.iter().map(|m| (m.name(), m.long_name().to_string())).collect()
 }
 pub(super) fn vbd_init_options() -> Vec<(&'static str, String)> {
     VbdInit::ALL.iter().map(|i| (i.name(), i.name().to_string())).collect()

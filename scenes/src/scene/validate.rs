@@ -42,13 +42,16 @@ impl Scene {
             p.check(params).map_err(|reason| invalid(&p.file_path(), (p.get)(params).to_string(), &reason))?;
         }
         let mesh = mesh_of(&file, source, base_dir.as_deref(), cached, &invalid)?;
-        // E, ν and ρ were range-checked against the table just now; what the material's own
-        // check can still refuse is the pair (E, ν) overflowing μ or λ, reported on E
-        let material =
-            Material::new(params.material, params.youngs_modulus_pa, params.poisson_ratio, params.density_kg_m3)
-                .map_err(|e| {
-                    invalid("material.youngs_modulus_pa", params.youngs_modulus_pa.to_string(), &e.to_string())
-                })?;
+        // E, ν and ρ were checked against the table just now, whose ranges are sim's
+        // (`hox_sim::material::YOUNGS_MODULUS_PA`, …): they are not checked again. What remains is
+        // the pair (E, ν) overflowing μ or λ, reported on E
+        let material = Material::from_checked_ranges(
+            params.material,
+            params.youngs_modulus_pa,
+            params.poisson_ratio,
+            params.density_kg_m3,
+        )
+        .map_err(|e| invalid("material.youngs_modulus_pa", params.youngs_modulus_pa.to_string(), &e.to_string()))?;
         if let Some(d) = params.quadrature_degree {
             let types: Vec<ElementType> = match &mesh {
                 SceneMesh::Box(b) => vec![b.element_type],

@@ -15,6 +15,7 @@
 //! the largest reference probe displacement.
 
 pub mod motion;
+pub mod pareto;
 pub mod solver_axis;
 
 use crate::{Instance, RunMode, SceneError, SceneOverrides, run};
@@ -545,18 +546,7 @@ pub fn svg(rows: &[StudyRow]) -> String {
         s.push_str(&format!(r##"<line x1="{left}" y1="{y}" x2="{}" y2="{y}" stroke="#ddd"/><text x="{}" y="{}" text-anchor="end">1e{d}</text>
 "##, w - right, left - 6.0, y + 4.0));
     }
-    s.push_str(&format!(
-        r#"<rect x="{left}" y="{top}" width="{}" height="{}" fill="none" stroke="black"/>
-<text x="{}" y="{}" text-anchor="middle">ms per frame</text>
-<text x="18" y="{}" text-anchor="middle" transform="rotate(-90 18 {})">tip error vs reference (m)</text>
-"#,
-        w - left - right,
-        h - top - bottom,
-        left + (w - left - right) / 2.0,
-        h - 14.0,
-        top + (h - top - bottom) / 2.0,
-        top + (h - top - bottom) / 2.0
-    ));
+    s.push_str(&svg_plot_frame([left, top, right, bottom], [w, h], "ms per frame", "tip error vs reference (m)"));
     for r in &bending {
         let c = colour(&r.element);
         if positive(&r.error_1pct_m) && r.substeps_for_1pct != 50 {
@@ -611,4 +601,20 @@ fn decades<'a>(values: impl Iterator<Item = &'a f64>) -> (f64, f64) {
     }
     let (lo, hi) = (lo.floor(), hi.ceil());
     if hi > lo { (lo, hi) } else { (lo, lo + 1.0) }
+}
+
+/// A chart's plot frame and its axis labels: `margins` `[left, top, right, bottom]` inside a
+/// `size` `[w, h]` picture.
+pub(crate) fn svg_plot_frame(margins: [f64; 4], size: [f64; 2], x_label: &str, y_label: &str) -> String {
+    let ([left, top, right, bottom], [w, h]) = (margins, size);
+    let middle_y = top + (h - top - bottom) / 2.0;
+    format!(
+        "<rect x=\"{left}\" y=\"{top}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"black\"/>\n\
+         <text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>\n\
+         <text x=\"18\" y=\"{middle_y}\" text-anchor=\"middle\" transform=\"rotate(-90 18 {middle_y})\">{y_label}</text>\n",
+        w - left - right,
+        h - top - bottom,
+        left + (w - left - right) / 2.0,
+        h - 14.0,
+    )
 }

@@ -333,24 +333,64 @@ pub struct SplitTerm {
     pub grad_f_scaled: Mat3,
 }
 
+/// An open interval `(min, max)` a material number must lie in (finite, and strictly inside).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OpenRange {
+    pub min: f64,
+    pub max: f64,
+}
+
+impl OpenRange {
+    /// Whether `x` is finite and strictly inside.
+    pub fn contains(&self, x: f64) -> bool {
+        x.is_finite() && x > self.min && x < self.max
+    }
+}
+
+/// Young's modulus E in pascals: finite and > 0. The rule [`Material::new`] checks; the parameter
+/// table's range for E is this (`hox_scenes::params`), so a scene is checked once.
+pub const YOUNGS_MODULUS_PA: OpenRange = OpenRange { min: 0.0, max: f64::INFINITY };
+/// Poisson's ratio ν: in (−1, 0.5) for every model (λ → ∞ at 0.5).
+pub const POISSON_RATIO: OpenRange = OpenRange { min: -1.0, max: 0.5 };
+/// Density ρ in kg/m³: finite and > 0.
+pub const DENSITY_KG_M3: OpenRange = OpenRange { min: 0.0, max: f64::INFINITY };
+
 impl Material {
-    /// Validates E > 0, ν ∈ (−1, 0.5), ρ > 0 (all finite) and that μ, λ are finite.
+    /// Validates E, ν and ρ against [`YOUNGS_MODULUS_PA`], [`POISSON_RATIO`] and
+    /// [`DENSITY_KG_M3`], then the pair (E, ν) ([`Material::from_checked_ranges`]).
     pub fn new(
         model: MaterialModel,
         youngs_modulus_pa: f64,
         poisson_ratio: f64,
         density_kg_m3: f64,
     ) -> Result<Material, MaterialError> {
-        if !(youngs_modulus_pa.is_finite() && youngs_modulus_pa > 0.0) {
+        if !YOUNGS_MODULUS_PA.contains(youngs_modulus_pa) {
             return Err(MaterialError::YoungsModulus { youngs_modulus_pa });
         }
         // Every model needs a finite λ, hence the open upper bound 0.5.
-        if !(poisson_ratio.is_finite() && poisson_ratio > -1.0 && poisson_ratio < 0.5) {
+        if !POISSON_RATIO.contains(poisson_ratio) {
             return Err(MaterialError::PoissonRatio { model, poisson_ratio });
         }
-        if !(density_kg_m3.is_finite() && density_kg_m3 > 0.0) {
+        if !DENSITY_KG_M3.contains(density_kg_m3) {
             return Err(MaterialError::Density { density_kg_m3 });
         }
+        Material::from_checked_ranges(model, youngs_modulus_pa, poisson_ratio, density_kg_m3)
+    }
+
+    /// A material from numbers the caller has already checked against [`YOUNGS_MODULUS_PA`],
+    /// [`POISSON_RATIO`] and [`DENSITY_KG_M3`] (the parameter table does, with these ranges: a
+    /// scene's E is checked once on its way to the kernel). Only what no single range can say is
+    /// checked here: that the pair (E, ν) gives finite Lamé parameters. The ranges are asserted in
+    /// debug builds.
+    pub fn from_checked_ranges(
+        model: MaterialModel,
+        youngs_modulus_pa: f64,
+        poisson_ratio: f64,
+        density_kg_m3: f64,
+    ) -> Result<Material, MaterialError> {
+        debug_assert!(YOUNGS_MODULUS_PA.contains(youngs_modulus_pa), "E = {youngs_modulus_pa} Pa unchecked");
+        debug_assert!(POISSON_RATIO.contains(poisson_ratio), "ν = {poisson_ratio} unchecked");
+        debug_assert!(DENSITY_KG_M3.contains(density_kg_m3), "ρ = {density_kg_m3} kg/m³ unchecked");
         let lame = Lame::from_youngs_poisson(youngs_modulus_pa, poisson_ratio);
         // λ + μ = E / (2(1+ν)(1−2ν)) is what stable Neo-Hookean divides by
         // (with the log term, λ + 5μ/6, > 0 for ν > −1 and finite when λ + μ is).

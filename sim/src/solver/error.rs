@@ -92,6 +92,9 @@ pub struct SolverCounters {
     pub coarse_corrections: u64,
     /// Newton's numeric factorisations of the stiffness.
     pub factorizations: u64,
+    /// Iterations of an iterative linear solver inside a Newton-type solver (conjugate-gradient
+    /// iterations; 0 under a direct one: `newton_core::LinearSolver`).
+    pub linear_iterations: u64,
     /// Newton steps that reached their iteration limit before the tolerance (VBD's under Newmark
     /// that reached its most rounds of sweeps).
     pub unconverged_steps: u64,

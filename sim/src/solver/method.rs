@@ -65,6 +65,20 @@ pub struct MethodInfo {
     /// implicit solvers looked broken, their beam losing half its swing with nothing said).
     /// The figures are the study's (docs/METHOD.md, docs/STUDY.md: the bending beam, 2 s).
     pub motion: &'static str,
+    /// Sweeps over the elements one of its steps (XPBD: substeps) takes, for the app's cost
+    /// estimate of a change.
+    pub sweeps_per_step: SweepsPerStep,
+}
+
+/// How many sweeps over the elements a solver's step takes ([`MethodInfo::sweeps_per_step`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SweepsPerStep {
+    /// The settings' `iterations` (XPBD's per substep).
+    Iterations,
+    /// The settings' `vbd.iterations`.
+    VbdIterations,
+    /// About this many (a Newton-type solver's iterations, each an assembly and a solve).
+    About(f64),
 }
 
 /// Every solver's entry, in [`Method::ALL`]'s order.
@@ -79,6 +93,7 @@ pub const INFO: [MethodInfo; 3] = [
         step_word: "substep",
         remedy: "more substeps, a softer material or stable Neo-Hookean",
         motion: "Keeps the motion: its small substeps barely damp the swing (0.1–2.7 % of the amplitude lost by 2 s on P2, P3 and Q2).",
+        sweeps_per_step: SweepsPerStep::Iterations,
     },
     MethodInfo {
         method: Method::Vbd,
@@ -98,6 +113,7 @@ pub const INFO: [MethodInfo; 3] = [
         step_word: "step",
         remedy: "more steps per frame, a softer material or stable Neo-Hookean",
         motion: "Sweeps the implicit step's potential; the motion is its integrator's (below). Its equilibrium is right: Settle shows it.",
+        sweeps_per_step: SweepsPerStep::VbdIterations,
     },
     MethodInfo {
         method: Method::Newton,
@@ -109,6 +125,7 @@ pub const INFO: [MethodInfo; 3] = [
         step_word: "step",
         remedy: "more steps per frame, a softer material or stable Neo-Hookean",
         motion: "Solves the implicit step to convergence; the motion is its integrator's (below). Its equilibrium is right: Settle shows it.",
+        sweeps_per_step: SweepsPerStep::About(5.0),
     },
 ];
 

@@ -69,7 +69,7 @@ mod simulation;
 
 pub use error::{SimError, SolverCounters};
 pub use integrator::{INFO as INTEGRATORS, Integrator, IntegratorInfo};
-pub use method::{INFO as METHODS, Method, MethodInfo};
+pub use method::{INFO as METHODS, Method, MethodInfo, SweepsPerStep};
 pub use residual::StaticResidual;
 pub use settings::{NewtonSettings, SolverSettings, Sweep, VbdInit, VbdSettings};
 pub use simulation::{NODE_LOOP_MIN_NODES_PER_THREAD, Simulation};

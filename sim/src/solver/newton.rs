@@ -31,7 +31,7 @@
 
 use super::error::SolverCounters;
 use super::nan_guard::{BadElement, ORIGIN_NEWTON};
-use super::newton_core::{Failure, HessianModel, Objective, Outcome, Scratch, minimise};
+use super::newton_core::{Failure, HessianModel, LinearSolver, Objective, Outcome, Scratch, minimise};
 use super::potential::Potential;
 use super::settings::SolverSettings;
 use super::sparse::SparsePattern;
@@ -40,15 +40,18 @@ use crate::Vec3;
 use crate::fem::geometry::BlockGeometry;
 use crate::mesh::Mesh;
 
-pub(crate) struct Newton {
-    pattern: Option<SparsePattern>,
+/// Newton's method on the step's incremental potential with the linear solver `L` (the sparse
+/// Cholesky factor of `sparse.rs` by default; any [`LinearSolver`], which is how another
+/// Newton-type solver is made: `registry.rs`).
+pub(crate) struct Newton<L: LinearSolver = SparsePattern> {
+    pattern: Option<L>,
     /// The model version and inertia step the pattern and factor were made for.
     made_for: (u64, f64),
     y: Vec<Vec3>,
     scratch: Scratch,
 }
 
-impl Newton {
+impl<L: LinearSolver> Newton<L> {
     pub fn new(_mesh: &Mesh) -> Self {
         Self { pattern: None, made_for: (u64::MAX, 0.0), y: Vec::new(), scratch: Scratch::default() }
     }
@@ -60,9 +63,9 @@ impl Objective for Potential<'_> {
     }
 }
 
-impl StepSolver for Newton {
-    fn work_summary(&self, _settings: &SolverSettings, counters: &SolverCounters) -> String {
-        format!("newton, {} factorisations", counters.factorizations)
+impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
+    fn work_summary(&self, settings: &SolverSettings, counters: &SolverCounters) -> String {
+        format!("{}, {}", settings.method, L::work_summary(counters))
     }
     fn as_any(&self) -> &dyn std::any::Any {
         self
@@ -90,7 +93,7 @@ impl StepSolver for Newton {
         let bad = |node: usize| BadElement::at_node(s.mesh, node, ORIGIN_NEWTON);
         super::nan_guard::check_input(s.mesh, positions)?;
         if self.pattern.is_none() || self.made_for != (s.model_version, s.inertia_h) {
-            let pattern = SparsePattern::new(s.mesh, |i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?;
+            let pattern = L::for_mesh(s.mesh, &|i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?;
             self.pattern = Some(pattern);
             self.made_for = (s.model_version, s.inertia_h);
         }
@@ -106,7 +109,7 @@ impl StepSolver for Newton {
         let w = 1.0 / (s.inertia_h * s.inertia_h);
         let potential = Potential { input: s, y: &self.y, springs: &springs, w };
         let body_force = potential.body_force_n();
-        let diagonal = potential.hessian_diagonal(pattern);
+        let diagonal = potential.hessian_diagonal(pattern.dof_of(), pattern.free_dofs());
         let model = HessianModel { mesh: s.mesh, geometry: s.geometry, material: s.material, diagonal: &diagonal };
         let outcome = minimise(
             &potential,

@@ -5,11 +5,14 @@
 //! steps among them).
 //!
 //! Each iteration solves `K Δ = −∇Φ` with `K = D + Σ_e Σ_q V_q Gᵀ ∂P/∂F G` (`D` a diagonal such
-//! as `M/h²` plus spring stiffnesses, none for statics; sparse Cholesky, `sparse.rs`) and
-//! backtracks on `Φ` (Nocedal & Wright, *Numerical Optimization*, 2nd ed., §3.1 and §3.4). One
-//! policy for every caller:
-//! - **Hessian:** the exact one where it is positive definite (quadratic convergence), else
-//!   `∂P/∂F` projected to positive semi-definite per quadrature point.
+//! as `M/h²` plus spring stiffnesses, none for statics) and backtracks on `Φ` (Nocedal & Wright,
+//! *Numerical Optimization*, 2nd ed., §3.1 and §3.4). How `K Δ = −∇Φ` is solved is a
+//! [`LinearSolver`]: the sparse Cholesky factor of `sparse.rs` (exact solves), or any other that
+//! implements the trait (an iterative one is told the residual, so it can solve loosely far from
+//! the solution: an inexact Newton, Nocedal & Wright §7.1). One policy for every caller:
+//! - **Hessian:** the linear solver's choice (`sparse.rs`: the exact one where it is positive
+//!   definite, for quadratic convergence, else `∂P/∂F` projected to positive semi-definite per
+//!   quadrature point).
 //! - **Factor reuse:** the numeric factor is kept between iterations (and, by the caller's
 //!   pattern, between steps) and refreshed at the current iterate when the residual falls by less
 //!   than 4× in an iteration or the line search had to cut the step;
@@ -79,8 +82,73 @@ pub(crate) enum Outcome {
 pub(crate) enum Failure {
     /// A position or gradient entry of this node is not finite (0 when only `Φ` is).
     NonFinite { node: usize },
-    /// `K` could not be factored even projected.
+    /// `K`'s model could not be made (the sparse factor: not even projected).
     Factorisation(SparseError),
+}
+
+/// How the one Newton solves `K Δ = r` (module docs): it keeps a model of `K` (a factor, element
+/// Hessians), made at an iterate when [`minimise`] asks, and solves with the last one made.
+pub(crate) trait LinearSolver {
+    /// A solver for `mesh` without the degrees of freedom of the nodes where `held(i)`.
+    fn for_mesh(mesh: &Mesh, held: &dyn Fn(usize) -> bool) -> Result<Self, SparseError>
+    where
+        Self: Sized;
+    /// Global DOF `3 i + a` → free DOF, `usize::MAX` for a held one.
+    fn dof_of(&self) -> &[usize];
+    /// The number of free degrees of freedom.
+    fn free_dofs(&self) -> usize;
+    /// Whether a model of `K` is held (so an iteration can start by solving).
+    fn is_ready(&self) -> bool;
+    /// Makes the model of `K` at `x`, counting its work in `counters`.
+    fn update(
+        &mut self,
+        model: &HessianModel<'_>,
+        x: &[Vec3],
+        counters: &mut SolverCounters,
+    ) -> Result<(), SparseError>;
+    /// Solves `K s = r` in place with the last model; `relative_residual` is the Newton
+    /// iteration's (an iterative solver's forcing term), ignored by an exact one.
+    fn solve(&mut self, r: &mut [f64], relative_residual: f64, counters: &mut SolverCounters);
+    /// A few words on its work for a status line ("12 factorisations").
+    fn work_summary(counters: &SolverCounters) -> String
+    where
+        Self: Sized;
+}
+
+impl LinearSolver for SparsePattern {
+    fn for_mesh(mesh: &Mesh, held: &dyn Fn(usize) -> bool) -> Result<Self, SparseError> {
+        SparsePattern::new(mesh, held)
+    }
+    fn dof_of(&self) -> &[usize] {
+        &self.dof_of
+    }
+    fn free_dofs(&self) -> usize {
+        self.free_dofs
+    }
+    fn is_ready(&self) -> bool {
+        self.is_factored()
+    }
+    /// The exact Hessian where it is positive definite, else the projected one.
+    fn update(
+        &mut self,
+        model: &HessianModel<'_>,
+        x: &[Vec3],
+        counters: &mut SolverCounters,
+    ) -> Result<(), SparseError> {
+        let exact = self.assemble_and_factor(model.mesh, model.geometry, model.material, x, model.diagonal, false, SEQ);
+        if exact.is_err() {
+            self.assemble_and_factor(model.mesh, model.geometry, model.material, x, model.diagonal, true, SEQ)?;
+            counters.factorizations += 1;
+        }
+        counters.factorizations += 1;
+        Ok(())
+    }
+    fn solve(&mut self, r: &mut [f64], _relative_residual: f64, _counters: &mut SolverCounters) {
+        self.solve_in_place(r, SEQ);
+    }
+    fn work_summary(counters: &SolverCounters) -> String {
+        format!("{} factorisations", counters.factorizations)
+    }
 }
 
 /// Buffers kept between minimisations (no allocation per step).
@@ -121,7 +189,7 @@ fn first_non_finite(x: &[Vec3], g: &[Vec3]) -> Option<usize> {
 pub(crate) fn minimise(
     objective: &dyn Objective,
     model: &HessianModel<'_>,
-    pattern: &mut SparsePattern,
+    linear: &mut dyn LinearSolver,
     x: &mut [Vec3],
     settings: &NewtonSettings,
     body_force_n: f64,
@@ -134,7 +202,7 @@ pub(crate) fn minimise(
     scratch.grad.resize(n, Vec3::zeros());
     scratch.trial_grad.resize(n, Vec3::zeros());
     scratch.step.clear();
-    scratch.step.resize(pattern.free_dofs, 0.0);
+    scratch.step.resize(linear.free_dofs(), 0.0);
     scratch.residuals.clear();
     let (mut energy, mut reactions) = objective.eval(x, &mut scratch.grad);
     if let Some(node) = first_non_finite(x, &scratch.grad) {
@@ -143,7 +211,7 @@ pub(crate) fn minimise(
     if !energy.is_finite() {
         return Err(Failure::NonFinite { node: 0 });
     }
-    let mut refactor = settings.refactor_every_iteration || !pattern.is_factored();
+    let mut refactor = settings.refactor_every_iteration || !linear.is_ready();
     for _ in 0..settings.max_iterations {
         let residual = norm(&scratch.grad) / load_scale(body_force_n, reactions);
         scratch.residuals.push(residual);
@@ -153,24 +221,15 @@ pub(crate) fn minimise(
         }
         counters.solver_iterations += 1;
         if refactor {
-            // the exact Hessian where it is positive definite, else the projected one
-            let exact =
-                pattern.assemble_and_factor(model.mesh, model.geometry, model.material, x, model.diagonal, false, SEQ);
-            if exact.is_err() {
-                pattern
-                    .assemble_and_factor(model.mesh, model.geometry, model.material, x, model.diagonal, true, SEQ)
-                    .map_err(Failure::Factorisation)?;
-                counters.factorizations += 1;
-            }
-            counters.factorizations += 1;
+            linear.update(model, x, counters).map_err(Failure::Factorisation)?;
         }
         let step = &mut scratch.step;
-        for (dof, &k) in pattern.dof_of.iter().enumerate() {
+        for (dof, &k) in linear.dof_of().iter().enumerate() {
             if k != usize::MAX {
                 step[k] = -scratch.grad[dof / 3][dof % 3];
             }
         }
-        pattern.solve_in_place(step, SEQ);
+        linear.solve(step, residual, counters);
         // backtracking on Φ: accept a decrease of Φ or, at its round-off floor, of the residual
         let mut t = 1.0;
         let mut accepted = false;
@@ -178,7 +237,7 @@ pub(crate) fn minimise(
         while t > MIN_STEP_FRACTION {
             scratch.trial.clear();
             scratch.trial.extend_from_slice(x);
-            for (dof, &k) in pattern.dof_of.iter().enumerate() {
+            for (dof, &k) in linear.dof_of().iter().enumerate() {
                 if k != usize::MAX {
                     scratch.trial[dof / 3][dof % 3] += t * step[k];
                 }

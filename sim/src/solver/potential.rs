@@ -7,7 +7,6 @@
 //! reports instead. Newton's implicit Euler minimises it (`newton.rs`), VBD's coarse correction
 //! takes its gradient (`vbd/coarse.rs`).
 
-use super::sparse::SparsePattern;
 use super::step::StepInput;
 use crate::Vec3;
 use crate::effect::NodeSpring;
@@ -51,18 +50,19 @@ impl Potential<'_> {
     }
 
     /// The diagonal of `E`'s Hessian beyond the elastic part, one value per free degree of
-    /// freedom of `pattern`: `m_i/h²` plus the stiffness of every spring on the node.
-    pub fn hessian_diagonal(&self, pattern: &SparsePattern) -> Vec<f64> {
+    /// freedom (`dof_of`: global DOF → free DOF, `usize::MAX` held; `free_dofs` of them):
+    /// `m_i/h²` plus the stiffness of every spring on the node.
+    pub fn hessian_diagonal(&self, dof_of: &[usize], free_dofs: usize) -> Vec<f64> {
         let s = self.input;
-        let mut d = vec![0.0; pattern.free_dofs];
-        for (dof, &k) in pattern.dof_of.iter().enumerate() {
+        let mut d = vec![0.0; free_dofs];
+        for (dof, &k) in dof_of.iter().enumerate() {
             if k != usize::MAX {
                 d[k] = s.masses_kg[dof / 3] * self.w;
             }
         }
         for sp in self.springs {
             for a in 0..3 {
-                let k = pattern.dof_of[3 * sp.node as usize + a];
+                let k = dof_of[3 * sp.node as usize + a];
                 if k != usize::MAX {
                     d[k] += sp.stiffness_n_per_m;
                 }

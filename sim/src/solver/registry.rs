@@ -5,6 +5,7 @@
 use super::method::Method;
 use super::newton::Newton;
 use super::settings::SolverSettings;
+use super::sparse::SparsePattern;
 use super::step::StepSolver;
 use super::vbd::Vbd;
 use super::xpbd::Xpbd;
@@ -16,6 +17,6 @@ pub(crate) fn make(mesh: &Mesh, geometry: &[BlockGeometry], settings: &SolverSet
     match settings.method {
         Method::Xpbd => Box::new(Xpbd::new(mesh, geometry, settings)),
         Method::Vbd => Box::new(Vbd::new(mesh, geometry, settings)),
-        Method::Newton => Box::new(Newton::new(mesh)),
+        Method::Newton => Box::new(Newton::<SparsePattern>::new(mesh)),
     }
 }
