@@ -20,6 +20,9 @@
 //! - [`Method::Newton`] (`newton.rs`): the same potential minimised by Newton's method with a
 //!   sparse Cholesky factorisation and a line search, to a stated tolerance
 //!   ([`super::newton_core`], the one Newton the static solver shares).
+//! - [`Method::NewtonCg`] (`newton_cg.rs`): the same Newton with each linear solve by
+//!   block-Jacobi preconditioned conjugate gradients on the element Hessians (an inexact Newton;
+//!   nothing assembled or factored).
 //!
 //! Effects declare how an implicit solver is to honour them ([`ImplicitRole`]); an effect a
 //! solver cannot honour refuses the scene by name.
@@ -40,6 +43,8 @@ pub enum Method {
     Vbd,
     /// Newton's method on the implicit step's incremental potential (sparse Cholesky).
     Newton,
+    /// The same Newton with each linear solve by preconditioned conjugate gradients.
+    NewtonCg,
 }
 
 /// What a solver is, for everything that lists, describes or checks solvers.
@@ -82,7 +87,7 @@ pub enum SweepsPerStep {
 }
 
 /// Every solver's entry, in [`Method::ALL`]'s order.
-pub const INFO: [MethodInfo; 3] = [
+pub const INFO: [MethodInfo; 4] = [
     MethodInfo {
         method: Method::Xpbd,
         name: "xpbd",
@@ -127,10 +132,22 @@ pub const INFO: [MethodInfo; 3] = [
         motion: "Solves the implicit step to convergence; the motion is its integrator's (below). Its equilibrium is right: Settle shows it.",
         sweeps_per_step: SweepsPerStep::About(5.0),
     },
+    MethodInfo {
+        method: Method::NewtonCg,
+        name: "newton-cg",
+        long_name: "Newton-CG (implicit step, no factorisation)",
+        implicit: true,
+        honours: &[ImplicitRole::Hooks, ImplicitRole::Potential],
+        parameters: &["steps_per_frame", "integrator", "newton_tolerance"],
+        step_word: "step",
+        remedy: "more steps per frame, a softer material or stable Neo-Hookean",
+        motion: "Solves the implicit step to convergence as Newton does, by conjugate gradients instead of a factorisation; the motion is its integrator's (below).",
+        sweeps_per_step: SweepsPerStep::About(40.0),
+    },
 ];
 
 impl Method {
-    pub const ALL: [Method; 3] = [Method::Xpbd, Method::Vbd, Method::Newton];
+    pub const ALL: [Method; 4] = [Method::Xpbd, Method::Vbd, Method::Newton, Method::NewtonCg];
     /// This solver's entry.
     pub fn info(self) -> &'static MethodInfo {
         &INFO[self as usize]

@@ -18,7 +18,8 @@
 //! solver's step reads and the one trait every solver implements); `residual.rs` (the static
 //! residual); `sparse.rs` (the sparse stiffness and its Cholesky factor); [`stability`] (the
 //! substep guard); `potential.rs` (implicit Euler's incremental potential); `newton_core.rs`
-//! (the one Newton's method with line search); the solvers `xpbd/`, `vbd/`, `newton.rs`;
+//! (the one Newton's method with line search); the solvers `xpbd/`, `vbd/`, `newton.rs`,
+//! `newton_cg.rs`;
 //! [`statics`] (the static equilibrium XPBD settles to, by the same Newton); `registry.rs` (the
 //! one match naming each solver's type); `simulation.rs` (the stateful [`Simulation`]: the step
 //! skeleton below, the NaN and stability guards).
@@ -60,6 +61,8 @@ mod xpbd;
 mod vbd;
 
 mod newton;
+
+mod newton_cg;
 
 pub mod statics;
 

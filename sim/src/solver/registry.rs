@@ -4,6 +4,7 @@
 
 use super::method::Method;
 use super::newton::Newton;
+use super::newton_cg::ConjugateGradients;
 use super::settings::SolverSettings;
 use super::sparse::SparsePattern;
 use super::step::StepSolver;
@@ -18,5 +19,6 @@ pub(crate) fn make(mesh: &Mesh, geometry: &[BlockGeometry], settings: &SolverSet
         Method::Xpbd => Box::new(Xpbd::new(mesh, geometry, settings)),
         Method::Vbd => Box::new(Vbd::new(mesh, geometry, settings)),
         Method::Newton => Box::new(Newton::<SparsePattern>::new(mesh)),
+        Method::NewtonCg => Box::new(Newton::<ConjugateGradients>::new(mesh)),
     }
 }
