@@ -435,7 +435,7 @@ impl Simulation {
             return Err(e.clone());
         }
         let h = self.substep_dt_secs();
-        if self.settings.method.is_implicit() { self.watched_step(h, 0) } else { self.advance(h) }
+        self.watched_step(h, 0)
     }
 
     /// One step of `h` (a substep of XPBD, a step of the implicit solvers).
