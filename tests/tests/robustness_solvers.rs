@@ -1,13 +1,14 @@
 //! The robustness families with every solver and integrator (issue #36, item 4, first part):
 //! stiff, soft, near-incompressible, inverted starts, extreme drives, coarse time steps and
-//! contact, each run with `xpbd`, `vbd` and `newton`, the implicit ones under each integrator.
+//! contact, each run with every solver of the registry (`xpbd`, `vbd`, `newton`, `newton-cg`), the
+//! implicit ones under each integrator.
 //!
 //! The one demand here is the issue's: **never finite but absurd with success**. A run either
 //! ends finite and sane — every node within ten body sizes of its rest position, no node of the
 //! body further from its mean displacement than five body sizes (the soft beam, 1 kPa, hangs
 //! 4.7 sizes long under its weight with every solver) — or stops with a clear error
 //! naming the solver (the NaN guard, the step watch's divergence or unsolved step) or the
-//! effect it cannot honour (contact under Newton). Which configurations stop instead of
+//! effect it cannot honour (contact under the Newton-type solvers). Which configurations stop instead of
 //! recovering is printed (`PASS` / `STOP` lines) for docs/STABILITY.md; the families' own
 //! recovery criteria (tests/tests/robustness.rs) still run with XPBD only.
 
@@ -131,12 +132,17 @@ fn cases() -> Vec<Case> {
     ]
 }
 
-/// Every (solver, integrator) pair: XPBD once (it ignores the integrator), VBD and Newton under
-/// each.
+/// Every (solver, integrator) pair: XPBD once (it ignores the integrator), each implicit solver
+/// under each.
 fn solvers() -> Vec<(Method, Integrator)> {
-    let mut v = vec![(Method::Xpbd, Integrator::default())];
-    for m in [Method::Vbd, Method::Newton] {
-        v.extend(Integrator::ALL.map(|i| (m, i)));
+    // every solver of the registry: the implicit ones under each integrator
+    let mut v = Vec::new();
+    for m in Method::ALL {
+        if m.is_implicit() {
+            v.extend(Integrator::ALL.map(|i| (m, i)));
+        } else {
+            v.push((m, Integrator::default()));
+        }
     }
     v
 }
