@@ -19,7 +19,8 @@
 //!   [`super::StaticResidual`]: the body force, or the reactions if larger), or when a step moves
 //!   no coordinate by more than `1e-12` of the body's size (a force-free step). A step that
 //!   reaches `max_iterations` keeps its last iterate and is counted in
-//!   [`super::SolverCounters::unconverged_steps`].
+//!   [`super::SolverCounters::unconverged_steps`]; if its residual is still above a tenth of the
+//!   load the step watch rejects it and takes it again in halves (as VBD's).
 //! - **Refactoring:** the numeric factor is kept between iterations and steps (same masses,
 //!   pinned nodes, material and step) and refreshed at the current iterate when the residual
 //!   falls by less than 4× in an iteration or the line search had to cut the step; near rest a
@@ -49,11 +50,18 @@ pub(crate) struct Newton<L: LinearSolver = SparsePattern> {
     made_for: (u64, f64),
     y: Vec<Vec3>,
     scratch: Scratch,
+    /// Whether the last step reached its iteration limit above [`UNSOLVED_RESIDUAL`] of the load.
+    failed: bool,
 }
+
+/// A step left by the iteration limit with an unbalanced force above this fraction of the load
+/// is reported failed ([`StepSolver::last_step_failed`]): the step watch takes it again in halves,
+/// as VBD's (issue #36: a Newton step at its limit was counted and warned about, and kept).
+const UNSOLVED_RESIDUAL: f64 = 1e-1;
 
 impl<L: LinearSolver> Newton<L> {
     pub fn new(_mesh: &Mesh) -> Self {
-        Self { pattern: None, made_for: (u64::MAX, 0.0), y: Vec::new(), scratch: Scratch::default() }
+        Self { pattern: None, made_for: (u64::MAX, 0.0), y: Vec::new(), scratch: Scratch::default(), failed: false }
     }
 }
 
@@ -80,6 +88,10 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
 
     fn last_step_residuals(&self) -> &[f64] {
         &self.scratch.residuals
+    }
+
+    fn last_step_failed(&self) -> bool {
+        self.failed
     }
 
     fn solve_step(
@@ -122,6 +134,7 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
             counters,
             &mut |_| {},
         );
+        self.failed = matches!(outcome, Ok(Outcome::Unconverged { residual }) if residual > UNSOLVED_RESIDUAL);
         match outcome {
             Ok(Outcome::Converged { .. } | Outcome::Stalled { .. }) => Ok(()),
             Ok(Outcome::Unconverged { .. }) => {

@@ -113,8 +113,9 @@ pub(crate) trait StepSolver: Send {
     fn as_any_mut(&mut self) -> &mut dyn std::any::Any;
     /// A few words on the work it does, for a status line ("xpbd, 1,200 constraints").
     fn work_summary(&self, settings: &SolverSettings, counters: &SolverCounters) -> String;
-    /// Whether the last step ended far from solved (VBD: a residual above a tenth of the load
-    /// after its recovery rounds): the step watch rejects it and takes it again in halves.
+    /// Whether the last step ended far from solved (a residual above a tenth of the load: VBD's
+    /// after its recovery rounds, a Newton-type step's at its iteration limit): the step watch
+    /// rejects it and takes it again in halves.
     fn last_step_failed(&self) -> bool {
         false
     }
