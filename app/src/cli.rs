@@ -84,7 +84,7 @@ pub enum Command {
     },
     /// Time the XPBD loop on the paper's Table 1 beams and the other element types: ms per
     /// frame against the paper's, ns per element per substep, GFLOP/s (docs/PERFORMANCE.md);
-    /// --solver vbd|newton times an implicit solver on the same beams.
+    /// --solver NAME times an implicit solver of `hox solvers` on the same beams.
     Bench {
         /// Timed frames per configuration (the median is reported).
         #[arg(long, default_value_t = 20)]
@@ -100,9 +100,9 @@ pub enum Command {
         /// order, one thread) on one thread. XPBD only.
         #[arg(long, value_delimiter = ',', default_value = "colour,element")]
         sweep: Vec<String>,
-        /// The solver timed: xpbd (the table above), vbd (µs per node update and per element
-        /// visit) or newton (ms per iteration and per factorisation); the thread counts run side
-        /// by side, with the speed-up over one thread.
+        /// The solver timed (`hox solvers`): xpbd (the table above), vbd (µs per node update and
+        /// per element visit) or a Newton-type one, newton or newton-cg (ms per iteration and per
+        /// factorisation); the thread counts run side by side, with the speed-up over one thread.
         #[arg(long, default_value = "xpbd")]
         solver: String,
     },

@@ -1,5 +1,5 @@
 //! `hox bench`: time the XPBD loop on the paper's Table 1 beams and the other element types, or
-//! (`--solver vbd|newton`) an implicit solver on the same beams.
+//! (`--solver NAME`, a solver of the registry) an implicit solver on the same beams.
 
 use anyhow::{Result, bail};
 use hox_sim::solver::Sweep;

@@ -8,11 +8,16 @@
 //! - **`K`** `= M/h̄² + Σ_k k_k I + Σ_e Σ_q V_q Gᵀ ∂P/∂F|₊ G`, the material tangent projected to
 //!   positive semi-definite per quadrature point, so `K` is positive definite on the free degrees
 //!   of freedom wherever a step has mass: what conjugate gradients need. It is kept as the element
-//!   Hessians (computed in parallel at the iterate the Newton asks for) and applied element by
-//!   element, never assembled nor factored: no fill-in, no symbolic analysis, and no frame that
-//!   stops for a refactorisation (issue #37: Newton's refactorising frames cost many times its
-//!   median on a part of 5,000 P2 nodes).
-//! - **Preconditioner**: block Jacobi, each free node's 3×3 diagonal block of `K`, inverted.
+//!   Hessians, computed in parallel at the iterate the Newton asks for (every iteration whose
+//!   residual fell less than 4×: with an inexact solve, most of them), and applied element by
+//!   element; it is never assembled for the product.
+//! - **Preconditioner**: the sparse Cholesky factor of `K` at an earlier iterate (`sparse.rs`,
+//!   projected), kept across iterations and steps and remade only when a solve needed more than
+//!   [`SLOW_CG_ITERATIONS`] iterations; where it cannot be made, block Jacobi (each free node's
+//!   3×3 diagonal block of `K`, inverted). With block Jacobi alone, the slender beams need
+//!   hundreds of iterations per solve (the Gmsh P2 beam settled in 29 s against Newton's 1.7 s);
+//!   with the kept factor, a handful (5.2–7.1 s), and at most a third of Newton's factorisations
+//!   (`newton_cg_follows_newton_step_by_step`: one in 40 frames of a P2 cantilever).
 //! - **Forcing term**: conjugate gradients stop when `‖K Δ + ∇E‖ ≤ η ‖∇E‖` with
 //!   `η = min(1/2, √r)`, `r` the Newton iteration's relative residual (Eisenstat & Walker 1996's
 //!   choice of order 3/2: loose far from the solution, superlinear near it), or after
@@ -22,17 +27,24 @@
 //!   order, so results do not depend on the thread count.
 //!
 //! The solver is `Newton::<ConjugateGradients>` (`newton.rs`, `registry.rs`): everything but the
-//! linear solve is Newton's.
+//! linear solve is Newton's. What it costs against Newton (release, one thread, Intel Xeon): on
+//! the bending beam P2 8×2×2 8.2 ms per frame against 1.5 (4.5 iterations per frame, every one
+//! computing the element Hessians, which Newton's reused factor spares it), on the Gmsh P2 beam
+//! 5.2–7.1 s to settle against 1.7 s, to the same equilibrium and the same motion (the study's
+//! rows): docs/PERFORMANCE.md, session 19.
 
 use super::error::SolverCounters;
 use super::newton_core::{HessianModel, LinearSolver};
-use super::sparse::{SparseError, element_hessian_at};
+use super::sparse::{SparseError, SparsePattern, element_hessian_at};
 use crate::Vec3;
 use crate::mesh::Mesh;
 use nalgebra::Matrix3;
 
 /// Conjugate-gradient iterations per linear solve at most.
 pub(crate) const MAX_CG_ITERATIONS: usize = 1000;
+
+/// Conjugate-gradient iterations of a solve above which the next update remakes the kept factor.
+pub(crate) const SLOW_CG_ITERATIONS: usize = 20;
 
 /// The forcing term's ceiling `η_max`.
 const MAX_FORCING: f64 = 0.5;
@@ -52,6 +64,13 @@ pub(crate) struct ConjugateGradients {
     /// Per node, the inverse of its 3×3 diagonal block of `K` (identity on held nodes).
     block_inverse: Vec<Matrix3<f64>>,
     ready: bool,
+    /// The kept preconditioner: the sparse Cholesky factor of `K` (projected) at an earlier
+    /// iterate, remade only when conjugate gradients needed more than [`SLOW_CG_ITERATIONS`].
+    factor: Option<SparsePattern>,
+    /// Whether [`Self::factor`] holds a factor to precondition with (else block Jacobi).
+    use_factor: bool,
+    /// Conjugate-gradient iterations of the last solve.
+    last_iterations: usize,
     residual: Vec<f64>,
     z: Vec<f64>,
     p: Vec<f64>,
@@ -92,8 +111,15 @@ impl ConjugateGradients {
         }
     }
 
-    /// `z = P r`, the block-Jacobi preconditioner.
+    /// `z = P r`: the kept factor's solve, else block Jacobi.
     fn precondition(&self, r: &[f64], z: &mut [f64]) {
+        if self.use_factor
+            && let Some(factor) = &self.factor
+        {
+            z.copy_from_slice(r);
+            factor.solve_in_place(z, faer::Par::Seq);
+            return;
+        }
         for (node, inv) in self.block_inverse.iter().enumerate() {
             let f = self.dof_of[3 * node];
             if f == usize::MAX {
@@ -133,6 +159,9 @@ impl LinearSolver for ConjugateGradients {
             diagonal: Vec::new(),
             block_inverse: vec![Matrix3::identity(); n],
             ready: false,
+            factor: SparsePattern::new(mesh, held).ok(),
+            use_factor: false,
+            last_iterations: usize::MAX,
             residual: Vec::new(),
             z: Vec::new(),
             p: Vec::new(),
@@ -155,7 +184,7 @@ impl LinearSolver for ConjugateGradients {
         &mut self,
         model: &HessianModel<'_>,
         x: &[Vec3],
-        _counters: &mut SolverCounters,
+        counters: &mut SolverCounters,
     ) -> Result<(), SparseError> {
         use rayon::prelude::*;
         self.ready = false;
@@ -206,6 +235,23 @@ impl LinearSolver for ConjugateGradients {
                 Matrix3::from_diagonal(&block.diagonal().map(|d| if d > 0.0 { 1.0 / d } else { 1.0 }))
             });
         }
+        // the kept factor, remade where conjugate gradients slowed down (or there is none yet)
+        if self.last_iterations > SLOW_CG_ITERATIONS
+            && let Some(factor) = &mut self.factor
+        {
+            let made = factor.assemble_and_factor(
+                model.mesh,
+                model.geometry,
+                model.material,
+                x,
+                model.diagonal,
+                true,
+                faer::Par::Seq,
+            );
+            counters.factorizations += 1;
+            self.use_factor = made.is_ok();
+            self.last_iterations = 0;
+        }
         self.ready = true;
         Ok(())
     }
@@ -232,6 +278,7 @@ impl LinearSolver for ConjugateGradients {
             p.copy_from_slice(&z);
             let mut rz = dot(&residual, &z);
             for iteration in 0..MAX_CG_ITERATIONS {
+                self.last_iterations = iteration + 1;
                 self.apply(&p, &mut q);
                 let pq = dot(&p, &q);
                 if !(pq > 0.0 && pq.is_finite()) {
@@ -265,7 +312,7 @@ impl LinearSolver for ConjugateGradients {
     }
 
     fn work_summary(counters: &SolverCounters) -> String {
-        format!("{} CG iterations, no factorisation", counters.linear_iterations)
+        format!("{} CG iterations, {} factorisations", counters.linear_iterations, counters.factorizations)
     }
 }
 
@@ -318,7 +365,9 @@ mod tests {
             for (a, b) in kv.iter().zip(expected.iter()) {
                 assert!((a - b).abs() <= 1e-10 * scale, "{element}: K v {a} against {b}");
             }
-            for relative_residual in [1e-2, 1e-8] {
+            // with the kept factor (made at this K: one iteration), and with block Jacobi alone
+            for (use_factor, relative_residual) in [(true, 1e-8), (false, 1e-2), (false, 1e-8)] {
+                cg.use_factor = use_factor;
                 let mut s = v.clone();
                 let mut counters = SolverCounters::default();
                 cg.solve(&mut s, relative_residual, &mut counters);
@@ -326,7 +375,10 @@ mod tests {
                 let b = nalgebra::DVector::from_column_slice(&v);
                 let achieved = (ks - &b).norm() / b.norm();
                 let asked = relative_residual.sqrt().min(MAX_FORCING);
-                assert!(achieved <= asked, "{element}: CG reached {achieved:.2e}, asked {asked:.2e}");
+                assert!(
+                    achieved <= asked,
+                    "{element}, factor {use_factor}: CG reached {achieved:.2e}, asked {asked:.2e}"
+                );
                 assert!(counters.linear_iterations > 0);
             }
         }
@@ -357,13 +409,20 @@ mod tests {
                 }
                 (tip, sim.counters())
             };
-            let (newton, _) = run(Method::Newton);
+            let (newton, direct) = run(Method::Newton);
             let (cg, counters) = run(Method::NewtonCg);
             let swing = newton.iter().fold(0.0f64, |m, z| m.max(z.abs()));
             for (frame, (a, b)) in newton.iter().zip(&cg).enumerate() {
                 assert!((a - b).abs() <= 1e-4 * swing, "{integrator}, frame {frame}: newton {a}, newton-cg {b}");
             }
-            assert!(counters.linear_iterations > 0 && counters.factorizations == 0, "{counters:?}");
+            // the kept factor is remade far more rarely than Newton refreshes its own
+            assert!(counters.linear_iterations > 0, "{counters:?}");
+            assert!(
+                counters.factorizations >= 1 && 3 * counters.factorizations <= direct.factorizations,
+                "{integrator}: newton-cg {} factorisations, newton {}",
+                counters.factorizations,
+                direct.factorizations
+            );
             assert_eq!(counters.unconverged_steps, 0, "{integrator}");
         }
     }
