@@ -59,6 +59,9 @@ pub struct Simulation {
     history: History,
     /// The rest shape's bounding-box diagonal: the step watch's bound, m.
     body_size_m: f64,
+    /// The positions and velocities a watched step started from (`guard.rs`), kept between steps
+    /// so that a step allocates nothing (`scenes/tests/no_alloc.rs`).
+    watch_start: (Vec<Vec3>, Vec<Vec3>),
 }
 
 impl Simulation {
@@ -101,6 +104,7 @@ impl Simulation {
             substeps_per_frame: settings.substeps,
             history: History::default(),
             body_size_m: 0.0,
+            watch_start: (Vec::new(), Vec::new()),
         };
         sim.body_size_m = super::newton_core::body_size_m(&sim.mesh.rest_positions);
         for e in effects {

@@ -29,13 +29,17 @@ impl Simulation {
     /// the run stops with [`SimError::Diverged`] naming the node (or [`SimError::Unsolved`]),
     /// keeping the last sound state.
     pub(super) fn watched_step(&mut self, h: f64, halvings: u32) -> Result<(), SimError> {
-        let start = (self.positions.clone(), self.velocities.clone(), self.time_secs, self.substeps_in_frame);
+        // (into buffers kept between steps: a step allocates nothing; a halving below restores
+        // this state before it overwrites the buffers with its own start)
+        self.watch_start.0.clone_from(&self.positions);
+        self.watch_start.1.clone_from(&self.velocities);
+        let (start_time, start_substeps) = (self.time_secs, self.substeps_in_frame);
         // (the energy is an evaluation over every element: once per implicit step, but not per
         // XPBD substep, which would double XPBD's cost; XPBD is watched for the throw)
         let watch_energy = self.settings.method.is_implicit() && self.effects.iter().all(|e| e.does_no_work());
         let energy_before = watch_energy.then(|| self.mechanical_energy_j());
         self.advance(h)?;
-        let excess = self.step_excess(&start.0);
+        let excess = self.step_excess(&self.watch_start.0);
         let failed = self.solver.last_step_failed();
         let gained = energy_before.and_then(|(total, scale)| {
             let (after, scale_after) = self.mechanical_energy_j();
@@ -45,7 +49,9 @@ impl Simulation {
         if excess.is_none() && !failed && gained.is_none() {
             return Ok(());
         }
-        (self.positions, self.velocities, self.time_secs, self.substeps_in_frame) = start;
+        self.positions.clone_from(&self.watch_start.0);
+        self.velocities.clone_from(&self.watch_start.1);
+        (self.time_secs, self.substeps_in_frame) = (start_time, start_substeps);
         self.prev_positions.copy_from_slice(&self.positions);
         self.history.clear();
         self.solver.reset_history(false, self.positions.len());
