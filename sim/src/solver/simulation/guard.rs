@@ -1,8 +1,7 @@
-//! The guards of a [`Simulation`]'s step: the **step watch** of every solver (a step or XPBD
-//! substep that throws a node further than the body's size; and, for the implicit solvers, one
-//! the solver left far from solved or that raised the energy of a body no effect does work on,
-//! is taken again in halves and, failing that, stops the run naming the solver and node;
-//! docs/STABILITY.md) and the **NaN guard**'s
+//! The guards of a [`Simulation`]'s step: the **step watch** of the implicit solvers (a step that
+//! throws a node further than the body's size, that the solver left far from solved, or that
+//! raised the energy of a body no effect does work on, is taken again in halves and, failing
+//! that, stops the run naming the solver and node; docs/STABILITY.md) and the **NaN guard**'s
 //! check and roll-back to the last finite state (module doc of [`super::super`]).
 
 use super::super::error::SimError;
@@ -19,11 +18,9 @@ pub const MAX_HALVINGS: u32 = 6;
 const ENERGY_GROWTH: f64 = 1e-2;
 
 impl Simulation {
-    /// A step of `h` (an XPBD substep, an implicit step) under the step watch: a step in which a
-    /// free node moves, against
+    /// An implicit step of `h` under the step watch: a step in which a free node moves, against
     /// the free nodes' mean motion, by more than the body's size, which the solver left far
-    /// from solved ([`StepSolver::last_step_failed`]), or which (an implicit step) raised the
-    /// mechanical energy by more than [`ENERGY_GROWTH`] of its scale while no effect does work
+    /// from solved ([`StepSolver::last_step_failed`]), or which raised the mechanical energy by more than [`ENERGY_GROWTH`] of its scale while no effect does work
     /// ([`Effect::does_no_work`]), is rejected — the state goes back to its
     /// start — and taken again as two steps of `h/2`, down to `h/2^`[`MAX_HALVINGS`]; past that
     /// the run stops with [`SimError::Diverged`] naming the node (or [`SimError::Unsolved`]),
@@ -34,9 +31,7 @@ impl Simulation {
         self.watch_start.0.clone_from(&self.positions);
         self.watch_start.1.clone_from(&self.velocities);
         let (start_time, start_substeps) = (self.time_secs, self.substeps_in_frame);
-        // (the energy is an evaluation over every element: once per implicit step, but not per
-        // XPBD substep, which would double XPBD's cost; XPBD is watched for the throw)
-        let watch_energy = self.settings.method.is_implicit() && self.effects.iter().all(|e| e.does_no_work());
+        let watch_energy = self.effects.iter().all(|e| e.does_no_work());
         let energy_before = watch_energy.then(|| self.mechanical_energy_j());
         self.advance(h)?;
         let excess = self.step_excess(&self.watch_start.0);
