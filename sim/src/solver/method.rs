@@ -141,7 +141,7 @@ pub const INFO: [MethodInfo; 4] = [
         parameters: &["steps_per_frame", "integrator", "newton_tolerance"],
         step_word: "step",
         remedy: "more steps per frame, a softer material or stable Neo-Hookean",
-        motion: "Solves the implicit step to convergence as Newton does, by conjugate gradients (4–5× Newton's time on the beams); the motion is its integrator's (below).",
+        motion: "Solves the implicit step to convergence as Newton does, by conjugate gradients (2–5× Newton's time on the beams); the motion is its integrator's (below).",
         sweeps_per_step: SweepsPerStep::About(20.0),
     },
 ];
