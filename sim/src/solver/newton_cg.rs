@@ -35,7 +35,7 @@
 
 use super::error::SolverCounters;
 use super::newton_core::{HessianModel, LinearSolver};
-use super::sparse::{SparseError, SparsePattern, element_hessian_at};
+use super::sparse::{SparseError, SparsePattern, map_element_hessians};
 use crate::Vec3;
 use crate::mesh::Mesh;
 use nalgebra::Matrix3;
@@ -186,17 +186,10 @@ impl LinearSolver for ConjugateGradients {
         x: &[Vec3],
         counters: &mut SolverCounters,
     ) -> Result<(), SparseError> {
-        use rayon::prelude::*;
         self.ready = false;
         self.hessians.clear();
-        for (block, geometry) in model.mesh.blocks.iter().zip(model.geometry) {
-            let per_element: Vec<nalgebra::DMatrix<f64>> = (0..block.len())
-                .into_par_iter()
-                .with_min_len(16)
-                .map(|e| element_hessian_at(model.mesh, geometry, e, block.element(e), model.material, x, true))
-                .collect();
-            per_element.iter().for_each(|h| self.hessians.extend_from_slice(h.as_slice()));
-        }
+        let per_element = map_element_hessians(model.mesh, model.geometry, model.material, x, true, |_, h| h);
+        per_element.iter().for_each(|h| self.hessians.extend_from_slice(h.as_slice()));
         if !self.hessians.iter().all(|v| v.is_finite()) {
             return Err(SparseError::NotPositiveDefinite);
         }

@@ -89,24 +89,15 @@ impl SparsePattern {
         projected: bool,
         par: Par,
     ) -> Result<(), SparseError> {
-        use rayon::prelude::*;
         self.factored = false;
         let dof_of = &self.dof_of;
         let mut values = Vec::with_capacity(self.symbolic.compute_nnz());
-        for (b, g) in mesh.blocks.iter().zip(geo) {
-            let per_element: Vec<Vec<f64>> = (0..b.len())
-                .into_par_iter()
-                .with_min_len(16)
-                .map(|e| {
-                    let nodes = b.element(e);
-                    let he = element_hessian_at(mesh, g, e, nodes, material, x, projected);
-                    let mut v = Vec::new();
-                    for_each_element_entry(dof_of, nodes, |_, _, i, j| v.push(he[(i, j)]));
-                    v
-                })
-                .collect();
-            per_element.iter().for_each(|v| values.extend_from_slice(v));
-        }
+        let per_element = map_element_hessians(mesh, geo, material, x, projected, |nodes, he| {
+            let mut v = Vec::new();
+            for_each_element_entry(dof_of, nodes, |_, _, i, j| v.push(he[(i, j)]));
+            v
+        });
+        per_element.iter().for_each(|v| values.extend_from_slice(v));
         if diagonal.is_empty() {
             values.extend(std::iter::repeat_n(0.0, self.free_dofs));
         } else {
@@ -171,6 +162,33 @@ fn for_each_element_entry(dof_of: &[usize], nodes: &[u32], mut visit: impl FnMut
             }
         }
     }
+}
+
+/// Every element's Hessian at `x` (`projected`: PSD-projected per quadrature point), computed in
+/// parallel and handed to `f` with the element's nodes; the results in mesh order, block by block,
+/// so sums over them take a fixed order (the sparse assembly here, Newton-CG's element Hessians).
+pub(crate) fn map_element_hessians<T: Send>(
+    mesh: &Mesh,
+    geo: &[BlockGeometry],
+    material: &Material,
+    x: &[Vec3],
+    projected: bool,
+    f: impl Fn(&[u32], DMatrix<f64>) -> T + Sync,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    let mut out = Vec::with_capacity(mesh.num_elements());
+    for (b, g) in mesh.blocks.iter().zip(geo) {
+        let per_element: Vec<T> = (0..b.len())
+            .into_par_iter()
+            .with_min_len(16)
+            .map(|e| {
+                let nodes = b.element(e);
+                f(nodes, element_hessian_at(mesh, g, e, nodes, material, x, projected))
+            })
+            .collect();
+        out.extend(per_element);
+    }
+    out
 }
 
 /// The Hessian of element `e` (nodes `nodes`) at positions `x` (`projected`: PSD-projected per
