@@ -42,6 +42,10 @@ impl Effect for Attachment {
     fn after_prediction(&mut self, _s: &mut EffectState<'_>) {
         self.lambda = 0.0;
     }
+    /// Its node's distance to the target: a drag may carry the node (and the body) that far.
+    fn reach_m(&self, positions: &[Vec3], _rest_positions: &[Vec3], _time_secs: f64, _dt_secs: f64) -> f64 {
+        positions.get(self.node as usize).map_or(0.0, |x| (x - self.target_m).norm())
+    }
     fn after_projection(&mut self, s: &mut EffectState<'_>) {
         let i = self.node as usize;
         let w = s.inv_mass[i];

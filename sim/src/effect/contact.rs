@@ -57,6 +57,10 @@ impl Effect for ContactPlane {
         }
         self.tests += s.positions.len() as u64;
     }
+    /// How far the plane travels in the step.
+    fn reach_m(&self, _positions: &[Vec3], _rest_positions: &[Vec3], time_secs: f64, dt_secs: f64) -> f64 {
+        (self.point_at(time_secs + dt_secs) - self.point_at(time_secs)).norm()
+    }
     fn work_count(&self) -> u64 {
         self.tests
     }

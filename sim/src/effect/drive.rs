@@ -89,6 +89,16 @@ impl Effect for Prescribed {
             s.positions[n as usize] = self.target(&s.rest_positions[n as usize], s.time_secs);
         }
     }
+    /// The farthest its nodes travel in the step (their targets' chord).
+    fn reach_m(&self, _positions: &[Vec3], rest_positions: &[Vec3], time_secs: f64, dt_secs: f64) -> f64 {
+        self.nodes
+            .iter()
+            .map(|&n| {
+                let rest = &rest_positions[n as usize];
+                (self.target(rest, time_secs + dt_secs) - self.target(rest, time_secs)).norm()
+            })
+            .fold(0.0, f64::max)
+    }
 }
 
 #[cfg(test)]

@@ -105,6 +105,13 @@ pub trait Effect: Send + Sync {
     fn spring(&self) -> Option<NodeSpring> {
         None
     }
+    /// How far this effect may carry a node in the step from `time_secs` to `time_secs + dt_secs`,
+    /// m: a drive, the path of its nodes; a drag, its node's distance to the target; a moving
+    /// plate, its travel. The step watch lets a free node move that much beyond the body's size
+    /// (a fast drag across the body is not a blow-up).
+    fn reach_m(&self, _positions: &[Vec3], _rest_positions: &[Vec3], _time_secs: f64, _dt_secs: f64) -> f64 {
+        0.0
+    }
 }
 
 /// An [`EffectState`] over the given slices, `dt_secs` = 0.01, for the effects' tests.

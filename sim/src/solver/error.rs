@@ -46,9 +46,9 @@ pub enum SimError {
         time_secs: f64,
     },
     #[error(
-        "the {solver} simulation diverged at frame {frame} (t = {time_secs:.6} s): in one {} node {node} moved {moved_m:.3e} m against the body's mean motion, more than the body's size ({size_m:.3e} m), and {} halvings of the step (down to {h_secs:.3e} s) did not help; the last sound state is kept — reset, or use {}",
-        step_word(solver),
+        "the {solver} simulation diverged at frame {frame} (t = {time_secs:.6} s): in one {span} node {node} moved {moved_m:.3e} m against the body's mean motion, more than the body's size and what its effects carry ({size_m:.3e} m), and {} halvings of the {} (down to {h_secs:.3e} s) did not help; the last sound state is kept — reset, or use {}",
         halvings,
+        step_word(solver),
         remedy(solver)
     )]
     Diverged {
@@ -56,7 +56,10 @@ pub enum SimError {
         /// The node that moved most against the body's mean motion (global index).
         node: usize,
         moved_m: f64,
+        /// The bound: the body's size plus the effects' reach ([`crate::effect::Effect::reach_m`]).
         size_m: f64,
+        /// What was watched: a "step" of an implicit solver, a "frame" of XPBD's substeps.
+        span: &'static str,
         frame: u64,
         time_secs: f64,
         /// How many times the step was halved, and the shortest step tried.

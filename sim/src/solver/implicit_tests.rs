@@ -352,11 +352,11 @@ fn the_coarse_correction_settles_a_stiff_beam_in_a_fraction_of_the_frames() {
 
 /// Finite but absurd is stopped as a NaN is (issue #36): a projection that throws a node ten
 /// body sizes each time it runs (a broken effect) moves it by more than the body's size in every
-/// step the watch tries, down to `h/2^MAX_HALVINGS`, so the run stops naming the solver and the
-/// node, keeps the state the step started from and refuses to step until reset;
-/// `rejected_steps` counts the tries.
+/// step the watch tries, down to `h/2^MAX_HALVINGS` (XPBD: its frame, up to 64 times the
+/// substeps), so the run stops naming the solver and the node, keeps the state the step started
+/// from and refuses to step until reset; `rejected_steps` counts the tries.
 #[test]
-fn a_node_thrown_across_the_body_stops_the_implicit_run_naming_it() {
+fn a_node_thrown_across_the_body_stops_the_run_naming_it() {
     struct Thrower(u32);
     impl Effect for Thrower {
         fn name(&self) -> &'static str {
@@ -373,17 +373,18 @@ fn a_node_thrown_across_the_body_stops_the_implicit_run_naming_it() {
     let material = Material::new(MaterialModel::StableNeoHookean, 1.0e5, 0.3, 1000.0).unwrap();
     let clamped = clamped_at_x0(&mesh);
     let node = mesh.num_nodes() as u32 - 1;
-    // (every implicit solver that honours a projection: Newton's cannot run the thrower)
-    for method in
-        Method::ALL.into_iter().filter(|m| m.is_implicit() && m.honours(crate::effect::ImplicitRole::Projection))
-    {
-        let mut sim =
-            Simulation::new(mesh.clone(), material, implicit(method, 60.0), cantilever_effects(&clamped, 0.0)).unwrap();
+    // (every solver that honours a projection: Newton's cannot run the thrower)
+    for method in Method::ALL.into_iter().filter(|m| m.honours(crate::effect::ImplicitRole::Projection)) {
+        let mut settings = implicit(method, 60.0);
+        settings.substeps = 5;
+        let mut sim = Simulation::new(mesh.clone(), material, settings, cantilever_effects(&clamped, 0.0)).unwrap();
         sim.step_frame().unwrap();
         let before = sim.positions.clone();
         sim.add_effect(Box::new(Thrower(node))).unwrap();
         let err = sim.step_frame().unwrap_err().to_string();
+        let span = if method.is_implicit() { "step" } else { "frame" };
         assert!(err.starts_with(&format!("the {method} simulation diverged")), "{err}");
+        assert!(err.contains(&format!("in one {span} node")), "{err}");
         assert!(err.contains(&format!("node {node} moved")) && err.contains("6 halvings"), "{err}");
         assert_eq!(sim.counters().rejected_steps, 7, "{method}: one rejection per depth, 1 to 1/64");
         assert_eq!(sim.positions, before, "{method}: the state the step started from is kept");
@@ -391,6 +392,40 @@ fn a_node_thrown_across_the_body_stops_the_implicit_run_naming_it() {
         sim.reset();
         sim.remove_effects_named("thrower");
         sim.step_frame().unwrap();
+    }
+}
+
+/// A fast drag is not a blow-up (issue #36): the mouse carries a node two body sizes away within
+/// one frame; under every solver and integrator the step watch (XPBD's frame watch) lets the node
+/// go as far as its target (the bound is the body's size plus the drag's reach), nothing is
+/// rejected, and the node ends near the target.
+#[test]
+fn a_node_dragged_across_the_body_in_one_frame_is_not_a_blow_up() {
+    let mesh = beam(ElementType::from_name("p2").unwrap(), [2, 1, 1]);
+    let material = Material::new(MaterialModel::StableNeoHookean, 1.0e5, 0.3, 1000.0).unwrap();
+    let clamped = clamped_at_x0(&mesh);
+    let tip = mesh.nodes_where(|p| (p - Vec3::new(1.0, 0.25, 0.25)).norm() < 1e-12)[0];
+    let size = super::newton_core::body_size_m(&mesh.rest_positions);
+    let target = mesh.rest_positions[tip as usize] + Vec3::new(0.0, 0.0, 2.0 * size);
+    let damped = [Integrator::Euler, Integrator::Bdf2];
+    for (method, integrator) in Method::ALL.into_iter().flat_map(|m| damped.map(|i| (m, i))) {
+        if !method.is_implicit() && integrator != Integrator::Euler {
+            continue;
+        }
+        let settings = SolverSettings { integrator, ..implicit(method, 60.0) };
+        let mut sim = Simulation::new(mesh.clone(), material, settings, cantilever_effects(&clamped, 5.0)).unwrap();
+        sim.step_frame().unwrap();
+        // the app's drag: an attachment of compliance 1e-6 m/N to where the mouse is
+        sim.add_effect(Box::new(Attachment::new(tip, target, 1e-6))).unwrap();
+        sim.step_frame().unwrap_or_else(|e| panic!("{method} {integrator}: {e}"));
+        let moved = (sim.positions[tip as usize] - mesh.rest_positions[tip as usize]).norm();
+        assert!(moved > size, "{method} {integrator}: the dragged node moved only {moved:.3} m in the frame");
+        for _ in 0..30 {
+            sim.step_frame().unwrap_or_else(|e| panic!("{method} {integrator}: {e}"));
+        }
+        let gap = (sim.positions[tip as usize] - target).norm();
+        assert!(gap < 0.1 * size, "{method} {integrator}: the dragged node is {gap:.3} m from its target");
+        assert_eq!(sim.counters().rejected_steps, 0, "{method} {integrator}");
     }
 }
 

@@ -425,8 +425,16 @@ impl Simulation {
 
     /// Advances one frame (`substeps` substeps, or more: the stability guard).
     pub fn step_frame(&mut self) -> Result<(), SimError> {
-        for _ in 0..self.substeps_per_frame {
-            self.substep()?;
+        if self.settings.method.is_implicit() {
+            for _ in 0..self.substeps_per_frame {
+                self.substep()?;
+            }
+        } else {
+            // XPBD's frame watch (`guard.rs`): its substeps, then the displacement check
+            if let Some(e) = &self.failure {
+                return Err(e.clone());
+            }
+            self.watched_frame()?;
         }
         self.frames += 1;
         self.substeps_in_frame = 0;

@@ -1,8 +1,14 @@
 //! The guards of a [`Simulation`]'s step: the **step watch** of the implicit solvers (a step that
 //! throws a node further than the body's size, that the solver left far from solved, or that
 //! raised the energy of a body no effect does work on, is taken again in halves and, failing
-//! that, stops the run naming the solver and node; docs/STABILITY.md) and the **NaN guard**'s
-//! check and roll-back to the last finite state (module doc of [`super::super`]).
+//! that, stops the run naming the solver and node; docs/STABILITY.md), XPBD's **frame watch**
+//! (the same displacement check once per frame, a rejected frame taken again with twice the
+//! substeps), and the **NaN guard**'s check and roll-back to the last finite state (module doc
+//! of [`super::super`]).
+//!
+//! The displacement bound is the body's size (its rest bounding-box diagonal) plus how far the
+//! effects may carry a node in the step ([`crate::effect::Effect::reach_m`]: a drive's path, a
+//! drag's distance to its target), so that a fast drag across the body is not a blow-up.
 
 use super::super::error::SimError;
 use super::super::nan_guard::{BadElement, ORIGIN_STATE};
@@ -33,8 +39,9 @@ impl Simulation {
         let (start_time, start_substeps) = (self.time_secs, self.substeps_in_frame);
         let watch_energy = self.effects.iter().all(|e| e.does_no_work());
         let energy_before = watch_energy.then(|| self.mechanical_energy_j());
+        let bound_m = self.displacement_bound_m(h);
         self.advance(h)?;
-        let excess = self.step_excess(&self.watch_start.0);
+        let excess = self.step_excess(&self.watch_start.0, bound_m);
         let failed = self.solver.last_step_failed();
         let gained = energy_before.and_then(|(total, scale)| {
             let (after, scale_after) = self.mechanical_energy_j();
@@ -57,7 +64,8 @@ impl Simulation {
                     solver: self.settings.method.name(),
                     node,
                     moved_m,
-                    size_m: self.body_size_m,
+                    size_m: bound_m,
+                    span: "step",
                     frame: self.frames + 1,
                     time_secs: self.time_secs + h,
                     halvings,
@@ -97,9 +105,73 @@ impl Simulation {
         (kinetic + elastic + gravity, kinetic + elastic + gravity.abs())
     }
 
+    /// XPBD's frame watch: the frame's substeps, then the step watch's displacement check over
+    /// the frame. A frame in which a free node moved, against the free nodes' mean motion, by
+    /// more than [`Self::displacement_bound_m`] is rejected (the state goes back to the frame's
+    /// start) and taken again with twice the substeps, up to 2^[`MAX_HALVINGS`] times as many;
+    /// past that the run stops with [`SimError::Diverged`] naming XPBD, the frame and the node.
+    /// Once per frame, not per substep: watching every substep cost 10–25 % of a P2 8×2×2 frame
+    /// (docs/STABILITY.md); a copy of the state and one pass over the nodes per frame is a few
+    /// microseconds against its milliseconds. The stability guard keeps XPBD's substeps below its
+    /// stability limit and the NaN guard checks every substep, as before.
+    pub(super) fn watched_frame(&mut self) -> Result<(), SimError> {
+        self.watch_start.0.clone_from(&self.positions);
+        self.watch_start.1.clone_from(&self.velocities);
+        let start_time = self.time_secs;
+        let frame_secs = 1.0 / self.settings.frames_per_second;
+        let bound_m = self.displacement_bound_m(frame_secs);
+        let mut substeps = self.substeps_per_frame;
+        for doublings in 0..=MAX_HALVINGS {
+            let h = frame_secs / substeps as f64;
+            self.substeps_in_frame = 0;
+            for _ in 0..substeps {
+                if let Some(e) = &self.failure {
+                    return Err(e.clone());
+                }
+                self.advance(h)?;
+            }
+            let Some((node, moved_m)) = self.step_excess(&self.watch_start.0, bound_m) else {
+                return Ok(());
+            };
+            self.positions.clone_from(&self.watch_start.0);
+            self.velocities.clone_from(&self.watch_start.1);
+            self.time_secs = start_time;
+            self.prev_positions.copy_from_slice(&self.positions);
+            self.counters.rejected_steps += 1;
+            if doublings == MAX_HALVINGS {
+                let err = SimError::Diverged {
+                    solver: self.settings.method.name(),
+                    node,
+                    moved_m,
+                    size_m: bound_m,
+                    span: "frame",
+                    frame: self.frames + 1,
+                    time_secs: start_time + frame_secs,
+                    halvings: doublings,
+                    h_secs: h,
+                };
+                self.failure = Some(err.clone());
+                return Err(err);
+            }
+            substeps *= 2;
+        }
+        unreachable!("the loop returns at its last doubling")
+    }
+
+    /// How far a free node may move, against the free nodes' mean motion, in a step of `h` from
+    /// now: the body's size plus the farthest any effect may carry a node in it.
+    fn displacement_bound_m(&self, h: f64) -> f64 {
+        let reach = self
+            .effects
+            .iter()
+            .map(|e| e.reach_m(&self.positions, &self.mesh.rest_positions, self.time_secs, h))
+            .fold(0.0, f64::max);
+        self.body_size_m + reach
+    }
+
     /// The free node that moved most in the step from `start` against the free nodes' mean
-    /// motion, and how far, when that is more than the body's size.
-    fn step_excess(&self, start: &[Vec3]) -> Option<(usize, f64)> {
+    /// motion, and how far, when that is more than `bound_m`.
+    fn step_excess(&self, start: &[Vec3], bound_m: f64) -> Option<(usize, f64)> {
         let free = |i: &usize| self.inv_mass[*i] > 0.0;
         let n = (0..start.len()).filter(free).count().max(1) as f64;
         let mean = (0..start.len()).filter(free).map(|i| self.positions[i] - start[i]).sum::<Vec3>() / n;
@@ -107,7 +179,7 @@ impl Simulation {
             .filter(free)
             .map(|i| (i, (self.positions[i] - start[i] - mean).norm()))
             .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
-        (moved > self.body_size_m).then_some((node, moved))
+        (moved > bound_m).then_some((node, moved))
     }
 }
 
