@@ -98,7 +98,8 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
     assert!(value("P2 8x2x2 five", "xpbd 50x1", "solver_error_pct") > 1.0);
     // implicit Euler damps the motion the reference (Newmark) keeps; Newmark and BDF2 keep it
     // (issue #36: Newmark's period within 1 % and amplitude within 2 % on this mesh; measured:
-    // Newmark −0.07 / +0.65 %, BDF2 +1.4–1.7 / −2.4–2.7 %)
+    // Newmark −0.07 / +0.65 %, BDF2 +1.4–1.8 / −2.7 (Newton) and −4.3 % (VBD, whose sweeps under
+    // BDF2 no longer lean towards an explicit scheme, which had gained energy over long runs))
     for (solver, integrator) in &implicit {
         let (period, amplitude) =
             (value("P2 8x2x2 five", solver, "period_error_pct"), value("P2 8x2x2 five", solver, "amplitude_error_pct"));
@@ -108,7 +109,7 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
                 assert!(period.abs() < 1.0 && amplitude.abs() < 2.0, "{solver}: {period} / {amplitude} %")
             }
             Integrator::Bdf2 => {
-                assert!(period.abs() < 2.5 && amplitude.abs() < 4.0, "{solver}: {period} / {amplitude} %")
+                assert!(period.abs() < 2.5 && amplitude.abs() < 5.0, "{solver}: {period} / {amplitude} %")
             }
         }
     }

@@ -18,7 +18,7 @@ use hox_sim::Vec3;
 use hox_sim::effect::{AxisRotation, ContactPlane, Damping, Effect, EffectState, Gravity, Prescribed};
 use hox_sim::material::{Material, MaterialModel};
 use hox_sim::mesh::Mesh;
-use hox_sim::solver::{SimError, Simulation};
+use hox_sim::solver::{Integrator, Method, SimError, Simulation, SolverSettings};
 use hox_sim::xpbd::constraint::Formulation;
 use hox_tests::*;
 
@@ -26,7 +26,64 @@ const SNH: MaterialModel = MaterialModel::StableNeoHookean;
 const SNH_LOG: MaterialModel = MaterialModel::StableNeoHookeanLog;
 const STVK: MaterialModel = MaterialModel::StVenantKirchhoff;
 const NH: MaterialModel = MaterialModel::NeoHookean;
-const BOTH: [Formulation; 2] = Formulation::ALL;
+/// XPBD under both formulations: the configurations every family runs in the debug suite.
+const BOTH: [Solve; 2] = [Solve::Xpbd(Formulation::Energy), Solve::Xpbd(Formulation::Split)];
+
+/// How a configuration is solved: XPBD (the paper's solver) with a formulation, or an implicit
+/// solver of the registry under an integrator (issue #36, item 4: every family with every solver).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Solve {
+    Xpbd(Formulation),
+    Implicit(Method, Integrator),
+}
+
+impl std::fmt::Display for Solve {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Solve::Xpbd(formulation) => write!(f, "{formulation}"),
+            Solve::Implicit(method, integrator) => write!(f, "{method} {integrator}"),
+        }
+    }
+}
+
+impl Solve {
+    /// The settings: XPBD's `substeps` per frame, or the implicit solver's one step per frame
+    /// (`substeps` is then unused: its steps are its own).
+    fn settings(self, substeps: u32, fps: f64) -> SolverSettings {
+        match self {
+            Solve::Xpbd(formulation) => settings(formulation, substeps, fps),
+            Solve::Implicit(method, integrator) => {
+                SolverSettings { method, integrator, ..settings(Formulation::default(), substeps, fps) }
+            }
+        }
+    }
+}
+
+/// The energy a configuration may gain beyond the families' bounds, as a fraction of their
+/// energy scale: none for the schemes that only dissipate (XPBD, implicit Euler, BDF2); 2 % for
+/// Newmark, which conserves energy exactly only for a linear body (on these strongly nonlinear
+/// cases its error reached 0.8–1.1 % of the scale: a sagging ν = 0.49 Q2 beam released, the
+/// 1 kPa jelly; the step watch allows 1 % per step).
+fn energy_slack(s: &Simulation) -> f64 {
+    let settings = s.settings();
+    if settings.method.is_implicit() && settings.integrator == Integrator::Newmark { 0.02 } else { 0.0 }
+}
+
+/// The implicit solvers and integrators the families run with in `.ci/run`: VBD and Newton under
+/// every integrator but VBD under Newmark. Under Newmark VBD sweeps every step to 1e-5 of the load,
+/// so it computes Newton's Newmark step (in session 20, 105 of 117 family outcomes were Newton's;
+/// docs/STABILITY.md lists the 12 others) at 5–10× Newton's time: it was 70 % of this suite's
+/// time; `HOX_ROBUSTNESS_VBD_NEWMARK=1` adds it (about 30 minutes). Newton-CG minimises the same
+/// potential as Newton to the same tolerance at 2–5× its time (tests/tests/robustness_solvers.rs
+/// runs both, and VBD under Newmark, in every family).
+fn implicit() -> Vec<Solve> {
+    let vbd_newmark = std::env::var_os("HOX_ROBUSTNESS_VBD_NEWMARK").is_some_and(|v| v == "1");
+    [Method::Vbd, Method::Newton]
+        .into_iter()
+        .flat_map(|m| Integrator::ALL.map(move |i| Solve::Implicit(m, i)))
+        .filter(|s| vbd_newmark || *s != Solve::Implicit(Method::Vbd, Integrator::Newmark))
+        .collect()
+}
 
 /// After release, every node within this fraction of the body's size of its rest position (or,
 /// for a body free to move, of the rigidly aligned rest shape).
@@ -36,35 +93,30 @@ const REST_TOLERANCE: f64 = 1e-3;
 /// ([`min_det_f_sampled`]).
 const SAMPLE_LEVELS: usize = 12;
 
-/// Runs `run` for every element type in `types` and formulation in `formulations`, prints a
-/// `PASS`/`FAIL` line per configuration with its figures (docs/STABILITY.md's table), and fails
-/// on any failure not listed in `known` ("p3 energy", …) — and on a listed one that now passes,
-/// so the list (and the table) cannot go stale.
-fn each_configuration(
-    case: &str,
-    types: &[&str],
-    formulations: &[Formulation],
-    known: &[&str],
-    run: impl Fn(&str, Formulation) -> Result<String, String>,
-) {
-    let problems = configurations(case, types, formulations, known, run);
-    assert!(problems.is_empty(), "{case}: {} configuration(s):\n{}", problems.len(), problems.join("\n"));
+/// Fails listing `problems` (what [`configurations`] returned), if any.
+fn none(problems: &[String]) {
+    assert!(problems.is_empty(), "{} configuration(s):\n{}", problems.len(), problems.join("\n"));
 }
 
-/// [`each_configuration`]'s runs, returning the problems instead of failing.
+/// Runs `run` for every element type in `types` and configuration in `configs`, prints a
+/// `PASS`/`FAIL` line per configuration with its figures and seconds (docs/STABILITY.md's
+/// tables), and returns the failures not listed in `known` ("p3 energy", "p1 vbd euler", …) —
+/// and a listed one that now passes, so the list (and the table) cannot go stale.
 fn configurations(
     case: &str,
     types: &[&str],
-    formulations: &[Formulation],
+    configs: &[Solve],
     known: &[&str],
-    run: impl Fn(&str, Formulation) -> Result<String, String>,
+    run: impl Fn(&str, Solve) -> Result<String, String>,
 ) -> Vec<String> {
     let mut problems = Vec::new();
     for et in types {
-        for &f in formulations {
+        for &f in configs {
             let label = format!("{et} {f}");
             let expected_to_fail = known.contains(&label.as_str());
-            match (run(et, f), expected_to_fail) {
+            let clock = std::time::Instant::now();
+            let outcome = run(et, f).map(|figures| format!("{figures} [{:.1} s]", clock.elapsed().as_secs_f64()));
+            match (outcome, expected_to_fail) {
                 (Ok(figures), false) => eprintln!("PASS {case} | {et} | {f} | {figures}"),
                 (Ok(figures), true) => {
                     eprintln!("FIXED {case} | {et} | {f} | {figures}");
@@ -122,12 +174,12 @@ fn beam(et: &str, length_m: f64, cells_x: usize) -> Mesh {
 fn sim(
     mesh: Mesh,
     material: Material,
-    formulation: Formulation,
+    solve: Solve,
     substeps: u32,
     fps: f64,
     effects: Vec<Box<dyn Effect>>,
 ) -> Simulation {
-    Simulation::new(mesh, material, settings(formulation, substeps, fps), effects).unwrap_or_else(|e| panic!("{e}"))
+    Simulation::new(mesh, material, solve.settings(substeps, fps), effects).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Frames in `secs` seconds at `fps`.
@@ -141,7 +193,7 @@ fn frames(secs: f64, fps: f64) -> u64 {
 /// A cantilever `[0, 0.5] × [0, 0.125]²` (2 cells) clamped at x = 0 with velocity damping
 /// `damping_per_sec`, every node mirrored through the clamped face (`x → −x`): every element
 /// inverted, `F = diag(−1, 1, 1)`.
-fn mirrored_cantilever(et: &str, model: MaterialModel, formulation: Formulation, damping_per_sec: f64) -> Simulation {
+fn mirrored_cantilever(et: &str, model: MaterialModel, formulation: Solve, damping_per_sec: f64) -> Simulation {
     let mesh = beam(et, 0.5, 2);
     let clamp = clamp_x0(&mesh);
     let damping: Box<dyn Effect> = Box::new(Damping { rate_per_sec: damping_per_sec });
@@ -153,7 +205,7 @@ fn mirrored_cantilever(et: &str, model: MaterialModel, formulation: Formulation,
 /// The free corner `(L, 0, 0)` of the same cantilever (damped at 10/s) mirrored through the cell
 /// face `x = L − h` (h: the cell length) to `(L − 2h, 0, 0)`: the elements holding it are
 /// inverted (curved and partly inverted for P2/P3, whose edge nodes stay put).
-fn corner_pushed_through(et: &str, model: MaterialModel, formulation: Formulation) -> Simulation {
+fn corner_pushed_through(et: &str, model: MaterialModel, formulation: Solve) -> Simulation {
     let mut s = mirrored_cantilever(et, model, formulation, 10.0);
     let rest = s.mesh().rest_positions.clone();
     s.positions.copy_from_slice(&rest);
@@ -170,7 +222,8 @@ fn run_inverted(mut s: Simulation, secs: f64, growth: f64) -> Result<(Simulation
     if !(start.min_det_f.det_f < 0.0) {
         return Err(format!("the start is not inverted: min det F = {}", start.min_det_f.det_f));
     }
-    let trace = run_checked(&mut s, frames(secs, 60.0), Vec3::zeros(), growth * start.total_j() + 1e-9)?;
+    let bound_j = (growth + energy_slack(&s)) * start.total_j() + 1e-9;
+    let trace = run_checked(&mut s, frames(secs, 60.0), Vec3::zeros(), bound_j)?;
     let end = health(&s, Vec3::zeros());
     Ok((s, start, end, trace))
 }
@@ -181,11 +234,15 @@ fn run_inverted(mut s: Simulation, secs: f64, growth: f64) -> Result<(Simulation
 /// [`p3_mirrored_under_strong_damping_is_trapped_inverted_between_its_quadrature_points`].
 #[test]
 fn stable_neo_hookean_recovers_from_elements_mirrored_through_a_face() {
-    each_configuration("1 mirrored, snh", &element_types(), &BOTH, &[], |et, f| {
+    none(&mirrored_snh(&BOTH, &[]));
+}
+
+fn mirrored_snh(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("1 mirrored, snh", &element_types(), configs, known, |et, f| {
         let (damping, secs) = if et == "p3" { (2.0, 8.0) } else { (10.0, 5.0) };
         let (s, start, end, _) = run_inverted(mirrored_cantilever(et, SNH, f, damping), secs, 1.0 + 1e-6)?;
         Ok(format!("damping {damping}/s, U(0) = {:.3e} J; {}", start.elastic_j, recovered(&s, &end, false)?))
-    });
+    })
 }
 
 /// A known limitation, kept visible: under strong damping (10/s) the mirrored P3 cantilever
@@ -260,10 +317,14 @@ fn trapped_states_are_minima_of_the_near_exactly_integrated_energy() {
 
 #[test]
 fn stable_neo_hookean_recovers_from_a_corner_pushed_through_its_element() {
-    each_configuration("1 corner through, snh", &element_types(), &BOTH, &[], |et, f| {
+    none(&corner_snh(&BOTH, &[]));
+}
+
+fn corner_snh(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("1 corner through, snh", &element_types(), configs, known, |et, f| {
         let (s, start, end, _) = run_inverted(corner_pushed_through(et, SNH, f), 3.0, 1.0 + 1e-6)?;
         Ok(format!("min det F(0) = {:.3}; {}", start.min_det_f.det_f, recovered(&s, &end, false)?))
-    });
+    })
 }
 
 /// StVK's known weakness: `ψ` depends on `FᵀF` only, so a mirrored element (`F = diag(−1,1,1)`,
@@ -272,7 +333,11 @@ fn stable_neo_hookean_recovers_from_a_corner_pushed_through_its_element() {
 /// it does stay mirrored, as documented.
 #[test]
 fn stvk_mirrored_through_a_face_is_a_rest_state_it_stays_in_bounded() {
-    each_configuration("1 mirrored, stvk", &element_types(), &BOTH, &[], |et, f| {
+    none(&mirrored_stvk(&BOTH, &[]));
+}
+
+fn mirrored_stvk(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("1 mirrored, stvk", &element_types(), configs, known, |et, f| {
         let (_, start, end, _) = run_inverted(mirrored_cantilever(et, STVK, f, 10.0), 1.0, 1.0 + 1e-6)?;
         if !(start.elastic_j.abs() < 1e-9 && end.max_displacement_m > 0.4) {
             return Err(format!(
@@ -281,7 +346,7 @@ fn stvk_mirrored_through_a_face_is_a_rest_state_it_stays_in_bounded() {
             ));
         }
         Ok(format!("stays mirrored, U = {:.1e} J, min det F {:.3}", end.elastic_j, end.min_det_f.det_f))
-    });
+    })
 }
 
 /// A corner pushed through its element with StVK: bounded (finite, energy not growing); whether
@@ -289,13 +354,17 @@ fn stvk_mirrored_through_a_face_is_a_rest_state_it_stays_in_bounded() {
 #[test]
 #[ignore = "release: CI runs it with --release --ignored"]
 fn stvk_corner_pushed_through_its_element_stays_bounded() {
-    each_configuration("1 corner through, stvk", &element_types(), &BOTH, &[], |et, f| {
+    none(&corner_stvk(&BOTH, &[]));
+}
+
+fn corner_stvk(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("1 corner through, stvk", &element_types(), configs, known, |et, f| {
         let (s, _, end, _) = run_inverted(corner_pushed_through(et, STVK, f), 3.0, 1.0 + 1e-6)?;
         Ok(match recovered(&s, &end, false) {
             Ok(r) => format!("recovers: {r}"),
             Err(e) => format!("bounded, does not recover: {e}"),
         })
-    });
+    })
 }
 
 /// Compressible Neo-Hookean below its `J` floor (`ln J` continued linearly from `J = 0.2`,
@@ -306,7 +375,11 @@ fn stvk_corner_pushed_through_its_element_stays_bounded() {
 #[test]
 #[ignore = "release: CI runs it with --release --ignored"]
 fn neo_hookean_inverted_starts_stay_bounded() {
-    each_configuration("1 inverted, nh", &element_types(), &BOTH, &[], |et, f| {
+    none(&inverted_nh(&BOTH, &[]));
+}
+
+fn inverted_nh(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("1 inverted, nh", &element_types(), configs, known, |et, f| {
         let mut out = Vec::new();
         for (what, s) in
             [("mirrored", mirrored_cantilever(et, NH, f, 10.0)), ("corner", corner_pushed_through(et, NH, f))]
@@ -319,7 +392,7 @@ fn neo_hookean_inverted_starts_stay_bounded() {
             });
         }
         Ok(out.join("; "))
-    });
+    })
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -331,7 +404,7 @@ fn gravity_cantilever(
     length_m: f64,
     cells_x: usize,
     material: Material,
-    formulation: Formulation,
+    formulation: Solve,
     substeps: u32,
     fps: f64,
 ) -> Simulation {
@@ -367,9 +440,11 @@ fn load_and_release_within(
     )
     .map_err(|e| e.to_string())?;
     let scale = run_checked(&mut probe_run, frames(load_secs, fps), GRAVITY_M_S2, f64::INFINITY)?.max_gravity_work_j;
-    let loaded = run_checked(&mut s, frames(load_secs, fps), GRAVITY_M_S2, allowance * scale)?;
+    let slack = energy_slack(&s);
+    let loaded = run_checked(&mut s, frames(load_secs, fps), GRAVITY_M_S2, (allowance + slack) * scale)?;
     let at_release = health(&s, Vec3::zeros());
-    let after = release(&mut s, &["gravity"], damping_per_sec, frames(release_secs, fps), at_release.total_j() + 1e-9)?;
+    let release_bound_j = at_release.total_j() + slack * at_release.total_j().abs().max(scale) + 1e-9;
+    let after = release(&mut s, &["gravity"], damping_per_sec, frames(release_secs, fps), release_bound_j)?;
     Ok(format!(
         "{} substeps (h·ω_max {:.2}), max sag {:.3e} m, max H {:.2e} J ({:+.1e} of |V_g| {:.2e} J), min det F loaded {:.3}; {}",
         s.substeps_per_frame(),
@@ -397,19 +472,21 @@ fn load_and_release_within(
 /// comparison is in docs/STABILITY.md).
 #[test]
 fn near_incompressible_cantilevers_do_not_blow_up() {
-    near_incompressible(SNH);
+    none(&near_incompressible(SNH, &BOTH, &[]));
 }
 
 #[test]
 #[ignore = "release: CI runs it with --release --ignored"]
 fn near_incompressible_stvk_cantilevers_do_not_blow_up() {
-    near_incompressible(STVK);
+    none(&near_incompressible(STVK, &BOTH, &[]));
 }
 
-fn near_incompressible(model: MaterialModel) {
+/// The near-incompressible family; `known` lists the known failures per ν.
+fn near_incompressible(model: MaterialModel, configs: &[Solve], known: &[(f64, &[&str])]) -> Vec<String> {
     let mut problems = Vec::new();
     for nu in [0.45, 0.49, 0.499] {
-        problems.extend(configurations(&format!("2 ν = {nu}, {model}"), &element_types(), &BOTH, &[], |et, f| {
+        let known = known.iter().find(|(v, _)| *v == nu).map_or(&[][..], |(_, k)| *k);
+        problems.extend(configurations(&format!("2 ν = {nu}, {model}"), &element_types(), configs, known, |et, f| {
             load_and_release_within(
                 gravity_cantilever(et, 1.0, 4, material(model, 1.0e6, nu), f, 50, 60.0),
                 1.0,
@@ -423,7 +500,7 @@ fn near_incompressible(model: MaterialModel) {
         // StVK: reported (PASS/FAIL lines); only a solver stop (NaN) fails the test
         problems.retain(|p| p.contains("solver:"));
     }
-    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    problems
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -432,7 +509,7 @@ fn near_incompressible(model: MaterialModel) {
 /// Runs a gravity-loaded cantilever (1 m, 4 cells, stable Neo-Hookean, ν = 0.3) for 3 s with
 /// the stability guard off (exactly the substeps asked for) and returns the largest
 /// `H / |V_g|max` (1 % is the bound of the passing cases; NaN when the solver's guard stopped it).
-fn energy_gain(et: &str, f: Formulation, youngs_modulus_pa: f64, substeps: u32, fps: f64) -> f64 {
+fn energy_gain(et: &str, f: Solve, youngs_modulus_pa: f64, substeps: u32, fps: f64) -> f64 {
     let mut s = unguarded(gravity_cantilever(et, 1.0, 4, material(SNH, youngs_modulus_pa, 0.3), f, substeps, fps));
     run_checked(&mut s, frames(3.0, fps), GRAVITY_M_S2, f64::INFINITY)
         .map(|t| t.max_total_j / t.max_gravity_work_j)
@@ -455,7 +532,7 @@ fn unguarded(mut s: Simulation) -> Simulation {
 fn guarded_cantilever(
     et: &str,
     model: MaterialModel,
-    f: Formulation,
+    f: Solve,
     youngs_modulus_pa: f64,
     substeps: u32,
     fps: f64,
@@ -463,6 +540,10 @@ fn guarded_cantilever(
     release_secs: f64,
 ) -> Result<String, String> {
     let mut s = gravity_cantilever(et, 1.0, 4, material(model, youngs_modulus_pa, 0.3), f, substeps, fps);
+    if let Solve::Implicit(..) = f {
+        // no guard: the implicit solvers take their one step per frame, however stiff
+        return Ok(format!("1 step per frame; {}", load_and_release(s, 1.0, damping_per_sec, release_secs)?));
+    }
     let guard = s.stability();
     if !guard.raised() {
         return Err(format!("the guard did not raise the substeps: {}", guard.summary()));
@@ -481,9 +562,13 @@ fn guarded_cantilever(
 #[test]
 #[ignore = "release: CI runs it with --release --ignored (hundreds of substeps per frame)"]
 fn a_stiff_cantilever_with_one_substep_per_frame_is_stable_under_the_stability_guard() {
-    each_configuration("3 E = 1e9 Pa, 1 substep asked, guard, snh", &element_types(), &BOTH, &[], |et, f| {
+    none(&stiff(&BOTH, &[]));
+}
+
+fn stiff(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("3 E = 1e9 Pa, 1 substep asked, guard, snh", &element_types(), configs, known, |et, f| {
         guarded_cantilever(et, SNH, f, 1.0e9, 1, 60.0, 10.0, 2.0)
-    });
+    })
 }
 
 /// **Known failure (case 3) without the stability guard, kept visible.** E = 10⁹ Pa with a
@@ -523,9 +608,13 @@ fn the_one_substep_cantilever_is_stable_below_the_stability_limit() {
 /// form is [`known_failure_a_very_soft_p1_cantilever_with_the_papers_stable_neo_hookean_stays_hanging`].
 #[test]
 fn a_very_soft_cantilever_hangs_and_springs_back() {
-    each_configuration("3 E = 1e3 Pa, snh-log", &element_types(), &BOTH, &[], |et, f| {
+    none(&soft_snh_log(&BOTH, &[]));
+}
+
+fn soft_snh_log(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("3 E = 1e3 Pa, snh-log", &element_types(), configs, known, |et, f| {
         load_and_release(gravity_cantilever(et, 0.1, 4, material(SNH_LOG, 1.0e3, 0.3), f, 50, 60.0), 2.0, 5.0, 6.0)
-    });
+    })
 }
 
 /// **Known failure (case 3, E = 10³ Pa), kept visible.** With the paper's stable Neo-Hookean (no
@@ -534,9 +623,13 @@ fn a_very_soft_cantilever_hangs_and_springs_back() {
 /// `det F` ≈ 0.63, not inverted) — the model's energy is not convex there; `snh-log` returns.
 #[test]
 fn known_failure_a_very_soft_p1_cantilever_with_the_papers_stable_neo_hookean_stays_hanging() {
-    each_configuration("3 E = 1e3 Pa, snh", &element_types(), &BOTH, &["p1 energy", "p1 split"], |et, f| {
+    none(&soft_snh(&BOTH, &["p1 energy", "p1 split"]));
+}
+
+fn soft_snh(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("3 E = 1e3 Pa, snh", &element_types(), configs, known, |et, f| {
         load_and_release(gravity_cantilever(et, 0.1, 4, material(SNH, 1.0e3, 0.3), f, 50, 60.0), 2.0, 5.0, 6.0)
-    });
+    })
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -550,7 +643,7 @@ fn known_failure_a_very_soft_p1_cantilever_with_the_papers_stable_neo_hookean_st
 fn drive_and_release(
     et: &str,
     model: MaterialModel,
-    f: Formulation,
+    f: Solve,
     drive: impl Fn(Vec<u32>) -> Prescribed,
     ramp_secs: f64,
     strain: f64,
@@ -570,7 +663,7 @@ fn drive_and_release(
 fn driven_cantilever(
     et: &str,
     model: MaterialModel,
-    f: Formulation,
+    f: Solve,
     drive: impl Fn(Vec<u32>) -> Prescribed,
     strain: f64,
 ) -> (Simulation, f64) {
@@ -611,9 +704,13 @@ fn stretch(by_m: f64, ramp_secs: f64) -> impl Fn(Vec<u32>) -> Prescribed {
 /// Torsion to 720°: shear strain `θ r / L` = 4π × 0.177 ≈ 2.2 at the corners.
 #[test]
 fn torsion_to_720_degrees_and_back() {
-    each_configuration("4 torsion 720°, snh", &element_types(), &BOTH, &[], |et, f| {
+    none(&torsion(&BOTH, &[]));
+}
+
+fn torsion(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("4 torsion 720°, snh", &element_types(), configs, known, |et, f| {
         drive_and_release(et, SNH, f, twist(720.0, 2.0), 2.0, 4.0 * std::f64::consts::PI * 0.177)
-    });
+    })
 }
 
 /// Stretch to three times the length (strain 2), released at once. Compressible Neo-Hookean
@@ -624,16 +721,18 @@ fn torsion_to_720_degrees_and_back() {
 /// [`trapped_states_are_minima_of_the_near_exactly_integrated_energy`]).
 #[test]
 fn stretch_to_three_times_the_length_and_back() {
-    each_configuration("4 stretch 3×, nh", &element_types(), &BOTH, &[], |et, f| {
+    none(&stretch_and_back(&BOTH, &[], &["p2 energy", "p2 split", "p3 energy", "p3 split"]));
+}
+
+/// The stretch family, `known_nh` and `known_snh` its known failures per material.
+fn stretch_and_back(configs: &[Solve], known_nh: &[&str], known_snh: &[&str]) -> Vec<String> {
+    let mut problems = configurations("4 stretch 3×, nh", &element_types(), configs, known_nh, |et, f| {
         drive_and_release(et, NH, f, stretch(2.0, 1.0), 1.0, 2.0)
     });
-    each_configuration(
-        "4 stretch 3×, snh",
-        &element_types(),
-        &BOTH,
-        &["p2 energy", "p2 split", "p3 energy", "p3 split"],
-        |et, f| drive_and_release(et, SNH, f, stretch(2.0, 1.0), 1.0, 2.0),
-    );
+    problems.extend(configurations("4 stretch 3×, snh", &element_types(), configs, known_snh, |et, f| {
+        drive_and_release(et, SNH, f, stretch(2.0, 1.0), 1.0, 2.0)
+    }));
+    problems
 }
 
 /// StVK under the same extreme drives: bounded (finite, energy within the bound); recovery
@@ -641,7 +740,11 @@ fn stretch_to_three_times_the_length_and_back() {
 #[test]
 #[ignore = "release: CI runs it with --release --ignored"]
 fn stvk_under_extreme_drives_stays_bounded() {
-    each_configuration("4 torsion 720° and stretch 3×, stvk", &element_types(), &BOTH, &[], |et, f| {
+    none(&drives_stvk(&BOTH, &[]));
+}
+
+fn drives_stvk(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("4 torsion 720° and stretch 3×, stvk", &element_types(), configs, known, |et, f| {
         let mut out = Vec::new();
         for (what, result) in [
             ("torsion", drive_and_release(et, STVK, f, twist(720.0, 2.0), 2.0, 4.0 * std::f64::consts::PI * 0.177)),
@@ -654,14 +757,14 @@ fn stvk_under_extreme_drives_stays_bounded() {
             });
         }
         Ok(out.join("; "))
-    });
+    })
 }
 
 /// A free block `[0, 0.25]³` (2 × 2 × 2 cells) squashed to 10 % of its height between two
 /// plates with friction 0.5 (the top plate moves down 0.225 m in 1 s, then stays), held 0.5 s,
 /// released (plates removed, damping 10/s) for 3 s; compared with its rest shape after rigid
 /// alignment. Bound: `10 μ V s²` with `s` = 0.9.
-fn squash(et: &str, model: MaterialModel, f: Formulation) -> Result<String, String> {
+fn squash(et: &str, model: MaterialModel, f: Solve) -> Result<String, String> {
     let mesh = box_mesh(et, [0.25; 3], [2, 2, 2]);
     let mat = material(model, 1.0e5, 0.3);
     let bound_j = 10.0 * mat.lame().mu_pa * 0.25f64.powi(3) * 0.81;
@@ -670,7 +773,14 @@ fn squash(et: &str, model: MaterialModel, f: Formulation) -> Result<String, Stri
         Box::new(ContactPlane::new(Vec3::new(0.0, 0.0, 0.25), -Vec3::z(), Vec3::new(0.0, 0.0, -0.225), 1.0, 0.5)),
         Box::new(Damping { rate_per_sec: 2.0 }),
     ];
-    let mut s = sim(mesh, mat, f, 50, 60.0, effects);
+    let mut s = match Simulation::new(mesh, mat, f.settings(50, 60.0), effects) {
+        Ok(s) => s,
+        // a solver that cannot honour contact refuses it by name (issue #36: Newton's)
+        Err(e @ SimError::Unsupported { .. }) if e.to_string().contains("contact") => {
+            return Ok(format!("refused: {e}"));
+        }
+        Err(e) => return Err(e.to_string()),
+    };
     let squashed = run_checked(&mut s, frames(1.5, 60.0), Vec3::zeros(), bound_j)?;
     let height = s.positions.iter().map(|x| x.z).fold(f64::NEG_INFINITY, f64::max)
         - s.positions.iter().map(|x| x.z).fold(f64::INFINITY, f64::min);
@@ -690,14 +800,22 @@ fn squash(et: &str, model: MaterialModel, f: Formulation) -> Result<String, Stri
 /// 0.2 by a quadratic penalty that every element type survives): squashed to 10 % and back.
 #[test]
 fn squash_to_ten_percent_between_plates_and_back() {
-    each_configuration("4 squash to 10 %, nh", &element_types(), &BOTH, &[], |et, f| squash(et, NH, f));
+    none(&squash_nh(&BOTH, &[]));
+}
+
+fn squash_nh(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("4 squash to 10 %, nh", &element_types(), configs, known, |et, f| squash(et, NH, f))
 }
 
 /// Stable Neo-Hookean with Smith et al.'s `log(I_C + 1)` term (`snh-log`): no spurious minimum
 /// at `F = 0` (`hox_sim::material::stable_neo_hookean_log`), so squashed elements come back.
 #[test]
 fn stable_neo_hookean_with_the_log_term_squashed_to_ten_percent_and_back() {
-    each_configuration("4 squash to 10 %, snh-log", &element_types(), &BOTH, &[], |et, f| squash(et, SNH_LOG, f));
+    none(&squash_snh_log(&BOTH, &[]));
+}
+
+fn squash_snh_log(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("4 squash to 10 %, snh-log", &element_types(), configs, known, |et, f| squash(et, SNH_LOG, f))
 }
 
 /// **Known failure (case 4, squash), kept visible.** Stable Neo-Hookean without Smith et al.'s
@@ -739,7 +857,11 @@ fn bent_and_twisted(rest: &[Vec3], length_m: f64) -> Vec<Vec3> {
 /// shape (after rigid alignment). No external work: `H ≤ H(0)`.
 #[test]
 fn a_node_ten_thousand_times_heavier_than_its_neighbours() {
-    each_configuration("5 heavy node ×1e4, snh", &element_types(), &BOTH, &[], |et, f| {
+    none(&heavy_node(&BOTH, &[]));
+}
+
+fn heavy_node(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("5 heavy node ×1e4, snh", &element_types(), configs, known, |et, f| {
         let mesh = beam(et, 0.5, 2);
         let corner =
             mesh.rest_positions.iter().position(|p| (p - Vec3::new(0.5, 0.0, 0.0)).norm() < 1e-12).expect("corner");
@@ -749,10 +871,11 @@ fn a_node_ten_thousand_times_heavier_than_its_neighbours() {
         s.set_mass_kg(corner, heavy_kg).map_err(|e| e.to_string())?;
         s.positions.copy_from_slice(&start);
         let h0 = health(&s, Vec3::zeros()).total_j();
-        run_checked(&mut s, frames(4.0, 60.0), Vec3::zeros(), h0 * (1.0 + 1e-6))?;
+        let bound_j = h0 * (1.0 + 1e-6 + energy_slack(&s));
+        run_checked(&mut s, frames(4.0, 60.0), Vec3::zeros(), bound_j)?;
         let after = health(&s, Vec3::zeros());
         Ok(format!("heavy node {heavy_kg:.1} kg, U(0) = {h0:.3e} J; {}", recovered(&s, &after, true)?))
-    });
+    })
 }
 
 /// Elements 1 mm next to elements 1 m: the box `[0, 2]³` of 2 × 2 × 2 cells mapped per axis
@@ -764,7 +887,11 @@ fn a_node_ten_thousand_times_heavier_than_its_neighbours() {
 #[test]
 #[ignore = "release: CI runs it with --release --ignored (the guard takes 309–3,911 substeps per frame; about 6 minutes)"]
 fn elements_one_millimetre_next_to_elements_one_metre() {
-    each_configuration("5 sizes 1 mm – 1 m, snh", &element_types(), &BOTH, &[], |et, f| {
+    none(&sizes(&BOTH, &[]));
+}
+
+fn sizes(configs: &[Solve], known: &[&str]) -> Vec<String> {
+    configurations("5 sizes 1 mm – 1 m, snh", &element_types(), configs, known, |et, f| {
         let mut mesh = box_mesh(et, [2.0; 3], [2, 2, 2]);
         let map = |c: f64| if c <= 1.0 { 1e-3 * c } else { 1e-3 + (c - 1.0) };
         mesh.rest_positions.iter_mut().for_each(|p| *p = p.map(map));
@@ -772,10 +899,10 @@ fn elements_one_millimetre_next_to_elements_one_metre() {
         let masses = s.masses_kg();
         let ratio = masses.iter().cloned().fold(0.0, f64::max) / masses.iter().cloned().fold(f64::INFINITY, f64::min);
         Ok(format!("mass ratio {ratio:.1e}; {}", load_and_release_within(s, 1.0, 10.0, 3.0, 1.0)?))
-    });
+    })
 }
 
-fn gravity_cantilever_from(mesh: Mesh, material: Material, formulation: Formulation) -> Simulation {
+fn gravity_cantilever_from(mesh: Mesh, material: Material, formulation: Solve) -> Simulation {
     let clamp = clamp_x0(&mesh);
     sim(mesh, material, formulation, 50, 60.0, vec![clamp, Box::new(Gravity::new(GRAVITY_M_S2))])
 }
@@ -791,16 +918,26 @@ fn gravity_cantilever_from(mesh: Mesh, material: Material, formulation: Formulat
 /// with a thin inverted layer (as in cases 1 and 4), listed.
 #[test]
 fn ten_frames_per_second_with_one_substep_is_stable_under_the_stability_guard() {
-    each_configuration("6 10 fps × 1 substep asked, E = 1e5 Pa, guard, nh", &element_types(), &BOTH, &[], |et, f| {
-        guarded_cantilever(et, NH, f, 1.0e5, 1, 10.0, 5.0, 6.0)
-    });
-    each_configuration(
+    none(&ten_fps(&BOTH, &[], &["p3 energy", "p3 split"]));
+}
+
+/// The large-step family, `known_nh` and `known_snh` its known failures per material.
+fn ten_fps(configs: &[Solve], known_nh: &[&str], known_snh: &[&str]) -> Vec<String> {
+    let mut problems = configurations(
+        "6 10 fps × 1 substep asked, E = 1e5 Pa, guard, nh",
+        &element_types(),
+        configs,
+        known_nh,
+        |et, f| guarded_cantilever(et, NH, f, 1.0e5, 1, 10.0, 5.0, 6.0),
+    );
+    problems.extend(configurations(
         "6 10 fps × 1 substep asked, E = 1e5 Pa, guard, snh",
         &element_types(),
-        &BOTH,
-        &["p3 energy", "p3 split"],
+        configs,
+        known_snh,
         |et, f| guarded_cantilever(et, SNH, f, 1.0e5, 1, 10.0, 5.0, 6.0),
-    );
+    ));
+    problems
 }
 
 /// **Known failure (case 6) without the stability guard, kept visible**: the energy grows by
@@ -823,7 +960,7 @@ fn known_failure_without_the_guard_ten_frames_per_second_with_one_substep_gains_
 /// split formulation; the energy formulation at E = 10³ Pa already gains energy.
 #[test]
 fn ten_frames_per_second_is_stable_for_a_soft_p1_cantilever_with_the_split_formulation() {
-    let gain = energy_gain("p1", Formulation::Split, 1.0e3, 1, 10.0);
+    let gain = energy_gain("p1", Solve::Xpbd(Formulation::Split), 1.0e3, 1, 10.0);
     eprintln!("PASS 6 10 fps × 1 substep, E = 1e3 Pa, snh | p1 | split | H/|V_g| up to {gain:.2e}");
     assert!(gain <= 0.01, "{gain}");
 }
@@ -907,46 +1044,55 @@ mod perturbed {
 #[test]
 #[ignore = "release: CI runs it with --release --ignored (about a minute)"]
 fn ten_thousand_frames_of_the_undamped_bending_scene_do_not_gain_energy() {
-    for formulation in ["energy", "split"] {
-        let scene = hox_scenes::by_name("bending")
-            .unwrap()
-            .with_overrides(&hox_scenes::SceneOverrides {
-                formulation: Some(hox_sim::xpbd::constraint::Formulation::from_name(formulation).unwrap()),
-                ..Default::default()
-            })
-            .unwrap();
-        let mut instance = hox_scenes::Instance::new(scene).unwrap();
-        let clock = std::time::Instant::now();
-        let (mut early_max, mut late_max) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-        let mut last = health(&instance.sim, GRAVITY_M_S2);
-        let mut work_j: f64 = 0.0;
-        for frame in 1..=10_000u64 {
-            instance.sim.step_frame().unwrap();
-            last = health(&instance.sim, GRAVITY_M_S2);
-            assert!(last.finite, "{formulation}: frame {frame}");
-            work_j = work_j.max(last.gravity_potential_j.abs());
-            if frame <= 1000 {
-                early_max = early_max.max(last.total_j());
-            } else {
-                late_max = late_max.max(last.total_j());
-            }
-            assert!(
-                last.total_j() <= 0.05 * work_j,
-                "{formulation}: H = {:.4e} J > 5 % of |V_g| = {work_j:.4e} J at frame {frame}",
-                last.total_j()
-            );
+    for solve in BOTH {
+        long_run(solve, 10_000, 0.0);
+    }
+}
+
+/// The long run with `solve`: `frames` frames of the undamped bending scene; the largest `H` over
+/// the frames after the first 1,000 may exceed the largest over the first 1,000 by at most
+/// `growth` × `|V_g|max` (0 for XPBD, which only dissipates).
+fn long_run(solve: Solve, frames: u64, growth: f64) {
+    let (formulation, method, integrator) = match solve {
+        Solve::Xpbd(f) => (Some(f), None, None),
+        Solve::Implicit(m, i) => (None, Some(m), Some(i)),
+    };
+    let scene = hox_scenes::by_name("bending")
+        .unwrap()
+        .with_overrides(&hox_scenes::SceneOverrides { formulation, method, integrator, ..Default::default() })
+        .unwrap();
+    let mut instance = hox_scenes::Instance::new(scene).unwrap();
+    let clock = std::time::Instant::now();
+    let (mut early_max, mut late_max) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+    let mut last = health(&instance.sim, GRAVITY_M_S2);
+    let mut work_j: f64 = 0.0;
+    for frame in 1..=frames {
+        instance.sim.step_frame().unwrap_or_else(|e| panic!("{solve}: frame {frame}: {e}"));
+        last = health(&instance.sim, GRAVITY_M_S2);
+        assert!(last.finite, "{solve}: frame {frame}");
+        work_j = work_j.max(last.gravity_potential_j.abs());
+        if frame <= 1000 {
+            early_max = early_max.max(last.total_j());
+        } else {
+            late_max = late_max.max(last.total_j());
         }
-        let max_ratio = early_max.max(late_max) / work_j;
         assert!(
-            late_max <= early_max,
-            "{formulation}: the energy grows: max H {late_max:.4e} J over frames 1001–10000 > {early_max:.4e} J over the first 1000"
-        );
-        eprintln!(
-            "PASS 8 10,000 frames, bending, no damping | p2 | {formulation} | max H/|V_g|max {max_ratio:.2e} (frames 1–1000: {early_max:.3e} J, 1001–10000: {late_max:.3e} J), H at the end {:.3e} J (|V_g|max {work_j:.3e} J), {:.1} s",
-            last.total_j(),
-            clock.elapsed().as_secs_f64()
+            last.total_j() <= 0.05 * work_j,
+            "{solve}: H = {:.4e} J > 5 % of |V_g| = {work_j:.4e} J at frame {frame}",
+            last.total_j()
         );
     }
+    let max_ratio = early_max.max(late_max) / work_j;
+    assert!(
+        late_max <= early_max + growth * work_j,
+        "{solve}: the energy grows: max H {late_max:.4e} J over frames 1001–{frames} > {early_max:.4e} J over the first 1000 (+ {growth:e} × |V_g|max {work_j:.3e} J)"
+    );
+    eprintln!(
+        "PASS 8 {frames} frames, bending, no damping | p2 | {solve} | max H/|V_g|max {max_ratio:.2e} (frames 1–1000: {early_max:.3e} J, 1001–{frames}: {late_max:.3e} J), H at the end {:.3e} J (|V_g|max {work_j:.3e} J), {} rejected steps, {:.1} s",
+        last.total_j(),
+        instance.sim.counters().rejected_steps,
+        clock.elapsed().as_secs_f64()
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1132,4 +1278,223 @@ fn a_non_finite_position_from_outside_is_named() {
         message.contains("node 40") && message.contains("frame 2") && message.contains("substep 1 of 50"),
         "{message}"
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Every family with the implicit solvers (issue #36, item 4).
+//
+// The families above, their own criteria unchanged (energy bounds, recovery to the rest shape
+// within `REST_TOLERANCE`, no element inverted), run with every implicit solver of the registry
+// under every integrator ([`implicit`]): one step per frame, however stiff, since the implicit
+// solvers have no stability limit to guard. The element-type × formulation tables of
+// docs/STABILITY.md get these as columns (`PASS`/`FAIL` lines: `--nocapture`). The known
+// failures listed here are each explained there. Release: `.ci/run` runs them with `--ignored`.
+
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn every_implicit_solver_on_inverted_starts() {
+    let configs = implicit();
+    let mut problems = mirrored_snh(
+        &configs,
+        &[
+            "p1 newton euler",
+            "p2 vbd euler",
+            "p2 vbd bdf2",
+            "p2 newton euler",
+            "p2 newton newmark",
+            "p2 newton bdf2",
+            "p3 vbd newmark",
+            "p3 newton euler",
+            "p3 newton newmark",
+            "p3 newton bdf2",
+            "q2 vbd bdf2",
+            "q2 newton euler",
+            "q2 newton bdf2",
+        ],
+    );
+    problems.extend(corner_snh(&configs, &["p3 newton newmark"]));
+    problems.extend(mirrored_stvk(&configs, &[]));
+    problems.extend(corner_stvk(
+        &configs,
+        &[
+            "p2 vbd newmark",
+            "p2 newton newmark",
+            "p3 vbd newmark",
+            "p3 newton newmark",
+            "q2 vbd newmark",
+            "q2 newton newmark",
+        ],
+    ));
+    problems.extend(inverted_nh(
+        &configs,
+        &[
+            "p1 vbd newmark",
+            "p1 newton newmark",
+            "p2 vbd euler",
+            "p2 vbd newmark",
+            "p2 vbd bdf2",
+            "p2 newton newmark",
+            "p3 vbd newmark",
+            "p3 newton newmark",
+            "q1 vbd newmark",
+            "q2 vbd euler",
+            "q2 vbd newmark",
+            "q2 newton newmark",
+            "prism vbd newmark",
+            "prism newton newmark",
+        ],
+    ));
+    none(&problems);
+}
+
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn every_implicit_solver_near_incompressibility() {
+    // (BDF2's energy is not monotone step by step: its first step after the release raised H by
+    // 0.02 % (Q2, Newton) and 0.9 % (prism, VBD) over the bound of "not above its value at
+    // release", where the check stops the run)
+    let mut problems = near_incompressible(SNH, &implicit(), &[(0.499, &["q2 newton bdf2", "prism vbd bdf2"])]);
+    problems.extend(near_incompressible(STVK, &implicit(), &[]));
+    none(&problems);
+}
+
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn every_implicit_solver_on_stiffness_extremes() {
+    let configs = implicit();
+    let mut problems = stiff(&configs, &[]);
+    problems.extend(soft_snh_log(
+        &configs,
+        &[
+            "p2 vbd newmark",
+            "p2 vbd bdf2",
+            "p2 newton newmark",
+            "p2 newton bdf2",
+            "p3 vbd newmark",
+            "p3 vbd bdf2",
+            "p3 newton newmark",
+            "p3 newton bdf2",
+            "q2 vbd newmark",
+            "q2 vbd bdf2",
+            "q2 newton newmark",
+            "q2 newton bdf2",
+        ],
+    ));
+    problems.extend(soft_snh(
+        &configs,
+        &[
+            "p1 vbd bdf2",
+            "p1 newton bdf2",
+            "p2 vbd euler",
+            "p2 vbd newmark",
+            "p2 vbd bdf2",
+            "p2 newton euler",
+            "p2 newton newmark",
+            "p2 newton bdf2",
+            "p3 vbd euler",
+            "p3 vbd newmark",
+            "p3 vbd bdf2",
+            "p3 newton euler",
+            "p3 newton newmark",
+            "p3 newton bdf2",
+            "q2 vbd newmark",
+            "q2 vbd bdf2",
+            "q2 newton newmark",
+            "q2 newton bdf2",
+            "pyramid vbd bdf2",
+            "pyramid newton bdf2",
+        ],
+    ));
+    none(&problems);
+}
+
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn every_implicit_solver_under_extreme_drives() {
+    let configs = implicit();
+    let mut problems = torsion(&configs, &["p3 vbd newmark", "p3 newton newmark"]);
+    problems.extend(stretch_and_back(
+        &configs,
+        &["p2 vbd newmark", "p3 vbd newmark", "q2 vbd newmark"],
+        &[
+            "p1 newton newmark",
+            "p2 vbd newmark",
+            "p2 vbd bdf2",
+            "p2 newton euler",
+            "p2 newton newmark",
+            "p2 newton bdf2",
+            "p3 vbd euler",
+            "p3 vbd newmark",
+            "p3 vbd bdf2",
+            "p3 newton euler",
+            "p3 newton newmark",
+            "p3 newton bdf2",
+            "q2 vbd euler",
+            "q2 vbd newmark",
+        ],
+    ));
+    problems.extend(drives_stvk(&configs, &[]));
+    problems.extend(squash_nh(
+        &configs,
+        &[
+            "p2 vbd euler",
+            "p2 vbd newmark",
+            "p2 vbd bdf2",
+            "p3 vbd euler",
+            "p3 vbd newmark",
+            "p3 vbd bdf2",
+            "q2 vbd euler",
+            "q2 vbd newmark",
+            "q2 vbd bdf2",
+        ],
+    ));
+    problems.extend(squash_snh_log(&configs, &["p3 vbd newmark"]));
+    none(&problems);
+}
+
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn every_implicit_solver_with_mass_and_size_ratios() {
+    let configs = implicit();
+    let mut problems = heavy_node(&configs, &[]);
+    problems.extend(sizes(&configs, &["p3 vbd newmark", "p3 newton newmark", "q2 newton newmark"]));
+    none(&problems);
+}
+
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn every_implicit_solver_with_large_steps() {
+    none(&ten_fps(
+        &implicit(),
+        &[
+            "p2 vbd bdf2",
+            "p2 newton bdf2",
+            "p3 vbd bdf2",
+            "p3 newton bdf2",
+            "q2 vbd newmark",
+            "q2 vbd bdf2",
+            "q2 newton bdf2",
+        ],
+        &[
+            "p2 vbd bdf2",
+            "p2 newton bdf2",
+            "p3 vbd newmark",
+            "p3 vbd bdf2",
+            "p3 newton newmark",
+            "p3 newton bdf2",
+            "q2 vbd bdf2",
+            "q2 newton bdf2",
+        ],
+    ));
+}
+
+/// The long run (case 8) with each implicit solver and integrator, 3,000 frames (50 s, about
+/// 30 periods of the beam's first mode): Newmark conserves the energy (the growth allowed is
+/// 10⁻³ of `|V_g|max`, the nonlinear scheme's wobble), implicit Euler and BDF2 dissipate it.
+#[test]
+#[ignore = "release: CI runs it with --release --ignored"]
+fn every_implicit_solver_keeps_the_undamped_bending_scene_from_gaining_energy() {
+    for solve in implicit() {
+        long_run(solve, 3_000, 1e-3);
+    }
 }

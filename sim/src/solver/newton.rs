@@ -120,7 +120,7 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
         let springs = hooks.springs();
         let w = 1.0 / (s.inertia_h * s.inertia_h);
         let potential = Potential { input: s, y: &self.y, springs: &springs, w };
-        let body_force = potential.body_force_n();
+        let body_force = potential.load_n();
         let diagonal = potential.hessian_diagonal(pattern.dof_of(), pattern.free_dofs());
         let model = HessianModel { mesh: s.mesh, geometry: s.geometry, material: s.material, diagonal: &diagonal };
         let outcome = minimise(

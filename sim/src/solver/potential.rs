@@ -71,9 +71,13 @@ impl Potential<'_> {
         d
     }
 
-    /// The body force `Σ_i m_i |a|`, newtons: the load Newton's residual is measured against.
-    pub fn body_force_n(&self) -> f64 {
+    /// The load the step's residual is measured against (with the reactions), newtons: the body
+    /// force `Σ_i m_i |a|`, never below [`super::residual::load_floor_n`].
+    pub fn load_n(&self) -> f64 {
         let s = self.input;
-        s.masses_kg.iter().map(|m| m * s.body_acceleration.norm()).sum()
+        let body_force: f64 = s.masses_kg.iter().map(|m| m * s.body_acceleration.norm()).sum();
+        let (lo, hi) = s.mesh.bounding_box();
+        let size = (hi - lo).norm();
+        body_force.max(super::residual::load_floor_n(s.material.lame().mu_pa, size))
     }
 }

@@ -210,7 +210,8 @@ impl Simulation {
     /// Forces of contact and of attachments are not counted.
     pub fn static_residual(&self) -> StaticResidual {
         let grad = self.elastic_gradient(&self.positions);
-        static_residual(&grad, &self.masses_kg, self.body_acceleration_m_s2(), |i| self.inv_mass[i] > 0.0)
+        let floor_n = super::residual::load_floor_n(self.material.lame().mu_pa, self.body_size_m);
+        static_residual(&grad, &self.masses_kg, self.body_acceleration_m_s2(), floor_n, |i| self.inv_mass[i] > 0.0)
     }
 
     /// `∇U(x)`, the elastic energy's gradient at `x`.

@@ -23,6 +23,12 @@ pub const MAX_HALVINGS: u32 = 6;
 /// nonlinear body is far below it, implicit Euler and BDF2 only lower the energy.
 const ENERGY_GROWTH: f64 = 1e-2;
 
+/// The least energy scale of that check, as a fraction of `μ V` (μ the shear modulus, V the rest
+/// volume): the elastic energy of a strain of about 10⁻⁵. A body coming to rest with no load has
+/// an energy that decays to the round-off of `U` (about `10⁻¹⁶ μ V`); against that scale a
+/// round-off wobble read as a growth of tens of % (the stiff cantilever released, issue #36).
+const ENERGY_FLOOR: f64 = 1e-10;
+
 impl Simulation {
     /// An implicit step of `h` under the step watch: a step in which a free node moves, against
     /// the free nodes' mean motion, by more than the body's size, which the solver left far
@@ -45,7 +51,9 @@ impl Simulation {
         let failed = self.solver.last_step_failed();
         let gained = energy_before.and_then(|(total, scale)| {
             let (after, scale_after) = self.mechanical_energy_j();
-            let growth = (after - total) / scale.max(scale_after).max(f64::MIN_POSITIVE);
+            let floor =
+                ENERGY_FLOOR * self.material.lame().mu_pa * crate::fem::geometry::total_volume_m3(&self.geometry);
+            let growth = (after - total) / scale.max(scale_after).max(floor).max(f64::MIN_POSITIVE);
             (growth > ENERGY_GROWTH).then_some(growth)
         });
         if excess.is_none() && !failed && gained.is_none() {
@@ -159,14 +167,22 @@ impl Simulation {
     }
 
     /// How far a free node may move, against the free nodes' mean motion, in a step of `h` from
-    /// now: the body's size plus the farthest any effect may carry a node in it.
+    /// now: the body's size, plus how far the body is from its rest shape (a node pushed through
+    /// its element snaps back that far: the corner of tests/tests/robustness.rs, 0.75 m in one
+    /// frame of a 0.53 m body), plus the farthest any effect may carry a node in the step.
     fn displacement_bound_m(&self, h: f64) -> f64 {
         let reach = self
             .effects
             .iter()
             .map(|e| e.reach_m(&self.positions, &self.mesh.rest_positions, self.time_secs, h))
             .fold(0.0, f64::max);
-        self.body_size_m + reach
+        let rest = &self.mesh.rest_positions;
+        let free = |i: &usize| self.inv_mass[*i] > 0.0;
+        let n = (0..rest.len()).filter(free).count().max(1) as f64;
+        let mean = (0..rest.len()).filter(free).map(|i| self.positions[i] - rest[i]).sum::<Vec3>() / n;
+        let deformed =
+            (0..rest.len()).filter(free).map(|i| (self.positions[i] - rest[i] - mean).norm()).fold(0.0, f64::max);
+        self.body_size_m + deformed + reach
     }
 
     /// The free node that moved most in the step from `start` against the free nodes' mean
