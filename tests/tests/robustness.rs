@@ -1342,6 +1342,7 @@ fn every_implicit_solver_on_inverted_starts() {
             "q2 newton newmark",
             "prism vbd newmark",
             "prism newton newmark",
+            "pyramid newton newmark",
         ],
     ));
     none(&problems);
