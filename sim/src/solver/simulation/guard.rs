@@ -176,25 +176,26 @@ impl Simulation {
             .iter()
             .map(|e| e.reach_m(&self.positions, &self.mesh.rest_positions, self.time_secs, h))
             .fold(0.0, f64::max);
-        let rest = &self.mesh.rest_positions;
-        let free = |i: &usize| self.inv_mass[*i] > 0.0;
-        let n = (0..rest.len()).filter(free).count().max(1) as f64;
-        let mean = (0..rest.len()).filter(free).map(|i| self.positions[i] - rest[i]).sum::<Vec3>() / n;
-        let deformed =
-            (0..rest.len()).filter(free).map(|i| (self.positions[i] - rest[i] - mean).norm()).fold(0.0, f64::max);
+        let (_, deformed) = self.farthest_against_mean(&self.mesh.rest_positions);
         self.body_size_m + deformed + reach
+    }
+
+    /// The free node farthest from `reference` against the free nodes' mean offset from it, and
+    /// how far: the motion of a step (`reference` its start) or the deformation (the rest shape).
+    fn farthest_against_mean(&self, reference: &[Vec3]) -> (usize, f64) {
+        let free = |i: &usize| self.inv_mass[*i] > 0.0;
+        let n = (0..reference.len()).filter(free).count().max(1) as f64;
+        let mean = (0..reference.len()).filter(free).map(|i| self.positions[i] - reference[i]).sum::<Vec3>() / n;
+        (0..reference.len())
+            .filter(free)
+            .map(|i| (i, (self.positions[i] - reference[i] - mean).norm()))
+            .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a })
     }
 
     /// The free node that moved most in the step from `start` against the free nodes' mean
     /// motion, and how far, when that is more than `bound_m`.
     fn step_excess(&self, start: &[Vec3], bound_m: f64) -> Option<(usize, f64)> {
-        let free = |i: &usize| self.inv_mass[*i] > 0.0;
-        let n = (0..start.len()).filter(free).count().max(1) as f64;
-        let mean = (0..start.len()).filter(free).map(|i| self.positions[i] - start[i]).sum::<Vec3>() / n;
-        let (node, moved) = (0..start.len())
-            .filter(free)
-            .map(|i| (i, (self.positions[i] - start[i] - mean).norm()))
-            .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+        let (node, moved) = self.farthest_against_mean(start);
         (moved > bound_m).then_some((node, moved))
     }
 }
