@@ -119,6 +119,30 @@ fn compare_mode_links_controls_and_shows_both_errors() {
     assert!(status_count(&h) == 2);
 }
 
+/// Issue #37: a curved part in compare mode is the same part at order 1 and 2 (P1's facets
+/// against P2's curved faces), labelled by the part; the element control offers only the orders
+/// the part was meshed at, a switch to P3 rebuilds from the P3 file, and a box parameter (refine)
+/// is not shown for it.
+#[test]
+fn a_curved_part_compares_its_orders_and_switches_between_them() {
+    let mut h = harness(AppArgs { scene: Some("tube".into()), compare: vec![String::new()], ..Default::default() });
+    h.run_steps(2);
+    let labels: Vec<String> = h.state().sessions.iter().map(|s| s.label()).collect();
+    assert_eq!(labels, ["P1 tube", "P2 tube"]);
+    let nodes: Vec<usize> = h.state().sessions.iter().map(|s| s.instance.sim.mesh().num_nodes()).collect();
+    assert_eq!(nodes, [829, 4911]);
+    assert!(h.query_by_label("Refine").is_none(), "no box parameters for a part");
+    let app = h.state_mut();
+    let mut c = app.sessions[1].config.clone();
+    c.element = hox_sim::element::ElementType::from_name("p3").unwrap();
+    app.active = 1;
+    app.apply_now("element", c);
+    assert_eq!(app.sessions[1].instance.sim.mesh().num_nodes(), 14670, "P3 from its own file");
+    assert_eq!(app.sessions[0].instance.sim.mesh().num_nodes(), 829, "the element type is not linked");
+    h.run_steps(2);
+    assert_eq!(status_count(&h), 2);
+}
+
 /// Waits until the lesson step asked for is prepared and installed.
 fn lesson_ready(h: &mut Harness<'_, HoxApp>) {
     h.run_steps(1);
@@ -792,7 +816,7 @@ fn play_step_to_its_end(app: &mut HoxApp) {
 /// twice in the app and once headlessly, shows the same numbers to the digits shown; a time per
 /// frame (the machine's) only has to be measured.
 #[test]
-#[cfg_attr(debug_assertions, ignore = "every lesson three times: release only, run by .ci/run")]
+#[ignore = "every lesson three times (minutes): .ci/run runs it with --ignored"]
 fn every_lesson_shows_the_same_numbers_in_the_app_as_headlessly() {
     use hox_scenes::lesson::{Measure, Run};
     for lesson in hox_scenes::lesson::registry().unwrap() {
