@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates the Gmsh test meshes in assets/meshes/ with the gmsh wheel from PyPI (in a venv at
-# $HOX_VENV, default ~/.cache/hox-venv). The meshes are committed: tests and CI do not run this.
+# Regenerates the Gmsh test meshes in assets/meshes/ and the curved parts in assets/parts/ with
+# the gmsh wheel from PyPI (in a venv at $HOX_VENV, default ~/.cache/hox-venv). The meshes are committed: tests and CI do not run this.
 # The wheel's libgmsh needs libGLU and a few X libraries, present on the project's machine
 # image; on a machine without them (and as root) they are installed with apt.
 set -euo pipefail
@@ -19,3 +19,4 @@ if ! ldconfig -p | grep -q 'libGLU.so.1'; then
     fi
 fi
 "$venv/bin/python" scripts/gmsh_meshes.py assets/meshes
+"$venv/bin/python" scripts/gmsh_parts.py assets/parts

@@ -134,7 +134,7 @@ pub fn entity_name(label: &str) -> String {
 pub fn configuration_markdown(instance: &Instance) -> String {
     let scene = &instance.scene;
     let mut text = format!("Configuration of scene `{}`:\n", scene.name());
-    for p in hox_scenes::params::PARAMS.iter().filter(|p| scene.is_box() || !p.box_only) {
+    for p in hox_scenes::params::PARAMS.iter().filter(|p| p.used_with(scene.mesh_kind())) {
         let unit = if p.unit.is_empty() { String::new() } else { format!(" {}", p.unit) };
         text += &format!("- `{}` = {}{unit}\n", p.file_path(), (p.get)(scene.params()));
     }

@@ -42,6 +42,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("accuracy-cost", include_str!("../../assets/lessons/accuracy-cost.toml")),
     ("stability", include_str!("../../assets/lessons/stability.toml")),
     ("materials", include_str!("../../assets/lessons/materials.toml")),
+    ("curved-boundaries", include_str!("../../assets/lessons/curved-boundaries.toml")),
 ];
 
 /// The camera presets a step may name (the app's).
@@ -73,10 +74,14 @@ pub enum Measure {
     Asymmetry,
     /// The most negative value of the element's shape functions over the reference element.
     ShapeMinimum,
+    /// The body's rest volume, m³: `Σ w_q det J` over every quadrature point, the volume the
+    /// elements enclose (P1's flat facets cut inside a curved surface; P2's and P3's curved
+    /// faces follow it).
+    Volume,
 }
 
 impl Measure {
-    pub const ALL: [Measure; 10] = [
+    pub const ALL: [Measure; 11] = [
         Measure::SettledError,
         Measure::SolverError,
         Measure::TipUz,
@@ -87,6 +92,7 @@ impl Measure {
         Measure::MaxDisplacement,
         Measure::Asymmetry,
         Measure::ShapeMinimum,
+        Measure::Volume,
     ];
 
     pub fn name(self) -> &'static str {
@@ -101,6 +107,7 @@ impl Measure {
             Measure::MaxDisplacement => "max-displacement",
             Measure::Asymmetry => "asymmetry",
             Measure::ShapeMinimum => "shape-minimum",
+            Measure::Volume => "volume",
         }
     }
 
@@ -117,6 +124,7 @@ impl Measure {
             Measure::MaxDisplacement => "largest node displacement",
             Measure::Asymmetry => "asymmetry of the twist (opposite corners)",
             Measure::ShapeMinimum => "most negative shape-function value",
+            Measure::Volume => "volume of the body at rest",
         }
     }
 
@@ -129,6 +137,7 @@ impl Measure {
             | Measure::MaxDisplacement
             | Measure::Asymmetry => "m",
             Measure::MsPerFrame => "ms",
+            Measure::Volume => "m³",
             Measure::MinDetF | Measure::Substeps | Measure::ShapeMinimum => "",
         }
     }
@@ -561,6 +570,10 @@ pub fn measure(
                 }
                 _ => Measured { value: f64::NAN, text: "needs two probes".into() },
             }
+        }
+        Measure::Volume => {
+            let v = hox_sim::fem::geometry::total_volume_m3(instance.sim.geometry());
+            Measured { value: v, text: format!("{v:.6} m³") }
         }
         Measure::ShapeMinimum => {
             let v = shape_minimum(instance.sim.mesh().blocks[0].element_type);

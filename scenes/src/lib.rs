@@ -19,7 +19,7 @@ pub use run::{
     SETTLE_KINETIC_REL, SETTLE_RESIDUAL_REL, SettleState, Settler, driven_until_secs, in_equilibrium, median, run,
     run_observed,
 };
-pub use scene::{Drive, NodeSelector, Scene, SceneFile, SceneMesh};
+pub use scene::{BUILTIN_MESHES, Drive, NodeSelector, Scene, SceneFile, SceneMesh, builtin_mesh};
 
 use hox_sim::measure::probe::Probe;
 use hox_sim::solver::Simulation;
@@ -32,6 +32,9 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("drop", include_str!("../../assets/scenes/drop.toml")),
     ("twist", include_str!("../../assets/scenes/twist.toml")),
     ("squash", include_str!("../../assets/scenes/squash.toml")),
+    ("tube", include_str!("../../assets/scenes/tube.toml")),
+    ("elbow", include_str!("../../assets/scenes/elbow.toml")),
+    ("hook", include_str!("../../assets/scenes/hook.toml")),
 ];
 
 /// The paper's three scenes.

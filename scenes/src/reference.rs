@@ -37,6 +37,7 @@ pub mod field;
 pub use compute::{LEVELS, OnEstimate, Progress, compute_with, grids, level_scene, own_mesh, provisional};
 pub use field::ReferenceField;
 
+use crate::params::MeshKind;
 use crate::scene::EffectSpec;
 use crate::{Scene, SceneError};
 use hox_sim::Vec3;
@@ -56,6 +57,9 @@ pub enum Origin {
     Computed,
     /// The static solution of the scene's own mesh (a mesh file): solver error only.
     OwnMesh,
+    /// The static solution of the part's highest-order file (a scene with one mesh file per
+    /// element type, `[mesh] files`): lower orders measure their mesh error against it.
+    HighestOrder,
 }
 
 /// A reference solution and how good it is.
@@ -126,6 +130,7 @@ impl Reference {
             (Origin::Committed, None) => "static (committed)",
             (Origin::Computed, None) => "static, computed",
             (Origin::OwnMesh, None) => "static solution of this mesh",
+            (Origin::HighestOrder, None) => "static solution of the part's highest order",
         };
         let estimate = match self.estimated_error_pct() {
             Some(pct) => format!(", ± {pct:.2} % ({})", self.estimate),
@@ -157,6 +162,10 @@ pub fn physics_key(scene: &Scene) -> String {
     let p = scene.params();
     let geometry = match &scene.mesh {
         crate::SceneMesh::Box(_) => format!("box {:?} {:?}", p.box_min_m, p.box_max_m),
+        // a part meshed per element type has one reference whichever file is on screen
+        crate::SceneMesh::File { .. } if scene.mesh_kind() == MeshKind::Files => {
+            format!("part {:?}", scene.file.mesh_files)
+        }
         crate::SceneMesh::File { path, imported } => {
             format!("file {} ({} nodes)", path.display(), imported.mesh.num_nodes())
         }
@@ -330,6 +339,12 @@ pub fn mesh_error(levels: &[(f64, Probes)]) -> (f64, String) {
     }
 }
 
+/// Whether a scene's computed reference is cached on disk: a box's (levels of Q2 solves) and a
+/// built-in part's (a P3 static solve of seconds); a user's own mesh file may change under its name.
+fn on_disk(scene: &Scene) -> bool {
+    scene.mesh_kind() != MeshKind::File
+}
+
 /// Why a scene has no reference, if it has none: no probes, or contact (no static counterpart).
 pub fn unavailable(scene: &Scene) -> Option<String> {
     if scene.file.probes.is_empty() {
@@ -390,6 +405,12 @@ impl Lookup {
     pub fn key(&self, scene: &Scene) -> String {
         if scene.is_box() {
             format!("{}; Q2 levels up to {} cells", physics_key(scene), self.finest_cells)
+        } else if scene.mesh_kind() == MeshKind::Files {
+            format!(
+                "{}; the part's highest order, quadrature {:?}",
+                physics_key(scene),
+                scene.params().quadrature_degree
+            )
         } else {
             format!("{}; own mesh, quadrature {:?}", physics_key(scene), scene.params().quadrature_degree)
         }
@@ -406,7 +427,7 @@ impl Lookup {
         if let Some(r) = committed(scene)? {
             return Ok(Some(r));
         }
-        Ok(self.load(&self.key(scene), scene.is_box()))
+        Ok(self.load(&self.key(scene), on_disk(scene)))
     }
 
     /// A reference stored under `key`: in memory, or (`disk`) in the cache folder.
@@ -486,7 +507,7 @@ impl Lookup {
         } else {
             own_mesh(scene, progress)?
         };
-        self.store(&key, &reference, scene.is_box());
+        self.store(&key, &reference, on_disk(scene));
         Ok(reference)
     }
 

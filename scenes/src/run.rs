@@ -59,6 +59,12 @@ pub struct RunReport {
     /// Median wall-clock time of one frame (stepping only), milliseconds; NaN (`null` in JSON)
     /// for a run of no frames.
     pub ms_per_frame: f64,
+    /// The 95th percentile of the frames' wall-clock times (nearest rank), milliseconds: what a
+    /// viewer feels as stutter (a Newton step that refactorises, a VBD step that remakes its
+    /// coarse space), where the median hides it; NaN for a run of no frames.
+    pub ms_per_frame_p95: f64,
+    /// The slowest frame, milliseconds.
+    pub ms_per_frame_max: f64,
     /// The run ended in equilibrium (`--settle`: residual and kinetic energy below their limits).
     pub settled: bool,
     /// The run ended with the body at rest, in equilibrium or not (`--settle`).
@@ -184,6 +190,8 @@ pub fn run_observed(
         frames,
         sim_seconds: instance.sim.time_secs(),
         ms_per_frame: median(&mut frame_ms),
+        ms_per_frame_p95: hox_sim::measure::quantile(&mut frame_ms, 0.95),
+        ms_per_frame_max: hox_sim::measure::quantile(&mut frame_ms, 1.0),
         settled,
         at_rest,
         residual_rel: instance.sim.static_residual().relative,

@@ -75,10 +75,12 @@ pub fn step_markdown(lesson: &Lesson, k: usize, outcome: Option<&[Measured]>) ->
 /// "P1 8×2×2 five r1, ν = 0.49": what distinguishes a configuration.
 fn scene_label(scene: &hox_scenes::Scene) -> String {
     let p = scene.params();
-    let mut label = if scene.is_box() {
-        format!("{} {}×{}×{}", p.element.name().to_uppercase(), p.grid[0], p.grid[1], p.grid[2])
-    } else {
-        scene.mesh.element_names()
+    let mut label = match scene.mesh_kind() {
+        hox_scenes::params::MeshKind::Box => {
+            format!("{} {}×{}×{}", p.element.name().to_uppercase(), p.grid[0], p.grid[1], p.grid[2])
+        }
+        hox_scenes::params::MeshKind::Files => format!("{} {}", p.element.name().to_uppercase(), scene.name()),
+        hox_scenes::params::MeshKind::File => scene.mesh.element_names(),
     };
     if p.refine > 0 {
         label += &format!(" r{}", p.refine);

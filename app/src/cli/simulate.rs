@@ -83,7 +83,7 @@ pub fn simulate(
             report.wall_secs,
             // the median of no frame is NaN (JSON null): nothing was timed
             if report.frames > 0 {
-                format!("{:.2} ms per frame", report.ms_per_frame)
+                format!("{:.2} ms per frame (95th percentile {:.2})", report.ms_per_frame, report.ms_per_frame_p95)
             } else {
                 "no frame timed".into()
             },

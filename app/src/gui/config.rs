@@ -15,7 +15,7 @@ pub fn from_scene(scene: &Scene) -> Config {
 /// Validates `config` on `base`: the scene it gives, or the reason it is refused. A mesh file's
 /// scene takes no box parameters.
 pub fn resolve(config: &Config, base: &Scene) -> Result<Scene, String> {
-    base.with_overrides(&config.as_overrides(base.is_box())).map_err(|e| plain_words(&e))
+    base.with_overrides(&config.as_overrides(base.mesh_kind())).map_err(|e| plain_words(&e))
 }
 
 /// A refusal in the words of the panel (issue #35: "builtin:bending: material.poisson_ratio
@@ -33,9 +33,14 @@ pub fn plain_words(e: &hox_scenes::SceneError) -> String {
     }
 }
 
-/// A short label, e.g. `P2 8×2×2 five`, or "mesh file".
+/// A short label, e.g. `P2 8×2×2 five`, `P2 tube` (a part meshed per element type), or
+/// "mesh file".
 pub fn label(config: &Config, base: &Scene) -> String {
-    if base.is_box() { config.box_label() } else { "mesh file".into() }
+    match base.mesh_kind() {
+        hox_scenes::params::MeshKind::Box => config.box_label(),
+        hox_scenes::params::MeshKind::Files => format!("{} {}", config.element.name().to_uppercase(), base.name()),
+        hox_scenes::params::MeshKind::File => "mesh file".into(),
+    }
 }
 
 #[cfg(test)]

@@ -269,12 +269,18 @@ fn combo<T: Clone + PartialEq>(
 /// parameter the app shows, its widget chosen by the parameter's kind.
 fn params_ui(app: &mut HoxApp, ui: &mut egui::Ui, group: Group) {
     ui.heading(group.heading());
-    let is_box = app.sessions[app.active].base.is_box();
-    if group == Group::Mesh && !is_box {
-        ui.label("from a mesh file (element type and grid are the file's)");
-        return;
+    let kind = app.sessions[app.active].base.mesh_kind();
+    match (group, kind) {
+        (Group::Mesh, params::MeshKind::File) => {
+            ui.label("from a mesh file (element type and grid are the file's)");
+            return;
+        }
+        (Group::Mesh, params::MeshKind::Files) => {
+            ui.label("a part meshed once, written at each order: the element type picks its file");
+        }
+        _ => {}
     }
-    for p in params::in_group(group).filter(|p| p.surfaces.app && (is_box || !p.box_only)) {
+    for p in params::in_group(group).filter(|p| p.surfaces.app && p.used_with(kind)) {
         param_ui(app, ui, p);
     }
 }
@@ -306,6 +312,8 @@ fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
     let k = app.active;
     let config = app.sessions[k].config.clone();
     let enabled = p.applies_to(&config);
+    // a part meshed per element type offers the types it has files for
+    let files: Vec<String> = app.sessions[k].base.file.mesh_files.keys().cloned().collect();
     let text = p.label_with_unit();
     let get = |c: &Config| (p.get)(c);
     let set = |c: &mut Config, v: Value| {
@@ -319,7 +327,10 @@ fn param_ui(app: &mut HoxApp, ui: &mut egui::Ui, p: &'static Param) {
             if let Some((first, _)) = name.split_once(',') {
                 *name = first.to_string();
             }
-            let entries = choice_menu(p);
+            let mut entries = choice_menu(p);
+            if p.picks_file && !files.is_empty() {
+                entries.retain(|(n, _)| files.contains(n));
+            }
             let shown = choice_shown(&entries, name);
             ui.add_enabled_ui(enabled, |ui| combo(ui, (p.key, k), name, shown, entries)).inner
         }),

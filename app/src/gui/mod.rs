@@ -291,6 +291,14 @@ impl HoxApp {
                 c.element = element;
                 c.refine = refine;
             }
+            // a part meshed per element type: the same part at the other order (P1's facets
+            // against P2's curved faces)
+            if first.base.mesh_kind() == hox_scenes::params::MeshKind::Files
+                && let Some((name, _)) = other
+                && let Some(element) = hox_sim::element::ElementType::from_name(name)
+            {
+                c.element = element;
+            }
             let second = Session::new(first.base.clone(), c.clone())
                 .or_else(|_| Session::new(first.base.clone(), first.config.clone()));
             match second {

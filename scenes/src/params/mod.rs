@@ -40,7 +40,7 @@ mod value;
 
 pub use applies::is_tetrahedral;
 pub use kind::{EVERYWHERE, FILE_ONLY, Group, Invalidates, Kind, Surfaces};
-pub use param::Param;
+pub use param::{MeshKind, Param};
 pub use size::{MAX_BOX_BYTES, MAX_BOX_ELEMENTS, box_bytes, box_elements, thousands};
 pub use value::{Choice, ParamType, Value};
 
@@ -109,12 +109,13 @@ macro_rules! params {
 }
 
 params! {
-    /// Element type of a box mesh: a registered element type ([`ElementType::all`]).
+    /// Element type of a box mesh (or the file of a scene with one per type): a registered
+    /// element type ([`ElementType::all`]).
     #[serde(with = "as_text")]
     element: ElementType = ElementType::from_name("p2").expect("P2 is registered") => {
         key: "element", group: Group::Mesh, file_key: "element", label: "Element",
         help: "The element type: its shape (tetrahedron, hexahedron, prism, pyramid) and polynomial order; `hox elements` describes each.",
-        kind: Kind::Choice(element_options), invalidates: Invalidates::Mesh, required: true, box_only: true, ..BASE
+        kind: Kind::Choice(element_options), invalidates: Invalidates::Mesh, required: true, box_only: true, picks_file: true, ..BASE
     }
     /// `five` (unbiased) or `six` (biased) tetrahedra per cell.
     #[serde(with = "as_text")]
@@ -394,10 +395,10 @@ impl Params {
     }
 
     /// Every value as overrides (what the app applies to its scene); a mesh file's scene takes
-    /// no box parameters.
-    pub fn as_overrides(&self, is_box: bool) -> SceneOverrides {
+    /// no box parameters ([`Param::used_with`]).
+    pub fn as_overrides(&self, kind: MeshKind) -> SceneOverrides {
         let mut o = SceneOverrides::default();
-        for p in PARAMS.iter().filter(|p| is_box || !p.box_only) {
+        for p in PARAMS.iter().filter(|p| p.used_with(kind)) {
             (p.set_override)(&mut o, (p.get)(self));
         }
         o
@@ -442,9 +443,9 @@ impl Params {
 
     /// Every parameter as JSON, by scene-file path (`material.youngs_modulus_pa`): what a
     /// recording or a report states about its configuration.
-    pub fn to_json(&self, is_box: bool) -> serde_json::Value {
+    pub fn to_json(&self, kind: MeshKind) -> serde_json::Value {
         let mut out = serde_json::Map::new();
-        for p in PARAMS.iter().filter(|p| is_box || !p.box_only) {
+        for p in PARAMS.iter().filter(|p| p.used_with(kind)) {
             out.insert(p.file_path(), (p.get)(self).to_json());
         }
         serde_json::Value::Object(out)

@@ -5,6 +5,18 @@ use super::kind::{EVERYWHERE, Group, Invalidates, Kind, Surfaces};
 use super::value::Value;
 use super::{Params, SceneOverrides};
 
+/// What a scene's mesh is, for which mesh parameters it reads ([`Param::used_with`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshKind {
+    /// A structured box: element, split, grid, refinement and the corners.
+    Box,
+    /// One mesh file (`[mesh] file`): none of the box's parameters.
+    File,
+    /// One mesh file per element type (`[mesh] files`, the curved parts of `assets/parts/`):
+    /// the element type picks the file.
+    Files,
+}
+
 /// One parameter (see the module docs). Built by the `params!` table below.
 pub struct Param {
     /// The short key: CLI flag `--KEY`, `--compare KEY=…`, the app's link name.
@@ -24,8 +36,11 @@ pub struct Param {
     pub surfaces: Surfaces,
     /// A scene file must give it (else the default applies).
     pub required: bool,
-    /// A box mesh's parameter, meaningless for a mesh file.
+    /// A box mesh's parameter, meaningless for a mesh file ([`Param::used_with`]).
     pub box_only: bool,
+    /// A box parameter that a scene with one mesh file per element type (`[mesh] files`) uses
+    /// too: the element type, which picks the file.
+    pub picks_file: bool,
     /// For a flag: the command line's switch and the value it sets (`--no-stability-guard`
     /// sets false) instead of `--KEY VALUE`.
     pub switch: Option<(&'static str, bool)>,
@@ -54,6 +69,16 @@ impl Param {
     /// parameter, the configuration's solver reads it ([`super::applies::solver_reads`]).
     pub fn applies_to(&self, p: &Params) -> bool {
         self.applies.is_none_or(|f| f(p)) && super::applies::solver_reads(p.method, self.file_key)
+    }
+
+    /// Whether a scene whose mesh is of kind `kind` reads this parameter: every one for a box, the
+    /// non-box ones for a mesh file, and the element type too for one file per element type.
+    pub fn used_with(&self, kind: MeshKind) -> bool {
+        match kind {
+            MeshKind::Box => true,
+            MeshKind::File => !self.box_only,
+            MeshKind::Files => !self.box_only || self.picks_file,
+        }
     }
 
     /// `material.youngs_modulus_pa`.
@@ -98,6 +123,7 @@ pub(super) const BASE: Param = Param {
     surfaces: EVERYWHERE,
     required: false,
     box_only: false,
+    picks_file: false,
     switch: None,
     applies: None,
     check_with: None,

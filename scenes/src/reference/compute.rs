@@ -249,21 +249,71 @@ pub(super) fn probes_at(scene: &Scene, mesh: &hox_sim::mesh::Mesh, positions: &[
 
 /// The static solution of the scene's own mesh (a mesh file's scene).
 pub fn own_mesh(scene: &Scene, progress: Progress<'_>) -> Result<Reference, SceneError> {
-    let mesh = scene.build_mesh()?;
-    let solution = crate::solve_static(scene, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
-        progress("computing reference: static solution of this mesh", fraction)
-    })?;
-    let probes = probes_at(scene, &mesh, &solution.positions)?;
-    Ok(Reference {
-        origin: Origin::OwnMesh,
-        probes,
-        mesh: format!("{} ({} elements)", scene.mesh.element_names(), mesh.num_elements()),
-        estimated_error_m: None,
-        estimate: "measures the solver's error only, not the mesh's".into(),
-        poisson_ratio: scene.params().poisson_ratio,
-        field: Some(ReferenceField::Nodes {
-            displacements_m: solution.positions.iter().zip(&mesh.rest_positions).map(|(x, r)| (x - r).into()).collect(),
-        }),
-        refining: None,
+    // a part meshed per element type: its highest order's file (P3), whichever is on screen
+    let highest = highest_order(scene)?;
+    let solved = highest.as_ref().unwrap_or(scene);
+    let mesh = solved.build_mesh()?;
+    let what = if highest.is_some() {
+        format!("computing reference: static solution of the {} part", solved.params().element.name().to_uppercase())
+    } else {
+        "computing reference: static solution of this mesh".to_string()
+    };
+    let solution =
+        crate::solve_static(solved, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| progress(&what, fraction))?;
+    let probes = probes_at(solved, &mesh, &solution.positions)?;
+    let described = format!("{} ({} elements)", solved.mesh.element_names(), mesh.num_elements());
+    Ok(match highest {
+        Some(h) => Reference {
+            origin: Origin::HighestOrder,
+            probes,
+            mesh: format!("{described}, {} nodes", mesh.num_nodes()),
+            estimated_error_m: None,
+            estimate: format!(
+                "the {} part's own mesh error is not estimated; lower orders' errors include their mesh's",
+                h.params().element.name().to_uppercase()
+            ),
+            poisson_ratio: scene.params().poisson_ratio,
+            // its nodes are not the lower orders' nodes: no field to colour their error by
+            field: None,
+            refining: None,
+        },
+        None => Reference {
+            origin: Origin::OwnMesh,
+            probes,
+            mesh: described,
+            estimated_error_m: None,
+            estimate: "measures the solver's error only, not the mesh's".into(),
+            poisson_ratio: scene.params().poisson_ratio,
+            field: Some(ReferenceField::Nodes {
+                displacements_m: solution
+                    .positions
+                    .iter()
+                    .zip(&mesh.rest_positions)
+                    .map(|(x, r)| (x - r).into())
+                    .collect(),
+            }),
+            refining: None,
+        },
     })
+}
+
+/// For a part meshed per element type (`[mesh] files`), the scene on its highest-order file
+/// (the highest polynomial order; P3 of P1, P2, P3); None for any other scene.
+pub fn highest_order(scene: &Scene) -> Result<Option<Scene>, SceneError> {
+    if scene.mesh_kind() != crate::params::MeshKind::Files {
+        return Ok(None);
+    }
+    let Some(element) = scene
+        .file
+        .mesh_files
+        .keys()
+        .filter_map(|n| hox_sim::element::ElementType::from_name(n))
+        .max_by_key(|e| e.order())
+    else {
+        return Ok(None);
+    };
+    if element == scene.params().element {
+        return Ok(Some(scene.clone()));
+    }
+    scene.with_overrides(&crate::SceneOverrides { element: Some(element), ..Default::default() }).map(Some)
 }

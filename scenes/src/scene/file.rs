@@ -5,7 +5,9 @@
 //! name = "bending"
 //! description = "…"
 //! [mesh]        # a structured box (see hox_sim::mesh::structured), or a Gmsh file:
-//!               # [mesh] file = "beam.msh" (relative to the scene file; see docs/MESHES.md)
+//!               # [mesh] file = "beam.msh" (relative to the scene file; see docs/MESHES.md),
+//!               # or one file per element type, `element` picking one:
+//!               # [mesh] files = { p1 = "tube-p1.msh", p2 = "tube-p2.msh" }
 //! box_min_m = [0, 0, 0]
 //! box_max_m = [2, 0.5, 0.5]
 //! element = "p2"          # a registered element type (`hox elements`)
@@ -72,7 +74,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use crate::SceneError;
-use crate::params::{Group, PARAMS, Params};
+use crate::params::{Group, MeshKind, PARAMS, Params};
 use hox_sim::Vec3;
 use hox_sim::effect::{AxisRotation, Prescribed};
 
@@ -84,6 +86,11 @@ pub struct SceneFile {
     pub description: String,
     /// `[mesh] file`: a Gmsh mesh file, relative to the scene file (or absolute).
     pub mesh_file: Option<String>,
+    /// `[mesh] files = { p1 = "…", p2 = "…", p3 = "…" }`: the same part meshed once per element
+    /// type (the curved parts of `assets/parts/`, made by `scripts/gmsh_parts.py`); `element`
+    /// picks the file. Relative like `file`; a built-in scene's are embedded
+    /// ([`super::BUILTIN_MESHES`]).
+    pub mesh_files: std::collections::BTreeMap<String, String>,
     /// Every parameter: the file's value, or the table's default.
     pub params: Params,
     /// The keys of the parameters the file gave (or an override set).
@@ -125,6 +132,7 @@ impl SceneFile {
             name: raw.name,
             description: raw.description,
             mesh_file: None,
+            mesh_files: Default::default(),
             params: Params::default(),
             given: BTreeSet::new(),
             effects: raw.effects,
@@ -145,6 +153,10 @@ impl SceneFile {
                     file.mesh_file = Some(f.to_string());
                     continue;
                 }
+                if group == Group::Mesh && key == "files" {
+                    file.mesh_files = files_table(value, &path, &invalid)?;
+                    continue;
+                }
                 let param = PARAMS.iter().find(|p| p.group == group && p.file_key == key).ok_or_else(|| {
                     let known: Vec<&str> = PARAMS.iter().filter(|p| p.group == group).map(|p| p.file_key).collect();
                     invalid(&path, value.to_string(), &format!("unknown key (expected one of {})", known.join(", ")))
@@ -160,8 +172,16 @@ impl SceneFile {
                 file.given.insert(param.key);
             }
         }
+        if file.mesh_file.is_some() && !file.mesh_files.is_empty() {
+            return Err(invalid(
+                "mesh.files",
+                "given".into(),
+                "give either file (one mesh) or files (one per element type)",
+            ));
+        }
+        let kind = file.mesh_kind();
         for p in PARAMS.iter().filter(|p| p.required && !file.given.contains(p.key)) {
-            if p.box_only && file.mesh_file.is_some() {
+            if kind != MeshKind::Box && p.box_only {
                 continue;
             }
             let reason = if p.box_only {
@@ -172,6 +192,15 @@ impl SceneFile {
             return Err(invalid(&p.file_path(), "missing".into(), reason));
         }
         Ok(file)
+    }
+
+    /// What the mesh is: a box, one file, or one file per element type.
+    pub fn mesh_kind(&self) -> MeshKind {
+        match (&self.mesh_file, self.mesh_files.is_empty()) {
+            (Some(_), _) => MeshKind::File,
+            (None, false) => MeshKind::Files,
+            (None, true) => MeshKind::Box,
+        }
     }
 
     /// The scene file's text (TOML): the parameters given (and those a box or a material needs),
@@ -187,9 +216,12 @@ impl SceneFile {
             {
                 t.insert("file".into(), f.clone().into());
             }
+            if group == Group::Mesh && !self.mesh_files.is_empty() {
+                let files: toml::Table = self.mesh_files.iter().map(|(k, v)| (k.clone(), v.clone().into())).collect();
+                t.insert("files".into(), toml::Value::Table(files));
+            }
             for p in PARAMS.iter().filter(|p| p.group == group) {
-                let relevant = if p.box_only { self.mesh_file.is_none() } else { true };
-                if relevant
+                if p.used_with(self.mesh_kind())
                     && (self.given.contains(p.key) || p.required)
                     && let Some(v) = (p.get)(&self.params).to_toml()
                 {
@@ -228,6 +260,7 @@ impl SceneFile {
             name: path.file_stem().map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned()),
             description: format!("the mesh {}", path.display()),
             mesh_file: Some(path.display().to_string()),
+            mesh_files: Default::default(),
             params,
             given,
             effects: if gravity {
@@ -238,6 +271,32 @@ impl SceneFile {
             probes: Vec::new(),
         }
     }
+}
+
+/// `[mesh] files`: a table from registered element type names to file names.
+fn files_table(
+    value: &toml::Value,
+    path: &str,
+    invalid: &dyn Fn(&str, String, &str) -> SceneError,
+) -> Result<std::collections::BTreeMap<String, String>, SceneError> {
+    let table = value.as_table().filter(|t| !t.is_empty()).ok_or_else(|| {
+        invalid(
+            path,
+            value.to_string(),
+            "expected a table of files by element type, e.g. { p1 = \"part-p1.msh\", p2 = \"part-p2.msh\" }",
+        )
+    })?;
+    let mut files = std::collections::BTreeMap::new();
+    for (element, f) in table {
+        let key = format!("{path}.{element}");
+        let Some(element_type) = hox_sim::element::ElementType::from_name(element) else {
+            let known = hox_sim::element::ElementType::names();
+            return Err(invalid(&key, element.clone(), &format!("not an element type (expected one of {known})")));
+        };
+        let name = f.as_str().ok_or_else(|| invalid(&key, f.to_string(), "expected a file name"))?;
+        files.insert(element_type.name().to_string(), name.to_string());
+    }
+    Ok(files)
 }
 
 /// Which nodes an effect acts on: those on an axis-aligned plane, inside a box, or in a

@@ -4,10 +4,12 @@
 //! (here) and builds the mesh and effects ([`build`]).
 
 pub mod build;
+pub mod builtin;
 pub mod file;
 pub mod validate;
 
 pub use build::select_nodes;
+pub use builtin::{BUILTIN_MESHES, builtin_mesh};
 pub use file::{EffectSpec, NodeSelector, ProbeSpec, SceneFile};
 pub(crate) use validate::invalid_in;
 
@@ -119,6 +121,12 @@ impl Scene {
     /// Whether the mesh is a structured box (element, split, grid and refinement apply).
     pub fn is_box(&self) -> bool {
         self.mesh.as_box().is_some()
+    }
+
+    /// What the mesh is: a box, one mesh file, or one file per element type (which mesh
+    /// parameters apply: [`crate::params::Param::used_with`]).
+    pub fn mesh_kind(&self) -> crate::params::MeshKind {
+        self.file.mesh_kind()
     }
 
     /// The material the parameters describe (built when the scene was validated).

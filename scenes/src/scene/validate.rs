@@ -13,7 +13,7 @@ use std::sync::Arc;
 use super::build::axis_index;
 use super::{EffectSpec, NodeSelector, Scene, SceneFile, SceneMesh};
 use crate::SceneError;
-use crate::params::PARAMS;
+use crate::params::{MeshKind, PARAMS};
 
 pub(crate) type Invalid<'a> = dyn Fn(&str, String, &str) -> SceneError + 'a;
 
@@ -37,8 +37,8 @@ impl Scene {
     ) -> Result<Scene, SceneError> {
         let invalid = invalid_in(source);
         let params = &file.params;
-        let is_box = file.mesh_file.is_none();
-        for p in PARAMS.iter().filter(|p| is_box || !p.box_only) {
+        let kind = file.mesh_kind();
+        for p in PARAMS.iter().filter(|p| p.used_with(kind)) {
             p.check(params).map_err(|reason| invalid(&p.file_path(), (p.get)(params).to_string(), &reason))?;
         }
         let mesh = mesh_of(&file, source, base_dir.as_deref(), cached, &invalid)?;
@@ -101,8 +101,25 @@ fn mesh_of(
     invalid: &Invalid<'_>,
 ) -> Result<SceneMesh, SceneError> {
     let p = &file.params;
-    if let Some(mesh_file) = &file.mesh_file {
-        if let Some(given) = PARAMS.iter().find(|q| q.box_only && file.given.contains(q.key)) {
+    let picked;
+    let mesh_file = match file.mesh_kind() {
+        MeshKind::Box => None,
+        MeshKind::File => file.mesh_file.as_ref(),
+        MeshKind::Files => {
+            let element = p.element.name();
+            picked = file.mesh_files.get(element).ok_or_else(|| {
+                let types: Vec<&str> = file.mesh_files.keys().map(String::as_str).collect();
+                invalid(
+                    "mesh.element",
+                    element.to_string(),
+                    &format!("this part is meshed as {} only (mesh.files)", types.join(", ")),
+                )
+            })?;
+            Some(picked)
+        }
+    };
+    if let Some(mesh_file) = mesh_file {
+        if let Some(given) = PARAMS.iter().find(|q| !q.used_with(file.mesh_kind()) && file.given.contains(q.key)) {
             return Err(invalid(
                 &given.file_path(),
                 "given".into(),
@@ -119,6 +136,14 @@ fn mesh_of(
             && *cached_path == path
         {
             return Ok(SceneMesh::File { path, imported: imported.clone() });
+        }
+        // a built-in scene's mesh files are in the binary (a scene read without a folder, such
+        // as a built-in one or its text written back, names them relative to assets/scenes/)
+        if base_dir.is_none()
+            && let Some(imported) = super::builtin_mesh(mesh_file)
+        {
+            let imported = imported.map_err(|message| SceneError::Mesh { source_name: source.to_string(), message })?;
+            return Ok(SceneMesh::File { path, imported });
         }
         let imported = hox_sim::io::gmsh::read_msh(&path).map_err(|e| {
             // a scene built from the mesh file alone (`--mesh`) is named by the file already

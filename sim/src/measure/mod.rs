@@ -19,4 +19,4 @@ pub mod probe;
 pub mod surface;
 
 pub use inversion::{MinDetF, min_det_f};
-pub use median::median;
+pub use median::{median, quantile};
