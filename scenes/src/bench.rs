@@ -33,9 +33,12 @@ use std::time::Instant;
 /// and FMA exist, `hox bench` measures the peak instead ([`peak::measured_avx2_peak_gflops`]).
 pub const NOMINAL_PEAK_GFLOPS_PER_CORE: f64 = 2.7 * 2.0 * 4.0 * 2.0;
 
-/// One benchmarked beam.
+/// One benchmarked configuration: a bending beam, or a curved part ([`PART_CASES`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BenchCase {
+    /// The built-in scene: `bending` (the beams: element, grid and refinement overridden) or a
+    /// curved part (`tube`, `elbow`, `hook`: only the element, which picks the part's file).
+    pub scene: &'static str,
     pub element: &'static str,
     pub grid: [usize; 3],
     pub refine: usize,
@@ -45,6 +48,9 @@ pub struct BenchCase {
 
 impl BenchCase {
     pub fn label(&self) -> String {
+        if self.scene != "bending" {
+            return format!("{} {}", self.element.to_uppercase(), self.scene);
+        }
         let [x, y, z] = self.grid;
         let r = if self.refine > 0 { format!(" r{}", self.refine) } else { String::new() };
         format!("{} {x}x{y}x{z}{r}", self.element.to_uppercase())
@@ -56,21 +62,32 @@ impl BenchCase {
 /// but P1 (whose largest is Table 1's 81,920): 32 cells along the beam (24 for the pyramids),
 /// large enough for the colour sweep to cut it into slabs for the threads.
 pub const CASES: [BenchCase; 15] = [
-    BenchCase { element: "p1", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: Some(43.6) },
-    BenchCase { element: "p1", grid: [16, 4, 4], refine: 1, paper_ms_per_frame: Some(363.0) },
-    BenchCase { element: "p1", grid: [16, 4, 4], refine: 2, paper_ms_per_frame: Some(3116.0) },
-    BenchCase { element: "p2", grid: [8, 2, 2], refine: 0, paper_ms_per_frame: Some(20.9) },
-    BenchCase { element: "p3", grid: [4, 2, 2], refine: 0, paper_ms_per_frame: Some(28.1) },
-    BenchCase { element: "q1", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: None },
-    BenchCase { element: "q2", grid: [8, 2, 2], refine: 0, paper_ms_per_frame: None },
-    BenchCase { element: "prism", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: None },
-    BenchCase { element: "pyramid", grid: [12, 3, 3], refine: 0, paper_ms_per_frame: None },
-    BenchCase { element: "p2", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
-    BenchCase { element: "p3", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
-    BenchCase { element: "q1", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
-    BenchCase { element: "q2", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
-    BenchCase { element: "prism", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
-    BenchCase { element: "pyramid", grid: [24, 6, 6], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "p1", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: Some(43.6) },
+    BenchCase { scene: "bending", element: "p1", grid: [16, 4, 4], refine: 1, paper_ms_per_frame: Some(363.0) },
+    BenchCase { scene: "bending", element: "p1", grid: [16, 4, 4], refine: 2, paper_ms_per_frame: Some(3116.0) },
+    BenchCase { scene: "bending", element: "p2", grid: [8, 2, 2], refine: 0, paper_ms_per_frame: Some(20.9) },
+    BenchCase { scene: "bending", element: "p3", grid: [4, 2, 2], refine: 0, paper_ms_per_frame: Some(28.1) },
+    BenchCase { scene: "bending", element: "q1", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "q2", grid: [8, 2, 2], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "prism", grid: [16, 4, 4], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "pyramid", grid: [12, 3, 3], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "p2", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "p3", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "q1", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "q2", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "prism", grid: [32, 8, 8], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "bending", element: "pyramid", grid: [24, 6, 6], refine: 0, paper_ms_per_frame: None },
+];
+
+/// The curved parts (issue #37: `assets/parts/`, docs/MESHES.md) the implicit solvers are timed
+/// on besides the beams (`hox bench --solver`): the tube at every order, the elbow and the hook at
+/// P2, each from rest under its scene's loads.
+pub const PART_CASES: [BenchCase; 5] = [
+    BenchCase { scene: "tube", element: "p1", grid: [0; 3], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "tube", element: "p2", grid: [0; 3], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "tube", element: "p3", grid: [0; 3], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "elbow", element: "p2", grid: [0; 3], refine: 0, paper_ms_per_frame: None },
+    BenchCase { scene: "hook", element: "p2", grid: [0; 3], refine: 0, paper_ms_per_frame: None },
 ];
 
 /// The paper's bending beam for `case`, at rest: the `bending` scene with the case's element
@@ -81,20 +98,22 @@ pub fn bending_beam(case: &BenchCase, sweep: Sweep) -> Result<Simulation, SceneE
 
 /// [`bending_beam`], solved by `method` if given (else the scene's own solver).
 fn beam(case: &BenchCase, sweep: Sweep, method: Option<hox_sim::solver::Method>) -> Result<Simulation, SceneError> {
+    let element = ElementType::from_name(case.element).ok_or_else(|| SceneError::Invalid {
+        source_name: "bench".into(),
+        key: "element".into(),
+        value: case.element.into(),
+        reason: format!("is not a registered element type ({})", ElementType::names()),
+    })?;
+    let beam = case.scene == "bending";
     let overrides = SceneOverrides {
-        element: Some(ElementType::from_name(case.element).ok_or_else(|| SceneError::Invalid {
-            source_name: "bench".into(),
-            key: "element".into(),
-            value: case.element.into(),
-            reason: format!("is not a registered element type ({})", ElementType::names()),
-        })?),
-        grid: Some(case.grid),
-        refine: Some(case.refine),
+        element: Some(element),
+        grid: beam.then_some(case.grid),
+        refine: beam.then_some(case.refine),
         sweep: Some(sweep),
         method,
         ..SceneOverrides::default()
     };
-    Ok(Instance::new(crate::by_name("bending")?.with_overrides(&overrides)?)?.sim)
+    Ok(Instance::new(crate::by_name(case.scene)?.with_overrides(&overrides)?)?.sim)
 }
 
 /// Flops of one energy-constraint projection of an element with `nodes` nodes and `points`
@@ -234,9 +253,21 @@ pub const BUDGET_SECS: f64 = 10.0;
 /// The case labelled `filter`, or else every case whose label contains it, ignoring case (a whole
 /// label picks that case alone: "P1 16x4x4" is also part of its refinements' labels).
 pub fn matching_cases(filter: &str) -> Vec<&'static BenchCase> {
+    matching(&CASES, filter)
+}
+
+/// [`matching_cases`] among the beams and the curved parts ([`PART_CASES`]): what the implicit
+/// solvers are timed on.
+pub fn matching_solver_cases(filter: &str) -> Vec<&'static BenchCase> {
+    let mut cases = matching(&CASES, filter);
+    cases.extend(matching(&PART_CASES, filter));
+    cases
+}
+
+fn matching(cases: &'static [BenchCase], filter: &str) -> Vec<&'static BenchCase> {
     let filter = filter.to_uppercase();
-    let exact = CASES.iter().any(|c| c.label().to_uppercase() == filter);
-    CASES
+    let exact = cases.iter().any(|c| c.label().to_uppercase() == filter);
+    cases
         .iter()
         .filter(|c| if exact { c.label().to_uppercase() == filter } else { c.label().to_uppercase().contains(&filter) })
         .collect()
@@ -279,7 +310,7 @@ mod tests {
     #[test]
     fn the_benchmark_beam_is_the_bending_scene_file() {
         let scene = crate::by_name("bending").unwrap();
-        let case = BenchCase { element: "q1", grid: [4, 1, 1], refine: 0, paper_ms_per_frame: None };
+        let case = BenchCase { scene: "bending", element: "q1", grid: [4, 1, 1], refine: 0, paper_ms_per_frame: None };
         let sim = bending_beam(&case, Sweep::Element).unwrap();
         assert_eq!(*sim.material(), scene.material());
         assert_eq!(*sim.settings(), hox_sim::solver::SolverSettings { sweep: Sweep::Element, ..scene.settings() });

@@ -1,5 +1,6 @@
 //! `hox bench`: time the XPBD loop on the paper's Table 1 beams and the other element types, or
-//! (`--solver NAME`, a solver of the registry) an implicit solver on the same beams.
+//! (`--solver NAME`, a solver of the registry) an implicit solver on the same beams and the
+//! curved parts (`--only tube`).
 
 use anyhow::{Result, bail};
 use hox_sim::solver::Sweep;
@@ -16,7 +17,12 @@ pub fn bench(frames: usize, threads: &[usize], only: &str, sweeps: &[String], so
     if frames == 0 || threads.contains(&0) {
         bail!("--frames and every --threads count must be at least 1");
     }
-    if hox_scenes::bench::matching_cases(only).is_empty() {
+    let matching = if method.is_implicit() {
+        hox_scenes::bench::matching_solver_cases(only)
+    } else {
+        hox_scenes::bench::matching_cases(only)
+    };
+    if matching.is_empty() {
         bail!("no configuration matches '{only}'");
     }
     if !method.is_implicit() {

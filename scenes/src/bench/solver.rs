@@ -1,5 +1,6 @@
 //! Timing the implicit solvers (`hox bench --solver vbd|newton`) on the benchmark beams
-//! ([`super::CASES`]): the same bending scene, started from rest, with only the solver changed
+//! ([`super::CASES`]) and the curved parts ([`super::PART_CASES`], each its own scene with only
+//! the element type and the solver changed): the same bending scene, started from rest, with only the solver changed
 //! (each solver's own settings are the scene's, i.e. the defaults: VBD 10 sweeps per step with
 //! Chebyshev ρ 0.9 after its coarse correction of 32 cells, whose two gradient evaluations per step
 //! and coarse matrix every ten steps are in its times per node update and element visit; Newton to 1e-6 of the load, at most 30 iterations; 1 step per frame).
@@ -23,7 +24,7 @@
 //!   is kept while the residual falls fast, so ms per factorisation is the whole frame's time per
 //!   factorisation, an upper bound of one factorisation's cost); iterations per step.
 
-use super::{BenchCase, matching_cases};
+use super::{BenchCase, matching_solver_cases};
 use crate::SceneError;
 use crate::study::solver_axis::opt;
 use hox_sim::measure::median;
@@ -245,7 +246,7 @@ pub fn run(
     progress: &mut dyn FnMut(&SolverBenchRow),
 ) -> Result<Vec<SolverBenchRow>, SceneError> {
     let mut rows = Vec::new();
-    for case in matching_cases(filter) {
+    for case in matching_solver_cases(filter) {
         for row in measure_side_by_side(case, method, threads, super::WARMUP_FRAMES, frames, super::BUDGET_SECS)? {
             progress(&row);
             rows.push(row);
@@ -340,7 +341,7 @@ mod tests {
     /// its iterations and factorisations; the timings are positive and finite.
     #[test]
     fn rows_count_the_solvers_work() {
-        let case = BenchCase { element: "p1", grid: [4, 1, 1], refine: 0, paper_ms_per_frame: None };
+        let case = BenchCase { scene: "bending", element: "p1", grid: [4, 1, 1], refine: 0, paper_ms_per_frame: None };
         let vbd = measure_side_by_side(&case, Method::Vbd, &[1, 2], 1, 2, 60.0).unwrap();
         assert_eq!(vbd.len(), 2);
         for r in &vbd {
@@ -365,5 +366,20 @@ mod tests {
         assert!(r.ms_per_iteration.is_some_and(|t| t.is_finite() && t > 0.0));
         let table = markdown(&[vbd, newton].concat());
         assert!(table.contains("µs per node update") && table.contains("ms per factorisation"), "{table}");
+    }
+
+    /// Issue #37: the implicit solvers are timed on the curved parts as on the beams; `--only tube`
+    /// picks the tube at each order, an exact label one of them.
+    #[test]
+    fn the_curved_parts_are_timed_like_the_beams() {
+        let labels = |f: &str| super::super::matching_solver_cases(f).iter().map(|c| c.label()).collect::<Vec<_>>();
+        assert_eq!(labels("tube"), ["P1 tube", "P2 tube", "P3 tube"]);
+        assert_eq!(labels("P2 tube"), ["P2 tube"]);
+        assert!(super::super::matching_cases("tube").is_empty(), "XPBD's table is the beams'");
+        let case = super::super::PART_CASES[0];
+        let rows = measure_side_by_side(&case, Method::Newton, &[1], 1, 2, 60.0).unwrap();
+        let r = &rows[0];
+        assert_eq!((r.case.label().as_str(), r.nodes, r.elements), ("P1 tube", 829, 2424));
+        assert!(r.iterations_per_frame >= 1.0 && r.ms_per_frame.is_finite());
     }
 }

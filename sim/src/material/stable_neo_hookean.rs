@@ -11,6 +11,8 @@
 //! * P = μF + λ̂ (J − α) cof F = μF + (λ̂ (J − 1) − μ) cof F,
 //!   cof F = det(F) F⁻ᵀ = [f1×f2, f2×f0, f0×f1] (columns f0, f1, f2)
 //! * dP(F; dF) = μ dF + λ̂ (cof F : dF) cof F + (λ̂ (J − 1) − μ) d cof(F; dF)
+//! * a node's block (vertex block descent), `g = ∇_X N_a`: B = μ |g|² I + λ̂ w ⊗ w with
+//!   w = cof F g (the d cof term cancels in pairs; `node_force_and_block`)
 //!
 //! Everything is polynomial in F, so the model is well defined for
 //! degenerate and inverted elements (J ≤ 0) — the model to use when elements
@@ -28,8 +30,9 @@
 
 use super::{
     HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
-    dpdf_from_directional, first_invariant_minus_three, node_block_from_directional,
+    dpdf_from_directional, first_invariant_minus_three,
 };
+use nalgebra::Vector3;
 
 /// λ̂ = λ + μ and r = μ/λ̂ = α − 1.
 fn lambda_hat_and_ratio(l: Lame) -> (f64, f64) {
@@ -71,8 +74,23 @@ impl HyperelasticModel for StableNeoHookean {
         dpdf_from_directional(linearisation(l, f))
     }
 
-    fn node_block(&self, l: Lame, f: &Mat3, g: &nalgebra::Vector3<f64>) -> Mat3 {
-        node_block_from_directional(linearisation(l, f), g)
+    fn node_block(&self, l: Lame, f: &Mat3, g: &Vector3<f64>) -> Mat3 {
+        self.node_force_and_block(l, f, g).1
+    }
+
+    /// Closed form (issue #37: VBD's visits on stable Neo-Hookean parts spent 60 % of their time
+    /// in the three directional derivatives and a separate `P`). With `dF = e_k ⊗ g`, column `k`
+    /// of `B` is `dP[e_k ⊗ g] g = μ |g|² e_k + λ̂ (w)_k w + (λ̂ (J − 1) − μ) d cof(F; e_k ⊗ g) g`,
+    /// `w = cof F g`, and the last term vanishes: with `cof F = [f1×f2, f2×f0, f0×f1]`,
+    /// `d cof(F; e_k ⊗ g) g = Σ_{i≠j} g_i g_j (e_k × f_m)` over the pairs of columns, each pair
+    /// once as `e_k × f` and once as `f × e_k`. So `B = μ |g|² I + λ̂ w ⊗ w`, positive
+    /// semi-definite for every F, and `P g = μ F g + (λ̂ (J − 1) − μ) w`.
+    fn node_force_and_block(&self, l: Lame, f: &Mat3, g: &Vector3<f64>) -> (Vector3<f64>, Mat3) {
+        let (lambda_hat, _) = lambda_hat_and_ratio(l);
+        let w = cofactor(f) * g;
+        let force = f * g * l.mu_pa + w * (lambda_hat * det_minus_one(f) - l.mu_pa);
+        let block = Mat3::identity() * (l.mu_pa * g.norm_squared()) + w * w.transpose() * lambda_hat;
+        (force, block)
     }
 
     fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2] {
