@@ -49,7 +49,7 @@ fn a_part_asked_for_an_element_type_it_was_not_meshed_as_names_the_types_it_has(
     // a box parameter means nothing to a part
     let o = SceneOverrides { refine: Some(1), ..Default::default() };
     let e = scene.with_overrides(&o).unwrap_err().to_string();
-    assert!(e.contains("mesh.refine") && e.contains("box"), "{e}");
+    assert!(e.contains("mesh.refine") && e.contains("box meshes") && e.contains("the element type picks"), "{e}");
 }
 
 #[test]

@@ -120,13 +120,16 @@ fn mesh_of(
     };
     if let Some(mesh_file) = mesh_file {
         if let Some(given) = PARAMS.iter().find(|q| !q.used_with(file.mesh_kind()) && file.given.contains(q.key)) {
-            return Err(invalid(
-                &given.file_path(),
-                "given".into(),
-                &format!(
+            let reason = if file.mesh_kind() == MeshKind::Files {
+                format!(
+                    "the part is read from {mesh_file} (the element type picks its file); box_min_m, box_max_m, grid, split and refine describe box meshes"
+                )
+            } else {
+                format!(
                     "the mesh is read from {mesh_file}; box_min_m, box_max_m, element, grid, split and refine describe box meshes"
-                ),
-            ));
+                )
+            };
+            return Err(invalid(&given.file_path(), "given".into(), &reason));
         }
         let path = match base_dir {
             Some(dir) if Path::new(mesh_file).is_relative() => dir.join(mesh_file),
