@@ -52,6 +52,17 @@ pub fn static_command(
         "residual": solution.relative_residual,
         "seconds": seconds,
         "dofs": dofs,
+        "cost": {
+            "pattern_secs": solution.cost.pattern_secs,
+            "hessian_secs": solution.cost.hessian_secs,
+            "factor_secs": solution.cost.factor_secs,
+            "solve_secs": solution.cost.solve_secs,
+            "other_secs": solution.total_secs
+                - (solution.cost.pattern_secs + solution.cost.hessian_secs + solution.cost.factor_secs + solution.cost.solve_secs),
+            "factorisations": solution.cost.factorisations,
+            "matrix_nonzeros": solution.cost.matrix_nonzeros,
+            "factor_nonzeros": solution.cost.factor_nonzeros,
+        },
     });
     reference::json(&mut out, found.as_ref(), &compared, of);
     if json {

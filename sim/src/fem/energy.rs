@@ -14,7 +14,7 @@
 
 use crate::Vec3;
 use crate::fem::geometry::{BlockGeometry, deformation_gradient};
-use crate::material::{Material, contract};
+use crate::material::{Material, contract, contract_left, contract_right};
 use crate::mesh::Mesh;
 use nalgebra::DMatrix;
 
@@ -65,20 +65,36 @@ pub fn element_hessian(
     projected: bool,
 ) -> DMatrix<f64> {
     let n = x.len();
-    let mut h = DMatrix::zeros(3 * n, 3 * n);
+    let m = 3 * n;
+    let mut h = DMatrix::zeros(m, m);
+    let out = h.as_mut_slice();
+    let mut right = vec![[0.0; 27]; n];
     for (q, v) in volumes.iter().enumerate() {
         let g = &grads[q * n..(q + 1) * n];
         let f = deformation_gradient(x, rest, g);
         let c = if projected { material.dpdf_projected(&f) } else { material.dpdf(&f) };
-        for i in 0..n {
-            for j in 0..n {
-                let block = contract(&c, &g[i], &g[j]);
-                for a in 0..3 {
-                    for b in 0..3 {
-                        h[(3 * i + a, 3 * j + b)] += v * block[(a, b)];
+        // the contraction in two stages (`contract_right` once per node, then 27 products per
+        // pair) over the pairs `i ≥ j` only: `C` is symmetric (a Hessian), so block `(j, i)` is
+        // block `(i, j)` transposed: the lower triangle is mirrored at the end (the diagonal
+        // blocks' too, so that the result is exactly symmetric)
+        for (t, gj) in right.iter_mut().zip(g) {
+            *t = contract_right(&c, &(gj * *v));
+        }
+        for (j, t) in right.iter().enumerate() {
+            for (i, gi) in g.iter().enumerate().skip(j) {
+                let block = contract_left(t, gi);
+                for b in 0..3 {
+                    let column = &mut out[(3 * j + b) * m + 3 * i..(3 * j + b) * m + 3 * i + 3];
+                    for (a, o) in column.iter_mut().enumerate() {
+                        *o += block[(a, b)];
                     }
                 }
             }
+        }
+    }
+    for col in 0..m {
+        for row in col + 1..m {
+            out[row * m + col] = out[col * m + row];
         }
     }
     h

@@ -49,7 +49,7 @@ pub mod tangent;
 
 pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
 pub use psd::{project_psd, project_psd3};
-pub use tangent::{FastLaw, contract};
+pub use tangent::{FastLaw, contract, contract_left, contract_right};
 
 /// 3×3 matrix of `f64` (deformation gradients, stresses).
 pub use crate::math::Mat3;

@@ -144,7 +144,9 @@ impl LinearSolver for SparsePattern {
         Ok(())
     }
     fn solve(&mut self, r: &mut [f64], _relative_residual: f64, _counters: &mut SolverCounters) {
+        let started = std::time::Instant::now();
         self.solve_in_place(r, SEQ);
+        self.cost.solve_secs += started.elapsed().as_secs_f64();
     }
     fn work_summary(counters: &SolverCounters) -> String {
         format!("{} factorisations", counters.factorizations)

@@ -2,8 +2,18 @@
 //! `K = D + Σ_e Σ_q V_q Gᵀ ∂P/∂F|_projected G` on the free degrees of freedom (lower triangle,
 //! `D` a diagonal such as `M/h²`, zero for statics), its assembly from the element Hessians
 //! (computed in parallel, summed in a fixed order) and its sparse Cholesky factorisation
-//! (`faer`, AMD ordering, the symbolic analysis done once per pattern and the numeric one kept
-//! for reuse).
+//! (`faer`'s supernodal `L Lᵀ`, the symbolic analysis done once per pattern and the numeric one
+//! kept for reuse).
+//!
+//! Made for 100k degrees of freedom (issue #37, docs/PERFORMANCE.md session 22): the pattern
+//! comes from the node graph (AMD on it, a ninth of the scalar graph: the same fill, since AMD
+//! merges a node's three indistinguishable degrees of freedom anyway), `K` is assembled straight
+//! into its compressed columns in elimination order (no triplets, no sort, no permuted copy inside
+//! the factorisation), with `u32` indices; the element Hessians come from the two-stage,
+//! one-triangle kernel of `fem::energy`. On the 33,748-node P3 tube: 100,128 unknowns, a
+//! 52-million-entry factor (418 MB of the 599 MB the whole `hox static` takes at its peak).
+//! Nested dissection by coordinate bisection was tried for the ordering and filled 2–50 % more
+//! than AMD on every mesh of the project (session 22).
 
 use crate::Vec3;
 use crate::fem::energy::{element_grads, element_hessian};
@@ -11,10 +21,11 @@ use crate::fem::geometry::BlockGeometry;
 use crate::material::Material;
 use crate::mesh::Mesh;
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
-use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, Par, Side};
 use nalgebra::DMatrix;
 
@@ -27,57 +38,198 @@ pub(crate) enum SparseError {
     NotPositiveDefinite,
 }
 
-/// The free-DOF stiffness pattern (lower triangle, with every diagonal entry), its value order,
+/// The free-DOF stiffness pattern (lower triangle, with every diagonal entry), its node graph,
 /// its symbolic Cholesky factorisation and the last numeric factor.
+///
+/// A node is held or free as a whole, so the free degrees of freedom come in triples (free node
+/// `k` owns `3k`, `3k + 1`, `3k + 2`) and the pattern is built from the node graph: column
+/// `3j + b` holds rows `3j + b … 3j + 2`, then the three rows of every neighbour `i > j` in
+/// increasing order, so an entry's place follows from the neighbour's place in node `j`'s list
+/// (no sort of the element entries, no index per entry). The fill-reducing ordering is AMD on
+/// the node graph (a ninth of the scalar graph's entries), each node's three degrees of freedom
+/// kept together, which the supernodal factorisation then finds as dense blocks.
 pub(crate) struct SparsePattern {
     pub free_dofs: usize,
     /// Global DOF `3 i + a` → free DOF, `usize::MAX` for a held one.
     pub dof_of: Vec<usize>,
-    symbolic: SymbolicSparseColMat<usize>,
-    argsort: faer::sparse::Argsort<usize>,
-    cholesky: SymbolicCholesky<usize>,
+    /// Global node → its place in the elimination order (`u32::MAX` for a held node), and free
+    /// DOF `3k + a` (natural order) → `3 place[k] + a`: `K` is stored and factored in that
+    /// order, so the factorisation needs no permuted copy of it.
+    place_of_node: Vec<u32>,
+    place_of_free: Vec<u32>,
+    /// Per place `j`, its neighbours `i ≥ j` (itself first), sorted:
+    /// `node_rows[node_col_ptr[j]..node_col_ptr[j + 1]]`.
+    node_col_ptr: Vec<usize>,
+    node_rows: Vec<u32>,
+    symbolic: SymbolicSparseColMat<u32>,
+    /// `K`'s values in the order of [`Self::symbolic`].
+    values: Vec<f64>,
+    cholesky: SymbolicCholesky<u32>,
     factor: Vec<f64>,
     factored: bool,
+    /// What the pattern's work has cost so far.
+    pub cost: SparseCost,
 }
+
+/// Where a sparse stiffness spent its time, cumulative over its life (`hox static --json`'s
+/// `cost`, docs/PERFORMANCE.md): the pattern and its symbolic analysis (the fill-reducing
+/// ordering included), the element Hessians with their assembly, the numeric factorisations and
+/// the triangular solves; with the sizes that set them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SparseCost {
+    /// The pattern, its fill-reducing ordering and the symbolic factorisation (once).
+    pub pattern_secs: f64,
+    /// The element Hessians and their assembly into `K` (every factorisation).
+    pub hessian_secs: f64,
+    /// The numeric Cholesky factorisations.
+    pub factor_secs: f64,
+    /// The triangular solves with the factor.
+    pub solve_secs: f64,
+    /// Numeric factorisations made.
+    pub factorisations: usize,
+    /// Stored entries of `K`'s lower triangle.
+    pub matrix_nonzeros: usize,
+    /// Stored entries of the Cholesky factor `L`.
+    pub factor_nonzeros: usize,
+}
+
+/// Elements whose Hessians are computed in parallel before they are added to `K` in mesh order
+/// (bounds the memory they take: 64 P3 Hessians are 1.8 MB).
+const ASSEMBLY_CHUNK: usize = 64;
 
 impl SparsePattern {
     /// The pattern of `mesh` with the DOFs of nodes where `held(i)` left out.
     pub fn new(mesh: &Mesh, held: impl Fn(usize) -> bool) -> Result<Self, SparseError> {
-        let n = mesh.num_nodes();
-        let mut dof_of = vec![usize::MAX; 3 * n];
-        let mut free_dofs = 0;
-        for (d, slot) in dof_of.iter_mut().enumerate() {
-            if !held(d / 3) {
-                *slot = free_dofs;
-                free_dofs += 1;
-            }
-        }
-        let mut pairs = Vec::new();
-        for block in &mesh.blocks {
-            for nodes in block.elements() {
-                for_each_element_entry(&dof_of, nodes, |row, col, _, _| pairs.push(Pair::new(row, col)));
-            }
-        }
-        pairs.extend((0..free_dofs).map(|d| Pair::new(d, d)));
+        let started = std::time::Instant::now();
         let pattern = |e: &dyn std::fmt::Debug| SparseError::Pattern(format!("{e:?}"));
-        let (symbolic, argsort) =
-            SymbolicSparseColMat::try_new_from_indices(free_dofs, free_dofs, &pairs).map_err(|e| pattern(&e))?;
+        let n = mesh.num_nodes();
+        let mut free_of = vec![u32::MAX; n];
+        let mut free_nodes = 0usize;
+        for (i, slot) in free_of.iter_mut().enumerate() {
+            if !held(i) {
+                *slot = free_nodes as u32;
+                free_nodes += 1;
+            }
+        }
+        let dof_of: Vec<usize> = (0..3 * n)
+            .map(|d| if free_of[d / 3] == u32::MAX { usize::MAX } else { 3 * free_of[d / 3] as usize + d % 3 })
+            .collect();
+        let free_dofs = 3 * free_nodes;
+        // the node graph (natural order), its AMD ordering, then the graph in that order
+        let natural = node_graph(mesh, &free_of, free_nodes);
+        let (mut perm, mut place_of_free) = (vec![0u32; free_nodes], vec![0u32; free_nodes]);
+        {
+            let graph = SymbolicSparseColMat::new_checked(free_nodes, free_nodes, natural.0, None, natural.1);
+            let scratch = amd::order_scratch::<u32>(free_nodes, graph.compute_nnz());
+            let mut buffer = MemBuffer::try_new(scratch).map_err(|e| pattern(&e))?;
+            amd::order(
+                &mut perm,
+                &mut place_of_free,
+                graph.as_ref(),
+                amd::Control::default(),
+                MemStack::new(&mut buffer),
+            )
+            .map_err(|e| pattern(&e))?;
+        }
+        let place_of_node: Vec<u32> =
+            free_of.iter().map(|&k| if k == u32::MAX { u32::MAX } else { place_of_free[k as usize] }).collect();
+        let (node_col_ptr, node_rows) = node_graph(mesh, &place_of_node, free_nodes);
+        let node_col_ptr: Vec<usize> = node_col_ptr.iter().map(|&v| v as usize).collect();
+        // the scalar pattern, column by column
+        let mut col_ptr = Vec::with_capacity(free_dofs + 1);
+        col_ptr.push(0u32);
+        let mut row_idx: Vec<u32> = Vec::new();
+        for j in 0..free_nodes {
+            let rows = &node_rows[node_col_ptr[j]..node_col_ptr[j + 1]];
+            for b in 0..3 {
+                row_idx.extend((b..3).map(|a| (3 * j + a) as u32));
+                row_idx.extend(rows[1..].iter().flat_map(|&i| (0..3).map(move |a| 3 * i + a)));
+                col_ptr.push(u32::try_from(row_idx.len()).map_err(|e| pattern(&e))?);
+            }
+        }
+        let nnz = row_idx.len();
+        let symbolic = SymbolicSparseColMat::new_checked(free_dofs, free_dofs, col_ptr, None, row_idx);
+        // (faer's symbolic analysis without an ordering reads the upper triangle whatever side it
+        // is told, so it is given the transpose; the numeric one then takes the lower as it is)
+        let upper = transposed(free_dofs, symbolic.col_ptr(), symbolic.row_idx());
         let cholesky = factorize_symbolic_cholesky(
-            symbolic.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
+            upper.as_ref(),
+            Side::Upper,
+            SymmetricOrdering::Identity,
             CholeskySymbolicParams::default(),
         )
         .map_err(|e| pattern(&e))?;
+        drop(upper);
         let factor = vec![0.0; cholesky.len_val()];
-        Ok(Self { free_dofs, dof_of, symbolic, argsort, cholesky, factor, factored: false })
+        let cost = SparseCost {
+            pattern_secs: started.elapsed().as_secs_f64(),
+            matrix_nonzeros: nnz,
+            factor_nonzeros: cholesky.len_val(),
+            ..SparseCost::default()
+        };
+        Ok(Self {
+            free_dofs,
+            dof_of,
+            place_of_node,
+            place_of_free,
+            node_col_ptr,
+            node_rows,
+            symbolic,
+            values: vec![0.0; nnz],
+            cholesky,
+            factor,
+            factored: false,
+            cost,
+        })
+    }
+
+    /// The internal (eliminated-order) index of natural free DOF `d`.
+    fn place(&self, d: usize) -> usize {
+        3 * self.place_of_free[d / 3] as usize + d % 3
+    }
+
+    /// Adds one element's Hessian `he` (nodes `nodes`) to [`Self::values`].
+    fn add_element(&mut self, nodes: &[u32], he: &DMatrix<f64>) {
+        let col_ptr = self.symbolic.col_ptr();
+        for (lj, &nj) in nodes.iter().enumerate() {
+            let j = self.place_of_node[nj as usize];
+            if j == u32::MAX {
+                continue;
+            }
+            let rows = &self.node_rows[self.node_col_ptr[j as usize]..self.node_col_ptr[j as usize + 1]];
+            for (li, &ni) in nodes.iter().enumerate() {
+                let i = self.place_of_node[ni as usize];
+                if i == u32::MAX || i < j {
+                    continue;
+                }
+                let place = rows.binary_search(&i).expect("the pattern holds every element's node pairs");
+                for b in 0..3 {
+                    let col = 3 * j as usize + b;
+                    let column = &mut self.values[col_ptr[col] as usize..col_ptr[col + 1] as usize];
+                    // column 3j + b: its own node's rows 3j + b … 3j + 2 first, then three rows per
+                    // neighbour
+                    if place == 0 {
+                        for a in b..3 {
+                            column[a - b] += he[(3 * li + a, 3 * lj + b)];
+                        }
+                    } else {
+                        let from = (3 - b) + 3 * (place - 1);
+                        for a in 0..3 {
+                            column[from + a] += he[(3 * li + a, 3 * lj + b)];
+                        }
+                    }
+                }
+            }
+        }
     }
 
     /// Assembles `K` at `x` plus `diagonal` (one value per free DOF, or empty for none) and
     /// factors it with parallelism `par`. With `projected`, `∂P/∂F` is projected to positive
     /// semi-definite at each quadrature point (always factorisable where the body is held or
     /// the diagonal positive); without, `K` is the exact Hessian (Newton's quadratic
-    /// convergence), which may not be positive definite.
+    /// convergence), which may not be positive definite. The element Hessians are computed in
+    /// parallel, [`ASSEMBLY_CHUNK`] at a time, and added in mesh order (the same sums on any
+    /// number of threads).
     #[allow(clippy::too_many_arguments)]
     pub fn assemble_and_factor(
         &mut self,
@@ -89,35 +241,51 @@ impl SparsePattern {
         projected: bool,
         par: Par,
     ) -> Result<(), SparseError> {
+        use rayon::prelude::*;
         self.factored = false;
-        let dof_of = &self.dof_of;
-        let mut values = Vec::with_capacity(self.symbolic.compute_nnz());
-        let per_element = map_element_hessians(mesh, geo, material, x, projected, |nodes, he| {
-            let mut v = Vec::new();
-            for_each_element_entry(dof_of, nodes, |_, _, i, j| v.push(he[(i, j)]));
-            v
-        });
-        per_element.iter().for_each(|v| values.extend_from_slice(v));
-        if diagonal.is_empty() {
-            values.extend(std::iter::repeat_n(0.0, self.free_dofs));
-        } else {
-            values.extend_from_slice(diagonal);
+        let started = std::time::Instant::now();
+        self.values.iter_mut().for_each(|v| *v = 0.0);
+        for (b, g) in mesh.blocks.iter().zip(geo) {
+            for chunk_start in (0..b.len()).step_by(ASSEMBLY_CHUNK) {
+                let chunk = chunk_start..(chunk_start + ASSEMBLY_CHUNK).min(b.len());
+                let hessians: Vec<DMatrix<f64>> = chunk
+                    .clone()
+                    .into_par_iter()
+                    .with_min_len(16)
+                    .map(|e| element_hessian_at(mesh, g, e, b.element(e), material, x, projected))
+                    .collect();
+                for (e, he) in chunk.zip(&hessians) {
+                    self.add_element(b.element(e), he);
+                }
+            }
         }
-        let k = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, &values)
-            .map_err(|e| SparseError::Pattern(format!("{e:?}")))?;
+        if !diagonal.is_empty() {
+            // each column's first entry is its diagonal
+            for (d, value) in diagonal.iter().enumerate() {
+                let first = self.symbolic.col_ptr()[self.place(d)] as usize;
+                self.values[first] += value;
+            }
+        }
+        let k = SparseColMatRef::new(self.symbolic.as_ref(), &self.values);
+        let assembled = std::time::Instant::now();
+        self.cost.hessian_secs += (assembled - started).as_secs_f64();
+        self.cost.factorisations += 1;
         let scratch = self.cholesky.factorize_numeric_llt_scratch::<f64>(par, Default::default());
         let mut buffer = MemBuffer::try_new(scratch).map_err(|e| SparseError::Pattern(format!("{e:?}")))?;
-        self.cholesky
+        let outcome = self
+            .cholesky
             .factorize_numeric_llt(
                 &mut self.factor,
-                k.as_ref(),
+                k,
                 Side::Lower,
                 Default::default(),
                 par,
                 MemStack::new(&mut buffer),
                 Default::default(),
             )
-            .map_err(|_| SparseError::NotPositiveDefinite)?;
+            .map_err(|_| SparseError::NotPositiveDefinite);
+        self.cost.factor_secs += assembled.elapsed().as_secs_f64();
+        outcome?;
         self.factored = self.factor.iter().all(|v| v.is_finite());
         if self.factored { Ok(()) } else { Err(SparseError::NotPositiveDefinite) }
     }
@@ -130,7 +298,11 @@ impl SparsePattern {
     /// Solves `K s = r` in place with the last factor (which must exist).
     pub fn solve_in_place(&self, r: &mut [f64], par: Par) {
         debug_assert!(self.factored);
-        let mut rhs = faer::MatMut::from_column_major_slice_mut(r, self.free_dofs, 1);
+        let mut placed = vec![0.0; self.free_dofs];
+        for (d, v) in r.iter().enumerate() {
+            placed[self.place(d)] = *v;
+        }
+        let mut rhs = faer::MatMut::from_column_major_slice_mut(&mut placed, self.free_dofs, 1);
         let scratch = self.cholesky.solve_in_place_scratch::<f64>(1, par);
         let mut buffer = MemBuffer::new(scratch);
         LltRef::new(&self.cholesky, &self.factor).solve_in_place_with_conj(
@@ -139,29 +311,59 @@ impl SparsePattern {
             par,
             MemStack::new(&mut buffer),
         );
+        for (d, v) in r.iter_mut().enumerate() {
+            *v = placed[self.place(d)];
+        }
     }
 }
 
-/// Visits every lower-triangle entry of one element's Hessian that couples two free DOFs, in a
-/// fixed order: `(global row, global col, local row, local col)`.
-fn for_each_element_entry(dof_of: &[usize], nodes: &[u32], mut visit: impl FnMut(usize, usize, usize, usize)) {
-    for (li, &ni) in nodes.iter().enumerate() {
-        for a in 0..3 {
-            let row = dof_of[3 * ni as usize + a];
-            if row == usize::MAX {
-                continue;
-            }
-            for (lj, &nj) in nodes.iter().enumerate() {
-                for c in 0..3 {
-                    let col = dof_of[3 * nj as usize + c];
-                    if col == usize::MAX || row < col {
-                        continue;
+/// The pattern of the transpose of the `n × n` pattern `(col_ptr, row_idx)`, rows sorted.
+fn transposed(n: usize, col_ptr: &[u32], row_idx: &[u32]) -> SymbolicSparseColMat<u32> {
+    let mut ptr = vec![0u32; n + 1];
+    for &r in row_idx {
+        ptr[r as usize + 1] += 1;
+    }
+    for k in 0..n {
+        ptr[k + 1] += ptr[k];
+    }
+    let mut next: Vec<u32> = ptr[..n].to_vec();
+    let mut rows = vec![0u32; row_idx.len()];
+    for c in 0..n {
+        for &r in &row_idx[col_ptr[c] as usize..col_ptr[c + 1] as usize] {
+            rows[next[r as usize] as usize] = c as u32;
+            next[r as usize] += 1;
+        }
+    }
+    SymbolicSparseColMat::new_checked(n, n, ptr, None, rows)
+}
+
+/// The lower triangle of the free nodes' graph, the diagonal included, in the numbering
+/// `index[node]` (`u32::MAX` for a held node): `(col_ptr, rows)`, each column's rows sorted, its
+/// own node first.
+fn node_graph(mesh: &Mesh, index: &[u32], free_nodes: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut pairs: Vec<(u32, u32)> = (0..free_nodes as u32).map(|k| (k, k)).collect();
+    for block in &mesh.blocks {
+        for nodes in block.elements() {
+            for &a in nodes {
+                for &b in nodes {
+                    let (i, j) = (index[a as usize], index[b as usize]);
+                    if i != u32::MAX && j != u32::MAX && i > j {
+                        pairs.push((j, i));
                     }
-                    visit(row, col, 3 * li + a, 3 * lj + c);
                 }
             }
         }
     }
+    pairs.sort_unstable();
+    pairs.dedup();
+    let mut col_ptr = vec![0u32; free_nodes + 1];
+    for &(j, _) in &pairs {
+        col_ptr[j as usize + 1] += 1;
+    }
+    for k in 0..free_nodes {
+        col_ptr[k + 1] += col_ptr[k];
+    }
+    (col_ptr, pairs.into_iter().map(|(_, i)| i).collect())
 }
 
 /// Every element's Hessian at `x` (`projected`: PSD-projected per quadrature point), computed in

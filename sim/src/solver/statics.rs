@@ -17,6 +17,7 @@
 use super::error::SolverCounters;
 use super::newton_core::{Failure, HessianModel, Objective, Outcome, Scratch, minimise};
 use super::settings::NewtonSettings;
+pub use super::sparse::SparseCost;
 use super::sparse::{SparseError, SparsePattern};
 use crate::Vec3;
 use crate::effect::Prescribed;
@@ -61,6 +62,10 @@ pub struct StaticSolution {
     pub newton_iterations: usize,
     pub relative_residual: f64,
     pub free_dofs: usize,
+    /// Where the solve's time went: the sparse stiffness's share ([`SparseCost`]) and the rest
+    /// (energies and gradients of the line search, load stepping), wall seconds.
+    pub cost: SparseCost,
+    pub total_secs: f64,
 }
 
 /// Progress of a solve: `(load fraction reached, Newton iteration, relative residual)`.
@@ -68,6 +73,7 @@ pub type Progress<'p> = &'p mut dyn FnMut(f64, usize, f64);
 
 /// Solves `problem`. `progress` is called after every Newton iteration.
 pub fn solve(problem: &StaticProblem<'_>, progress: Progress<'_>) -> Result<StaticSolution, StaticError> {
+    let started = std::time::Instant::now();
     let mesh = problem.mesh;
     let geo = precompute(mesh, problem.quadrature_degree)?;
     let masses = lumped_masses_kg(mesh, problem.material.density_kg_m3)?;
@@ -120,6 +126,8 @@ pub fn solve(problem: &StaticProblem<'_>, progress: Progress<'_>) -> Result<Stat
         newton_iterations: total_iterations,
         relative_residual: last_residual,
         free_dofs,
+        cost: pattern.cost,
+        total_secs: started.elapsed().as_secs_f64(),
     })
 }
 
