@@ -11,7 +11,7 @@
 //! into its compressed columns in elimination order (no triplets, no sort, no permuted copy inside
 //! the factorisation), with `u32` indices; the element Hessians come from the two-stage,
 //! one-triangle kernel of `fem::energy`. On the 33,748-node P3 tube: 100,128 unknowns, a
-//! 52-million-entry factor (418 MB of the 599 MB the whole `hox static` takes at its peak).
+//! 52-million-entry factor (418 MB of the 577 MB the whole `hox static` takes at its peak).
 //! Nested dissection by coordinate bisection was tried for the ordering and filled 2–50 % more
 //! than AMD on every mesh of the project (session 22).
 
@@ -160,6 +160,7 @@ impl SparsePattern {
         )
         .map_err(|e| pattern(&e))?;
         drop(upper);
+        release_freed_memory();
         let factor = vec![0.0; cholesky.len_val()];
         let cost = SparseCost {
             pattern_secs: started.elapsed().as_secs_f64(),
@@ -314,6 +315,18 @@ impl SparsePattern {
         for (d, v) in r.iter_mut().enumerate() {
             *v = placed[self.place(d)];
         }
+    }
+}
+
+/// Hands the memory freed so far back to the system. glibc raises its threshold for mapping
+/// large blocks each time one is freed, so the pattern's scratch (the node graph, the transposed
+/// pattern: tens of MB at 100k unknowns) would stay resident under the factor made next; on
+/// other platforms nothing is done.
+fn release_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: `malloc_trim` only returns free pages of the allocator's heap to the system.
+    unsafe {
+        libc::malloc_trim(0);
     }
 }
 
