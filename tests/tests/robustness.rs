@@ -1339,14 +1339,11 @@ fn every_implicit_solver_on_inverted_starts() {
     let mut problems = mirrored_snh(
         &configs,
         &[
-            "p1 newton euler",
             "p2 vbd euler",
             "p2 vbd bdf2",
             "p2 newton euler",
-            "p2 newton newmark",
             "p2 newton bdf2",
             "p3 vbd newmark",
-            "p3 newton euler",
             "p3 newton newmark",
             "p3 newton bdf2",
             "q2 vbd bdf2",
@@ -1354,7 +1351,7 @@ fn every_implicit_solver_on_inverted_starts() {
             "q2 newton bdf2",
         ],
     );
-    problems.extend(corner_snh(&configs, &["p3 newton newmark"]));
+    problems.extend(corner_snh(&configs, &[]));
     problems.extend(mirrored_stvk(&configs, &[]));
     problems.extend(corner_stvk(
         &configs,
