@@ -1,7 +1,8 @@
 //! Per-frame work of a solver on a scene (issue #37: the curved parts): `part_profile SCENE
-//! SOLVER [ELEMENT] [FRAMES] [INTEGRATOR]` prints every frame's wall time with the solver's
+//! SOLVER [ELEMENT] [FRAMES] [INTEGRATOR] [settle]` prints every frame's wall time with the solver's
 //! counts (iterations or sweeps, factorisations, node updates), then the median, the 95th
-//! percentile and the share of the time in frames that refactorised.
+//! percentile and the share of the time in frames that refactorised. With `settle` the run adds
+//! the settle damping and stops when settled (at most FRAMES frames), as `hox simulate --settle`.
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let name = a.get(1).map_or("tube", String::as_str);
@@ -16,6 +17,9 @@ fn main() {
     }
     let scene = hox_scenes::by_name(name).unwrap().with_overrides(&o).unwrap();
     let mut inst = hox_scenes::Instance::new(scene).unwrap();
+    let mut settler = (a.get(6).map(String::as_str) == Some("settle"))
+        .then(|| hox_scenes::Settler::start(&mut inst, hox_scenes::SETTLE_CAP_SECS).unwrap());
+    let run_clock = std::time::Instant::now();
     println!("{name}: {} nodes, {} elements", inst.sim.mesh().num_nodes(), inst.sim.mesh().num_elements());
     let mut times = Vec::new();
     let (mut with_factor, mut total) = (0.0, 0.0);
@@ -35,6 +39,12 @@ fn main() {
         total += ms;
         if factors > 0 {
             with_factor += ms;
+        }
+        if let Some(s) = settler.as_mut() {
+            if s.check(&inst) != hox_scenes::SettleState::Running {
+                println!("settle ended at frame {f} ({:?}), {:.2} s wall", s.check(&inst), run_clock.elapsed().as_secs_f64());
+                break;
+            }
         }
     }
     let median = hox_sim::measure::median(&mut times.clone());
