@@ -16,6 +16,7 @@ mod list;
 mod mesh;
 mod record;
 mod reference;
+mod serve;
 mod simulate;
 mod statics;
 mod study;
@@ -142,6 +143,9 @@ pub enum Command {
     /// Run a lesson headlessly, step by step, printing each step's measurement; `--record`
     /// writes it as a Rerun file a student plays in the stock viewer.
     Lesson(Box<lesson::LessonArgs>),
+    /// Serve a recording (.rrd, e.g. from `hox record`) to browsers: students open the URL it
+    /// prints and play it in the Rerun web viewer, nothing to install.
+    Serve(Box<serve::ServeFileArgs>),
 }
 
 #[derive(Args)]
@@ -187,6 +191,7 @@ pub fn run(command: Command) -> Result<()> {
         Command::Inspect(args) => inspect::inspect(&args),
         Command::Lessons { json } => lesson::lessons(json),
         Command::Lesson(args) => lesson::lesson(&args),
+        Command::Serve(args) => serve::serve(&args),
     }
 }
 

@@ -16,7 +16,9 @@
 //! - `hox record` records a scene, or configurations side by side, to a Rerun file (.rrd);
 //! - `hox inspect` reads a Rerun recording back and lists its entities, components and frames;
 //! - `hox lessons` lists the built-in lessons;
-//! - `hox lesson` runs a lesson headlessly step by step, and records it with `--record`;
+//! - `hox lesson` runs a lesson headlessly step by step, and records it with `--record` or serves
+//!   it to browsers with `--serve-web`;
+//! - `hox serve` serves a recording (.rrd) to browsers with the Rerun web viewer (`web.rs`);
 //! - `hox app` opens the interactive app (the default when no command is given).
 //!
 //! The app's modules ("rooms") use each other in one order, `colour`, `output` → `config` →
@@ -33,6 +35,7 @@ mod display;
 mod gui;
 mod output;
 mod recording;
+mod web;
 
 use clap::{Parser, Subcommand};
 

@@ -52,6 +52,9 @@ pub struct LogSettings {
     /// Added to every frame's `frame` and `sim_time` (a lesson's step starts where the last
     /// one ended).
     pub time_offset: (i64, f64),
+    /// The blueprint shows a lesson's step text (`lesson/step`) above the legend (the app's
+    /// stream while a lesson is open).
+    pub lesson_text: bool,
 }
 
 impl LogSettings {
@@ -63,6 +66,7 @@ impl LogSettings {
             static_data: true,
             blueprint: true,
             time_offset: (0, 0.0),
+            lesson_text: false,
         }
     }
 }
@@ -119,6 +123,8 @@ pub struct Recorder {
     probe_names: Vec<String>,
     /// Added to the frame and time of every frame logged.
     time_offset: (i64, f64),
+    /// The blueprint's legend column starts with the lesson's step text.
+    lesson_text: bool,
 }
 
 /// A name usable as one entity path part: lowercase letters, digits and `_`.
@@ -401,7 +407,14 @@ impl Recorder {
             loggers.push(SimLogger::new(rec, k, c, settings, &fields)?);
         }
         let probe_names = first.map(|i| i.probes.iter().map(|p| p.name.clone()).collect()).unwrap_or_default();
-        let recorder = Recorder { loggers, fields, scales, probe_names, time_offset: settings.time_offset };
+        let recorder = Recorder {
+            loggers,
+            fields,
+            scales,
+            probe_names,
+            time_offset: settings.time_offset,
+            lesson_text: settings.lesson_text,
+        };
         for field in &recorder.fields {
             rec.log_static(format!("legend/{}/bar", field.name()), &colour_bar_image())?;
         }
@@ -520,9 +533,15 @@ impl Recorder {
         if let Some(s) = shares_3d.first_mut() {
             *s = 2.0;
         }
-        let mut legend: Vec<bp::ContainerLike> = vec![
+        let mut legend: Vec<bp::ContainerLike> = Vec::new();
+        if self.lesson_text {
+            legend.push(
+                bp::TextDocumentView::new("Lesson").with_origin("lesson/step").with_contents(["+ lesson/step"]).into(),
+            );
+        }
+        legend.push(
             bp::TextDocumentView::new("Legend").with_origin("legend/text").with_contents(["+ legend/text"]).into(),
-        ];
+        );
         for (field, scale) in self.fields.iter().zip(&self.scales) {
             legend.push(
                 bp::Spatial2DView::new(format!("colours: {}", scale.range().heading()))
@@ -531,7 +550,8 @@ impl Recorder {
                     .into(),
             );
         }
-        let legend_shares: Vec<f32> = std::iter::once(1.2).chain(self.fields.iter().map(|_| 1.0)).collect();
+        let text_views = if self.lesson_text { vec![1.6, 1.2] } else { vec![1.2] };
+        let legend_shares: Vec<f32> = text_views.into_iter().chain(self.fields.iter().map(|_| 1.0)).collect();
         let chart = |title: String, path: String| -> bp::ContainerLike {
             bp::TimeSeriesView::new(title).with_origin(path.as_str()).with_contents([format!("+ {path}/**")]).into()
         };

@@ -42,7 +42,11 @@ fn main() {
         }
         if let Some(s) = settler.as_mut() {
             if s.check(&inst) != hox_scenes::SettleState::Running {
-                println!("settle ended at frame {f} ({:?}), {:.2} s wall", s.check(&inst), run_clock.elapsed().as_secs_f64());
+                println!(
+                    "settle ended at frame {f} ({:?}), {:.2} s wall",
+                    s.check(&inst),
+                    run_clock.elapsed().as_secs_f64()
+                );
                 break;
             }
         }

@@ -27,6 +27,15 @@ pub struct LessonArgs {
     /// Print the measurements as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Serve the lesson to the class's browsers as it runs (the Rerun web viewer): students open
+    /// the address printed first and follow the steps live; it stays served until Ctrl-C.
+    #[arg(long, conflicts_with = "record")]
+    pub serve_web: bool,
+    /// With --serve-web: stop serving this many seconds after the last step (default: Ctrl-C).
+    #[arg(long, requires = "serve_web")]
+    pub serve_secs: Option<f64>,
+    #[command(flatten)]
+    pub serve: crate::web::ServeArgs,
 }
 
 /// `hox lessons`: every built-in lesson, its goal and steps.
@@ -95,6 +104,12 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
     if let Some(out) = &args.record {
         check_writable(out)?;
     }
+    if let Some(s) = args.serve_secs
+        && !(s.is_finite() && s >= 0.0)
+    {
+        anyhow::bail!("--serve-secs must be a finite, non-negative number of seconds, got {s}");
+    }
+    let mut web = None;
     let rec = match &args.record {
         Some(out) => Some(
             rerun::RecordingStreamBuilder::new("hox")
@@ -102,6 +117,15 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
                 .save(out)
                 .with_context(|| format!("cannot write {}", out.display()))?,
         ),
+        None if args.serve_web => {
+            let (rec, server) = crate::web::serve_recording(&format!("hox lesson {}", lesson.name), &args.serve)?;
+            if !args.json {
+                println!("{}", server.url);
+            }
+            eprintln!("serving the lesson to the class's browsers: open {}", server.url);
+            web = Some(server);
+            Some(rec)
+        }
         None => None,
     };
     if let Some(rec) = &rec {
@@ -145,18 +169,26 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
             "texts": measured.iter().map(|m| m.text.clone()).collect::<Vec<_>>(),
         }));
     }
-    if let Some(rec) = rec {
+    if let Some(rec) = &rec {
         rec.flush_blocking().context("cannot finish the recording")?;
     }
+    let url = web.as_ref().map(|w| w.url.clone());
     if args.json {
         println!(
             "{}",
-            serde_json::json!({ "lesson": lesson.name, "title": lesson.title, "steps": report, "file": args.record })
+            serde_json::json!({ "lesson": lesson.name, "title": lesson.title, "steps": report, "file": args.record, "url": url })
         );
     } else if let Some(out) = &args.record {
         println!("{}: the lesson's {} steps, one after the other on the timeline", out.display(), lesson.steps.len());
         println!("play it with the stock Rerun viewer 0.36.3: scripts/rerun.sh {}", out.display());
     }
+    if web.is_some() {
+        match args.serve_secs {
+            Some(s) => std::thread::sleep(std::time::Duration::from_secs_f64(s)),
+            None => crate::web::wait_for_ctrl_c("the lesson is done and still served")?,
+        }
+    }
+    drop(rec);
     Ok(())
 }
 

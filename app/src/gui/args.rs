@@ -69,6 +69,12 @@ pub struct AppArgs {
     /// Do not wait for the display's vertical sync (frame-rate measurements).
     #[arg(long)]
     pub no_vsync: bool,
+    /// Serve what the app shows to the class's browsers (the Rerun web viewer): students open
+    /// the address printed (and shown with a QR code in presenter mode) and follow live.
+    #[arg(long)]
+    pub serve_web: bool,
+    #[command(flatten)]
+    pub serve: crate::web::ServeArgs,
 }
 
 /// The app's options from command-line words (the UI tests start the app as a teacher would).

@@ -4,6 +4,7 @@
 //! what the change invalidates.
 
 use super::config::Config;
+use super::rerun_link::RerunTarget;
 use super::{HoxApp, SceneSource};
 use eframe::egui;
 use hox_scenes::params::{self, Group, Kind, Param, Value};
@@ -479,10 +480,10 @@ fn rerun_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         let l = label(ui, "File", "An .rrd file to save the recording to.");
         ui.add_enabled(!on, egui::TextEdit::singleline(&mut app.rerun_file).desired_width(200.0)).labelled_by(l.id);
     });
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         if on {
             if ui.button("Stop Rerun").clicked() {
-                app.set_rerun(false, false);
+                app.set_rerun(None);
             }
         } else {
             if ui
@@ -490,15 +491,32 @@ fn rerun_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 .on_hover_text("Log every simulated frame to the viewer at the URL above.")
                 .clicked()
             {
-                app.set_rerun(true, false);
+                app.set_rerun(Some(RerunTarget::Viewer));
             }
             if ui.button("Save to file").on_hover_text("Log every simulated frame to the .rrd file above.").clicked() {
-                app.set_rerun(true, true);
+                app.set_rerun(Some(RerunTarget::File));
+            }
+            let bind = app.serve.bind;
+            if ui
+                .button("Serve to browsers")
+                .on_hover_text(format!(
+                    "Serve the Rerun web viewer on {bind} (--bind names another address, e.g. 0.0.0.0 for the \
+                     classroom network): students open the address shown below and follow live, nothing to install."
+                ))
+                .clicked()
+            {
+                app.set_rerun(Some(RerunTarget::Browsers));
             }
         }
     });
     if let Some(t) = app.rerun_target() {
         ui.label(format!("Rerun: {t}"));
+    }
+    if let Some(url) = app.web_url() {
+        let url = url.to_string();
+        if ui.button("Copy the address").clicked() {
+            ui.ctx().copy_text(url);
+        }
     }
 }
 

@@ -12,7 +12,7 @@ use eframe::egui;
 use hox_scenes::lesson::{Lesson, Measure, Measured, Run};
 
 /// What the panel and the caption say while a step is prepared.
-const PREPARING: &str = "Preparing this step: building its meshes and solving what it needs…";
+pub(super) const PREPARING: &str = "Preparing this step: building its meshes and solving what it needs…";
 
 /// Interface scale of presenter mode.
 pub const PRESENTER_ZOOM: f32 = 1.6;

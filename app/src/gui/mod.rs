@@ -30,6 +30,7 @@ pub mod raster;
 pub mod readout;
 mod rerun_link;
 mod run;
+mod serve_web;
 pub mod session;
 pub mod study_chart;
 pub mod teach;
@@ -73,6 +74,8 @@ pub struct HoxApp {
     pub probe_axes: Option<[bool; 3]>,
     pub rerun_url: String,
     pub rerun_file: String,
+    /// Where the class's browsers are served (`--bind`, the ports, the history bound).
+    pub serve: crate::web::ServeArgs,
     rerun: Option<RerunLink>,
     generation: u64,
     /// Text being edited in numeric fields, by control.
@@ -144,6 +147,7 @@ impl HoxApp {
                 .as_ref()
                 .map_or_else(|| "rerun+http://127.0.0.1:9876/proxy".into(), |s| s.rerun_url.clone()),
             rerun_file: saved.as_ref().map_or_else(|| "hox.rrd".into(), |s| s.rerun_file.clone()),
+            serve: args.serve.clone(),
             rerun: None,
             generation: 0,
             edits: Default::default(),
@@ -197,6 +201,9 @@ impl HoxApp {
         }
         if args.presenter {
             app.set_presenter(true);
+        }
+        if args.serve_web {
+            app.serve_web_at_start();
         }
         if app.measure.is_some() {
             app.playback.playing = true;

@@ -173,6 +173,7 @@ impl HoxApp {
             });
         }
         super::lesson::welcome_ui(self, &ctx);
+        super::serve_web::address_ui(self, &ctx);
         if self.show_reference_element {
             let mut open = true;
             egui::Window::new("Reference element")

@@ -1,0 +1,250 @@
+//! Serving what hox shows to browsers (issue #38): the Rerun web viewer (the pre-built
+//! WebAssembly viewer of rerun 0.36.3, packed by `app/build.rs` and embedded in the binary) over
+//! HTTP, and the data over Rerun's gRPC proxy, to which each browser connects. Used by
+//! `hox app --serve-web` (and the app's Rerun section), `hox lesson NAME --serve-web` and
+//! `hox serve FILE.rrd`.
+//!
+//! - **Safe by default:** both servers listen on the loopback address (127.0.0.1) unless
+//!   `--bind` names another (`0.0.0.0`: every network of this machine). The simulation never
+//!   reads from the servers: a browser orbits, scrubs and hovers its own copy of the data.
+//! - **Clear refusals:** a port in use or an address that is not this machine's is refused by
+//!   name before anything starts; a browser that closes is nothing to the server.
+//! - **Bounded memory:** the gRPC proxy keeps at most [`ServeArgs::history_mb`] of history for
+//!   browsers that connect late (Rerun's `ServerOptions::memory_limit`); beyond it the oldest
+//!   frames are dropped (static data — topology, rest shape, labels, blueprint — never is).
+//! - **The address students open:** on the loopback address, `http://127.0.0.1:PORT`; bound to
+//!   every network, this machine's address on the network of its default route (found by
+//!   asking the system which local address would reach a public one: nothing is sent).
+use anyhow::{Context, Result, bail};
+use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener, UdpSocket};
+use std::path::PathBuf;
+
+/// The web viewer's files (`app/build.rs`): a zip archive, empty when the build did not find
+/// them.
+static VIEWER_ARCHIVE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/web_viewer.zip"));
+
+/// Where and how to serve (`--bind`, `--web-port`, `--grpc-port`, `--history-mb`).
+#[derive(Clone, Debug, clap::Args)]
+pub struct ServeArgs {
+    /// Address to listen on: 127.0.0.1 (this machine only) unless another is named, e.g.
+    /// 0.0.0.0 for every network of this machine (a classroom's).
+    #[arg(long, default_value = "127.0.0.1")]
+    pub bind: IpAddr,
+    /// Port of the web page students open (0: any free port).
+    #[arg(long, default_value_t = 9090)]
+    pub web_port: u16,
+    /// Port of the data stream the page connects to (0: any free port).
+    #[arg(long, default_value_t = 9876)]
+    pub grpc_port: u16,
+    /// History kept for browsers that connect late, MB: beyond it the oldest frames are dropped
+    /// (static data never is).
+    #[arg(long, default_value_t = 256)]
+    pub history_mb: u64,
+}
+
+impl Default for ServeArgs {
+    fn default() -> Self {
+        ServeArgs { bind: IpAddr::V4(Ipv4Addr::LOCALHOST), web_port: 9090, grpc_port: 9876, history_mb: 256 }
+    }
+}
+
+/// The web viewer's HTTP server; it stops when dropped. The gRPC server lives in the recording
+/// stream's sink ([`serve_recording`]) or in [`serve_messages`]'s.
+pub struct WebServer {
+    _http: re_web_viewer_server::WebViewerServer,
+    /// What students open: the page with the data stream's address in it.
+    pub url: String,
+    /// The bound on the history kept for late browsers, bytes.
+    pub history_bytes: u64,
+}
+
+/// A port to listen on: `port` itself if it is free on `ip`, any free one for 0; a clear error
+/// otherwise.
+fn free_port(ip: IpAddr, port: u16, what: &str, flag: &str) -> Result<u16> {
+    let listener = TcpListener::bind(SocketAddr::new(ip, port)).map_err(|e| {
+        let why = match e.kind() {
+            std::io::ErrorKind::AddrInUse => "the port is in use (another hox, or another program)".to_string(),
+            std::io::ErrorKind::AddrNotAvailable => format!("{ip} is not an address of this machine"),
+            std::io::ErrorKind::PermissionDenied => "permission denied (ports below 1024 need root)".to_string(),
+            _ => e.to_string(),
+        };
+        anyhow::anyhow!(
+            "cannot serve the {what} on {ip}:{port}: {why}; choose another with {flag}, or 0 for any free port"
+        )
+    })?;
+    Ok(listener.local_addr().map(|a| a.port()).unwrap_or(port))
+}
+
+/// The host name browsers reach the servers by (module docs).
+fn public_host(bind: IpAddr) -> String {
+    let ip = if bind.is_unspecified() { default_route_address().unwrap_or(bind) } else { bind };
+    match ip {
+        IpAddr::V4(v4) if v4.is_unspecified() => "127.0.0.1".into(),
+        IpAddr::V4(v4) => v4.to_string(),
+        IpAddr::V6(v6) if v6.is_unspecified() => "[::1]".into(),
+        IpAddr::V6(v6) => format!("[{v6}]"),
+    }
+}
+
+/// This machine's address on the network of its default route: a UDP socket "connected" to a
+/// public address sends nothing, but the system picks the local address it would use.
+fn default_route_address() -> Option<IpAddr> {
+    let socket = UdpSocket::bind("0.0.0.0:0").ok()?;
+    socket.connect("192.0.2.1:9").ok()?;
+    socket.local_addr().ok().map(|a| a.ip()).filter(|ip| !ip.is_unspecified())
+}
+
+/// `rerun+http://HOST:PORT/proxy` percent-encoded for the page's `url=` parameter (every byte
+/// but ASCII letters and digits, as the web viewer's own helper does).
+fn percent_encoded(s: &str) -> String {
+    s.bytes().map(|b| if b.is_ascii_alphanumeric() { (b as char).to_string() } else { format!("%{b:02X}") }).collect()
+}
+
+/// The embedded archive written where the web server can read it (once per version and size).
+fn viewer_archive() -> Result<PathBuf> {
+    if VIEWER_ARCHIVE.is_empty() {
+        bail!(
+            "this hox was built without the Rerun web viewer's files (the build did not find \
+             re_web_viewer_server-0.36.3/web_viewer; rebuild with HOX_WEB_VIEWER_DIR naming it)"
+        );
+    }
+    let path =
+        std::env::temp_dir().join(format!("hox-{}-web-viewer-{}.zip", env!("CARGO_PKG_VERSION"), VIEWER_ARCHIVE.len()));
+    let current = std::fs::metadata(&path).map(|m| m.len() == VIEWER_ARCHIVE.len() as u64).unwrap_or(false);
+    if !current {
+        let partial = path.with_extension(format!("zip.{}", std::process::id()));
+        std::fs::write(&partial, VIEWER_ARCHIVE)
+            .and_then(|()| std::fs::rename(&partial, &path))
+            .with_context(|| format!("cannot write the web viewer's files to {}", path.display()))?;
+    }
+    Ok(path)
+}
+
+/// The gRPC server's options: the history bound, and the page's origin allowed where it is not
+/// the loopback address (the proxy admits only localhost's by default).
+fn server_options(args: &ServeArgs, host: &str, web_port: u16) -> rerun::ServerOptions {
+    let mut cors_allowed_origins = vec![format!("http://{host}:{web_port}")];
+    if args.bind.is_unspecified() {
+        // reached by another of this machine's names or addresses
+        cors_allowed_origins.push(format!("http://*:{web_port}"));
+    }
+    rerun::ServerOptions {
+        playback_behavior: rerun::PlaybackBehavior::OldestFirst,
+        memory_limit: rerun::MemoryLimit::from_bytes(args.history_mb.saturating_mul(1_000_000)),
+        cors_allowed_origins,
+    }
+}
+
+/// Checks the ports, starts the web viewer's server, and returns it with the gRPC address to
+/// serve on and the gRPC server's options.
+fn start_http(args: &ServeArgs) -> Result<(WebServer, u16, rerun::ServerOptions)> {
+    if args.history_mb == 0 {
+        bail!("--history-mb must be at least 1 (the static data alone needs room)");
+    }
+    let archive = viewer_archive()?;
+    let grpc_port = free_port(args.bind, args.grpc_port, "data stream", "--grpc-port")?;
+    let web_port = free_port(args.bind, args.web_port, "web page", "--web-port")?;
+    if grpc_port == web_port {
+        bail!("--web-port and --grpc-port must differ (both are {web_port})");
+    }
+    let http = re_web_viewer_server::WebViewerServer::with_archive(
+        &args.bind.to_string(),
+        re_web_viewer_server::WebViewerServerPort(web_port),
+        Some(&archive),
+    )
+    .map_err(|e| anyhow::anyhow!("cannot serve the web page on {}:{web_port}: {e}", args.bind))?;
+    let host = public_host(args.bind);
+    let grpc = format!("rerun+http://{host}:{grpc_port}/proxy");
+    let url = format!("http://{host}:{web_port}/?url={}", percent_encoded(&grpc));
+    let options = server_options(args, &host, web_port);
+    let history_bytes = options.memory_limit.as_bytes();
+    Ok((WebServer { _http: http, url, history_bytes }, grpc_port, options))
+}
+
+/// A recording stream named `name` whose data every browser at [`WebServer::url`] sees live.
+pub fn serve_recording(name: &str, args: &ServeArgs) -> Result<(rerun::RecordingStream, WebServer)> {
+    let (web, grpc_port, options) = start_http(args)?;
+    let rec = rerun::RecordingStreamBuilder::new("hox")
+        .recording_name(name)
+        .serve_grpc_opts(args.bind.to_string(), grpc_port, options)
+        .with_context(|| format!("cannot serve the data stream on {}:{grpc_port}", args.bind))?;
+    Ok((rec, web))
+}
+
+/// A gRPC server fed with `messages` as they come (a recording read from a file), and the web
+/// viewer pointing at it.
+pub fn serve_messages(
+    args: &ServeArgs,
+    messages: impl Iterator<Item = Result<rerun::log::LogMsg>>,
+) -> Result<(rerun::grpc_server::GrpcServerSink, WebServer, usize)> {
+    use rerun::sink::LogSink as _;
+    let (web, grpc_port, options) = start_http(args)?;
+    let sink = rerun::grpc_server::GrpcServerSink::new(&args.bind.to_string(), grpc_port, options)
+        .with_context(|| format!("cannot serve the data stream on {}:{grpc_port}", args.bind))?;
+    let mut count = 0;
+    for msg in messages {
+        sink.send(msg?);
+        count += 1;
+    }
+    Ok((sink, web, count))
+}
+
+/// The URL as a QR code: `modules[row * width + column]` is dark.
+pub fn qr_modules(url: &str) -> Option<(usize, Vec<bool>)> {
+    let code = qrcode::QrCode::new(url.as_bytes()).ok()?;
+    let width = code.width();
+    let modules = code.to_colors().into_iter().map(|c| c == qrcode::Color::Dark).collect();
+    Some((width, modules))
+}
+
+/// Waits for Ctrl-C (the servers keep running meanwhile).
+pub fn wait_for_ctrl_c(what: &str) -> Result<()> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    ctrlc::set_handler(move || {
+        let _ = tx.send(());
+    })
+    .context("cannot watch for Ctrl-C")?;
+    eprintln!("{what}: Ctrl-C to stop");
+    let _ = rx.recv();
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_port_in_use_is_refused_by_name() {
+        let held = TcpListener::bind("127.0.0.1:0").unwrap();
+        let port = held.local_addr().unwrap().port();
+        let args = ServeArgs { web_port: port, grpc_port: 0, ..ServeArgs::default() };
+        let e = start_http(&args).err().expect("a port in use").to_string();
+        assert!(e.contains(&format!("127.0.0.1:{port}")) && e.contains("in use") && e.contains("--web-port"), "{e}");
+    }
+
+    #[test]
+    fn an_address_not_of_this_machine_is_refused_by_name() {
+        let args = ServeArgs { bind: "192.0.2.7".parse().unwrap(), web_port: 0, grpc_port: 0, ..ServeArgs::default() };
+        let e = start_http(&args).err().expect("a foreign address").to_string();
+        assert!(e.contains("192.0.2.7") && e.contains("not an address of this machine"), "{e}");
+    }
+
+    #[test]
+    fn the_page_names_the_data_stream_it_reads() {
+        let args = ServeArgs { web_port: 0, grpc_port: 0, ..ServeArgs::default() };
+        let (web, grpc_port, options) = start_http(&args).unwrap();
+        let expected = percent_encoded(&format!("rerun+http://127.0.0.1:{grpc_port}/proxy"));
+        assert!(web.url.starts_with("http://127.0.0.1:") && web.url.ends_with(&expected), "{}", web.url);
+        assert_eq!(web.history_bytes, 256_000_000);
+        assert_eq!(options.memory_limit.as_bytes(), 256_000_000);
+    }
+
+    #[test]
+    fn the_url_fits_a_qr_code() {
+        let (width, modules) =
+            qr_modules("http://192.168.100.200:9090/?url=rerun%2Bhttp%3A%2F%2F192%2E168%2E100%2E200%3A9876%2Fproxy")
+                .unwrap();
+        assert_eq!(modules.len(), width * width);
+        assert!(modules.iter().any(|&m| m) && modules.iter().any(|&m| !m));
+    }
+}

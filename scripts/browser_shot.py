@@ -1,0 +1,215 @@
+#!/usr/bin/env python3
+"""Screenshots of a web page as a student's browser shows it: headless Chromium (Debian's
+package, installed by scripts/setup.sh --browser) with software WebGL (SwiftShader), driven
+over the DevTools protocol with the standard library only (no pip package).
+
+    scripts/browser_shot.py URL OUT.png [--size 1280x720] [--wait 20] [--shots 1] [--every 5]
+
+Opens URL, waits --wait seconds (the Rerun web viewer compiles 42 MB of WebAssembly first),
+then writes --shots screenshots --every seconds apart: OUT.png, or OUT-1.png, OUT-2.png, ...
+when there are several. The page's console errors are printed to stderr. Exit 0 when every
+screenshot was written."""
+
+import argparse
+import base64
+import json
+import os
+import shutil
+import socket
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+
+
+class WebSocket:
+    """The client side of RFC 6455, text frames only: what the DevTools protocol needs."""
+
+    def __init__(self, url):
+        assert url.startswith("ws://")
+        host_port, path = url[5:].split("/", 1)
+        host, port = host_port.split(":")
+        self.sock = socket.create_connection((host, int(port)), timeout=120)
+        key = base64.b64encode(os.urandom(16)).decode()
+        request = (
+            f"GET /{path} HTTP/1.1\r\nHost: {host_port}\r\nUpgrade: websocket\r\n"
+            f"Connection: Upgrade\r\nSec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n\r\n"
+        )
+        self.sock.sendall(request.encode())
+        response = b""
+        while b"\r\n\r\n" not in response:
+            chunk = self.sock.recv(4096)
+            if not chunk:
+                raise RuntimeError("the browser closed the DevTools connection")
+            response += chunk
+        if b" 101 " not in response.split(b"\r\n")[0]:
+            raise RuntimeError(f"DevTools handshake refused: {response[:200]!r}")
+        self.buffer = response.split(b"\r\n\r\n", 1)[1]
+
+    def send(self, text):
+        data = text.encode()
+        header = bytes([0x81])
+        n = len(data)
+        if n < 126:
+            header += bytes([0x80 | n])
+        elif n < 65536:
+            header += bytes([0x80 | 126]) + struct.pack(">H", n)
+        else:
+            header += bytes([0x80 | 127]) + struct.pack(">Q", n)
+        mask = os.urandom(4)
+        self.sock.sendall(header + mask + bytes(b ^ mask[i % 4] for i, b in enumerate(data)))
+
+    def _frame(self):
+        """One whole frame from the buffer (reading more as needed), or raises the socket's
+        timeout with the buffer intact: a wait that times out mid-frame loses nothing."""
+        while True:
+            b = self.buffer
+            if len(b) >= 2:
+                n, at = b[1] & 0x7F, 2
+                if n == 126 and len(b) >= 4:
+                    n, at = struct.unpack(">H", b[2:4])[0], 4
+                elif n == 127 and len(b) >= 10:
+                    n, at = struct.unpack(">Q", b[2:10])[0], 10
+                if (b[1] & 0x7F) < 126 or at > 2:
+                    if len(b) >= at + n:
+                        self.buffer = b[at + n :]
+                        return b[0], b[at : at + n]
+            chunk = self.sock.recv(1 << 20)
+            if not chunk:
+                raise RuntimeError("the browser closed the DevTools connection")
+            self.buffer += chunk
+
+    def recv(self):
+        message = b""
+        while True:
+            b0, payload = self._frame()
+            opcode = b0 & 0x0F
+            if opcode == 0x8:
+                raise RuntimeError("the browser closed the DevTools connection")
+            if opcode in (0x9, 0xA):
+                continue
+            message += payload
+            if b0 & 0x80:
+                return message.decode()
+
+
+class Page:
+    def __init__(self, ws):
+        self.ws = ws
+        self.next_id = 0
+        self.errors = []
+
+    def call(self, method, **params):
+        if os.environ.get("BROWSER_SHOT_DEBUG"):
+            print(f"{time.strftime('%X')} {method}", file=sys.stderr)
+        self.next_id += 1
+        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
+        while True:
+            msg = json.loads(self.ws.recv())
+            if msg.get("id") == self.next_id:
+                if "error" in msg:
+                    raise RuntimeError(f"{method}: {msg['error']}")
+                return msg.get("result", {})
+            self.note(msg)
+
+    def note(self, msg):
+        method = msg.get("method", "")
+        if method == "Runtime.exceptionThrown":
+            self.errors.append(msg["params"]["exceptionDetails"].get("text", "exception"))
+        elif method == "Runtime.consoleAPICalled" and msg["params"].get("type") == "error":
+            args = msg["params"].get("args", [])
+            self.errors.append(" ".join(str(a.get("value", a.get("description", ""))) for a in args))
+
+    def sleep(self, secs):
+        """Waits, reading the events meanwhile (a pause in the protocol stalls nothing)."""
+        end = time.time() + secs
+        while time.time() < end:
+            self.ws.sock.settimeout(max(0.05, end - time.time()))
+            try:
+                self.note(json.loads(self.ws.recv()))
+            except (socket.timeout, TimeoutError):
+                pass
+        self.ws.sock.settimeout(120)
+
+
+def chromium():
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        path = shutil.which(name)
+        if path:
+            return path
+    sys.exit("browser_shot: no Chromium found (scripts/setup.sh --browser installs Debian's)")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("url")
+    ap.add_argument("out")
+    ap.add_argument("--size", default="1280x720")
+    ap.add_argument("--wait", type=float, default=20.0)
+    ap.add_argument("--shots", type=int, default=1)
+    ap.add_argument("--every", type=float, default=5.0)
+    args = ap.parse_args()
+    width, height = (int(v) for v in args.size.split("x"))
+    profile = tempfile.mkdtemp(prefix="hox-chromium-")
+    browser = subprocess.Popen(
+        [
+            chromium(),
+            "--headless=new",
+            "--no-sandbox",
+            "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--no-first-run",
+            "--disable-extensions",
+            "--remote-debugging-port=0",
+            f"--user-data-dir={profile}",
+            f"--window-size={width},{height}",
+            "about:blank",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        port_file = os.path.join(profile, "DevToolsActivePort")
+        for _ in range(300):
+            if os.path.exists(port_file) and open(port_file).read().count("\n") >= 1:
+                break
+            time.sleep(0.1)
+        else:
+            sys.exit("browser_shot: Chromium did not start its DevTools server")
+        port = open(port_file).read().split("\n")[0].strip()
+        targets = json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list"))
+        page_target = next(t for t in targets if t.get("type") == "page")
+        page = Page(WebSocket(page_target["webSocketDebuggerUrl"]))
+        page.call("Runtime.enable")
+        page.call("Page.enable")
+        page.call("Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1, mobile=False)
+        page.call("Page.navigate", url=args.url)
+        page.sleep(args.wait)
+        base, ext = os.path.splitext(args.out)
+        for k in range(args.shots):
+            if k > 0:
+                page.sleep(args.every)
+            # the viewer paints only when something changes: a pointer move over the empty
+            # middle of its top bar makes it paint now, so the capture has a frame to take
+            for x in (width // 2, width // 2 + 1):
+                page.call("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=14)
+            shot = page.call("Page.captureScreenshot", format="png")
+            path = args.out if args.shots == 1 else f"{base}-{k + 1}{ext}"
+            with open(path, "wb") as f:
+                f.write(base64.b64decode(shot["data"]))
+            print(path)
+        for e in page.errors:
+            print(f"browser_shot: page error: {e}", file=sys.stderr)
+    finally:
+        browser.terminate()
+        try:
+            browser.wait(10)
+        except subprocess.TimeoutExpired:
+            browser.kill()
+        shutil.rmtree(profile, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
