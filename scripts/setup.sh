@@ -36,3 +36,25 @@ if [ -n "$missing" ]; then
 else
     echo "setup: GUI packages present"
 fi
+
+# The browser tests (app/tests/web.rs: what `--serve-web` and `hox serve` show, seen in a real
+# browser) use Debian's Chromium, headless with software WebGL (SwiftShader, built in), and
+# python3 (scripts/browser_shot.py: the standard library only). Installed when missing and root;
+# otherwise the browser tests say how to install it.
+browser_packages="chromium fonts-liberation python3"
+missing=""
+for p in $browser_packages; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        echo "setup: installing$missing (the browser tests)"
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing >/dev/null
+    else
+        echo "setup: the browser tests need these Debian packages:$missing" >&2
+        echo "setup: install them with: sudo apt-get install -y$missing" >&2
+    fi
+else
+    echo "setup: browser packages present"
+fi

@@ -36,6 +36,24 @@ use hox_sim::measure::surface::{PointMap, Surface};
 use rerun::RecordingStream;
 use rerun::blueprint as bp;
 
+pub mod eye;
+
+/// The bounding box of `instances`' rest shapes placed at `offsets`, metres (what a
+/// recording's 3D views open on: [`eye::send`]).
+pub fn bounds_of<'a>(placed: impl IntoIterator<Item = (&'a Instance, Vec3)>) -> Option<(Vec3, Vec3)> {
+    let mut out: Option<(Vec3, Vec3)> = None;
+    for (instance, offset) in placed {
+        for p in &instance.sim.mesh().rest_positions {
+            let q = p + offset;
+            out = Some(match out {
+                Some((lo, hi)) => (lo.inf(&q), hi.sup(&q)),
+                None => (q, q),
+            });
+        }
+    }
+    out
+}
+
 /// What to log besides the always-present surface, edges, probes and time series.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LogSettings {
@@ -420,7 +438,8 @@ impl Recorder {
         }
         fixed.log("legend/text", &rerun::TextDocument::from_markdown(recorder.legend_markdown(configs)))?;
         if settings.blueprint {
-            recorder.blueprint().send(rec, bp::BlueprintActivation { make_active: true, make_default: true })?;
+            let bounds = bounds_of(configs.iter().map(|c| (c.instance, c.offset_m)));
+            eye::send(rec, recorder.blueprint(), bounds)?;
         }
         Ok(recorder)
     }

@@ -69,7 +69,8 @@ const SCENES: &[&[&str]] =
     &[&["params"], &["scene"], &["run"], &["reference"], &["study"], &["bench"], &["lesson"], &["lib"]];
 
 /// The app's rooms (`hox`), lowest first: `cli` and `gui` share what both need through `config`.
-const APP: &[&[&str]] = &[&["colour", "output"], &["config"], &["display"], &["recording"], &["cli", "gui"], &["main"]];
+const APP: &[&[&str]] =
+    &[&["colour", "output", "web"], &["config"], &["display"], &["recording"], &["cli", "gui"], &["main"]];
 
 fn orders() -> [Order<'static>; 3] {
     [

@@ -129,7 +129,6 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
         None => None,
     };
     if let Some(rec) = &rec {
-        blueprint(&lesson).send(rec, bp::BlueprintActivation { make_active: true, make_default: true })?;
         name_series(rec, &lesson)?;
         rec.log_static(
             "lesson/goal",
@@ -146,6 +145,17 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
             bar.bar.set_message(format!("step {}: {what}", k + 1));
         };
         let mut runner = StepRunner::start(step, &mut progress)?;
+        if let (0, Some(rec)) = (k, &rec) {
+            // the layout, its 3D view on the first step's bodies as `record_step` places them
+            let first_mesh = runner.instances[0].sim.mesh().clone();
+            let offsets = crate::display::side_by_side_offsets(
+                &first_mesh,
+                runner.instances.len(),
+                crate::display::LayoutAxis::X,
+            );
+            let bounds = crate::recording::bounds_of(runner.instances.iter().zip(offsets.iter().copied()));
+            crate::recording::eye::send(rec, blueprint(&lesson), bounds)?;
+        }
         let measured = match &rec {
             Some(rec) => record_step(rec, &lesson, k, step, &mut runner, &mut offset, &mut progress)?,
             None => {
