@@ -40,15 +40,10 @@ fn main() {
         if factors > 0 {
             with_factor += ms;
         }
-        if let Some(s) = settler.as_mut() {
-            if s.check(&inst) != hox_scenes::SettleState::Running {
-                println!(
-                    "settle ended at frame {f} ({:?}), {:.2} s wall",
-                    s.check(&inst),
-                    run_clock.elapsed().as_secs_f64()
-                );
-                break;
-            }
+        let state = settler.as_mut().map(|s| s.check(&inst));
+        if let Some(state) = state.filter(|s| *s != hox_scenes::SettleState::Running) {
+            println!("settle ended at frame {f} ({state:?}), {:.2} s wall", run_clock.elapsed().as_secs_f64());
+            break;
         }
     }
     let median = hox_sim::measure::median(&mut times.clone());

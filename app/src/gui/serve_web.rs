@@ -50,33 +50,24 @@ impl LessonState {
     }
 }
 
-/// Presenter mode while serving: the address and its QR code over the 3D view's top right
-/// corner (dark modules on white, with the quiet zone a scanner needs).
-pub fn address_ui(app: &HoxApp, ctx: &egui::Context) {
-    let (true, Some(url)) = (app.presenter, app.web_url()) else { return };
+/// Presenter mode while serving: the address and its QR code in a narrow panel at the right of
+/// the 3D view (dark modules on white, with the quiet zone a scanner needs), beside the bodies,
+/// never over them (issue #35's rule: no text over a body).
+pub fn address_ui(app: &HoxApp, ui: &mut egui::Ui) {
+    let Some(url) = app.web_url() else { return };
     let Some((width, modules)) = crate::web::qr_modules(url) else { return };
-    let module = 4.0;
+    let side = ui.available_width().clamp(120.0, 220.0);
+    let module = (side / (width as f32 + 8.0)).floor().max(2.0);
     let quiet = 4.0 * module;
     let side = width as f32 * module + 2.0 * quiet;
-    egui::Area::new(egui::Id::unique("serve_web_address"))
-        .anchor(egui::Align2::RIGHT_TOP, egui::vec2(-12.0, 40.0))
-        .interactable(false)
-        .show(ctx, |ui| {
-            egui::Frame::popup(ui.style()).show(ui, |ui| {
-                ui.label(egui::RichText::new("Follow in your browser:").strong());
-                let (rect, _) = ui.allocate_exact_size(egui::vec2(side, side), egui::Sense::hover());
-                let painter = ui.painter_at(rect);
-                painter.rect_filled(rect, 0.0, egui::Color32::WHITE);
-                for (k, _) in modules.iter().enumerate().filter(|(_, dark)| **dark) {
-                    let (row, col) = ((k / width) as f32, (k % width) as f32);
-                    let min = rect.min + egui::vec2(quiet + col * module, quiet + row * module);
-                    painter.rect_filled(
-                        egui::Rect::from_min_size(min, egui::vec2(module, module)),
-                        0.0,
-                        egui::Color32::BLACK,
-                    );
-                }
-                ui.label(egui::RichText::new(url).monospace().small());
-            });
-        });
+    ui.label(egui::RichText::new("Follow in your browser:").strong());
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(side, side), egui::Sense::hover());
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(rect, 0.0, egui::Color32::WHITE);
+    for (k, _) in modules.iter().enumerate().filter(|(_, dark)| **dark) {
+        let (row, col) = ((k / width) as f32, (k % width) as f32);
+        let min = rect.min + egui::vec2(quiet + col * module, quiet + row * module);
+        painter.rect_filled(egui::Rect::from_min_size(min, egui::vec2(module, module)), 0.0, egui::Color32::BLACK);
+    }
+    ui.add(egui::Label::new(egui::RichText::new(url).monospace().small()).wrap());
 }

@@ -1029,3 +1029,29 @@ fn a_lesson_opens_on_the_step_asked_for() {
     let err = HoxApp::new(&args::parse_for_test(&["--lesson-step", "2"]), None).err().unwrap_or_default();
     assert!(err.contains("--lesson-step needs a lesson"), "{err}");
 }
+
+/// Issue #38: `hox app --serve-web` in presenter mode serves at once and shows the address with
+/// its QR code in a panel at the window's right edge (beside the bodies, never over them); a
+/// port in use is a message in the app, which runs on without serving.
+#[test]
+fn serving_browsers_shows_the_address_beside_the_view_and_a_busy_port_is_a_message() {
+    let free = crate::web::ServeArgs { web_port: 0, grpc_port: 0, ..Default::default() };
+    let args = AppArgs { presenter: true, serve_web: true, serve: free, ..Default::default() };
+    let mut h = harness(args);
+    h.run_steps(4);
+    let url = h.state().web_url().expect("serving from the start").to_string();
+    assert!(url.starts_with("http://127.0.0.1:") && url.contains("?url=rerun"), "{url}");
+    let qr = h.get_by_label("Follow in your browser:").rect();
+    let width = h.ctx.content_rect().width();
+    assert!(qr.min.x > width - 240.0, "the address panel sits at the right edge of {width} points: {qr:?}");
+    // a port in use: refused by name, the app runs on
+    let held = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = held.local_addr().unwrap().port();
+    let busy = crate::web::ServeArgs { web_port: port, grpc_port: 0, ..Default::default() };
+    let mut h = harness(AppArgs { serve_web: true, serve: busy, ..Default::default() });
+    h.run_steps(3);
+    assert!(h.state().web_url().is_none());
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains(&format!("127.0.0.1:{port}")) && message.contains("in use"), "{message}");
+    assert!(h.query_by_label("Follow in your browser:").is_none());
+}

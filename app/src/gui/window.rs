@@ -157,6 +157,13 @@ impl HoxApp {
         if self.presenter && self.lesson.is_some() {
             egui::Panel::bottom("caption").frame(frame).show(ui, |ui| super::lesson::caption_ui(self, ui));
         }
+        // presenter mode while serving the class's browsers: the address and its QR code beside
+        // the view
+        if self.presenter && self.web_url().is_some() {
+            egui::Panel::right("serve_web").frame(frame).resizable(false).default_size(230.0).show(ui, |ui| {
+                super::serve_web::address_ui(self, ui);
+            });
+        }
         if !self.presenter {
             egui::Panel::bottom("plots")
                 .frame(frame)
@@ -173,7 +180,6 @@ impl HoxApp {
             });
         }
         super::lesson::welcome_ui(self, &ctx);
-        super::serve_web::address_ui(self, &ctx);
         if self.show_reference_element {
             let mut open = true;
             egui::Window::new("Reference element")
