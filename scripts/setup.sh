@@ -16,45 +16,34 @@ if [ "$(printf '%s\n%s\n' "$need_rust" "$have" | sort -V | head -n1)" != "$need_
 fi
 echo "setup: rustc $have OK"
 
+# Installs the Debian packages named after $2 that are missing (as root), else says how;
+# $1 says what they are for.
+install_missing() {
+    local what="$1"
+    shift
+    local missing=""
+    for p in "$@"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+    done
+    if [ -z "$missing" ]; then
+        echo "setup: $what: packages present"
+    elif [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        echo "setup: installing$missing ($what)"
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing >/dev/null
+    else
+        echo "setup: $what needs these Debian packages:$missing" >&2
+        echo "setup: install them with: sudo apt-get install -y$missing" >&2
+    fi
+}
+
 # The app's window and its headless screenshots run under Xvfb with Mesa's software OpenGL; the
 # stock Rerun viewer needs Vulkan (lavapipe). Building needs none of these: all GUI libraries
 # are loaded at run time. Installed once, as root, from Debian's packages.
-gui_packages="xvfb xauth libgl1 libegl1 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6"
-missing=""
-for p in $gui_packages; do
-    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
-done
-if [ -n "$missing" ]; then
-    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        echo "setup: installing$missing"
-        apt-get update -qq
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing >/dev/null
-    else
-        echo "setup: the app's window needs these Debian packages:$missing" >&2
-        echo "setup: install them with: sudo apt-get install -y$missing" >&2
-    fi
-else
-    echo "setup: GUI packages present"
-fi
+install_missing "the app's window" xvfb xauth libgl1 libegl1 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
+    libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6
 
 # The browser tests (app/tests/web.rs: what `--serve-web` and `hox serve` show, seen in a real
 # browser) use Debian's Chromium, headless with software WebGL (SwiftShader, built in), and
-# python3 (scripts/browser_shot.py: the standard library only). Installed when missing and root;
-# otherwise the browser tests say how to install it.
-browser_packages="chromium fonts-liberation python3"
-missing=""
-for p in $browser_packages; do
-    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
-done
-if [ -n "$missing" ]; then
-    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        echo "setup: installing$missing (the browser tests)"
-        apt-get update -qq
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing >/dev/null
-    else
-        echo "setup: the browser tests need these Debian packages:$missing" >&2
-        echo "setup: install them with: sudo apt-get install -y$missing" >&2
-    fi
-else
-    echo "setup: browser packages present"
-fi
+# python3 (scripts/browser_shot.py: the standard library only).
+install_missing "the browser tests" chromium fonts-liberation python3

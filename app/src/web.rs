@@ -171,22 +171,20 @@ pub fn serve_recording(name: &str, args: &ServeArgs) -> Result<(rerun::Recording
     Ok((rec, web))
 }
 
-/// A gRPC server fed with `messages` as they come (a recording read from a file), and the web
-/// viewer pointing at it.
+/// A gRPC server holding `messages` (a recording read from a file), and the web viewer
+/// pointing at it.
 pub fn serve_messages(
     args: &ServeArgs,
-    messages: impl Iterator<Item = Result<rerun::log::LogMsg>>,
-) -> Result<(rerun::grpc_server::GrpcServerSink, WebServer, usize)> {
+    messages: Vec<rerun::log::LogMsg>,
+) -> Result<(rerun::grpc_server::GrpcServerSink, WebServer)> {
     use rerun::sink::LogSink as _;
     let (web, grpc_port, options) = start_http(args)?;
     let sink = rerun::grpc_server::GrpcServerSink::new(&args.bind.to_string(), grpc_port, options)
         .with_context(|| format!("cannot serve the data stream on {}:{grpc_port}", args.bind))?;
-    let mut count = 0;
     for msg in messages {
-        sink.send(msg?);
-        count += 1;
+        sink.send(msg);
     }
-    Ok((sink, web, count))
+    Ok((sink, web))
 }
 
 /// The URL as a QR code: `modules[row * width + column]` is dark.

@@ -32,7 +32,8 @@ pub fn serve(args: &ServeFileArgs) -> Result<()> {
     if messages.is_empty() {
         bail!("{} holds no Rerun messages", path.display());
     }
-    let (_sink, web, count) = serve_messages(&args.serve, messages.into_iter().map(Ok))?;
+    let count = messages.len();
+    let (_sink, web) = serve_messages(&args.serve, messages)?;
     println!("{}", web.url);
     eprintln!(
         "serving {} ({count} messages) to browsers at the URL above (history bound {} MB)",
