@@ -111,7 +111,15 @@ pub fn simulate(
     if settle && !report.settled {
         eprintln!("warning: {}", report.settle_summary());
     }
-    if report.unconverged_steps > 0 {
+    let budget = instance.scene.params().newton_iterations;
+    let budgeted = instance.scene.params().method.reads_parameter("newton_iterations")
+        && budget < hox_sim::solver::NewtonSettings::default().max_iterations as usize;
+    if report.unconverged_steps > 0 && budgeted {
+        eprintln!(
+            "note: {} {} steps ended at their budget of {budget} iterations (--newton-iterations) above the tolerance, their unbalanced force carried into the next step",
+            report.unconverged_steps, report.solver
+        );
+    } else if report.unconverged_steps > 0 {
         eprintln!(
             "warning: {} {} steps reached their iteration limit before the tolerance",
             report.unconverged_steps, report.solver

@@ -230,6 +230,12 @@ params! {
         help: "A Newton step has converged when its unbalanced force is at most this fraction of the load (the body force, or the reactions if larger), as `hox static` measures it; in (0, 1).",
         kind: Kind::Number { min: 0.0, min_inclusive: false, max: 1.0, max_inclusive: false, soft: None }, ..BASE
     }
+    /// Newton iterations per step at most.
+    newton_iterations: usize = solver().newton.max_iterations as usize => {
+        key: "newton-iterations", group: Group::Solver, file_key: "newton_iterations", label: "Newton iterations",
+        help: "Newton iterations per step at most (the implicit solvers of the Newton family). The default runs a step to its tolerance; a budget of 2 keeps a large part at the display's rate: a step left above the tolerance carries its unbalanced force into the next, so a swinging body lags slightly and a settled one is as exact as ever (docs/PERFORMANCE.md, session 24).",
+        kind: Kind::Whole { min: 1, max: 1000, soft_max: 50 }, ..BASE
+    }
     /// energy | split.
     #[serde(with = "as_text")]
     formulation: Formulation = solver().formulation => {

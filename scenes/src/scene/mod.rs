@@ -155,7 +155,11 @@ impl Scene {
                 init: p.vbd_init,
                 ..VbdSettings::default()
             },
-            newton: NewtonSettings { tolerance: p.newton_tolerance, ..Default::default() },
+            newton: NewtonSettings {
+                tolerance: p.newton_tolerance,
+                max_iterations: u32::try_from(p.newton_iterations).unwrap_or(u32::MAX),
+                ..Default::default()
+            },
         }
     }
 

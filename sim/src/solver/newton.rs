@@ -104,11 +104,17 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
         let settings = s.settings.newton;
         let bad = |node: usize| BadElement::at_node(s.mesh, node, ORIGIN_NEWTON);
         super::nan_guard::check_input(s.mesh, positions)?;
-        if self.pattern.is_none() || self.made_for != (s.model_version, s.inertia_h) {
-            let pattern = L::for_mesh(s.mesh, &|i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?;
-            self.pattern = Some(pattern);
-            self.made_for = (s.model_version, s.inertia_h);
+        match &mut self.pattern {
+            Some(pattern) if self.made_for.0 == s.model_version => {
+                if self.made_for.1 != s.inertia_h {
+                    // only the inertia's weight M/h̄² changed (a multistep integrator's first
+                    // steps): the same pattern, a new factor
+                    pattern.forget_model();
+                }
+            }
+            _ => self.pattern = Some(L::for_mesh(s.mesh, &|i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?),
         }
+        self.made_for = (s.model_version, s.inertia_h);
         let pattern = self.pattern.as_mut().expect("made above");
         self.y.clear();
         self.y.extend_from_slice(positions);

@@ -179,6 +179,9 @@ impl LinearSolver for ConjugateGradients {
     fn is_ready(&self) -> bool {
         self.ready
     }
+    fn forget_model(&mut self) {
+        self.ready = false;
+    }
 
     fn update(
         &mut self,
@@ -239,6 +242,7 @@ impl LinearSolver for ConjugateGradients {
                 x,
                 model.diagonal,
                 true,
+                false,
                 faer::Par::Seq,
             );
             counters.factorizations += 1;

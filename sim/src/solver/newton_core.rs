@@ -14,10 +14,28 @@
 //!   definite, for quadratic convergence, else `∂P/∂F` projected to positive semi-definite per
 //!   quadrature point).
 //! - **Factor reuse:** the numeric factor is kept between iterations (and, by the caller's
-//!   pattern, between steps) and refreshed at the current iterate when the residual falls by less
-//!   than 4× in an iteration or the line search had to cut the step;
+//!   pattern, between steps) and refreshed at the current iterate when the line search had to cut
+//!   the step, when the residual no longer halves, or when keeping it costs more than a refresh:
+//!   a refresh costs [`LinearSolver::refresh_cost_in_iterations`] iterations `R`; an iteration
+//!   whose residual fell by less than 4× (ratio `ρ`) predicts `n = ln(tol/r)/ln ρ` more kept-factor
+//!   iterations where a fresh factor needs about one, and the factor is refreshed when
+//!   `debt + n − 1 > R`, the debt being the iterations beyond two per minimisation spent with it
+//!   since its last refresh (a rent-or-buy rule: a factor that is always slightly slow is still
+//!   refreshed, after about `R` iterations' worth of slowness; issue #37: the fixed 4× rule
+//!   refactorised in frames a fresh factor took as many iterations as the kept one);
 //!   [`super::NewtonSettings::refactor_every_iteration`] refreshes it every iteration (pure
 //!   Newton).
+//! - **Quasi-Newton correction of the kept factor:** with an exact linear solver (the factor),
+//!   each accepted step's secant pair `(s, y)` (`y` the gradient's change) is kept, the last
+//!   [`SECANT_PAIRS`] of them since the factor was made, and the step is L-BFGS's two-loop
+//!   recursion with the factor's `K⁻¹` as its initial inverse Hessian (Nocedal & Wright §7.2;
+//!   Liu, Bouaziz & Kavan 2017, "Quasi-Newton methods for real-time simulation of hyperelastic
+//!   materials", ACM TOG 36(3), prefactor one matrix and correct it so). The pairs stay valid
+//!   across time steps, whose potentials differ by a linear term only. On the P2 tube settling,
+//!   the factorisations fell from 18 to 5 (docs/PERFORMANCE.md session 24).
+//! - **Precision:** a time step's factor (an inertia diagonal `D`) is single precision
+//!   (`sparse.rs`: half the solves' memory traffic), its error corrected by the iteration; a
+//!   static solve's stiffness alone keeps double precision.
 //! - **Line search:** halve `t` from 1 until `Φ` does not increase or, at `Φ`'s round-off floor,
 //!   the residual falls; below `t = 1e-8` the step is refused: with a reused factor the factor
 //!   is refreshed and the iteration retried, with a fresh one the method stops.
@@ -42,8 +60,19 @@ use crate::mesh::Mesh;
 /// The factorisation runs on one thread: results independent of the thread count.
 const SEQ: faer::Par = faer::Par::Seq;
 
-/// Residual decrease per iteration below which the kept factor is refreshed.
+/// Residual decrease per iteration at or below which the kept factor is kept without weighing.
 const SLOW_RATIO: f64 = 0.25;
+
+/// Residual decrease per iteration above which the kept factor is refreshed whatever it costs.
+const STALE_RATIO: f64 = 0.5;
+
+/// Secant pairs the quasi-Newton correction of the kept factor remembers.
+const SECANT_PAIRS: usize = 8;
+
+/// Iterations per minimisation a fresh factor takes at least (from a step's predictor to the
+/// tolerance); the first whole minimisation after a refresh tells how many it does take, and the
+/// iterations later ones take beyond that count as the kept factor's debt.
+const FRESH_ITERATIONS: usize = 2;
 
 /// Smallest line-search fraction tried before the step is refused.
 const MIN_STEP_FRACTION: f64 = 1e-8;
@@ -99,6 +128,9 @@ pub(crate) trait LinearSolver {
     fn free_dofs(&self) -> usize;
     /// Whether a model of `K` is held (so an iteration can start by solving).
     fn is_ready(&self) -> bool;
+    /// Drops the model of `K` (the potential changed, not the pattern: the next iteration remakes
+    /// it on the pattern kept).
+    fn forget_model(&mut self);
     /// Makes the model of `K` at `x`, counting its work in `counters`.
     fn update(
         &mut self,
@@ -109,6 +141,17 @@ pub(crate) trait LinearSolver {
     /// Solves `K s = r` in place with the last model; `relative_residual` is the Newton
     /// iteration's (an iterative solver's forcing term), ignored by an exact one.
     fn solve(&mut self, r: &mut [f64], relative_residual: f64, counters: &mut SolverCounters);
+    /// What remaking the model costs, in iterations with the kept one (the factor reuse rule of
+    /// the module docs). An estimate from counts, never a clock, so that runs are repeatable.
+    fn refresh_cost_in_iterations(&self) -> f64 {
+        1.0
+    }
+    /// Whether a solve applies one fixed linear operator (an exact factor's `K⁻¹`), so that the
+    /// kept model may be corrected by secant pairs (module docs); an iterative solver's varying
+    /// inexact solves are used as they come.
+    fn solves_exactly(&self) -> bool {
+        false
+    }
     /// A few words on its work for a status line ("12 factorisations").
     fn work_summary(counters: &SolverCounters) -> String
     where
@@ -128,6 +171,9 @@ impl LinearSolver for SparsePattern {
     fn is_ready(&self) -> bool {
         self.is_factored()
     }
+    fn forget_model(&mut self) {
+        self.forget_factor();
+    }
     /// The exact Hessian where it is positive definite, else the projected one.
     fn update(
         &mut self,
@@ -135,13 +181,42 @@ impl LinearSolver for SparsePattern {
         x: &[Vec3],
         counters: &mut SolverCounters,
     ) -> Result<(), SparseError> {
-        let exact = self.assemble_and_factor(model.mesh, model.geometry, model.material, x, model.diagonal, false, SEQ);
-        if exact.is_err() {
-            self.assemble_and_factor(model.mesh, model.geometry, model.material, x, model.diagonal, true, SEQ)?;
+        // with an inertia diagonal (a time step) the factor is kept in single precision, its
+        // error corrected by the iteration; a static solve's stiffness alone is too ill-conditioned
+        let single = !model.diagonal.is_empty();
+        let attempts: &[(bool, bool)] =
+            if single { &[(false, true), (true, true), (true, false)] } else { &[(false, false), (true, false)] };
+        let mut last = Err(SparseError::NotPositiveDefinite);
+        for &(projected, single) in attempts {
             counters.factorizations += 1;
+            last = self.assemble_and_factor(
+                model.mesh,
+                model.geometry,
+                model.material,
+                x,
+                model.diagonal,
+                projected,
+                single,
+                SEQ,
+            );
+            if last.is_ok() {
+                break;
+            }
         }
-        counters.factorizations += 1;
-        Ok(())
+        last
+    }
+    /// A factorisation's floating-point work grows as the factor's entries times its mean column
+    /// length, a solve's memory traffic as its entries: their ratio is the mean column length
+    /// over a rate measured on the P2 tube (4,911 nodes, 260 entries per column: in single
+    /// precision a factorisation 60–75 ms, an iteration with the kept factor 3.5–4.5 ms,
+    /// docs/PERFORMANCE.md session 24).
+    fn refresh_cost_in_iterations(&self) -> f64 {
+        const ENTRIES_PER_COLUMN_PER_ITERATION: f64 = 15.0;
+        let per_column = self.cost.factor_nonzeros as f64 / self.free_dofs.max(1) as f64;
+        (per_column / ENTRIES_PER_COLUMN_PER_ITERATION).max(2.0)
+    }
+    fn solves_exactly(&self) -> bool {
+        true
     }
     fn solve(&mut self, r: &mut [f64], _relative_residual: f64, _counters: &mut SolverCounters) {
         let started = std::time::Instant::now();
@@ -162,6 +237,86 @@ pub(crate) struct Scratch {
     step: Vec<f64>,
     /// The relative residual at the start of each iteration of the last minimisation.
     pub residuals: Vec<f64>,
+    /// Iterations spent with the kept factor beyond [`Self::fresh_iterations`] per minimisation
+    /// since it was made (the factor reuse rule of the module docs).
+    debt_iterations: f64,
+    /// The iterations of the first whole minimisation with the kept factor (at least
+    /// [`FRESH_ITERATIONS`]), `None` until one has ended.
+    fresh_iterations: Option<usize>,
+    /// The secant pairs gathered since the kept factor was made (module docs: the quasi-Newton
+    /// correction), oldest first.
+    pairs: SecantPairs,
+    /// The free gradient before the last accepted step.
+    grad_free: Vec<f64>,
+}
+
+/// Secant pairs `(s, y, 1/(s·y))` of the potential in free degrees of freedom (`s` an accepted
+/// step, `y` the gradient's change over it), for the two-loop recursion of L-BFGS (Nocedal &
+/// Wright §7.2, Algorithm 7.4) with the kept factor as the initial inverse Hessian.
+#[derive(Default)]
+pub(crate) struct SecantPairs {
+    pairs: std::collections::VecDeque<(Vec<f64>, Vec<f64>, f64)>,
+    alphas: Vec<f64>,
+}
+
+impl SecantPairs {
+    fn clear(&mut self) {
+        self.pairs.clear();
+    }
+
+    /// Adds `(s, y)` when it has positive curvature (`s·y > 0`, so the update stays positive
+    /// definite), dropping the oldest beyond [`SECANT_PAIRS`].
+    fn push(&mut self, s: &[f64], y: &[f64]) {
+        let sy: f64 = s.iter().zip(y).map(|(a, b)| a * b).sum();
+        let (ss, yy): (f64, f64) = (s.iter().map(|a| a * a).sum(), y.iter().map(|b| b * b).sum());
+        if !(sy > 1e-12 * (ss * yy).sqrt()) {
+            return;
+        }
+        let (mut s_kept, mut y_kept) = if self.pairs.len() == SECANT_PAIRS {
+            self.pairs.pop_front().map(|(a, b, _)| (a, b)).unwrap_or_default()
+        } else {
+            Default::default()
+        };
+        s_kept.clear();
+        s_kept.extend_from_slice(s);
+        y_kept.clear();
+        y_kept.extend_from_slice(y);
+        self.pairs.push_back((s_kept, y_kept, 1.0 / sy));
+    }
+
+    /// `q ← H q` with `H` the L-BFGS inverse over `solve` (the kept factor's `K⁻¹`).
+    fn apply(&mut self, q: &mut [f64], solve: &mut dyn FnMut(&mut [f64])) {
+        self.alphas.clear();
+        for (s, y, rho) in self.pairs.iter().rev() {
+            let alpha = rho * dot(s, q);
+            q.iter_mut().zip(y).for_each(|(v, yi)| *v -= alpha * yi);
+            self.alphas.push(alpha);
+        }
+        solve(q);
+        for ((s, y, rho), alpha) in self.pairs.iter().zip(self.alphas.iter().rev()) {
+            let beta = rho * dot(y, q);
+            q.iter_mut().zip(s).for_each(|(v, si)| *v += (alpha - beta) * si);
+        }
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Whether the kept factor should be refreshed after an iteration that reduced the residual
+/// from `old_norm` to `new_norm` with a full step, `target` being the converged residual and
+/// `refresh_cost` a refresh's cost in iterations (module docs).
+fn kept_factor_costs_more(old_norm: f64, new_norm: f64, target: f64, refresh_cost: f64, debt: f64) -> bool {
+    let ratio = new_norm / old_norm;
+    if new_norm <= target || ratio <= SLOW_RATIO {
+        return false;
+    }
+    if !(ratio < STALE_RATIO) {
+        return true;
+    }
+    let remaining = ((target / new_norm).ln() / ratio.ln()).ceil();
+    debt + remaining - 1.0 > refresh_cost
 }
 
 /// The body's size (the diagonal of its rest bounding box), for the stalled-step test.
@@ -214,24 +369,51 @@ pub(crate) fn minimise(
         return Err(Failure::NonFinite { node: 0 });
     }
     let mut refactor = settings.refactor_every_iteration || !linear.is_ready();
-    for _ in 0..settings.max_iterations {
-        let residual = norm(&scratch.grad) / load_scale(body_force_n, reactions);
+    let refresh_cost = linear.refresh_cost_in_iterations();
+    let correct_by_secants = linear.solves_exactly() && !settings.refactor_every_iteration;
+    if scratch.pairs.pairs.front().is_some_and(|(s, _, _)| s.len() != linear.free_dofs()) {
+        scratch.pairs.clear();
+    }
+    let mut solves = 0usize;
+    let mut refreshed_midway = false;
+    // the kept factor's debt grows by the iterations beyond a fresh factor's when a minimisation
+    // ends; the first one wholly with a fresh factor sets what a fresh factor's are
+    let settle_debt = |scratch: &mut Scratch, solves: usize, refreshed_midway: bool| match scratch.fresh_iterations {
+        None if !refreshed_midway => scratch.fresh_iterations = Some(solves.max(FRESH_ITERATIONS)),
+        None => {}
+        Some(fresh) => scratch.debt_iterations += solves.saturating_sub(fresh) as f64,
+    };
+    for iteration in 0..settings.max_iterations {
+        let scale = load_scale(body_force_n, reactions);
+        let residual = norm(&scratch.grad) / scale;
         scratch.residuals.push(residual);
         on_iteration(residual);
         if residual <= settings.tolerance {
+            settle_debt(scratch, solves, refreshed_midway);
             return Ok(Outcome::Converged { residual });
         }
         counters.solver_iterations += 1;
         if refactor {
             linear.update(model, x, counters).map_err(Failure::Factorisation)?;
+            scratch.debt_iterations = 0.0;
+            scratch.fresh_iterations = None;
+            scratch.pairs.clear();
+            refreshed_midway = solves > 0;
         }
+        solves += 1;
         let step = &mut scratch.step;
+        scratch.grad_free.resize(step.len(), 0.0);
         for (dof, &k) in linear.dof_of().iter().enumerate() {
             if k != usize::MAX {
+                scratch.grad_free[k] = scratch.grad[dof / 3][dof % 3];
                 step[k] = -scratch.grad[dof / 3][dof % 3];
             }
         }
-        linear.solve(step, residual, counters);
+        if correct_by_secants {
+            scratch.pairs.apply(step, &mut |q| linear.solve(q, residual, counters));
+        } else {
+            linear.solve(step, residual, counters);
+        }
         // backtracking on Φ: accept a decrease of Φ or, at its round-off floor, of the residual
         let mut t = 1.0;
         let mut accepted = false;
@@ -262,6 +444,16 @@ pub(crate) fn minimise(
         }
         x.copy_from_slice(&scratch.trial);
         std::mem::swap(&mut scratch.grad, &mut scratch.trial_grad);
+        if correct_by_secants {
+            // s = t Δ, y = ∇Φ(x + s) − ∇Φ(x), in free degrees of freedom (grad_free becomes y)
+            for (dof, &k) in linear.dof_of().iter().enumerate() {
+                if k != usize::MAX {
+                    scratch.grad_free[k] = scratch.grad[dof / 3][dof % 3] - scratch.grad_free[k];
+                }
+            }
+            step.iter_mut().for_each(|v| *v *= t);
+            scratch.pairs.push(step, &scratch.grad_free);
+        }
         // a full step that moves nothing and no longer reduces the residual: the iterate is the
         // minimiser to round-off (a step the line search cut short, or one that still reduces
         // the residual, says nothing of the kind)
@@ -269,10 +461,19 @@ pub(crate) fn minimise(
         let new_norm = norm(&scratch.grad);
         if t == 1.0 && moved <= 1e-12 * body_size && new_norm > SLOW_RATIO * old_norm {
             let residual = new_norm / load_scale(body_force_n, reactions);
+            settle_debt(scratch, solves, refreshed_midway);
             return Ok(Outcome::Stalled { residual });
         }
-        refactor = settings.refactor_every_iteration || t < 1.0 || new_norm > SLOW_RATIO * old_norm;
+        let target = settings.tolerance * load_scale(body_force_n, reactions);
+        // a step's first iteration says little of the factor: from the predictor even a fresh
+        // factor's full Newton step contracts the residual only 2–3× on a swinging body (the
+        // nonlinearity), and a fresh factor then converges quadratically
+        refactor = settings.refactor_every_iteration
+            || t < 1.0
+            || (iteration > 0
+                && kept_factor_costs_more(old_norm, new_norm, target, refresh_cost, scratch.debt_iterations));
     }
+    settle_debt(scratch, solves, refreshed_midway);
     if let Some(node) = first_non_finite(x, &scratch.grad) {
         return Err(Failure::NonFinite { node });
     }

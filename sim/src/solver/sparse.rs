@@ -66,6 +66,10 @@ pub(crate) struct SparsePattern {
     values: Vec<f64>,
     cholesky: SymbolicCholesky<u32>,
     factor: Vec<f64>,
+    /// The factor in single precision, when the last factorisation asked for it (empty until).
+    factor_single: Vec<f32>,
+    /// Whether the held factor is [`Self::factor_single`].
+    single: bool,
     factored: bool,
     /// What the pattern's work has cost so far.
     pub cost: SparseCost,
@@ -179,6 +183,8 @@ impl SparsePattern {
             values: vec![0.0; nnz],
             cholesky,
             factor,
+            factor_single: Vec::new(),
+            single: false,
             factored: false,
             cost,
         })
@@ -228,9 +234,12 @@ impl SparsePattern {
     /// factors it with parallelism `par`. With `projected`, `∂P/∂F` is projected to positive
     /// semi-definite at each quadrature point (always factorisable where the body is held or
     /// the diagonal positive); without, `K` is the exact Hessian (Newton's quadratic
-    /// convergence), which may not be positive definite. The element Hessians are computed in
-    /// parallel, [`ASSEMBLY_CHUNK`] at a time, and added in mesh order (the same sums on any
-    /// number of threads).
+    /// convergence), which may not be positive definite. With `single`, `K` is rounded to `f32`
+    /// and factored in single precision: half the memory traffic of every later solve (which is
+    /// memory-bound: on the P2 tube's 3.8 M-entry factor a double solve moves 61 MB), for a
+    /// caller that corrects the solve's error itself (Newton's iteration does, as iterative
+    /// refinement would). The element Hessians are computed in parallel, [`ASSEMBLY_CHUNK`] at a
+    /// time, and added in mesh order (the same sums on any number of threads).
     #[allow(clippy::too_many_arguments)]
     pub fn assemble_and_factor(
         &mut self,
@@ -240,6 +249,7 @@ impl SparsePattern {
         x: &[Vec3],
         diagonal: &[f64],
         projected: bool,
+        single: bool,
         par: Par,
     ) -> Result<(), SparseError> {
         use rayon::prelude::*;
@@ -271,24 +281,33 @@ impl SparsePattern {
         let assembled = std::time::Instant::now();
         self.cost.hessian_secs += (assembled - started).as_secs_f64();
         self.cost.factorisations += 1;
-        let scratch = self.cholesky.factorize_numeric_llt_scratch::<f64>(par, Default::default());
-        let mut buffer = MemBuffer::try_new(scratch).map_err(|e| SparseError::Pattern(format!("{e:?}")))?;
-        let outcome = self
-            .cholesky
-            .factorize_numeric_llt(
-                &mut self.factor,
-                k,
-                Side::Lower,
-                Default::default(),
+        self.single = single;
+        let outcome = if single {
+            let values: Vec<f32> = self.values.iter().map(|&v| v as f32).collect();
+            self.factor_single.resize(self.cholesky.len_val(), 0.0);
+            factor_numeric(
+                &self.cholesky,
+                &mut self.factor_single,
+                SparseColMatRef::new(self.symbolic.as_ref(), &values),
                 par,
-                MemStack::new(&mut buffer),
-                Default::default(),
             )
-            .map_err(|_| SparseError::NotPositiveDefinite);
+        } else {
+            factor_numeric(&self.cholesky, &mut self.factor, k, par)
+        };
         self.cost.factor_secs += assembled.elapsed().as_secs_f64();
         outcome?;
-        self.factored = self.factor.iter().all(|v| v.is_finite());
+        self.factored = if single {
+            self.factor_single.iter().all(|v| v.is_finite())
+        } else {
+            self.factor.iter().all(|v| v.is_finite())
+        };
         if self.factored { Ok(()) } else { Err(SparseError::NotPositiveDefinite) }
+    }
+
+    /// Drops the numeric factor (the matrix's values changed); the pattern and its symbolic
+    /// analysis are kept.
+    pub fn forget_factor(&mut self) {
+        self.factored = false;
     }
 
     /// Whether a numeric factor is held.
@@ -303,19 +322,50 @@ impl SparsePattern {
         for (d, v) in r.iter().enumerate() {
             placed[self.place(d)] = *v;
         }
-        let mut rhs = faer::MatMut::from_column_major_slice_mut(&mut placed, self.free_dofs, 1);
-        let scratch = self.cholesky.solve_in_place_scratch::<f64>(1, par);
-        let mut buffer = MemBuffer::new(scratch);
-        LltRef::new(&self.cholesky, &self.factor).solve_in_place_with_conj(
-            Conj::No,
-            rhs.as_mut(),
-            par,
-            MemStack::new(&mut buffer),
-        );
+        if self.single {
+            let mut placed_single: Vec<f32> = placed.iter().map(|&v| v as f32).collect();
+            solve_with(&self.cholesky, &self.factor_single, &mut placed_single, par);
+            placed.iter_mut().zip(&placed_single).for_each(|(v, &w)| *v = f64::from(w));
+        } else {
+            solve_with(&self.cholesky, &self.factor, &mut placed, par);
+        }
         for (d, v) in r.iter_mut().enumerate() {
             *v = placed[self.place(d)];
         }
     }
+}
+
+/// Factors `k` into `factor` (the numeric `L Lᵀ` on `cholesky`'s symbolic analysis), in `T`'s
+/// precision.
+fn factor_numeric<T: faer::traits::ComplexField>(
+    cholesky: &SymbolicCholesky<u32>,
+    factor: &mut [T],
+    k: SparseColMatRef<'_, u32, T>,
+    par: Par,
+) -> Result<(), SparseError> {
+    let scratch = cholesky.factorize_numeric_llt_scratch::<T>(par, Default::default());
+    let mut buffer = MemBuffer::try_new(scratch).map_err(|e| SparseError::Pattern(format!("{e:?}")))?;
+    cholesky
+        .factorize_numeric_llt(
+            factor,
+            k,
+            Side::Lower,
+            Default::default(),
+            par,
+            MemStack::new(&mut buffer),
+            Default::default(),
+        )
+        .map(|_| ())
+        .map_err(|_| SparseError::NotPositiveDefinite)
+}
+
+/// Solves `L Lᵀ s = r` in place (`r` in elimination order), in `T`'s precision.
+fn solve_with<T: faer::traits::ComplexField>(cholesky: &SymbolicCholesky<u32>, factor: &[T], r: &mut [T], par: Par) {
+    let n = r.len();
+    let mut rhs = faer::MatMut::from_column_major_slice_mut(r, n, 1);
+    let scratch = cholesky.solve_in_place_scratch::<T>(1, par);
+    let mut buffer = MemBuffer::new(scratch);
+    LltRef::new(cholesky, factor).solve_in_place_with_conj(Conj::No, rhs.as_mut(), par, MemStack::new(&mut buffer));
 }
 
 /// Hands the memory freed so far back to the system. glibc raises its threshold for mapping
@@ -477,7 +527,7 @@ mod tests {
             let mut pattern = SparsePattern::new(&mesh, held).unwrap();
             let n = pattern.free_dofs;
             let diagonal: Vec<f64> = (0..n).map(|d| 10.0 + d as f64).collect();
-            pattern.assemble_and_factor(&mesh, &geo, &material, &x, &diagonal, true, Par::Seq).unwrap();
+            pattern.assemble_and_factor(&mesh, &geo, &material, &x, &diagonal, true, false, Par::Seq).unwrap();
             let dense = assemble_dense(&mesh, &geo, &material, &x);
             let mut k = DMatrix::zeros(n, n);
             for (gi, &fi) in pattern.dof_of.iter().enumerate() {
