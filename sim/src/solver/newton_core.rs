@@ -480,3 +480,60 @@ pub(crate) fn minimise(
     let residual = norm(&scratch.grad) / load_scale(body_force_n, reactions);
     Ok(Outcome::Unconverged { residual })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The two-loop recursion satisfies the newest secant equation `H y = s` whatever the
+    /// initial inverse, and with no pairs it is that inverse; a pair of negative curvature is
+    /// left out.
+    #[test]
+    fn the_secant_correction_satisfies_the_newest_secant_equation() {
+        let n = 7;
+        // a symmetric positive definite A: secant pairs of the quadratic ½ xᵀ A x
+        let a = |x: &[f64]| -> Vec<f64> {
+            (0..n)
+                .map(|i| {
+                    (0..n).map(|j| x[j] * if i == j { 4.0 + i as f64 } else { 1.0 / (1.0 + (i + j) as f64) }).sum()
+                })
+                .collect()
+        };
+        // the initial inverse: a diagonal, far from A⁻¹
+        let mut initial = |q: &mut [f64]| q.iter_mut().enumerate().for_each(|(i, v)| *v /= 1.0 + 0.5 * i as f64);
+        let mut pairs = SecantPairs::default();
+        let mut q: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        let plain: Vec<f64> = q.iter().enumerate().map(|(i, v)| v / (1.0 + 0.5 * i as f64)).collect();
+        pairs.apply(&mut q, &mut initial);
+        assert_eq!(q, plain, "no pairs: the initial inverse");
+        for k in 0..(SECANT_PAIRS + 3) {
+            let s: Vec<f64> = (0..n).map(|i| ((k * n + i) as f64 * 0.7).cos()).collect();
+            let y = a(&s);
+            pairs.push(&s, &y);
+            let mut hy = y.clone();
+            pairs.apply(&mut hy, &mut initial);
+            let gap = hy.iter().zip(&s).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+            assert!(gap < 1e-12, "pair {k}: H y differs from s by {gap:e}");
+            assert!(pairs.pairs.len() <= SECANT_PAIRS);
+        }
+        let before = pairs.pairs.len();
+        let s = vec![1.0; n];
+        let y: Vec<f64> = a(&s).iter().map(|v| -v).collect();
+        pairs.push(&s, &y);
+        assert_eq!(pairs.pairs.len(), before, "a pair of negative curvature is refused");
+    }
+
+    /// The refresh rule: a fast kept factor is kept, a slow one refreshed when what it would
+    /// still cost outweighs a factorisation, a diverging one always.
+    #[test]
+    fn the_kept_factor_is_refreshed_when_it_costs_more_than_a_factorisation() {
+        let target = 1e-6;
+        assert!(!kept_factor_costs_more(1.0, 0.2, target, 10.0, 0.0), "4× or better: kept");
+        assert!(!kept_factor_costs_more(1.0, 0.4, 0.5, 10.0, 0.0), "one more iteration: kept");
+        assert!(kept_factor_costs_more(1.0, 0.4, target, 10.0, 0.0), "15 more iterations at 0.4: refreshed");
+        assert!(!kept_factor_costs_more(1.0, 0.4, target, 20.0, 0.0), "unless a factorisation costs more");
+        assert!(kept_factor_costs_more(1.0, 0.3, 1e-3, 10.0, 9.0), "the debt counts");
+        assert!(kept_factor_costs_more(1.0, 0.95, 0.9, 1e9, 0.0), "no longer halving: refreshed");
+        assert!(!kept_factor_costs_more(1.0, 0.95, 0.96, 1e9, 0.0), "converged: nothing to refresh");
+    }
+}

@@ -549,6 +549,22 @@ mod tests {
             assert!(error <= 1e-9 * expected.amax(), "{et}: {error:e} of {:e}", expected.amax());
             assert_eq!(pattern.cost.factorisations, 1);
             assert!(pattern.cost.factor_nonzeros >= pattern.cost.matrix_nonzeros);
+            // the single-precision factor of the same K: the same solve to f32's rounding times
+            // K's condition, and a double factor made after it is exact again
+            pattern.assemble_and_factor(&mesh, &geo, &material, &x, &diagonal, true, true, Par::Seq).unwrap();
+            let mut s = r.clone();
+            pattern.solve_in_place(&mut s, Par::Seq);
+            let error = (nalgebra::DVector::from_column_slice(&s) - &expected).amax();
+            let eigen = k.clone().symmetric_eigenvalues();
+            let condition = eigen.max() / eigen.min();
+            let bar = 1e-6 * condition * expected.amax();
+            assert!(error <= bar, "{et}, single: {error:e} of {:e} (condition {condition:.1e})", expected.amax());
+            assert!(error > 0.0, "{et}: the single-precision solve should round");
+            pattern.assemble_and_factor(&mesh, &geo, &material, &x, &diagonal, true, false, Par::Seq).unwrap();
+            let mut s = r.clone();
+            pattern.solve_in_place(&mut s, Par::Seq);
+            let error = (nalgebra::DVector::from_column_slice(&s) - &expected).amax();
+            assert!(error <= 1e-9 * expected.amax(), "{et}, double again: {error:e}");
         }
     }
 }
