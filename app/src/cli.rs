@@ -19,6 +19,7 @@ mod reference;
 mod serve;
 mod simulate;
 mod statics;
+mod paper;
 mod study;
 use crate::config::{MeshArgs, PhysicsArgs};
 
@@ -72,6 +73,17 @@ pub enum Command {
         reference: reference::ReferenceArgs,
         #[arg(long)]
         json: bool,
+    },
+    /// The paper reproduced: its tension, torsion and bending experiments at its settings, Table 1
+    /// beside the paper's rows with a column per solver, Figs. 1–3 as SVG and PNG with the
+    /// reference drawn in, and PAPER.md checking each caption's claim, written to --out.
+    Paper {
+        /// Coarse references, short runs and the small meshes only (under a minute).
+        #[arg(long)]
+        quick: bool,
+        /// Output folder (created if missing).
+        #[arg(long)]
+        out: PathBuf,
     },
     /// The accuracy-versus-time study over the paper scenes: writes study.md, study.csv,
     /// locking.csv (P1/P2/P3 near incompressibility) and study.svg to --out.
@@ -181,6 +193,7 @@ pub fn run(command: Command) -> Result<()> {
             simulate::simulate(&scene, &mesh, &physics, seconds, settle, &vtk, &reference, json)
         }
         Command::Study { quick, out } => study::study(quick, &out),
+        Command::Paper { quick, out } => paper::paper(quick, &out),
         Command::Bench { frames, threads, only, sweep, solver } => {
             bench::bench(frames, &threads, &only, &sweep, &solver)
         }

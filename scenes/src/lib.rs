@@ -11,6 +11,7 @@ pub mod params;
 pub mod reference;
 pub mod run;
 pub mod scene;
+pub mod paper;
 pub mod study;
 
 pub use params::{Params, SceneOverrides};
