@@ -14,12 +14,12 @@ mod inspect;
 mod lesson;
 mod list;
 mod mesh;
+mod paper;
 mod record;
 mod reference;
 mod serve;
 mod simulate;
 mod statics;
-mod paper;
 mod study;
 use crate::config::{MeshArgs, PhysicsArgs};
 

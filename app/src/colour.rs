@@ -1,27 +1,12 @@
-//! The colour map shared by the recordings and the app: viridis (perceptually uniform,
-//! readable in grey and by colour-blind viewers), from the degree-6 polynomial fit of
-//! matplotlib's table by Matt Zucker (within 5/255 per channel of the table); the colour
-//! range of a field, fixed or automatic, with its saturation colours and legend text.
+//! The colour map shared by the recordings and the app: viridis (`hox_scenes::paper::viridis`,
+//! also the figures'); the colour range of a field, fixed or automatic, with its saturation
+//! colours and legend text.
 
 use hox_sim::measure::field::Field;
 
-/// Viridis at `t ∈ [0, 1]` (clamped; NaN maps to 0), as RGB bytes.
-pub fn viridis(t: f64) -> [u8; 3] {
-    const C: [[f64; 3]; 7] = [
-        [0.277_727_327_223_417_7, 0.005_407_344_544_966_578, 0.334_099_805_335_306_1],
-        [0.105_093_043_108_577_4, 1.404_613_529_898_575, 1.384_590_162_594_685],
-        [-0.330_861_828_725_556_3, 0.214_847_559_468_213, 0.095_095_163_028_236_59],
-        [-4.634_230_498_983_486, -5.799_100_973_351_585, -19.332_440_956_279_87],
-        [6.228_269_936_347_081, 14.179_933_366_805_09, 56.690_552_600_681_05],
-        [4.776_384_997_670_288, -13.745_145_377_746_01, -65.353_032_633_372_34],
-        [-5.435_455_855_934_631, 4.645_852_612_178_535, 26.312_435_249_583_2],
-    ];
-    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
-    std::array::from_fn(|k| {
-        let v = C.iter().rev().fold(0.0, |acc, c| acc * t + c[k]);
-        (v.clamp(0.0, 1.0) * 255.0).round() as u8
-    })
-}
+/// Viridis at `t ∈ [0, 1]`, as RGB bytes: one formula for the app, the recordings and
+/// `hox paper`'s figures.
+pub use hox_scenes::paper::viridis;
 
 /// Drawn where a value is above the top of a fixed range (saturated): a pink no viridis
 /// colour is near, as matplotlib's `set_over`.

@@ -7,11 +7,11 @@
 
 pub mod bench;
 pub mod lesson;
+pub mod paper;
 pub mod params;
 pub mod reference;
 pub mod run;
 pub mod scene;
-pub mod paper;
 pub mod study;
 
 pub use params::{Params, SceneOverrides};

@@ -66,7 +66,7 @@ fn solver_files() -> &'static [&'static [&'static str]] {
 
 /// hox-scenes' rooms, lowest first; `lib` (the registry of scenes, `Instance`, the front) last.
 const SCENES: &[&[&str]] =
-    &[&["params"], &["scene"], &["run"], &["reference"], &["study"], &["bench"], &["lesson"], &["lib"]];
+    &[&["params"], &["scene"], &["run"], &["reference"], &["study"], &["paper"], &["bench"], &["lesson"], &["lib"]];
 
 /// The app's rooms (`hox`), lowest first: `cli` and `gui` share what both need through `config`.
 const APP: &[&[&str]] =
