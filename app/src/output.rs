@@ -21,3 +21,28 @@ pub fn check_writable(path: &Path) -> Result<()> {
     }
     Ok(())
 }
+
+/// The SVG `svg` rasterised to PNG bytes at twice its own size (resvg, with the Ubuntu font
+/// egui ships, so no system font is needed): `hox paper`'s figures and the app's export.
+pub fn svg_to_png(svg: &str) -> Result<Vec<u8>> {
+    let mut options = resvg::usvg::Options::default();
+    options.fontdb_mut().load_font_data(epaint_default_fonts::UBUNTU_LIGHT.to_vec());
+    options.fontdb_mut().set_sans_serif_family("Ubuntu");
+    let tree = resvg::usvg::Tree::from_str(svg, &options).context("the figure's SVG does not parse")?;
+    let scale = 2.0;
+    let size = tree.size();
+    let (w, h) = ((size.width() * scale).ceil() as u32, (size.height() * scale).ceil() as u32);
+    let mut pixmap = resvg::tiny_skia::Pixmap::new(w, h).context("the figure is too large to rasterise")?;
+    pixmap.fill(resvg::tiny_skia::Color::WHITE);
+    resvg::render(&tree, resvg::tiny_skia::Transform::from_scale(scale, scale), &mut pixmap.as_mut());
+    let mut bytes = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut bytes, w, h);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().context("PNG header")?;
+        // opaque white background: premultiplied RGBA is plain RGBA
+        writer.write_image_data(pixmap.data()).context("PNG data")?;
+    }
+    Ok(bytes)
+}

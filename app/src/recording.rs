@@ -10,6 +10,8 @@
 //!   `world/<config>/clamped`, `world/<config>/driven`: the edges of clamped and driven faces;
 //! - `world/<config>/rest_edges`: the rest shape's edges, static, as a ghost;
 //! - `world/<config>/probes`, `world/<config>/quadrature_points` (on request): `Points3D`;
+//! - `world/<config>/section`, `…/section/outline`: in the paper's scenes, the section `hox
+//!   paper` draws (`recording/section.rs`);
 //! - `legend/<field>/bar`, `legend/<field>/ticks`: each field's colour bar (an image) with its
 //!   tick labels in the field's unit (relabelled as an automatic range grows; a fixed range's
 //!   top and bottom labels say how much of the surface is saturated); `legend/text`: the
@@ -37,6 +39,7 @@ use rerun::RecordingStream;
 use rerun::blueprint as bp;
 
 pub mod eye;
+mod section;
 
 /// The bounding box of `instances`' rest shapes placed at `offsets`, metres (what a
 /// recording's 3D views open on: [`eye::send`]).
@@ -129,6 +132,8 @@ struct SimLogger {
     driven_edges: Vec<usize>,
     /// The reference's probe displacements, metres.
     reference: Option<hox_scenes::reference::Probes>,
+    /// The paper's figure section, in the paper's scenes (`section.rs`).
+    section: Option<section::Section>,
 }
 
 /// Logs several configurations side by side on shared colour ranges, with the recording's
@@ -317,6 +322,7 @@ impl SimLogger {
             clamped_edges,
             driven_edges,
             reference,
+            section: section::Section::of(instance),
         })
     }
 
@@ -339,6 +345,9 @@ impl SimLogger {
     ) -> Result<(), rerun::RecordingStreamError> {
         let sim = &instance.sim;
         let root = format!("world/{}", self.name);
+        if let Some(section) = &mut self.section {
+            section.log(rec, &root, instance)?;
+        }
         let frame = &self.frame;
         let positions: Vec<[f32; 3]> = frame.positions_m.iter().map(f32s).collect();
         let normals: Vec<[f32; 3]> = frame.normals.iter().map(f32s).collect();

@@ -144,6 +144,13 @@ pub fn check_frames(entities: &BTreeMap<String, EntitySummary>, frames: usize) -
                 bail!("{entity} has {component} at {n} frames, expected {frames}");
             }
         }
+        // the paper's figure section, where recorded (the paper's scenes), at every frame too
+        if let Some(section) = entities.get(&format!("world/{c}/section")) {
+            let n = section.frames_per_component.get("Mesh3D:vertex_positions").map_or(0, BTreeSet::len);
+            if n != frames {
+                bail!("world/{c}/section has Mesh3D:vertex_positions at {n} frames, expected {frames}");
+            }
+        }
         for quantity in ["kinetic_energy_j", "elastic_energy_j", "min_det_f"] {
             let entity = format!("plots/{quantity}/{c}");
             let n = entities

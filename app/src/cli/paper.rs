@@ -1,6 +1,5 @@
 //! `hox paper`: the paper's experiments, Table 1 and Figs. 1–3 written to a folder
-//! (`hox_scenes::paper`), each figure as SVG and as PNG (rasterised here by resvg, with the
-//! Ubuntu font egui ships, so no system font is needed).
+//! (`hox_scenes::paper`), each figure as SVG and as PNG (`output::svg_to_png`).
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -19,30 +18,6 @@ pub fn machine() -> String {
         .unwrap_or_else(|| std::env::consts::ARCH.to_string());
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     format!("\"{cpu}\", {cores} logical cores")
-}
-
-/// The SVG `svg` rasterised to PNG bytes at its own size (twice over for sharpness).
-pub fn svg_to_png(svg: &str) -> Result<Vec<u8>> {
-    let mut options = resvg::usvg::Options::default();
-    options.fontdb_mut().load_font_data(epaint_default_fonts::UBUNTU_LIGHT.to_vec());
-    options.fontdb_mut().set_sans_serif_family("Ubuntu");
-    let tree = resvg::usvg::Tree::from_str(svg, &options).context("the figure's SVG does not parse")?;
-    let scale = 2.0;
-    let size = tree.size();
-    let (w, h) = ((size.width() * scale).ceil() as u32, (size.height() * scale).ceil() as u32);
-    let mut pixmap = resvg::tiny_skia::Pixmap::new(w, h).context("the figure is too large to rasterise")?;
-    pixmap.fill(resvg::tiny_skia::Color::WHITE);
-    resvg::render(&tree, resvg::tiny_skia::Transform::from_scale(scale, scale), &mut pixmap.as_mut());
-    let mut bytes = Vec::new();
-    {
-        let mut encoder = png::Encoder::new(&mut bytes, w, h);
-        encoder.set_color(png::ColorType::Rgba);
-        encoder.set_depth(png::BitDepth::Eight);
-        let mut writer = encoder.write_header().context("PNG header")?;
-        // opaque white background: premultiplied RGBA is plain RGBA
-        writer.write_image_data(pixmap.data()).context("PNG data")?;
-    }
-    Ok(bytes)
 }
 
 pub fn paper(quick: bool, out: &std::path::Path) -> Result<()> {
@@ -68,7 +43,7 @@ pub fn paper(quick: bool, out: &std::path::Path) -> Result<()> {
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     for figure in &result.figures {
         files.push((format!("{}.svg", figure.name), figure.svg.clone().into_bytes()));
-        files.push((format!("{}.png", figure.name), svg_to_png(&figure.svg)?));
+        files.push((format!("{}.png", figure.name), crate::output::svg_to_png(&figure.svg)?));
     }
     files.push(("table1.md".into(), hox_scenes::paper::table_markdown(&result.table, &machine, quick).into_bytes()));
     files.push(("PAPER.md".into(), hox_scenes::paper::paper_markdown(&result, &machine, secs).into_bytes()));

@@ -218,6 +218,8 @@ pub fn controls_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
     view_ui(app, ui);
     ui.separator();
     rerun_ui(app, ui);
+    ui.separator();
+    figure_ui(app, ui);
 }
 
 /// One control row: its label (with tooltip), a widget editing a copy of the value, the link
@@ -517,6 +519,37 @@ fn rerun_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         if ui.button("Copy the address").clicked() {
             ui.ctx().copy_text(url);
         }
+    }
+}
+
+/// The paper's figure of the configurations on screen, exported as SVG and PNG (issue #39).
+fn figure_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+    ui.heading("Figure");
+    ui.horizontal(|ui| {
+        let l = label(ui, "Folder", "Where the figure's SVG and PNG are written.");
+        ui.add(egui::TextEdit::singleline(&mut app.figure_folder).desired_width(200.0)).labelled_by(l.id);
+    });
+    let name = app.sessions[app.active].base.name().to_string();
+    let paper = hox_scenes::paper::FigureKind::of_scene(&name).is_some();
+    let help = if paper {
+        "Draw the configurations on screen (A and B in compare mode) as they are now in the style of the paper's \
+         figure for this scene (hox paper): sampled inside the elements, against the reference in red."
+    } else {
+        "The paper's figures are of its three scenes: tension, torsion and bending."
+    };
+    if ui
+        .add_enabled(paper, egui::Button::new("Export figure"))
+        .on_hover_text(help)
+        .on_disabled_hover_text(help)
+        .clicked()
+    {
+        let folder = std::path::PathBuf::from(&app.figure_folder);
+        app.message = Some(match super::figure::export_figure(app, &folder) {
+            Ok(files) => {
+                format!("wrote {}", files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(" and "))
+            }
+            Err(e) => e,
+        });
     }
 }
 

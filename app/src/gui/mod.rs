@@ -19,6 +19,7 @@ mod args;
 pub mod config;
 pub mod controls;
 mod cost;
+mod figure;
 pub mod gl_view;
 pub mod lesson;
 mod links;
@@ -74,6 +75,8 @@ pub struct HoxApp {
     pub probe_axes: Option<[bool; 3]>,
     pub rerun_url: String,
     pub rerun_file: String,
+    /// Where *Export figure* writes the paper's figure of the view.
+    pub figure_folder: String,
     /// Where the class's browsers are served (`--bind`, the ports, the history bound).
     pub serve: crate::web::ServeArgs,
     rerun: Option<RerunLink>,
@@ -147,6 +150,7 @@ impl HoxApp {
                 .as_ref()
                 .map_or_else(|| "rerun+http://127.0.0.1:9876/proxy".into(), |s| s.rerun_url.clone()),
             rerun_file: saved.as_ref().map_or_else(|| "hox.rrd".into(), |s| s.rerun_file.clone()),
+            figure_folder: "figures".into(),
             serve: args.serve.clone(),
             rerun: None,
             generation: 0,

@@ -1055,3 +1055,40 @@ fn serving_browsers_shows_the_address_beside_the_view_and_a_busy_port_is_a_messa
     assert!(message.contains(&format!("127.0.0.1:{port}")) && message.contains("in use"), "{message}");
     assert!(h.query_by_label("Follow in your browser:").is_none());
 }
+
+/// Issue #39: *Export figure* draws the configurations on screen — here A and B of the torsion
+/// scene in compare mode, after a few frames — in the paper's figure style against the reference
+/// of their physics, as SVG and PNG in the folder named; on a scene that is not one of the
+/// paper's the button is off and says why.
+#[test]
+fn export_figure_writes_the_papers_figure_of_the_configurations_on_screen() {
+    let folder = std::env::temp_dir().join(format!("hox-figure-export-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&folder);
+    let mut h = harness(AppArgs { scene: Some("torsion".into()), compare: vec![String::new()], ..Default::default() });
+    h.run_steps(2);
+    h.state_mut().step(20);
+    h.state_mut().figure_folder = folder.display().to_string();
+    h.get_by_label("Export figure").scroll_to_me();
+    h.run_steps(2);
+    h.get_by_label("Export figure").click_accesskit();
+    h.run_steps(1);
+    h.run_steps(1);
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.starts_with("wrote ") && message.contains("fig2-torsion.png"), "{message}");
+    let svg = std::fs::read_to_string(folder.join("fig2-torsion.svg")).expect("the SVG");
+    assert!(svg.contains(r##"stroke="#e00000""##), "the reference's outline in red");
+    let labels: Vec<String> = h.state().sessions.iter().map(|s| s.label()).collect();
+    for (k, label) in labels.iter().enumerate() {
+        let panel = format!(">{}: {label}<", ["A", "B"][k]);
+        assert!(svg.contains(&panel), "no panel {panel} in the figure");
+    }
+    assert!(svg.contains(">reference"), "no reference panel");
+    assert!(svg.contains("mm from the reference"), "the cases are measured against the reference");
+    let png = std::fs::read(folder.join("fig2-torsion.png")).expect("the PNG");
+    assert!(png.starts_with(b"\x89PNG") && png.len() > 20_000, "{} bytes", png.len());
+    let _ = std::fs::remove_dir_all(&folder);
+    // the tube is not one of the paper's scenes
+    let mut h = harness(AppArgs { scene: Some("tube".into()), ..Default::default() });
+    h.run_steps(2);
+    assert!(h.get_by_label("Export figure").accesskit_node().is_disabled(), "the export is off for the tube");
+}

@@ -176,7 +176,7 @@ pub(super) fn draw_deformed(
                     if p.settled { "" } else { " · moving" }
                 ),
             ),
-            _ => (format!("{} (Q2, static)", p.label), format!("{} nodes", p.nodes)),
+            _ => (p.label.clone(), if p.nodes > 0 { format!("{} nodes", p.nodes) } else { String::new() }),
         };
         let _ = write!(
             s,
@@ -257,7 +257,7 @@ pub(super) fn draw_strips(title: &str, panels: &[Panel], rest: &[Vec3], nu: usiz
                 p.label.clone(),
                 format!("offset {offset:.2} % · {ms:.1} ms/frame{}", if p.settled { "" } else { " · moving" }),
             ),
-            _ => (format!("{} (Q2, static)", p.label), format!("{} nodes", p.nodes)),
+            _ => (p.label.clone(), if p.nodes > 0 { format!("{} nodes", p.nodes) } else { String::new() }),
         };
         let _ = write!(
             s,

@@ -244,6 +244,39 @@ pub fn panel_of(
     })
 }
 
+/// The reference panel of `scene` — its physics as they are (another ν, E, …) — at `points`:
+/// the static solution on a Q2 mesh of its box, the figure's reference grid (`quick`: the coarse
+/// one), solved here.
+pub fn reference_panel(
+    scene: &crate::scene::Scene,
+    kind: FigureKind,
+    points: &[Vec3],
+    quick: bool,
+) -> Result<Panel, SceneError> {
+    let name = match kind {
+        FigureKind::Tension => "tension",
+        FigureKind::Torsion => "torsion",
+        FigureKind::Bending => "bending",
+    };
+    let (cells, load_steps) = reference_grid(name, quick);
+    let overrides = SceneOverrides {
+        element: hox_sim::element::ElementType::from_name("q2"),
+        grid: Some(cells),
+        refine: Some(0),
+        ..Default::default()
+    };
+    let built = scene.with_overrides(&overrides)?;
+    let instance = Instance::new(built)?;
+    let solution = crate::solve_static(&instance.scene, instance.sim.mesh(), 1e-9, load_steps, &mut |_, _, _| {})?;
+    panel_of(reference_label(name, quick), instance.sim.mesh(), &solution.positions, points, None)
+}
+
+/// The reference panel's label: its mesh.
+fn reference_label(scene: &str, quick: bool) -> String {
+    let (cells, _) = reference_grid(scene, quick);
+    format!("reference (Q2 {}×{}×{}, static)", cells[0], cells[1], cells[2])
+}
+
 /// Deformed positions at the rest points `points`, by each one's element's shape functions.
 pub fn sample(mesh: &Mesh, positions: &[Vec3], points: &[Vec3]) -> Result<Vec<Vec3>, SceneError> {
     points
@@ -266,7 +299,7 @@ fn grid(origin: Vec3, u: Vec3, v: Vec3, nu: usize, nv: usize) -> Vec<Vec3> {
 }
 
 /// The indices of a `nu × nv` grid's boundary, in order round it.
-fn ring(nu: usize, nv: usize) -> Vec<usize> {
+pub fn ring(nu: usize, nv: usize) -> Vec<usize> {
     let mut r: Vec<usize> = (0..nu).collect();
     r.extend((1..nv).map(|j| j * nu + nu - 1));
     r.extend((0..nu - 1).rev().map(|i| (nv - 1) * nu + i));
@@ -374,7 +407,7 @@ pub fn run_paper(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<PaperRes
                 panels.push(panel(label, &instance, &instance.sim.positions, &points, Some(&report))?);
             }
         }
-        panels.push(panel("reference".into(), &reference, &ref_positions, &points, None)?);
+        panels.push(panel(reference_label(scene, quick), &reference, &ref_positions, &points, None)?);
         figures.push(draw_figure(kind, panels, &points, nu, nv));
     }
 
@@ -440,7 +473,7 @@ pub fn run_paper(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<PaperRes
         let label = format!("{} {elements}", config.element.to_uppercase());
         panels.push(panel(label, &instance, &instance.sim.positions, &top, Some(&report))?);
     }
-    panels.push(panel("reference".into(), &reference, &ref_positions, &top, None)?);
+    panels.push(panel(reference_label("bending", quick), &reference, &ref_positions, &top, None)?);
     figures.push(draw_figure(FigureKind::Bending, panels, &top, nu, nv));
     Ok(PaperResult { figures, table, quick })
 }
