@@ -445,7 +445,7 @@ pub fn run_paper(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<PaperRes
         };
         let (paper_label, paper_elements, paper_ms, paper_error) = PAPER_TABLE_1[*row];
         let mut solvers = Vec::new();
-        for method in ["vbd", "newton"] {
+        for method in ["vbd", "newton", "newton-cg"] {
             progress(&format!("bending: {} {method} at its defaults", config.label()));
             let mut o = config.overrides();
             o.method = hox_sim::solver::Method::from_name(method);

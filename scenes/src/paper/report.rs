@@ -7,7 +7,7 @@ use std::fmt::Write;
 /// Table 1 in Markdown: the paper's rows beside hox's, and a column per solver at its defaults.
 pub fn table_markdown(rows: &[TableRow], machine: &str, quick: bool) -> String {
     let mut s = format!(
-        "## Table 1 — bending: the paper's rows and hox's\n\nMachine: {machine}; XPBD at the paper's settings (50 substeps × 1 iteration, 60 fps), one thread, settled (or its last-second mean where it keeps moving); VBD and Newton at their defaults. Error: the tip's distance from the committed reference (`assets/reference/bending-fine.json`, Q2 32×8×8 static).{}\n\n| mesh | vertices | elements | paper ms/frame | paper error, m | hox XPBD ms/frame | hox XPBD error, m | VBD ms/frame | VBD error, m | Newton ms/frame | Newton error, m |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "## Table 1 — bending: the paper's rows and hox's\n\nMachine: {machine}; XPBD at the paper's settings (50 substeps × 1 iteration, 60 fps), one thread, settled (or its last-second mean where it keeps moving); VBD, Newton and Newton-CG at their defaults (each step solved: the mesh's error without XPBD's bias). Error: the tip's distance from the committed reference (`assets/reference/bending-fine.json`, Q2 32×8×8 static).{}\n\n| mesh | vertices | elements | paper ms/frame | paper error, m | hox XPBD ms/frame | hox XPBD error, m | VBD ms/frame | VBD error, m | Newton ms/frame | Newton error, m | Newton-CG ms/frame | Newton-CG error, m |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         if quick { " **--quick: the 10,240 and 81,920 P1 beams left out, runs capped at 2 s.**" } else { "" }
     );
     for r in rows {
@@ -19,7 +19,7 @@ pub fn table_markdown(rows: &[TableRow], machine: &str, quick: bool) -> String {
         };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.1} | {:.1e} | {:.2} | {:.2e}{} | {} | {} |",
+            "| {} | {} | {} | {:.1} | {:.1e} | {:.2} | {:.2e}{} | {} | {} | {} |",
             r.label,
             r.vertices,
             r.elements,
@@ -29,7 +29,8 @@ pub fn table_markdown(rows: &[TableRow], machine: &str, quick: bool) -> String {
             r.xpbd_error_m,
             if r.xpbd_settled { "" } else { " (moving)" },
             solver("vbd"),
-            solver("newton")
+            solver("newton"),
+            solver("newton-cg")
         );
     }
     s
@@ -141,7 +142,7 @@ pub fn paper_markdown(result: &PaperResult, machine: &str, secs: f64) -> String 
         };
         let _ = writeln!(s, "| {} | {} | {holds} |", c.claim, c.measured);
     }
-    s.push_str("\nWhere the solver's bias changes the conclusion (docs/STUDY.md): at the paper's fixed 50 substeps XPBD's settled state is softer than the finite-element solution of its own mesh, by a bias that grows as the elements shrink (`(h ω_max)²`). On the coarse high-order beams that softness partly cancels the mesh's own stiffness, so P2 160 and P3 80 look better at 50 substeps than their discretisation error; the finest P1 beam (81,920 elements) does not settle at 50 substeps and is measured by its last-second mean. The VBD and Newton columns of Table 1 solve each step to convergence and show each mesh's error without that bias.\n\n");
+    s.push_str("\nWhere the solver's bias changes the conclusion (docs/STUDY.md): at the paper's fixed 50 substeps XPBD's settled state is softer than the finite-element solution of its own mesh, by a bias that grows as the elements shrink (`(h ω_max)²`). On the coarse high-order beams that softness partly cancels the mesh's own stiffness, so P2 160 and P3 80 look better at 50 substeps than their discretisation error; the finest P1 beam (81,920 elements) does not settle at 50 substeps and is measured by its last-second mean. The VBD, Newton and Newton-CG columns of Table 1 solve each step to convergence and show each mesh's error without that bias.\n\n");
     s.push_str(&table_markdown(&result.table, machine, result.quick));
     for f in &result.figures {
         let _ = write!(
