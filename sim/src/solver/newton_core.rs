@@ -15,7 +15,10 @@
 //!   quadrature point).
 //! - **Factor reuse:** the numeric factor is kept between iterations (and, by the caller's
 //!   pattern, between steps) and refreshed at the current iterate when the line search had to cut
-//!   the step, when the residual no longer halves, or when keeping it costs more than a refresh:
+//!   the step or the residual fell less than 4× in an iteration. In the interactive mode
+//!   ([`super::NewtonSettings::quasi_newton`]; off by default, the robustness suite's hard cases
+//!   are measured without it) the 4× rule gives way to a weighing: the factor is refreshed when
+//!   the residual no longer halves, or when keeping it costs more than a refresh:
 //!   a refresh costs [`LinearSolver::refresh_cost_in_iterations`] iterations `R`; an iteration
 //!   whose residual fell by less than 4× (ratio `ρ`) predicts `n = ln(tol/r)/ln ρ` more kept-factor
 //!   iterations where a fresh factor needs about one, and the factor is refreshed when
@@ -25,7 +28,8 @@
 //!   refactorised in frames a fresh factor took as many iterations as the kept one);
 //!   [`super::NewtonSettings::refactor_every_iteration`] refreshes it every iteration (pure
 //!   Newton).
-//! - **Quasi-Newton correction of the kept factor:** with an exact linear solver (the factor),
+//! - **Quasi-Newton correction of the kept factor** (interactive mode): with an exact linear
+//!   solver (the factor),
 //!   each accepted step's secant pair `(s, y)` (`y` the gradient's change) is kept, the last
 //!   [`SECANT_PAIRS`] of them since the factor was made, and the step is L-BFGS's two-loop
 //!   recursion with the factor's `K⁻¹` as its initial inverse Hessian (Nocedal & Wright §7.2;
@@ -33,7 +37,8 @@
 //!   materials", ACM TOG 36(3), prefactor one matrix and correct it so). The pairs stay valid
 //!   across time steps, whose potentials differ by a linear term only. On the P2 tube settling,
 //!   the factorisations fell from 18 to 5 (docs/PERFORMANCE.md session 24).
-//! - **Precision:** a time step's factor (an inertia diagonal `D`) is single precision
+//! - **Precision** (interactive mode): a time step's factor (an inertia diagonal `D`) is single
+//!   precision
 //!   (`sparse.rs`: half the solves' memory traffic), its error corrected by the iteration; a
 //!   static solve's stiffness alone keeps double precision.
 //! - **Line search:** halve `t` from 1 until `Φ` does not increase or, at `Φ`'s round-off floor,
@@ -131,6 +136,8 @@ pub(crate) trait LinearSolver {
     /// Drops the model of `K` (the potential changed, not the pattern: the next iteration remakes
     /// it on the pattern kept).
     fn forget_model(&mut self);
+    /// Whether a time step's model may be kept in single precision (the interactive mode).
+    fn set_single_precision(&mut self, _single: bool) {}
     /// Makes the model of `K` at `x`, counting its work in `counters`.
     fn update(
         &mut self,
@@ -174,6 +181,9 @@ impl LinearSolver for SparsePattern {
     fn forget_model(&mut self) {
         self.forget_factor();
     }
+    fn set_single_precision(&mut self, single: bool) {
+        self.single_precision = single;
+    }
     /// The exact Hessian where it is positive definite, else the projected one.
     fn update(
         &mut self,
@@ -183,7 +193,7 @@ impl LinearSolver for SparsePattern {
     ) -> Result<(), SparseError> {
         // with an inertia diagonal (a time step) the factor is kept in single precision, its
         // error corrected by the iteration; a static solve's stiffness alone is too ill-conditioned
-        let single = !model.diagonal.is_empty();
+        let single = self.single_precision && !model.diagonal.is_empty();
         let attempts: &[(bool, bool)] =
             if single { &[(false, true), (true, true), (true, false)] } else { &[(false, false), (true, false)] };
         let mut last = Err(SparseError::NotPositiveDefinite);
@@ -370,7 +380,8 @@ pub(crate) fn minimise(
     }
     let mut refactor = settings.refactor_every_iteration || !linear.is_ready();
     let refresh_cost = linear.refresh_cost_in_iterations();
-    let correct_by_secants = linear.solves_exactly() && !settings.refactor_every_iteration;
+    linear.set_single_precision(settings.quasi_newton);
+    let correct_by_secants = settings.quasi_newton && linear.solves_exactly() && !settings.refactor_every_iteration;
     if scratch.pairs.pairs.front().is_some_and(|(s, _, _)| s.len() != linear.free_dofs()) {
         scratch.pairs.clear();
     }
@@ -468,10 +479,12 @@ pub(crate) fn minimise(
         // a step's first iteration says little of the factor: from the predictor even a fresh
         // factor's full Newton step contracts the residual only 2–3× on a swinging body (the
         // nonlinearity), and a fresh factor then converges quadratically
-        refactor = settings.refactor_every_iteration
-            || t < 1.0
-            || (iteration > 0
-                && kept_factor_costs_more(old_norm, new_norm, target, refresh_cost, scratch.debt_iterations));
+        let slow = if settings.quasi_newton {
+            iteration > 0 && kept_factor_costs_more(old_norm, new_norm, target, refresh_cost, scratch.debt_iterations)
+        } else {
+            new_norm > SLOW_RATIO * old_norm
+        };
+        refactor = settings.refactor_every_iteration || t < 1.0 || slow;
     }
     settle_debt(scratch, solves, refreshed_midway);
     if let Some(node) = first_non_finite(x, &scratch.grad) {

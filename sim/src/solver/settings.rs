@@ -150,11 +150,16 @@ pub struct NewtonSettings {
     /// Refactor the stiffness at every iteration (pure Newton) instead of reusing the last
     /// factorisation while it keeps converging fast.
     pub refactor_every_iteration: bool,
+    /// The interactive mode (issue #37, `newton_core.rs`): the factor kept across steps in single
+    /// precision, corrected by secant pairs (L-BFGS) and refreshed when keeping it costs more
+    /// than a factorisation. Off: the factor refreshed whenever the residual falls less than 4×
+    /// in an iteration, in double precision (the robustness suite's hard cases are measured so).
+    pub quasi_newton: bool,
 }
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { tolerance: 1e-6, max_iterations: 30, refactor_every_iteration: false }
+        Self { tolerance: 1e-6, max_iterations: 30, refactor_every_iteration: false, quasi_newton: false }
     }
 }
 

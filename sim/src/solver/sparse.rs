@@ -70,6 +70,8 @@ pub(crate) struct SparsePattern {
     factor_single: Vec<f32>,
     /// Whether the held factor is [`Self::factor_single`].
     single: bool,
+    /// Whether a time step's factor may be single precision (`NewtonSettings::quasi_newton`).
+    pub single_precision: bool,
     factored: bool,
     /// What the pattern's work has cost so far.
     pub cost: SparseCost,
@@ -185,6 +187,7 @@ impl SparsePattern {
             factor,
             factor_single: Vec::new(),
             single: false,
+            single_precision: false,
             factored: false,
             cost,
         })

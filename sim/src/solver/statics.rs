@@ -150,6 +150,7 @@ impl StaticProblem<'_> {
             tolerance: self.tolerance,
             max_iterations: MAX_ITERATIONS_PER_INCREMENT,
             refactor_every_iteration: false,
+            quasi_newton: false,
         }
     }
 }
