@@ -2,8 +2,6 @@
 //! (`hox_scenes::paper`), each figure as SVG and as PNG (`output::svg_to_png`).
 
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressStyle};
-use std::time::{Duration, Instant};
 
 /// The CPU's name, the machine's logical cores, for every figure's caption.
 pub fn machine() -> String {
@@ -21,21 +19,9 @@ pub fn machine() -> String {
 }
 
 pub fn paper(quick: bool, out: &std::path::Path) -> Result<()> {
-    // refuse an unwritable folder before spending minutes
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
-    let probe = out.join(".hox-write-test");
-    std::fs::write(&probe, b"").with_context(|| format!("cannot write to the output folder {}", out.display()))?;
-    let _ = std::fs::remove_file(&probe);
-    let bar = ProgressBar::new_spinner();
-    bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed}] {msg}").expect("valid template"));
-    bar.enable_steady_tick(Duration::from_millis(200));
-    let started = Instant::now();
-    let mut report = |message: &str| {
-        if bar.is_hidden() {
-            eprintln!("[{:>6.1} s] {message}", started.elapsed().as_secs_f64());
-        }
-        bar.set_message(message.to_string());
-    };
+    let job = super::study::FolderJob::start(out)?;
+    let (bar, started) = (&job.bar, job.started);
+    let mut report = |message: &str| job.report(message);
     let result = hox_scenes::paper::run_paper(quick, &mut report)?;
     bar.finish_and_clear();
     let machine = machine();

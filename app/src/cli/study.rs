@@ -6,23 +6,39 @@ use hox_scenes::study::solver_axis;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::time::{Duration, Instant};
 
-pub fn study(quick: bool, out: &std::path::Path) -> Result<()> {
-    // refuse an unwritable folder before spending minutes
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
-    let probe = out.join(".hox-write-test");
-    std::fs::write(&probe, b"").with_context(|| format!("cannot write to the output folder {}", out.display()))?;
-    let _ = std::fs::remove_file(&probe);
-    let bar = ProgressBar::new_spinner();
-    bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed}] {msg}").expect("valid template"));
-    bar.enable_steady_tick(Duration::from_millis(200));
-    let started = Instant::now();
-    let mut report = |message: &str| {
-        // a log line per step when stderr is not a terminal (CI), the spinner otherwise
-        if bar.is_hidden() {
-            eprintln!("[{:>6.1} s] {message}", started.elapsed().as_secs_f64());
+/// A long job writing to a folder: the folder checked writable before any work, then a spinner
+/// (a log line per step when stderr is not a terminal, as in CI). Shared by `study` and `paper`.
+pub(super) struct FolderJob {
+    pub bar: ProgressBar,
+    pub started: Instant,
+}
+
+impl FolderJob {
+    pub fn start(out: &std::path::Path) -> Result<FolderJob> {
+        // refuse an unwritable folder before spending minutes
+        std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
+        let probe = out.join(".hox-write-test");
+        std::fs::write(&probe, b"").with_context(|| format!("cannot write to the output folder {}", out.display()))?;
+        let _ = std::fs::remove_file(&probe);
+        let bar = ProgressBar::new_spinner();
+        bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed}] {msg}").expect("valid template"));
+        bar.enable_steady_tick(Duration::from_millis(200));
+        Ok(FolderJob { bar, started: Instant::now() })
+    }
+
+    /// Says what runs now.
+    pub fn report(&self, message: &str) {
+        if self.bar.is_hidden() {
+            eprintln!("[{:>6.1} s] {message}", self.started.elapsed().as_secs_f64());
         }
-        bar.set_message(message.to_string());
-    };
+        self.bar.set_message(message.to_string());
+    }
+}
+
+pub fn study(quick: bool, out: &std::path::Path) -> Result<()> {
+    let job = FolderJob::start(out)?;
+    let bar = &job.bar;
+    let mut report = |message: &str| job.report(message);
     let rows = hox_scenes::study::run_study(quick, &mut report)?;
     let locking = hox_scenes::study::locking(quick, &mut report)?;
     let solvers = solver_axis::run_solver_axis(quick, &mut report)?;
