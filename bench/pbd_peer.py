@@ -14,8 +14,9 @@ PBD's solid method 3 is its XPBD FEM tetrahedron (the constitutive model of Bend
 2014 / PBD's `FEMTetConstraint`): one constraint per tetrahedron, like hox's energy
 formulation; stiffness is Young's modulus, 3 MPa, Poisson ratio 0.35. Times are medians of ms
 per frame on one thread (PBD's OpenMP loop is limited with OMP_NUM_THREADS=1); hox is timed
-with both of its sweeps: colour (the default: four tetrahedra of one colour per 256-bit register,
-`Sweep::Colour`) and element order (`Sweep::Element`, the order before issue #22).
+with both of its sweeps: colour (the default: a register of same-colour tetrahedra at a time,
+`Sweep::Colour`) at each register width the CPU runs (8 lanes on AVX-512, the default there; 4
+on AVX2) and element order (`Sweep::Element`, the order before issue #22).
 """
 import argparse
 import json
@@ -119,15 +120,30 @@ def main() -> None:
                              env=env, check=True, capture_output=True, text=True).stdout
         pbd_ms = json.loads(out.strip().splitlines()[-1])["ms_per_frame"]
         hox_out = subprocess.run(cargo() + args.hox.split() + [str(args.frames), "1", label], cwd=ROOT, check=True, capture_output=True, text=True,
-                                 env=dict(os.environ, HOX_BENCH_ELEMENT_ORDER="1")).stdout
-        # one row per sweep: colour (the default: four tetrahedra per register) and element (mesh order)
-        hox = {line.split("|")[4].strip(): float(line.split("|")[6]) for line in hox_out.splitlines() if line.startswith("| P1")}
-        rows.append((label, len(mesh["tets"]) // 4, pbd_ms, hox["colour"], hox.get("element", float("nan"))))
-        print(f"{label}: PBD {pbd_ms:.2f} ms/frame, hox default (colour) {hox['colour']:.2f}, element order {hox.get('element', float('nan')):.2f} ms/frame", file=sys.stderr)
-    print("| beam | tetrahedra | PBD ms/frame (1 thread) | hox default (colour sweep, SIMD ×4) ms/frame | hox / PBD | hox element-order sweep ms/frame | hox / PBD |")
-    print("|---|---|---|---|---|---|---|")
-    for label, n, p, h, e in rows:
-        print(f"| {label} | {n} | {p:.2f} | {h:.2f} | {h / p:.2f} | {e:.2f} | {e / p:.2f} |")
+                                 env=dict(os.environ, HOX_BENCH_ELEMENT_ORDER="1", HOX_BENCH_LANES=lanes_here())).stdout
+        # one row per sweep and width: colour ×8 / ×4 (a register of tetrahedra) and element (mesh order)
+        hox = {}
+        for line in hox_out.splitlines():
+            if line.startswith("| P1"):
+                cells = [c.strip() for c in line.split("|")]
+                key = cells[4] if cells[5] in ("", "–") else f"{cells[4]} x{cells[5]}"
+                hox[key] = float(cells[7])
+        nan = float("nan")
+        rows.append((label, len(mesh["tets"]) // 4, pbd_ms, hox.get("colour x8", nan), hox.get("colour x4", nan), hox.get("element", nan)))
+        print(f"{label}: PBD {pbd_ms:.2f} ms/frame, hox {hox} ms/frame", file=sys.stderr)
+    print("| beam | tetrahedra | PBD ms/frame (1 thread) | hox colour ×8 (AVX-512, the default there) | hox / PBD | hox colour ×4 (AVX2) | hox / PBD | hox element order | hox / PBD |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for label, n, p, h8, h4, e in rows:
+        print(f"| {label} | {n} | {p:.2f} | {h8:.2f} | {h8 / p:.2f} | {h4:.2f} | {h4 / p:.2f} | {e:.2f} | {e / p:.2f} |")
+
+
+def lanes_here() -> str:
+    """The register widths this CPU runs: 4,8 with AVX-512 F, else 4."""
+    try:
+        flags = Path("/proc/cpuinfo").read_text()
+    except OSError:
+        return "4"
+    return "4,8" if " avx512f" in flags else "4"
 
 
 if __name__ == "__main__":

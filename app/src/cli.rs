@@ -108,11 +108,15 @@ pub enum Command {
         /// Only the configurations whose label contains this (e.g. "p1", "r2").
         #[arg(long, default_value = "")]
         only: String,
-        /// The sweep orders timed, comma-separated: colour (the default everywhere: four
-        /// elements per 256-bit register, every thread) on each thread count, element (mesh
-        /// order, one thread) on one thread. XPBD only.
+        /// The sweep orders timed, comma-separated: colour (the default everywhere: a register
+        /// of elements at a time, every thread) on each thread count, element (mesh order, one
+        /// thread) on one thread. XPBD only.
         #[arg(long, value_delimiter = ',', default_value = "colour,element")]
         sweep: Vec<String>,
+        /// The colour sweep's register widths timed side by side, comma-separated: 4 (AVX2) and
+        /// 8 (AVX-512). Default: the widest this CPU has. XPBD only.
+        #[arg(long, value_delimiter = ',')]
+        lanes: Vec<usize>,
         /// The solver timed (`hox solvers`): xpbd (the table above), vbd (µs per node update and
         /// per element visit) or a Newton-type one, newton or newton-cg (ms per iteration and per
         /// factorisation); the thread counts run side by side, with the speed-up over one thread.
@@ -194,8 +198,8 @@ pub fn run(command: Command) -> Result<()> {
         }
         Command::Study { quick, out } => study::study(quick, &out),
         Command::Paper { quick, out } => paper::paper(quick, &out),
-        Command::Bench { frames, threads, only, sweep, solver } => {
-            bench::bench(frames, &threads, &only, &sweep, &solver)
+        Command::Bench { frames, threads, only, sweep, lanes, solver } => {
+            bench::bench(frames, &threads, &only, &sweep, &lanes, &solver)
         }
         Command::Static { scene, mesh, physics, tolerance, load_steps, reference, json } => {
             statics::static_command(&scene, &mesh, &physics, tolerance, load_steps, &reference, json)

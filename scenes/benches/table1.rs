@@ -113,7 +113,7 @@ fn kernels(c: &mut Criterion) {
 }
 
 /// One colour sweep over every element of the sagged P1 beam: one element at a time against
-/// four same-colour elements per 256-bit register (`hox_sim::xpbd::kernels::p1x4`).
+/// a register of same-colour elements at a time (`hox_sim::xpbd::kernels::p1`).
 fn colour_batches(c: &mut Criterion) {
     let mut sim = bending_beam(&CASES[0], Sweep::Colour).expect("beam");
     for _ in 0..5 {

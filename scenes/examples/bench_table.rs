@@ -2,7 +2,8 @@
 //! `cargo run --release -p hox-scenes --example bench_table [-- FRAMES [THREADS [FILTER]]]`
 //! (THREADS: comma-separated, default 1,2; FILTER: a substring of the configuration label;
 //! the colour sweep, the default, on every thread count, and the element-order sweep on one thread;
-//! HOX_BENCH_ELEMENT_ORDER=0 times the colour sweep only).
+//! HOX_BENCH_ELEMENT_ORDER=0 times the colour sweep only; HOX_BENCH_LANES=4,8 times the colour
+//! sweep at each register width, default the CPU's widest).
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -12,6 +13,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => vec![1, 2],
     };
     let filter = args.next().unwrap_or_default();
+    let lanes: Vec<usize> = match std::env::var("HOX_BENCH_LANES") {
+        Ok(list) if !list.is_empty() => list.split(',').map(str::parse).collect::<Result<_, _>>()?,
+        _ => Vec::new(),
+    };
     let rows = hox_scenes::bench::run(
         &filter,
         &threads,
@@ -20,6 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         } else {
             &[hox_sim::solver::Sweep::Colour, hox_sim::solver::Sweep::Element][..]
         },
+        &lanes,
         frames,
         &mut |r| eprintln!("{}", r.progress_line()),
     )?;

@@ -133,6 +133,9 @@ pub struct BenchRow {
     pub threads: usize,
     /// The sweep's order: colour by colour (the default) or element by element.
     pub sweep: Sweep,
+    /// The colour sweep's register width (elements per batch: 4 on AVX2, 8 on AVX-512); None
+    /// for the element-order sweep, which has no batches.
+    pub lanes: Option<usize>,
     pub ms_per_frame: f64,
     /// `ms_per_frame / (elements × substeps)`, in ns.
     pub ns_per_element_substep: f64,
@@ -141,13 +144,14 @@ pub struct BenchRow {
 
 impl BenchRow {
     /// The progress line printed as each row is measured, e.g.
-    /// `P2 8x2x2 on 1 thread(s), colour sweep: 2.08 ms/frame`.
+    /// `P2 8x2x2 on 1 thread(s), colour sweep (8 lanes): 2.08 ms/frame`.
     pub fn progress_line(&self) -> String {
         format!(
-            "{} on {} thread(s), {} sweep: {:.2} ms/frame",
+            "{} on {} thread(s), {} sweep{}: {:.2} ms/frame",
             self.case.label(),
             self.threads,
             self.sweep.name(),
+            self.lanes.map_or(String::new(), |l| format!(" ({l} lanes)")),
             self.ms_per_frame
         )
     }
@@ -158,13 +162,16 @@ impl BenchRow {
     }
 }
 
-/// Times `case` with the sweep `sweep`, in a rayon pool of
+/// Times `case` with the sweep `sweep` (the colour sweep on `lanes` elements per batch, None:
+/// the widest the CPU has), in a rayon pool of
 /// `threads`: `warmup_frames` untimed, then the median of `frames` timed frames. Frames are
 /// also capped by `budget_secs` of timed work (at least 3 frames).
+#[allow(clippy::too_many_arguments)]
 pub fn measure(
     case: &BenchCase,
     threads: usize,
     sweep: Sweep,
+    lanes: Option<usize>,
     warmup_frames: usize,
     frames: usize,
     budget_secs: f64,
@@ -178,6 +185,15 @@ pub fn measure(
         |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: case.label(), message: e.to_string() };
     pool.install(|| {
         let mut sim = bending_beam(case, sweep)?;
+        if let Some(l) = lanes
+            && !sim.set_simd_lanes(l)
+        {
+            return Err(SceneError::Simulation {
+                source_name: "bench".into(),
+                message: format!("this CPU cannot run batches of {l} elements (4 needs AVX2 and FMA, 8 AVX-512 F)"),
+            });
+        }
+        let lanes = if sweep == Sweep::Colour { sim.simd_lanes() } else { None };
         for _ in 0..warmup_frames {
             sim.step_frame().map_err(failed)?;
         }
@@ -203,6 +219,7 @@ pub fn measure(
             points_per_element: g.points_per_element,
             threads,
             sweep,
+            lanes,
             ms_per_frame,
             ns_per_element_substep: ms_per_frame * 1e6 / (elements as f64 * substeps),
             gflops: flops / (ms_per_frame * 1e6),
@@ -215,18 +232,19 @@ pub fn measure(
 /// scalar peak (one double per FMA).
 pub fn markdown(rows: &[BenchRow], peak_gflops: f64) -> String {
     let mut s = format!(
-        "| configuration | elements | threads | sweep | paper ms/frame | ours ms/frame | paper / ours | ns per element·substep | GFLOP/s | % of AVX2 peak ({peak_gflops:.1} GFLOP/s per core) | % of scalar peak |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| configuration | elements | threads | sweep | lanes | paper ms/frame | ours ms/frame | paper / ours | ns per element·substep | GFLOP/s | % of AVX2 peak ({peak_gflops:.1} GFLOP/s per core) | % of scalar peak |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let paper = r.case.paper_ms_per_frame.map_or(String::new(), |p| format!("{p}"));
         let ratio = r.speedup_over_paper().map_or(String::new(), |x| format!("{x:.1}×"));
         let peak = peak_gflops * r.threads as f64;
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.2} | {} | {:.1} | {:.2} | {:.1} % | {:.1} % |\n",
+            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.1} | {:.2} | {:.1} % | {:.1} % |\n",
             r.case.label(),
             r.elements,
             r.threads,
             r.sweep.name(),
+            r.lanes.map_or("–".to_string(), |l| l.to_string()),
             paper,
             r.ms_per_frame,
             ratio,
@@ -275,12 +293,14 @@ fn matching(cases: &'static [BenchCase], filter: &str) -> Vec<&'static BenchCase
 
 /// Measures the case labelled `filter`, or else every case whose label contains it (ignoring
 /// case), on each of `threads` with each of `sweeps` (the element-order sweep runs on one
-/// thread whatever the pool, so it is measured on one thread only), reporting each row to
-/// `progress` as it is measured (what `hox bench` runs).
+/// thread whatever the pool, so it is measured on one thread only; the colour sweep on each of
+/// `lanes`, or the CPU's widest when empty), reporting each row to `progress` as it is measured
+/// (what `hox bench` runs).
 pub fn run(
     filter: &str,
     threads: &[usize],
     sweeps: &[Sweep],
+    lanes: &[usize],
     frames: usize,
     progress: &mut dyn FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, SceneError> {
@@ -291,9 +311,16 @@ pub fn run(
                 if sweep == Sweep::Element && t > 1 {
                     continue;
                 }
-                let row = measure(case, t, sweep, WARMUP_FRAMES, frames, BUDGET_SECS)?;
-                progress(&row);
-                rows.push(row);
+                let widths: Vec<Option<usize>> = if sweep == Sweep::Colour && !lanes.is_empty() {
+                    lanes.iter().map(|&l| Some(l)).collect()
+                } else {
+                    vec![None]
+                };
+                for l in widths {
+                    let row = measure(case, t, sweep, l, WARMUP_FRAMES, frames, BUDGET_SECS)?;
+                    progress(&row);
+                    rows.push(row);
+                }
             }
         }
     }

@@ -21,7 +21,7 @@
 //!
 //! **The point law is written once**, [`energy_and_pk1`], over any [`Lane`]: this module's
 //! functions run it on one `f64`, the scalar kernels on one `f64` with fused multiply–adds, and
-//! the four-lane P1 batches (`crate::xpbd::kernels::p1x4`) on four elements at a time. Its NaN rule:
+//! the P1 batches (`crate::xpbd::kernels::p1`) on four or eight elements at a time. Its NaN rule:
 //! λ tr(E) is added to the diagonal of S only, so a non-finite tr(E) leaves the off-diagonal
 //! (shear) stress as 2μE; a NaN or infinite entry of F otherwise propagates into ψ and P.
 

@@ -31,11 +31,6 @@ impl F64x4 {
     pub fn zero() -> Self {
         Self(unsafe { _mm256_setzero_pd() })
     }
-    /// `[a, b, c, d]` in lanes 0..3.
-    #[inline(always)]
-    pub fn new(a: f64, b: f64, c: f64, d: f64) -> Self {
-        Self(unsafe { _mm256_set_pd(d, c, b, a) })
-    }
     /// # Safety
     /// `p` points to four doubles.
     #[inline(always)]
@@ -168,5 +163,157 @@ impl Lane for F64x4 {
             }
         }
         sum
+    }
+}
+
+/// `[x, y, z, 0]` of node `p` (reads three doubles only).
+///
+/// # Safety
+/// `p` points to a `Vec3`; only called under AVX2.
+#[inline(always)]
+pub unsafe fn load_row(p: *const crate::Vec3) -> __m256d {
+    unsafe { _mm256_maskload_pd(p.cast(), _mm256_set_epi64x(0, -1, -1, -1)) }
+}
+
+/// Four rows `[x, y, z, ·]` (one per lane) into `[x, y, z]` lanes.
+#[inline(always)]
+pub fn transpose(r: [__m256d; 4]) -> [F64x4; 3] {
+    unsafe {
+        let t0 = _mm256_unpacklo_pd(r[0], r[1]); // x0 x1 z0 z1
+        let t1 = _mm256_unpackhi_pd(r[0], r[1]); // y0 y1 ·  ·
+        let t2 = _mm256_unpacklo_pd(r[2], r[3]); // x2 x3 z2 z3
+        let t3 = _mm256_unpackhi_pd(r[2], r[3]); // y2 y3 ·  ·
+        [
+            F64x4(_mm256_permute2f128_pd::<0x20>(t0, t2)),
+            F64x4(_mm256_permute2f128_pd::<0x20>(t1, t3)),
+            F64x4(_mm256_permute2f128_pd::<0x31>(t0, t2)),
+        ]
+    }
+}
+
+/// Writes lane `l` of `v` to `out[l]` for the lanes set in `lanes`.
+///
+/// # Safety
+/// Each `out[l]` written points to a `Vec3`; only called under AVX2.
+#[inline(always)]
+pub unsafe fn store_rows(v: [F64x4; 3], out: [*mut crate::Vec3; 4], lanes: u32) {
+    unsafe {
+        let xy_02 = _mm256_unpacklo_pd(v[0].0, v[1].0); // x0 y0 x2 y2
+        let xy_13 = _mm256_unpackhi_pd(v[0].0, v[1].0); // x1 y1 x3 y3
+        let z_01 = _mm256_castpd256_pd128(v[2].0);
+        let z_23 = _mm256_extractf128_pd::<1>(v[2].0);
+        let xy = [
+            _mm256_castpd256_pd128(xy_02),
+            _mm256_castpd256_pd128(xy_13),
+            _mm256_extractf128_pd::<1>(xy_02),
+            _mm256_extractf128_pd::<1>(xy_13),
+        ];
+        for (l, p) in out.into_iter().enumerate() {
+            if lanes & (1 << l) == 0 {
+                continue;
+            }
+            let p: *mut f64 = p.cast();
+            _mm_storeu_pd(p, xy[l]);
+            match l {
+                0 => _mm_store_sd(p.add(2), z_01),
+                1 => _mm_storeh_pd(p.add(2), z_01),
+                2 => _mm_store_sd(p.add(2), z_23),
+                _ => _mm_storeh_pd(p.add(2), z_23),
+            }
+        }
+    }
+}
+
+impl super::wide::Wide for F64x4 {
+    const WIDTH: usize = 4;
+    type Mask = F64x4;
+    #[inline]
+    fn available() -> bool {
+        available()
+    }
+    #[inline(always)]
+    fn zero() -> Self {
+        Self::zero()
+    }
+    #[inline(always)]
+    unsafe fn load(v: *const f64) -> Self {
+        unsafe { Self::load(v) }
+    }
+    #[inline(always)]
+    unsafe fn store(self, out: *mut f64) {
+        unsafe { Self::store(self, out) }
+    }
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        Self::div(self, o)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Self::sqrt(self)
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        Self::max(self, o)
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Self::neg(self)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> Self {
+        Self::gt(self, o)
+    }
+    #[inline(always)]
+    fn ne(self, o: Self) -> Self {
+        Self::ne(self, o)
+    }
+    #[inline(always)]
+    fn finite(self) -> Self {
+        Self::finite(self)
+    }
+    #[inline(always)]
+    fn mask_and(a: Self, b: Self) -> Self {
+        a.and(b)
+    }
+    #[inline(always)]
+    fn mask_or(a: Self, b: Self) -> Self {
+        a.or(b)
+    }
+    #[inline(always)]
+    fn mask_bits(m: Self) -> u32 {
+        m.mask_bits()
+    }
+    #[inline(always)]
+    fn mask_none() -> Self {
+        Self::zero()
+    }
+    #[inline(always)]
+    fn select(mask: Self, a: Self, other: Self) -> Self {
+        Self::select(mask, a, other)
+    }
+    /// Four scalar loads (AVX2's gather is no faster on the cores measured).
+    #[inline(always)]
+    unsafe fn gather_f64(base: *const f64, index: &[usize], valid: u32) -> Self {
+        let at = |l: usize| if valid & (1 << l) != 0 { unsafe { *base.add(index[l]) } } else { 0.0 };
+        Self(unsafe { _mm256_set_pd(at(3), at(2), at(1), at(0)) })
+    }
+    #[inline(always)]
+    unsafe fn gather_rows(base: *const crate::Vec3, index: &[usize]) -> [Self; 3] {
+        // SAFETY: forwarded from the caller.
+        unsafe {
+            transpose([
+                load_row(base.add(index[0])),
+                load_row(base.add(index[1])),
+                load_row(base.add(index[2])),
+                load_row(base.add(index[3])),
+            ])
+        }
+    }
+    #[inline(always)]
+    unsafe fn scatter_rows(v: [Self; 3], base: *mut crate::Vec3, index: &[usize], lanes: u32) {
+        // SAFETY: forwarded from the caller.
+        unsafe {
+            store_rows(v, [base.add(index[0]), base.add(index[1]), base.add(index[2]), base.add(index[3])], lanes)
+        }
     }
 }

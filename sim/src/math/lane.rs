@@ -1,7 +1,7 @@
 //! The number type a point law is written over, so that each law is written once and runs both
 //! on one `f64` ([`Scalar`]: the materials' own functions and the scalar kernels) and on four
 //! elements at a time, one per lane of a 256-bit register (the linear-tetrahedron batches of
-//! `crate::xpbd::kernels::p1x4`, StVK's four-lane node law).
+//! `crate::xpbd::kernels::p1`, StVK's four-lane node law).
 //!
 //! A [`Lane`] offers the four arithmetic operations a law needs, a multiply–add that is fused
 //! (one rounding) or not as the type decides, and one reduction, the sum of squares of a 3×3

@@ -1,6 +1,7 @@
 //! The number types below every other room: the lane a point law is written over ([`lane`]: one
-//! `f64` or four SIMD lanes), the four-lane AVX2 type and the one runtime check that the CPU can
-//! run it ([`f64x4`]), and the raw shared pointer parallel sweeps write through ([`shared`]).
+//! `f64` or a SIMD register), the SIMD register types behind one trait ([`wide`]) — four lanes
+//! on AVX2 ([`f64x4`]) and eight on AVX-512 ([`f64x8`]), each with the runtime check that the
+//! CPU can run it — and the raw shared pointer parallel sweeps write through ([`shared`]).
 //! It reads no other room (as Rapier keeps its SIMD number type in a `math` module below
 //! `dynamics`): the materials, the XPBD kernels and the solvers all build on it.
 
@@ -9,6 +10,10 @@ pub mod shared;
 
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod f64x4;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod f64x8;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod wide;
 
 /// A 3×3 matrix of f64 (deformation gradients, stresses).
 pub type Mat3 = nalgebra::Matrix3<f64>;

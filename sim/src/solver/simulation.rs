@@ -149,14 +149,38 @@ impl Simulation {
     pub fn effects(&self) -> &[Box<dyn Effect>] {
         &self.effects
     }
-    /// Whether the colour sweep ([`Sweep::Colour`]) projects four same-colour elements at a
-    /// time, one per lane of a 256-bit register (on by default where the CPU has AVX2 and FMA;
-    /// every element type and material; equal to the one-at-a-time colour sweep up to
-    /// round-off). Off: one at a time, for comparison.
+    /// Whether the colour sweep ([`Sweep::Colour`]) projects a register of same-colour elements
+    /// at a time, one per lane (on by default where the CPU has AVX2 and FMA; every element type
+    /// and material; equal to the one-at-a-time colour sweep up to round-off). Off: one at a
+    /// time, for comparison.
     pub fn set_simd_batches(&mut self, on: bool) {
         if let Some(x) = self.solver.as_any_mut().downcast_mut::<Xpbd>() {
             x.simd_batches = on;
         }
+    }
+
+    /// The colour sweep's register width: 4 elements per batch (AVX2) or 8 (AVX-512). The
+    /// default is the widest this CPU runs ([`crate::xpbd::kernels::widest_available`]); the
+    /// narrower one stays, for CPUs without AVX-512 and for comparison side by side. Returns
+    /// false, changing nothing, when this CPU cannot run `lanes` (or the solver is not XPBD).
+    pub fn set_simd_lanes(&mut self, lanes: usize) -> bool {
+        if !crate::xpbd::kernels::lanes_available(lanes) {
+            return false;
+        }
+        let Some(x) = self.solver.as_any_mut().downcast_mut::<Xpbd>() else {
+            return false;
+        };
+        if x.lanes != lanes {
+            x.lanes = lanes;
+            x.pack(&self.mesh, &self.geometry);
+        }
+        true
+    }
+
+    /// The colour sweep's register width (see [`Simulation::set_simd_lanes`]); None for a solver
+    /// other than XPBD.
+    pub fn simd_lanes(&self) -> Option<usize> {
+        self.solver.as_any().downcast_ref::<Xpbd>().map(|x| x.lanes)
     }
 
     /// The colour sweep cuts a block into [`crate::xpbd::kernels::slab_count`]`(size, per_slab)`

@@ -456,21 +456,35 @@ fn the_default_sweep_is_bitwise_the_same_on_one_and_two_threads_for_every_elemen
     }
 }
 
-/// The colour sweep with four linear tetrahedra per register sags a beam as the one-at-a-time
-/// colour sweep does, up to round-off, over several substeps.
+/// The colour sweep with four (AVX2) and eight (AVX-512, where the CPU has it) linear
+/// tetrahedra per register sags a beam as the one-at-a-time colour sweep does, up to round-off,
+/// over several substeps; the default width is the widest the CPU has, and a width the CPU
+/// cannot run is refused without changing anything.
 #[test]
 fn p1_simd_batches_follow_the_scalar_colour_sweep_on_a_sagging_beam() {
     let mut scalar = sagging_p1_beam();
-    let mut batched = sagging_p1_beam();
     scalar.set_simd_batches(false);
+    assert_eq!(scalar.simd_lanes(), crate::xpbd::kernels::widest_available().or(Some(4)));
+    assert!(!scalar.set_simd_lanes(3), "no three-lane register");
     for _ in 0..10 {
         scalar.substep().unwrap();
-        batched.substep().unwrap();
     }
-    assert_eq!(scalar.counters(), batched.counters());
     let scale = scalar.displacements().iter().map(|d| d.norm()).fold(0.0, f64::max);
-    let gap = scalar.positions.iter().zip(&batched.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-    assert!(scale > 1e-6 && gap <= 1e-12 * scale, "{gap:e} against {scale:e}");
+    for lanes in [4, 8] {
+        let mut batched = sagging_p1_beam();
+        if !batched.set_simd_lanes(lanes) {
+            assert!(!crate::xpbd::kernels::lanes_available(lanes));
+            eprintln!("{lanes} lanes: not on this CPU");
+            continue;
+        }
+        assert_eq!(batched.simd_lanes(), Some(lanes));
+        for _ in 0..10 {
+            batched.substep().unwrap();
+        }
+        assert_eq!(scalar.counters(), batched.counters(), "{lanes} lanes");
+        let gap = scalar.positions.iter().zip(&batched.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        assert!(scale > 1e-6 && gap <= 1e-12 * scale, "{lanes} lanes: {gap:e} against {scale:e}");
+    }
 }
 
 /// The stability guard follows every change that moves ω_max: E and ρ rescale it, ν and a

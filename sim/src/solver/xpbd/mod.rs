@@ -25,9 +25,12 @@ pub(crate) struct Xpbd {
     pub(crate) colours: Vec<Vec<Vec<u32>>>,
     /// Per block, the element data packed for the sweeps (element order and colour order).
     pub(crate) packed: crate::xpbd::kernels::SolverData,
-    /// The colour sweep projects four elements at a time ([`crate::xpbd::kernels::p1x4`],
+    /// The colour sweep projects a register of elements at a time ([`crate::xpbd::kernels::p1`],
     /// [`crate::xpbd::kernels::batch`]).
     pub(crate) simd_batches: bool,
+    /// Elements per batch: 8 where the CPU has AVX-512 F, else 4 (or as set,
+    /// [`super::Simulation::set_simd_lanes`]).
+    pub(crate) lanes: usize,
     /// Per block, its cut into slabs for the colour sweep and the slab count it was made for
     /// (built on first use; the count depends on the block's size alone; None: the block is too
     /// thin for that many slabs and is swept colour by colour).
@@ -45,6 +48,7 @@ impl Xpbd {
             colours,
             packed: crate::xpbd::kernels::SolverData::default(),
             simd_batches: true,
+            lanes: crate::xpbd::kernels::widest_available().unwrap_or(4),
             partitions: Vec::new(),
             partition_min_per_slab: crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_SLAB,
         };
@@ -53,8 +57,8 @@ impl Xpbd {
         xpbd
     }
 
-    fn pack(&mut self, mesh: &Mesh, geometry: &[BlockGeometry]) {
-        self.packed = crate::xpbd::kernels::SolverData::new(&mesh.blocks, geometry, &self.colours);
+    pub(crate) fn pack(&mut self, mesh: &Mesh, geometry: &[BlockGeometry]) {
+        self.packed = crate::xpbd::kernels::SolverData::new(&mesh.blocks, geometry, &self.colours, self.lanes);
         self.partitions = vec![(0, None); mesh.blocks.len()];
     }
 

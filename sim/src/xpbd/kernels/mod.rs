@@ -24,8 +24,10 @@
 //! ([`mul3`], [`LANES`]); `shared.rs` the raw shared pointers ([`SharedMut`]); `pack.rs` the
 //! packed element data ([`PackedBlock`]); `schedule.rs` the parallel schedules and every
 //! threshold that cuts work between threads ([`parallel_energy_block`], [`Partition`]);
-//! [`p1x4`] four linear tetrahedra per AVX2 register, [`batch`] four elements of any other type
-//! (`lanes4.rs`: the four-lane type and what both batches share).
+//! [`p1`] the linear tetrahedron a register at a time, [`batch`] any other type (`lanes.rs`: what
+//! both batches share). Each batch kernel is written once over the register type
+//! (`crate::math::wide`) and compiled twice, four lanes for AVX2 and eight for AVX-512; the width
+//! is chosen at packing ([`PackedBlock::lanes`]: the widest the CPU has, or as asked).
 
 mod pack;
 mod point_law;
@@ -37,23 +39,39 @@ mod sweep;
 #[cfg(target_arch = "x86_64")]
 pub mod batch;
 #[cfg(target_arch = "x86_64")]
-pub(crate) mod lanes4;
+pub(crate) mod lanes;
 #[cfg(target_arch = "x86_64")]
-pub mod p1x4;
+pub mod p1;
 
-/// Doubles per batch of four elements of `nodes` nodes and `points` quadrature points in
-/// [`PackedBlock::batches`] (the layouts of [`p1x4`] and [`batch`]).
-pub const fn batch_values(nodes: usize, points: usize) -> usize {
-    if nodes == 4 && points == 1 {
-        BATCH_VALUES
-    } else if batch::from_reference_gradients(nodes) {
-        points * batch::POINT_VALUES
-    } else {
-        points * (3 * nodes + 1) * 4
-    }
+/// Doubles per batch of `lanes` elements of `nodes` nodes and `points` quadrature points in
+/// [`PackedBlock::batches`] (the layouts of [`p1`] and [`batch`]).
+pub const fn batch_values(nodes: usize, points: usize, lanes: usize) -> usize {
+    lanes
+        * if nodes == 4 && points == 1 {
+            P1_VALUES_PER_LANE
+        } else if batch::from_reference_gradients(nodes) {
+            points * batch::POINT_VALUES_PER_LANE
+        } else {
+            points * (3 * nodes + 1)
+        }
 }
 
-pub use pack::{BATCH_VALUES, BlockData, PackedBlock, SolverData};
+/// The register widths the colour sweep can batch with: the widest this CPU runs (8 with
+/// AVX-512 F, 4 with AVX2 and FMA), None without either; and whether a given width runs here.
+#[cfg(target_arch = "x86_64")]
+pub use lanes::{lanes_available, widest_available};
+/// No batches off x86-64: the scalar sweep only.
+#[cfg(not(target_arch = "x86_64"))]
+pub fn widest_available() -> Option<usize> {
+    None
+}
+/// No batches off x86-64.
+#[cfg(not(target_arch = "x86_64"))]
+pub fn lanes_available(_lanes: usize) -> bool {
+    false
+}
+
+pub use pack::{BlockData, P1_VALUES_PER_LANE, PackedBlock, SolverData};
 pub use point_law::{AnyMaterial, PointMaterial, Stvk};
 pub use schedule::{
     BlockSweep, ELEMENTS_PER_EXTRA_SLAB, GENERIC_MIN_ELEMENTS_PER_TASK, MAX_SLABS, MIN_SLABS,

@@ -1,8 +1,8 @@
 //! The element data as the sweeps read it: a block's connectivity, material gradients (structure
 //! of arrays per element and point, padded to [`super::LANES`]) and quadrature volumes, copied
 //! in element order (the serial sweep) or colour by colour (the parallel sweeps, so that a
-//! colour is one contiguous range), plus the lane-interleaved batches of four elements
-//! ([`super::p1x4`], [`super::batch`]).
+//! colour is one contiguous range), plus the lane-interleaved batches of a register of elements
+//! each ([`super::p1`], [`super::batch`]; four or eight lanes, [`PackedBlock::lanes`]).
 
 use super::simd::padded;
 use crate::fem::geometry::BlockGeometry;
@@ -27,9 +27,9 @@ pub struct BlockData<'a> {
     pub element_ids: Option<&'a [u32]>,
 }
 
-/// Doubles stored per batch of four linear tetrahedra in [`PackedBlock::p1x4`]: 9 gradient
-/// entries and the volume, four lanes each.
-pub const BATCH_VALUES: usize = 40;
+/// Doubles stored per lane of a batch of linear tetrahedra in [`PackedBlock::batches`]: 9
+/// gradient entries and the volume.
+pub const P1_VALUES_PER_LANE: usize = 10;
 
 /// A block's element data packed for the sweep: in element order (the serial sweep), or
 /// reordered colour by colour (the parallel sweep; see the module doc), gradients as structure
@@ -44,33 +44,54 @@ pub struct PackedBlock {
     pub element_ids: Option<Vec<u32>>,
     pub colour_starts: Vec<usize>,
     pub points: usize,
-    /// In colour order only: the gradients and volumes of each colour's first `4 ⌊len/4⌋`
-    /// elements in batches of four, lane-interleaved ([`super::batch_values`] per batch: the
-    /// layout of [`super::p1x4`] for the linear tetrahedron at one point, of [`super::batch`]
-    /// otherwise; see [`colour_sweep`](super::colour_sweep)). Empty in element order.
+    /// In colour order only: the gradients and volumes of each colour's elements in batches of
+    /// `L` = [`PackedBlock::lanes`] (`⌈len/L⌉` per colour, the last one padded with zeros),
+    /// lane-interleaved
+    /// ([`super::batch_values`] per batch: the layout of [`super::p1`] for the linear
+    /// tetrahedron at one point, of [`super::batch`] otherwise; see
+    /// [`colour_sweep`](super::colour_sweep)). Empty in element order.
     pub batches: Vec<f64>,
+    /// Elements per batch: 4 (AVX2) or 8 (AVX-512).
+    pub lanes: usize,
     /// In colour order only: `∂N_i/∂r_b(r_q)` at `(q 3 + b) N + i`, the reference gradients the
     /// batches of [`super::batch`] read (the same for every element of the block).
     pub ref_grads: Vec<f64>,
     /// The first batch of colour `c` in [`PackedBlock::batches`] (one more entry than colours).
     pub colour_batches: Vec<usize>,
+    /// One more than the largest node index and element id of the block (0 when empty): what
+    /// the colour sweep checks its positions and multipliers against once per call, instead
+    /// of every index in every batch.
+    pub node_bound: usize,
+    pub id_bound: usize,
 }
 
 impl PackedBlock {
     /// `block`'s data in element order.
     pub fn in_element_order(block: &ElementBlock, geometry: &BlockGeometry) -> Self {
         let all: Vec<u32> = (0..block.len() as u32).collect();
-        let mut packed = Self::new(block, geometry, std::slice::from_ref(&all), false);
+        let mut packed = Self::new(block, geometry, std::slice::from_ref(&all), false, 4);
         packed.element_ids = None;
         packed
     }
 
-    /// `block`'s data in the order of `colours` (element indices per colour).
+    /// `block`'s data in the order of `colours` (element indices per colour), batched for the
+    /// widest register this CPU has ([`super::widest_available`]).
     pub fn in_colour_order(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>]) -> Self {
-        Self::new(block, geometry, colours, true)
+        Self::in_colour_order_with_lanes(block, geometry, colours, super::widest_available().unwrap_or(4))
     }
 
-    fn new(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>], batches: bool) -> Self {
+    /// As [`PackedBlock::in_colour_order`], in batches of `lanes` (4 or 8) elements.
+    pub fn in_colour_order_with_lanes(
+        block: &ElementBlock,
+        geometry: &BlockGeometry,
+        colours: &[Vec<u32>],
+        lanes: usize,
+    ) -> Self {
+        assert!(lanes == 4 || lanes == 8, "{lanes} lanes: 4 or 8");
+        Self::new(block, geometry, colours, true, lanes)
+    }
+
+    fn new(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>], batches: bool, lanes: usize) -> Self {
         let (n, q) = (block.nodes_per_element(), geometry.points_per_element);
         let total: usize = colours.iter().map(Vec::len).sum();
         let mut ids = Vec::with_capacity(total);
@@ -82,8 +103,11 @@ impl PackedBlock {
             colour_starts: Vec::with_capacity(colours.len() + 1),
             points: q,
             batches: Vec::new(),
+            lanes,
             ref_grads: Vec::new(),
             colour_batches: vec![0],
+            node_bound: 0,
+            id_bound: 0,
         };
         packed.colour_starts.push(0);
         // the reference gradients at each point, shared by every element of the block
@@ -120,45 +144,52 @@ impl PackedBlock {
             }
             packed.colour_starts.push(ids.len());
             if batches {
-                for four in colour.chunks_exact(4) {
+                for batch in colour.chunks(lanes) {
+                    // a colour's last batch may be partial: its missing lanes hold zero gradients
+                    // and volumes (the sweep masks them out; see colour_sweep)
+                    let pad = lanes - batch.len();
+                    let mut put = |values: &mut dyn Iterator<Item = f64>| {
+                        packed.batches.extend(values);
+                        packed.batches.extend(std::iter::repeat_n(0.0, pad));
+                    };
                     if n == 4 && q == 1 {
                         for r in 1..4 {
                             for c in 0..3 {
-                                packed.batches.extend(four.iter().map(|&e| geometry.gradients(e as usize, 0)[r][c]));
+                                put(&mut batch.iter().map(|&e| geometry.gradients(e as usize, 0)[r][c]));
                             }
                         }
-                        packed.batches.extend(four.iter().map(|&e| geometry.volumes(e as usize)[0]));
+                        put(&mut batch.iter().map(|&e| geometry.volumes(e as usize)[0]));
                         continue;
                     }
                     if !super::batch::from_reference_gradients(n) {
                         for p in 0..q {
                             for axis in 0..3 {
                                 for i in 0..n {
-                                    packed
-                                        .batches
-                                        .extend(four.iter().map(|&e| geometry.gradients(e as usize, p)[i][axis]));
+                                    put(&mut batch.iter().map(|&e| geometry.gradients(e as usize, p)[i][axis]));
                                 }
                             }
-                            packed.batches.extend(four.iter().map(|&e| geometry.volumes(e as usize)[p]));
+                            put(&mut batch.iter().map(|&e| geometry.volumes(e as usize)[p]));
                         }
                         continue;
                     }
                     for p in 0..q {
-                        let jinv: Vec<Matrix3<f64>> = four
+                        let jinv: Vec<Matrix3<f64>> = batch
                             .iter()
                             .map(|&e| inverse_jacobian(&ref_grads[p], geometry.gradients(e as usize, p)))
                             .collect();
                         for r in 0..3 {
                             for c in 0..3 {
-                                packed.batches.extend(jinv.iter().map(|j| j[(r, c)]));
+                                put(&mut jinv.iter().map(|j| j[(r, c)]));
                             }
                         }
-                        packed.batches.extend(four.iter().map(|&e| geometry.volumes(e as usize)[p]));
+                        put(&mut batch.iter().map(|&e| geometry.volumes(e as usize)[p]));
                     }
                 }
-                packed.colour_batches.push(packed.batches.len() / super::batch_values(n, q));
+                packed.colour_batches.push(packed.batches.len() / super::batch_values(n, q, lanes));
             }
         }
+        packed.node_bound = packed.nodes.iter().map(|&i| i as usize + 1).max().unwrap_or(0);
+        packed.id_bound = ids.iter().map(|&i| i as usize + 1).max().unwrap_or(0);
         packed.element_ids = Some(ids);
         packed
     }
@@ -199,14 +230,15 @@ pub struct SolverData {
 }
 
 impl SolverData {
-    pub fn new(blocks: &[ElementBlock], geometry: &[BlockGeometry], colours: &[Vec<Vec<u32>>]) -> Self {
+    /// Batches of `lanes` (4 or 8) elements in the colour order.
+    pub fn new(blocks: &[ElementBlock], geometry: &[BlockGeometry], colours: &[Vec<Vec<u32>>], lanes: usize) -> Self {
         Self {
             serial: blocks.iter().zip(geometry).map(|(b, g)| PackedBlock::in_element_order(b, g)).collect(),
             colour: blocks
                 .iter()
                 .zip(geometry)
                 .zip(colours)
-                .map(|((b, g), c)| PackedBlock::in_colour_order(b, g, c))
+                .map(|((b, g), c)| PackedBlock::in_colour_order_with_lanes(b, g, c, lanes))
                 .collect(),
         }
     }

@@ -88,8 +88,8 @@ pub enum BlockSweep<'a> {
 /// The parallel sweep of the energy formulation over one block, by slabs (see [`Partition`]) or
 /// else colour after colour, each
 /// colour's packed range cut into one contiguous chunk per thread of rayon's current pool (at
-/// least [`SWEEP_MIN_ELEMENTS_PER_THREAD`] elements each, cut at multiples of 4 elements from the
-/// colour's start; see [`colour_sweep`] for `batched`). Same-colour elements share no node, so the
+/// least [`SWEEP_MIN_ELEMENTS_PER_THREAD`] elements each, cut at multiples of the batch width from
+/// the colour's start; see [`colour_sweep`] for `batched`). Same-colour elements share no node, so the
 /// result is the same for any thread count and scheduling; on a non-finite correction the
 /// colour is finished (other chunks may have been scattered) and the error of the first such
 /// chunk is returned. None when the node count has no specialised sweep.
@@ -130,8 +130,9 @@ pub fn parallel_energy_block(
     for c in 0..packed.num_colours() {
         let range = packed.colour(c);
         let chunks = threads.min(range.len().div_ceil(SWEEP_MIN_ELEMENTS_PER_THREAD)).max(1);
-        let fours = range.len().div_ceil(4);
-        let cut = |i: usize| range.start + (4 * (fours * i / chunks)).min(range.len());
+        let width = packed.lanes;
+        let batches = range.len().div_ceil(width);
+        let cut = |i: usize| range.start + (width * (batches * i / chunks)).min(range.len());
         let chunk = |i: usize| cut(i)..cut(i + 1);
         // SAFETY: the chunks of a colour are disjoint ranges of elements that share no node
         // (crate::xpbd::colouring) and own their multipliers; node and element indices come from the
@@ -185,14 +186,16 @@ pub struct Partition {
 }
 
 impl Partition {
-    /// `block` cut into `slabs` slabs (even, at least 2), or None when two slabs of one phase
-    /// would share a node.
+    /// `block` cut into `slabs` slabs (even, at least 2), each packed in batches of `lanes`
+    /// elements ([`PackedBlock::in_colour_order_with_lanes`]), or None when two slabs of one
+    /// phase would share a node.
     pub fn new(
         block: &ElementBlock,
         geometry: &BlockGeometry,
         colours: &[Vec<u32>],
         rest: &[Vec3],
         slabs: usize,
+        lanes: usize,
     ) -> Option<Self> {
         if slabs < 2 || !slabs.is_multiple_of(2) || block.len() < slabs {
             return None;
@@ -237,7 +240,9 @@ impl Partition {
                 .collect()
         };
         Some(Self {
-            slabs: (0..slabs).map(|s| PackedBlock::in_colour_order(block, geometry, &restricted(s))).collect(),
+            slabs: (0..slabs)
+                .map(|s| PackedBlock::in_colour_order_with_lanes(block, geometry, &restricted(s), lanes))
+                .collect(),
         })
     }
 }

@@ -1,6 +1,6 @@
 //! The energy-constraint sweep itself, specialised per node count (see the module doc of
 //! [`super`]): [`energy_sweep`] over a packed range in order, [`colour_sweep`] over one colour
-//! with the four-lane P1 batches, and the per-element projections [`project_p1`] and
+//! with the batches of a register of elements, and the per-element projections [`project_p1`] and
 //! [`project_energy`] they run.
 
 use super::pack::{BlockData, PackedBlock};
@@ -13,7 +13,7 @@ use crate::xpbd::constraint::xpbd_step;
 
 use super::batch_values;
 #[cfg(target_arch = "x86_64")]
-use super::{batch, lanes4, p1x4};
+use super::{batch, lanes, p1};
 
 /// What the sweep hands back when an element's corrections come out non-finite: its element
 /// index in the block and its first non-finite node (nothing was scattered for it).
@@ -49,7 +49,7 @@ pub unsafe fn energy_sweep(
 ) -> Option<Result<u64, NonFiniteElement>> {
     let io = SweepIo { positions, rest, inv_mass, data, lambdas, inv_dt2 };
     #[cfg(target_arch = "x86_64")]
-    let wide = super::lanes4::available();
+    let wide = super::lanes::lanes_available(4);
     macro_rules! dispatch {
         ($(($n:literal, $p:literal)),*) => {
             match nodes_per_element {
@@ -272,13 +272,15 @@ pub fn project_energy<const N: usize, const P: usize, const FMA: bool, M: PointM
 }
 
 /// The colour sweep over packed range `range` of colour `colour` of `packed` (a colour-ordered
-/// block), whose start is a multiple of 4 elements from the colour's start: as [`energy_sweep`],
-/// but with `batched` four elements at a time where the CPU has AVX2 and FMA — the linear
-/// tetrahedron at one point through [`p1x4::batches_avx2`], every other specialised node count
-/// through [`batch::batches_avx2`], StVK as a law over lanes and any other model lane by lane
-/// ([`lanes4::BatchLaw`]); the colour's last `len mod 4` elements through the scalar sweep. Which
-/// elements are batched depends only on the colour, not on how its range is cut, so the result
-/// does not depend on the thread count.
+/// block), whose start is a multiple of `L` = [`PackedBlock::lanes`] elements from the colour's
+/// start: as [`energy_sweep`], but with `batched` `L` elements at a time where the CPU has the
+/// register (4: AVX2 and FMA; 8: AVX-512 F too) — the linear tetrahedron at one point through
+/// [`p1::batches_avx2`] or [`p1::batches_avx512`], every other specialised node count through
+/// [`batch::batches_avx2`] or [`batch::batches_avx512`], StVK as a law over lanes and any other
+/// model lane by lane ([`lanes::BatchLaw`]); the colour's last `len mod L` elements in one
+/// partial batch, its missing lanes masked out. Which elements share a batch depends only on the
+/// colour and `L`, not on how the range is cut, so the result does not depend on the thread
+/// count.
 ///
 /// # Safety
 /// As [`energy_sweep`].
@@ -301,40 +303,78 @@ pub unsafe fn colour_sweep(
     }
     let data = packed.data();
     let colour_start = packed.colour_starts[colour];
-    assert!((range.start - colour_start).is_multiple_of(4) && range.end <= packed.colour_starts[colour + 1]);
+    let width = packed.lanes;
+    assert!((range.start - colour_start).is_multiple_of(width) && range.end <= packed.colour_starts[colour + 1]);
     let mut tail = range.clone();
     let mut projected = 0;
     #[cfg(target_arch = "x86_64")]
-    if batched && packed.colour_batches.len() == packed.colour_starts.len() && super::lanes4::available() {
+    if batched && packed.colour_batches.len() == packed.colour_starts.len() && lanes::lanes_available(width) {
         let (n, q) = (nodes_per_element, packed.points);
-        let per_batch = batch_values(n, q);
-        let first = packed.colour_batches[colour] + (range.start - colour_start) / 4;
-        let batches = (range.len() / 4).min(packed.colour_batches[colour + 1] - first);
+        let per_batch = batch_values(n, q, width);
+        // every node index and element id of the batches, checked once (the kernels do not)
+        assert!(
+            packed.node_bound <= positions.len().min(rest.len()).min(inv_mass.len())
+                && packed.id_bound <= lambdas.len(),
+            "the packed block's indices exceed the positions or multipliers"
+        );
+        let first = packed.colour_batches[colour] + (range.start - colour_start) / width;
+        let stored = packed.colour_batches[colour + 1] - first;
+        let full = (range.len() / width).min(stored);
         let ids = data.element_ids.expect("colour order");
-        let io = p1x4::BatchIo {
+        let run = |io: p1::BatchIo<'_>, batches: usize| {
+            // SAFETY: forwarded from the caller; the register's features were detected; the
+            // elements of a batch are of one colour (a padding lane repeats one but is never
+            // written).
+            unsafe {
+                if let Some(FastLaw::StVenantKirchhoff(l)) = material.fast_law() {
+                    let law = Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa };
+                    batches_of(width, n, q, &packed.ref_grads, &law, io, batches)
+                } else {
+                    batches_of(width, n, q, &packed.ref_grads, &AnyMaterial(material), io, batches)
+                }
+            }
+        };
+        let io = p1::BatchIo {
             positions,
             rest,
             inv_mass,
-            nodes: &data.nodes[range.start * n..(range.start + 4 * batches) * n],
-            values: &packed.batches[first * per_batch..(first + batches) * per_batch],
-            element_ids: &ids[range.start..range.start + 4 * batches],
+            nodes: &data.nodes[range.start * n..(range.start + width * full) * n],
+            values: &packed.batches[first * per_batch..(first + full) * per_batch],
+            element_ids: &ids[range.start..range.start + width * full],
             lambdas,
             inv_dt2,
+            last_lanes: u32::MAX,
         };
-        // SAFETY: forwarded from the caller; AVX2 and FMA were detected; the elements of a
-        // batch are of one colour.
-        let result = unsafe {
-            if let Some(FastLaw::StVenantKirchhoff(l)) = material.fast_law() {
-                batches_of(n, q, &packed.ref_grads, &Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa }, io, batches)
-            } else {
-                batches_of(n, q, &packed.ref_grads, &AnyMaterial(material), io, batches)
-            }
-        };
-        match result {
+        match run(io, full) {
             Ok(k) => projected = k,
             Err(bad) => return Some(Err(bad)),
         }
-        tail.start += 4 * batches;
+        tail.start += width * full;
+        // the colour's last, partial batch (only the last chunk of a colour has one): its
+        // missing lanes repeat its last element's nodes and id, masked out
+        let partial = tail.len();
+        if partial > 0 && partial < width && full < stored {
+            let mut nodes = [0u32; 8 * 27];
+            let mut element_ids = [0u32; 8];
+            nodes[..partial * n].copy_from_slice(&data.nodes[tail.start * n..tail.end * n]);
+            element_ids[..partial].copy_from_slice(&ids[tail.clone()]);
+            for l in partial..width {
+                nodes.copy_within((partial - 1) * n..partial * n, l * n);
+                element_ids[l] = element_ids[partial - 1];
+            }
+            let io = p1::BatchIo {
+                nodes: &nodes[..width * n],
+                values: &packed.batches[(first + full) * per_batch..(first + full + 1) * per_batch],
+                element_ids: &element_ids[..width],
+                last_lanes: (1 << partial) - 1,
+                ..io
+            };
+            match run(io, 1) {
+                Ok(k) => projected += k,
+                Err(bad) => return Some(Err(bad)),
+            }
+            tail.start = tail.end;
+        }
     }
     // SAFETY: forwarded from the caller.
     let rest_of =
@@ -342,31 +382,43 @@ pub unsafe fn colour_sweep(
     Some(rest_of.map(|k| k + projected))
 }
 
-/// The batches of `io` for `n` nodes and `q` points, by the kernel of that node count.
+/// The batches of `io` for `n` nodes and `q` points on `width` lanes, by the kernel of that
+/// node count and width.
 ///
 /// # Safety
-/// As [`p1x4::batches_avx2`]; `n` one of [`SPECIALISED_NODE_COUNTS`].
+/// As [`p1::batches_avx2`] (`width` 4) or [`p1::batches_avx512`] (8); `n` one of
+/// [`SPECIALISED_NODE_COUNTS`].
 #[cfg(target_arch = "x86_64")]
-unsafe fn batches_of<L: lanes4::BatchLaw>(
+unsafe fn batches_of<L: lanes::BatchLaw>(
+    width: usize,
     n: usize,
     q: usize,
     ref_grads: &[f64],
     law: &L,
-    io: p1x4::BatchIo<'_>,
+    io: p1::BatchIo<'_>,
     batches: usize,
 ) -> Result<u64, NonFiniteElement> {
+    macro_rules! by_node_count {
+        ($p1:path, $batch:ident) => {
+            match n {
+                4 if q == 1 => $p1(law, io, batches),
+                4 => batch::$batch::<4, L>(law, io, ref_grads, q, batches),
+                5 => batch::$batch::<5, L>(law, io, ref_grads, q, batches),
+                6 => batch::$batch::<6, L>(law, io, ref_grads, q, batches),
+                8 => batch::$batch::<8, L>(law, io, ref_grads, q, batches),
+                10 => batch::$batch::<10, L>(law, io, ref_grads, q, batches),
+                20 => batch::$batch::<20, L>(law, io, ref_grads, q, batches),
+                27 => batch::$batch::<27, L>(law, io, ref_grads, q, batches),
+                _ => unreachable!("{n} nodes: no specialised sweep"),
+            }
+        };
+    }
     // SAFETY: forwarded.
     unsafe {
-        match n {
-            4 if q == 1 => p1x4::batches_avx2(law, io, batches),
-            4 => batch::batches_avx2::<4, L>(law, io, ref_grads, q, batches),
-            5 => batch::batches_avx2::<5, L>(law, io, ref_grads, q, batches),
-            6 => batch::batches_avx2::<6, L>(law, io, ref_grads, q, batches),
-            8 => batch::batches_avx2::<8, L>(law, io, ref_grads, q, batches),
-            10 => batch::batches_avx2::<10, L>(law, io, ref_grads, q, batches),
-            20 => batch::batches_avx2::<20, L>(law, io, ref_grads, q, batches),
-            27 => batch::batches_avx2::<27, L>(law, io, ref_grads, q, batches),
-            _ => unreachable!("{n} nodes: no specialised sweep"),
+        match width {
+            4 => by_node_count!(p1::batches_avx2, batches_avx2),
+            8 => by_node_count!(p1::batches_avx512, batches_avx512),
+            _ => unreachable!("{width} lanes"),
         }
     }
 }

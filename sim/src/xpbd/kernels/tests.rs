@@ -255,18 +255,27 @@ fn the_sweeps_stvk_is_the_materials_point_law_bit_for_bit() {
     }
 }
 
-/// Four same-colour elements per register, for every element type (the linear tetrahedron also
-/// at a raised quadrature degree, through the generic batch) and every material, on curved
-/// elements (every rest node moved by a smooth map): the one-at-a-time colour sweep's positions
-/// and multipliers up to round-off, the same pinned elements skipped, and the same element and
-/// node named when a correction comes out non-finite, with the same nodes scattered before it.
+/// Four same-colour elements per register (AVX2) and eight (AVX-512, where the CPU has it), for
+/// every element type (the linear tetrahedron also at a raised quadrature degree, through the
+/// generic batch) and every material, on curved elements (every rest node moved by a smooth
+/// map): the one-at-a-time colour sweep's positions and multipliers up to round-off, the same
+/// pinned elements skipped, and the same element and node named when a correction comes out
+/// non-finite (in the register's second-to-last lane), with the same nodes scattered before it.
 #[cfg(target_arch = "x86_64")]
 #[test]
-fn batches_of_four_match_the_scalar_colour_sweep_for_every_element_type_and_material() {
-    use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
-    if !(std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")) {
-        return;
+fn batches_of_four_and_eight_match_the_scalar_colour_sweep_for_every_element_type_and_material() {
+    let widths: Vec<usize> = [4, 8].into_iter().filter(|&l| lanes_available(l)).collect();
+    if !widths.contains(&8) {
+        eprintln!("this CPU has no AVX-512 F: the eight-lane batches are not run here");
     }
+    for lanes in widths {
+        batches_match_the_scalar_colour_sweep(lanes);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+fn batches_match_the_scalar_colour_sweep(lanes: usize) {
+    use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
     let cases = [
         ("p1", Some(2)),
         ("p1", None),
@@ -277,6 +286,7 @@ fn batches_of_four_match_the_scalar_colour_sweep_for_every_element_type_and_mate
         ("prism", None),
         ("pyramid", None),
     ];
+    let mut partial_cases = 0;
     for (name, degree) in cases {
         let mut mesh = BoxMeshSpec {
             grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(2.0, 0.5, 0.5), cells: [8, 4, 4] },
@@ -293,8 +303,8 @@ fn batches_of_four_match_the_scalar_colour_sweep_for_every_element_type_and_mate
         let block = &mesh.blocks[0];
         let n = block.nodes_per_element();
         let colours = crate::xpbd::colouring::colour_elements(block, mesh.num_nodes());
-        let packed = PackedBlock::in_colour_order(block, &geo[0], &colours);
-        let what = format!("{name} (quadrature degree {degree:?})");
+        let packed = PackedBlock::in_colour_order_with_lanes(block, &geo[0], &colours, lanes);
+        let what = format!("{name} (quadrature degree {degree:?}, {lanes} lanes)");
         assert!(packed.colour_batches.last().copied().unwrap_or(0) > 0, "{what}: some elements in batches");
         let deformed: Vec<Vec3> = mesh
             .rest_positions
@@ -336,30 +346,50 @@ fn batches_of_four_match_the_scalar_colour_sweep_for_every_element_type_and_mate
                 }
             }
         }
-        // a non-finite node first met (in sweep order) in the third lane of a batch
+        // a non-finite node first met (in sweep order) in the second-to-last lane of a full
+        // batch, then in the last element of a colour's partial batch (its other lanes padding)
         let mut first_seen = vec![usize::MAX; mesh.num_nodes()];
         for (k, element) in packed.nodes.chunks_exact(n).enumerate() {
             for &nd in element {
                 first_seen[nd as usize] = first_seen[nd as usize].min(k);
             }
         }
-        let batched_end = |c: usize| packed.colour(c).start + 4 * (packed.colour(c).len() / 4);
-        let k = (0..packed.num_colours())
+        let batched_end = |c: usize| packed.colour(c).start + lanes * (packed.colour(c).len() / lanes);
+        let first_met = |k: usize| {
+            let node = packed.nodes[n * k + n - 1] as usize;
+            first_seen[node] == k && w[node] > 0.0
+        };
+        let in_full = (0..packed.num_colours())
             .flat_map(|c| (packed.colour(c).start..batched_end(c)).map(move |k| (c, k)))
-            .find(|&(c, k)| {
-                let node = packed.nodes[n * k + n - 1] as usize;
-                (k - packed.colour(c).start) % 4 == 2 && first_seen[node] == k && w[node] > 0.0
-            })
+            .find(|&(c, k)| (k - packed.colour(c).start) % lanes == lanes - 2 && first_met(k))
             .map(|(_, k)| k)
-            .expect("a node first met in a third lane");
+            .expect("a node first met in the second-to-last lane");
+        let in_partial = (0..packed.num_colours())
+            .filter(|&c| batched_end(c) < packed.colour(c).end)
+            .map(|c| packed.colour(c).end - 1)
+            .find(|&k| first_met(k));
+        partial_cases += usize::from(in_partial.is_some());
+        for k in std::iter::once(in_full).chain(in_partial) {
+            nan_at(name, n, &packed, &mesh.rest_positions, &w, &deformed, k);
+        }
+    }
+    assert!(partial_cases > 0, "{lanes} lanes: a NaN in a partial batch was tried");
+}
+
+/// A NaN put on the last node of packed element `k`: the batched and one-at-a-time colour
+/// sweeps name the same element and node and scatter the same positions before it.
+#[cfg(target_arch = "x86_64")]
+fn nan_at(name: &str, n: usize, packed: &PackedBlock, rest: &[Vec3], w: &[f64], deformed: &[Vec3], k: usize) {
+    let elements = packed.len();
+    {
         let bad_node = packed.nodes[n * k + n - 1];
         let material = materials()[0];
-        let (mut x1, mut l1) = (deformed.clone(), vec![0.0; elements]);
-        let (mut x4, mut l4) = (deformed.clone(), vec![0.0; elements]);
+        let (mut x1, mut l1) = (deformed.to_vec(), vec![0.0; elements]);
+        let (mut x4, mut l4) = (deformed.to_vec(), vec![0.0; elements]);
         x1[bad_node as usize].y = f64::NAN;
         x4[bad_node as usize].y = f64::NAN;
-        let r1 = sweep_colours_of(n, &material, &packed, &mesh.rest_positions, &w, &mut x1, &mut l1, false);
-        let r4 = sweep_colours_of(n, &material, &packed, &mesh.rest_positions, &w, &mut x4, &mut l4, true);
+        let r1 = sweep_colours_of(n, &material, packed, rest, w, &mut x1, &mut l1, false);
+        let r4 = sweep_colours_of(n, &material, packed, rest, w, &mut x4, &mut l4, true);
         let bad = r1.unwrap_err();
         assert_eq!(bad, r4.unwrap_err(), "{name}");
         assert_eq!(bad.node, bad_node, "{name}");
