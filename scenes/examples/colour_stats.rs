@@ -2,7 +2,7 @@
 //! their sizes, and how far apart in memory the four elements of a batch reach (the node-index
 //! span a batch's gathers touch); then the colour sweep timed on the beam as built and with its
 //! nodes renumbered along x (a test of the L1 working-set hypothesis of docs/PERFORMANCE.md,
-//! session 22), one thread, alternately: `cargo run --release -p hox-scenes --example colour_stats`.
+//! session 22), on one and two threads, alternately: `cargo run --release -p hox-scenes --example colour_stats`.
 
 use hox_sim::Vec3;
 use hox_sim::effect::{Clamp, Effect, Gravity};
@@ -87,12 +87,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut built = hox_scenes::bench::bending_beam(case, hox_sim::solver::Sweep::Colour)?;
         let mut along_x = renumbered(&built)?;
         let frames = if block.len() > 50_000 { 6 } else { 20 };
-        let mut pairs = Vec::new();
-        for _ in 0..3 {
-            pairs.push((ms_per_frame(&mut built, frames)?, ms_per_frame(&mut along_x, frames)?));
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+            let mut pairs = Vec::new();
+            for _ in 0..3 {
+                pairs.push(pool.install(|| -> Result<(f64, f64), String> {
+                    let time = |sim: &mut Simulation| ms_per_frame(sim, frames).map_err(|e| e.to_string());
+                    Ok((time(&mut built)?, time(&mut along_x)?))
+                })?);
+            }
+            let ratios: Vec<String> =
+                pairs.iter().map(|(a, b)| format!("{a:.2} -> {b:.2} ms ({:.2})", b / a)).collect();
+            println!("  colour sweep, {threads} thread(s), as built -> numbered along x: {}", ratios.join(", "));
         }
-        let ratios: Vec<String> = pairs.iter().map(|(a, b)| format!("{a:.2} -> {b:.2} ms ({:.2})", b / a)).collect();
-        println!("  colour sweep, one thread, as built -> numbered along x: {}", ratios.join(", "));
     }
     Ok(())
 }

@@ -193,7 +193,7 @@ pub fn measure(
                 message: format!("this CPU cannot run batches of {l} elements (4 needs AVX2 and FMA, 8 AVX-512 F)"),
             });
         }
-        let lanes = if sweep == Sweep::Colour { sim.simd_lanes() } else { None };
+        let lanes = if sweep == Sweep::Colour { sim.simd_lanes().first().copied() } else { None };
         for _ in 0..warmup_frames {
             sim.step_frame().map_err(failed)?;
         }

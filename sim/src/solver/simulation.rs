@@ -159,10 +159,11 @@ impl Simulation {
         }
     }
 
-    /// The colour sweep's register width: 4 elements per batch (AVX2) or 8 (AVX-512). The
-    /// default is the widest this CPU runs ([`crate::xpbd::kernels::widest_available`]); the
-    /// narrower one stays, for CPUs without AVX-512 and for comparison side by side. Returns
-    /// false, changing nothing, when this CPU cannot run `lanes` (or the solver is not XPBD).
+    /// The colour sweep's register width for every block: 4 elements per batch (AVX2) or 8
+    /// (AVX-512). By default each block's own, from its colours and the CPU
+    /// ([`crate::xpbd::kernels::auto_lanes`]); the narrower width stays, for CPUs without
+    /// AVX-512 and for comparison side by side. Returns false, changing nothing, when this CPU
+    /// cannot run `lanes` (or the solver is not XPBD).
     pub fn set_simd_lanes(&mut self, lanes: usize) -> bool {
         if !crate::xpbd::kernels::lanes_available(lanes) {
             return false;
@@ -170,17 +171,20 @@ impl Simulation {
         let Some(x) = self.solver.as_any_mut().downcast_mut::<Xpbd>() else {
             return false;
         };
-        if x.lanes != lanes {
-            x.lanes = lanes;
+        if x.lanes != Some(lanes) {
+            x.lanes = Some(lanes);
             x.pack(&self.mesh, &self.geometry);
         }
         true
     }
 
-    /// The colour sweep's register width (see [`Simulation::set_simd_lanes`]); None for a solver
-    /// other than XPBD.
-    pub fn simd_lanes(&self) -> Option<usize> {
-        self.solver.as_any().downcast_ref::<Xpbd>().map(|x| x.lanes)
+    /// The colour sweep's register width per block (see [`Simulation::set_simd_lanes`]); empty
+    /// for a solver other than XPBD.
+    pub fn simd_lanes(&self) -> Vec<usize> {
+        self.solver
+            .as_any()
+            .downcast_ref::<Xpbd>()
+            .map_or(Vec::new(), |x| x.packed.colour.iter().map(|p| p.lanes).collect())
     }
 
     /// The colour sweep cuts a block into [`crate::xpbd::kernels::slab_count`]`(size, per_slab)`

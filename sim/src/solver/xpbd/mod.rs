@@ -28,9 +28,9 @@ pub(crate) struct Xpbd {
     /// The colour sweep projects a register of elements at a time ([`crate::xpbd::kernels::p1`],
     /// [`crate::xpbd::kernels::batch`]).
     pub(crate) simd_batches: bool,
-    /// Elements per batch: 8 where the CPU has AVX-512 F, else 4 (or as set,
-    /// [`super::Simulation::set_simd_lanes`]).
-    pub(crate) lanes: usize,
+    /// Elements per batch, as set ([`super::Simulation::set_simd_lanes`]); None: each block's
+    /// own ([`crate::xpbd::kernels::auto_lanes`]).
+    pub(crate) lanes: Option<usize>,
     /// Per block, its cut into slabs for the colour sweep and the slab count it was made for
     /// (built on first use; the count depends on the block's size alone; None: the block is too
     /// thin for that many slabs and is swept colour by colour).
@@ -48,7 +48,7 @@ impl Xpbd {
             colours,
             packed: crate::xpbd::kernels::SolverData::default(),
             simd_batches: true,
-            lanes: crate::xpbd::kernels::widest_available().unwrap_or(4),
+            lanes: None,
             partitions: Vec::new(),
             partition_min_per_slab: crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_SLAB,
         };

@@ -125,7 +125,7 @@ impl Xpbd {
                         &self.colours[bi],
                         &s.mesh.rest_positions,
                         slabs,
-                        self.lanes,
+                        self.packed.colour[bi].lanes,
                     );
                     self.partitions[bi] = (slabs, partition);
                 }

@@ -71,7 +71,7 @@ pub fn lanes_available(_lanes: usize) -> bool {
     false
 }
 
-pub use pack::{BlockData, P1_VALUES_PER_LANE, PackedBlock, SolverData};
+pub use pack::{BlockData, EIGHT_LANE_BATCH_COST, P1_VALUES_PER_LANE, PackedBlock, SolverData, auto_lanes};
 pub use point_law::{AnyMaterial, PointMaterial, Stvk};
 pub use schedule::{
     BlockSweep, ELEMENTS_PER_EXTRA_SLAB, GENERIC_MIN_ELEMENTS_PER_TASK, MAX_SLABS, MIN_SLABS,

@@ -75,9 +75,9 @@ impl PackedBlock {
     }
 
     /// `block`'s data in the order of `colours` (element indices per colour), batched for the
-    /// widest register this CPU has ([`super::widest_available`]).
+    /// register [`auto_lanes`] picks for these colours.
     pub fn in_colour_order(block: &ElementBlock, geometry: &BlockGeometry, colours: &[Vec<u32>]) -> Self {
-        Self::in_colour_order_with_lanes(block, geometry, colours, super::widest_available().unwrap_or(4))
+        Self::in_colour_order_with_lanes(block, geometry, colours, auto_lanes(colours))
     }
 
     /// As [`PackedBlock::in_colour_order`], in batches of `lanes` (4 or 8) elements.
@@ -230,18 +230,49 @@ pub struct SolverData {
 }
 
 impl SolverData {
-    /// Batches of `lanes` (4 or 8) elements in the colour order.
-    pub fn new(blocks: &[ElementBlock], geometry: &[BlockGeometry], colours: &[Vec<Vec<u32>>], lanes: usize) -> Self {
+    /// Batches of `lanes` (4 or 8) elements in the colour order; None: each block's
+    /// [`auto_lanes`].
+    pub fn new(
+        blocks: &[ElementBlock],
+        geometry: &[BlockGeometry],
+        colours: &[Vec<Vec<u32>>],
+        lanes: Option<usize>,
+    ) -> Self {
         Self {
             serial: blocks.iter().zip(geometry).map(|(b, g)| PackedBlock::in_element_order(b, g)).collect(),
             colour: blocks
                 .iter()
                 .zip(geometry)
                 .zip(colours)
-                .map(|((b, g), c)| PackedBlock::in_colour_order_with_lanes(b, g, c, lanes))
+                .map(|((b, g), c)| {
+                    PackedBlock::in_colour_order_with_lanes(b, g, c, lanes.unwrap_or_else(|| auto_lanes(c)))
+                })
                 .collect(),
         }
     }
+}
+
+/// What a batch of eight elements counts for against a batch of four in [`auto_lanes`]. On the
+/// AVX-512 core measured (Sapphire Rapids, one thread, `hox bench --lanes 4,8` alternately,
+/// three rounds), 1.25 sorts every beam measured onto its faster width: the paper's P3 (35
+/// batches of four against 32 of eight: four lanes 0.73–0.75× the time of eight) and Q2 (8
+/// against 8: 0.55–0.78×) keep four; its P2 (45 against 35: eight lanes 0.64–1.0×), the prism
+/// and pyramid beams (130 against 67, 171 against 96: 0.55–0.74×) and every beam whose colours
+/// fill their batches (P1 1,280 to 81,920, the 32×8×8 beams but the pyramid's) take eight.
+pub const EIGHT_LANE_BATCH_COST: f64 = 1.25;
+
+/// The register width for a block swept in `colours`: 8 where the CPU has AVX-512 F and the
+/// block's batches of eight (`Σ ⌈len/8⌉`, a colour's last batch padded) cost less than its
+/// batches of four (`Σ ⌈len/4⌉`), a batch of eight counting [`EIGHT_LANE_BATCH_COST`]; else 4
+/// (also where the CPU has no SIMD batches at all: they are then not run). Small blocks with
+/// short colours (the paper's P3 beam: 80 elements) keep four lanes, where half-empty batches
+/// of eight were slower. A function of the colours and the CPU alone, never of the thread count.
+pub fn auto_lanes(colours: &[Vec<u32>]) -> usize {
+    if super::widest_available() != Some(8) {
+        return 4;
+    }
+    let batches = |w: usize| colours.iter().map(|c| c.len().div_ceil(w)).sum::<usize>() as f64;
+    if EIGHT_LANE_BATCH_COST * batches(8) < batches(4) { 8 } else { 4 }
 }
 
 /// `J⁻¹` at a point from the reference gradients `g_r` (`∂N_i/∂r`) and the material gradients

@@ -399,3 +399,19 @@ fn nan_at(name: &str, n: usize, packed: &PackedBlock, rest: &[Vec3], w: &[f64], 
         }
     }
 }
+
+/// The register width follows the colours: long colours take eight lanes where the CPU has
+/// AVX-512 (four where it has not), short ones keep four, where half-empty batches of eight
+/// cost more than they save.
+#[test]
+fn long_colours_take_eight_lanes_and_short_ones_keep_four() {
+    let long: Vec<Vec<u32>> = (0..10).map(|c| (0..64).map(|e| 64 * c + e).collect()).collect();
+    let short: Vec<Vec<u32>> = (0..20).map(|c| (0..4).map(|e| 4 * c + e).collect()).collect();
+    let ragged: Vec<Vec<u32>> = (0..20).map(|c| (0..5).map(|e| 5 * c + e).collect()).collect();
+    let eight = widest_available() == Some(8);
+    assert_eq!(auto_lanes(&long), if eight { 8 } else { 4 });
+    assert_eq!(auto_lanes(&short), 4, "one half-empty batch of eight per colour");
+    // 5 per colour: 2 batches of four against 1 of eight; 4: 1 against 1
+    assert_eq!(auto_lanes(&ragged), if eight { 8 } else { 4 });
+    assert_eq!(auto_lanes(&[]), 4);
+}
