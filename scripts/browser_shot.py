@@ -7,7 +7,8 @@ over the DevTools protocol with the standard library only (no pip package).
 
 Opens URL, waits --wait seconds (the Rerun web viewer compiles 42 MB of WebAssembly first),
 then writes --shots screenshots --every seconds apart: OUT.png, or OUT-1.png, OUT-2.png, ...
-when there are several. The page's console errors are printed to stderr. Exit 0 when every
+when there are several, all of the one page kept open (the first captured, the others taken
+from the page's screencast, the frames it streams as it repaints). The page's console errors are printed to stderr. Exit 0 when every
 screenshot was written."""
 
 import argparse
@@ -100,6 +101,9 @@ class Page:
         self.ws = ws
         self.next_id = 0
         self.errors = []
+        # the screencast's frames: the latest one's PNG bytes and how many have come
+        self.frame = None
+        self.frames = 0
 
     def call(self, method, **params):
         if os.environ.get("BROWSER_SHOT_DEBUG"):
@@ -114,8 +118,17 @@ class Page:
                 return msg.get("result", {})
             self.note(msg)
 
+    def send(self, method, **params):
+        """A call whose answer is not waited for (read later and ignored)."""
+        self.next_id += 1
+        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
+
     def note(self, msg):
         method = msg.get("method", "")
+        if method == "Page.screencastFrame":
+            self.frame = base64.b64decode(msg["params"]["data"])
+            self.frames += 1
+            self.send("Page.screencastFrameAck", sessionId=msg["params"]["sessionId"])
         if method == "Runtime.exceptionThrown":
             self.errors.append(msg["params"]["exceptionDetails"].get("text", "exception"))
         elif method == "Runtime.consoleAPICalled" and msg["params"].get("type") == "error":
@@ -191,6 +204,23 @@ def main():
         for k in range(args.shots):
             if k > 0:
                 page.sleep(args.every)
+                # Page.captureScreenshot of a page that repaints continuously in software WebGL
+                # returns once and then never again: the later pictures of the same open page
+                # are frames its screencast streams (each acknowledged as it comes), the first
+                # one painted after this picture was asked for
+                seen = page.frames
+                end = time.time() + 90
+                while page.frames == seen and time.time() < end:
+                    for x in (width // 2, width // 2 + 1):
+                        page.send("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=14)
+                    page.sleep(1.0)
+                if page.frames == seen:
+                    sys.exit(f"browser_shot: no new frame of the open page for picture {k + 1} in 90 s")
+                path = f"{base}-{k + 1}{ext}"
+                with open(path, "wb") as f:
+                    f.write(page.frame)
+                print(path)
+                continue
             # the viewer paints only when something changes: a pointer move over the empty
             # middle of its top bar makes it paint now, so the capture has a frame to take
             for x in (width // 2, width // 2 + 1):
@@ -200,6 +230,8 @@ def main():
             with open(path, "wb") as f:
                 f.write(base64.b64decode(shot["data"]))
             print(path)
+            if args.shots > 1:
+                page.call("Page.startScreencast", format="png", maxWidth=width, maxHeight=height)
         for e in page.errors:
             print(f"browser_shot: page error: {e}", file=sys.stderr)
     finally:
