@@ -104,6 +104,8 @@ class Page:
         # the screencast's frames: the latest one's PNG bytes and how many have come
         self.frame = None
         self.frames = 0
+        # (folder, start time) where every frame is also written (--frames)
+        self.keep_frames = None
 
     def call(self, method, **params):
         if os.environ.get("BROWSER_SHOT_DEBUG"):
@@ -128,6 +130,10 @@ class Page:
         if method == "Page.screencastFrame":
             self.frame = base64.b64decode(msg["params"]["data"])
             self.frames += 1
+            if self.keep_frames:
+                folder, start = self.keep_frames
+                with open(os.path.join(folder, f"frame-{time.time() - start:07.3f}.png"), "wb") as f:
+                    f.write(self.frame)
             self.send("Page.screencastFrameAck", sessionId=msg["params"]["sessionId"])
         if method == "Runtime.exceptionThrown":
             self.errors.append(msg["params"]["exceptionDetails"].get("text", "exception"))
@@ -163,6 +169,8 @@ def main():
     ap.add_argument("--wait", type=float, default=20.0)
     ap.add_argument("--shots", type=int, default=1)
     ap.add_argument("--every", type=float, default=5.0)
+    ap.add_argument("--frames", help="also keep every frame the page paints from the moment it is "
+                    "opened, as DIR/frame-SECONDS.png (seconds since the page was asked for)")
     args = ap.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
     profile = tempfile.mkdtemp(prefix="hox-chromium-")
@@ -198,6 +206,10 @@ def main():
         page.call("Runtime.enable")
         page.call("Page.enable")
         page.call("Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1, mobile=False)
+        if args.frames:
+            os.makedirs(args.frames, exist_ok=True)
+            page.keep_frames = (args.frames, time.time())
+            page.call("Page.startScreencast", format="png", maxWidth=width, maxHeight=height)
         page.call("Page.navigate", url=args.url)
         page.sleep(args.wait)
         base, ext = os.path.splitext(args.out)
@@ -230,7 +242,7 @@ def main():
             with open(path, "wb") as f:
                 f.write(base64.b64decode(shot["data"]))
             print(path)
-            if args.shots > 1:
+            if args.shots > 1 and not args.frames:
                 page.call("Page.startScreencast", format="png", maxWidth=width, maxHeight=height)
         for e in page.errors:
             print(f"browser_shot: page error: {e}", file=sys.stderr)
