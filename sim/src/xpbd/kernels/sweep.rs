@@ -376,6 +376,10 @@ pub unsafe fn colour_sweep(
             tail.start = tail.end;
         }
     }
+    // every element batched (the usual case since the partial batches): no scalar sweep to set up
+    if tail.is_empty() {
+        return Some(Ok(projected));
+    }
     // SAFETY: forwarded from the caller.
     let rest_of =
         unsafe { energy_sweep(nodes_per_element, material, positions, rest, inv_mass, &data, tail, lambdas, inv_dt2) }?;
