@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Screenshots of a web page as a student's browser shows it: headless Chromium (Debian's
-package, installed by scripts/setup.sh --browser) with software WebGL (SwiftShader), driven
+package, installed by scripts/setup.sh) with software WebGL (SwiftShader), driven
 over the DevTools protocol with the standard library only (no pip package).
 
     scripts/browser_shot.py URL OUT.png [--size 1280x720] [--wait 20] [--shots 1] [--every 5]
@@ -158,7 +158,7 @@ def chromium():
         path = shutil.which(name)
         if path:
             return path
-    sys.exit("browser_shot: no Chromium found (scripts/setup.sh --browser installs Debian's)")
+    sys.exit("browser_shot: no Chromium found (scripts/setup.sh installs Debian's)")
 
 
 def main():
