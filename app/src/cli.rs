@@ -99,10 +99,12 @@ pub enum Command {
     /// frame against the paper's, ns per element per substep, GFLOP/s (docs/PERFORMANCE.md);
     /// --solver NAME times an implicit solver of `hox solvers` on the same beams.
     Bench {
-        /// Timed frames per configuration (the median is reported).
+        /// Timed frames per configuration (the median is reported); a case's configurations
+        /// (thread counts, sweeps, widths) are timed side by side, a frame of each in turn.
         #[arg(long, default_value_t = 20)]
         frames: usize,
-        /// Thread counts, comma-separated.
+        /// Thread counts, comma-separated; with more than one thread a row also shows its
+        /// speed-up over one thread, frame by frame.
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
         threads: Vec<usize>,
         /// Only the configurations whose label contains this (e.g. "p1", "r2").

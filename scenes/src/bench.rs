@@ -140,6 +140,10 @@ pub struct BenchRow {
     /// `ms_per_frame / (elements × substeps)`, in ns.
     pub ns_per_element_substep: f64,
     pub gflops: f64,
+    /// With more than one thread: the median over rounds of the one-thread frame's time over
+    /// this row's, the frames timed side by side ([`measure_side_by_side`]); None on one thread
+    /// or when no one-thread row of the same sweep and width was timed.
+    pub speedup_over_one_thread: Option<f64>,
 }
 
 impl BenchRow {
@@ -162,69 +166,102 @@ impl BenchRow {
     }
 }
 
-/// Times `case` with the sweep `sweep` (the colour sweep on `lanes` elements per batch, None:
-/// the widest the CPU has), in a rayon pool of
-/// `threads`: `warmup_frames` untimed, then the median of `frames` timed frames. Frames are
-/// also capped by `budget_secs` of timed work (at least 3 frames).
-#[allow(clippy::too_many_arguments)]
-pub fn measure(
+/// One configuration of a case ([`measure_side_by_side`]): the rayon pool's thread count, the
+/// sweep, and the colour sweep's register width (None: the widest the CPU has).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BenchConfig {
+    pub threads: usize,
+    pub sweep: Sweep,
+    pub lanes: Option<usize>,
+}
+
+/// Times `case` in each of `configs` **side by side**: one simulation per configuration, each in
+/// its own rayon pool, `warmup_frames` untimed frames each, then rounds of one timed frame per
+/// configuration, in turn (the order reversed every other round, so that none always goes
+/// first), until `frames` rounds or `budget_secs` of timed work in all (at least 3 rounds).
+/// A change in the machine's speed — a shared machine's other work, its clock — then falls on
+/// every configuration alike instead of on whichever was timed at that moment. Each row's
+/// `ms_per_frame` is the median of its frames; a row with more than one thread also gets
+/// `speedup_over_one_thread`, the median over rounds of the one-thread frame's time over its own
+/// (the one-thread configuration of the same sweep and width), a ratio of frames timed a fraction
+/// of a second apart.
+pub fn measure_side_by_side(
     case: &BenchCase,
-    threads: usize,
-    sweep: Sweep,
-    lanes: Option<usize>,
+    configs: &[BenchConfig],
     warmup_frames: usize,
     frames: usize,
     budget_secs: f64,
-) -> Result<BenchRow, SceneError> {
-    let threads = threads.max(1);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| SceneError::Simulation { source_name: "bench".into(), message: e.to_string() })?;
+) -> Result<Vec<BenchRow>, SceneError> {
     let failed =
         |e: hox_sim::solver::SimError| SceneError::Simulation { source_name: case.label(), message: e.to_string() };
-    pool.install(|| {
-        let mut sim = bending_beam(case, sweep)?;
-        if let Some(l) = lanes
-            && !sim.set_simd_lanes(l)
-        {
-            return Err(SceneError::Simulation {
-                source_name: "bench".into(),
-                message: format!("this CPU cannot run batches of {l} elements (4 needs AVX2 and FMA, 8 AVX-512 F)"),
-            });
-        }
-        let lanes = if sweep == Sweep::Colour { sim.simd_lanes().first().copied() } else { None };
-        for _ in 0..warmup_frames {
-            sim.step_frame().map_err(failed)?;
-        }
-        let mut times_ms = Vec::with_capacity(frames);
-        let start = Instant::now();
-        for i in 0..frames.max(1) {
-            let clock = Instant::now();
-            sim.step_frame().map_err(failed)?;
-            times_ms.push(clock.elapsed().as_secs_f64() * 1e3);
-            if i >= 2 && start.elapsed().as_secs_f64() > budget_secs {
-                break;
+    let mut runs = Vec::with_capacity(configs.len());
+    for config in configs {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(config.threads.max(1))
+            .build()
+            .map_err(|e| SceneError::Simulation { source_name: "bench".into(), message: e.to_string() })?;
+        let sim = pool.install(|| {
+            let mut sim = bending_beam(case, config.sweep)?;
+            if let Some(l) = config.lanes
+                && !sim.set_simd_lanes(l)
+            {
+                return Err(SceneError::Simulation {
+                    source_name: "bench".into(),
+                    message: format!("this CPU cannot run batches of {l} elements (4 needs AVX2 and FMA, 8 AVX-512 F)"),
+                });
             }
+            for _ in 0..warmup_frames {
+                sim.step_frame().map_err(failed)?;
+            }
+            Ok(sim)
+        })?;
+        runs.push((pool, sim, Vec::<f64>::with_capacity(frames)));
+    }
+    let start = Instant::now();
+    for round in 0..frames.max(1) {
+        let order: Vec<usize> =
+            if round % 2 == 0 { (0..runs.len()).collect() } else { (0..runs.len()).rev().collect() };
+        for k in order {
+            let (pool, sim, times_ms) = &mut runs[k];
+            let clock = Instant::now();
+            pool.install(|| sim.step_frame()).map_err(failed)?;
+            times_ms.push(clock.elapsed().as_secs_f64() * 1e3);
         }
-        let ms_per_frame = median(&mut times_ms);
+        if round >= 2 && start.elapsed().as_secs_f64() > budget_secs {
+            break;
+        }
+    }
+    let mut rows = Vec::with_capacity(runs.len());
+    for (k, (config, (_, sim, times_ms))) in configs.iter().zip(&runs).enumerate() {
+        let lanes = if config.sweep == Sweep::Colour { sim.simd_lanes().first().copied() } else { None };
+        let one_thread = configs
+            .iter()
+            .position(|c| c.threads <= 1 && c.sweep == config.sweep && c.lanes == config.lanes)
+            .filter(|&one| one != k && config.threads > 1);
+        let speedup_over_one_thread = one_thread.map(|one| {
+            let mut ratios: Vec<f64> = runs[one].2.iter().zip(times_ms).map(|(a, b)| a / b).collect();
+            median(&mut ratios)
+        });
+        let ms_per_frame = median(&mut times_ms.clone());
         let elements = sim.mesh().num_elements();
         let substeps = sim.substeps_per_frame() as f64;
         let g = &sim.geometry()[0];
         let flops = flops_per_element(g.nodes_per_element, g.points_per_element) * elements as f64 * substeps;
-        Ok(BenchRow {
+        rows.push(BenchRow {
             case: *case,
             elements,
             nodes: sim.mesh().num_nodes(),
             points_per_element: g.points_per_element,
-            threads,
-            sweep,
+            threads: config.threads.max(1),
+            sweep: config.sweep,
             lanes,
             ms_per_frame,
             ns_per_element_substep: ms_per_frame * 1e6 / (elements as f64 * substeps),
             gflops: flops / (ms_per_frame * 1e6),
-        })
-    })
+            speedup_over_one_thread,
+        });
+    }
+    Ok(rows)
 }
 
 /// The table `hox bench` prints: per case, one row per thread count and sweep; `peak_gflops`
@@ -232,14 +269,14 @@ pub fn measure(
 /// scalar peak (one double per FMA).
 pub fn markdown(rows: &[BenchRow], peak_gflops: f64) -> String {
     let mut s = format!(
-        "| configuration | elements | threads | sweep | lanes | paper ms/frame | ours ms/frame | paper / ours | ns per element·substep | GFLOP/s | % of AVX2 peak ({peak_gflops:.1} GFLOP/s per core) | % of scalar peak |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| configuration | elements | threads | sweep | lanes | paper ms/frame | ours ms/frame | paper / ours | ns per element·substep | GFLOP/s | % of AVX2 peak ({peak_gflops:.1} GFLOP/s per core) | % of scalar peak | over one thread, frame by frame |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let paper = r.case.paper_ms_per_frame.map_or(String::new(), |p| format!("{p}"));
         let ratio = r.speedup_over_paper().map_or(String::new(), |x| format!("{x:.1}×"));
         let peak = peak_gflops * r.threads as f64;
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.1} | {:.2} | {:.1} % | {:.1} % |\n",
+            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.1} | {:.2} | {:.1} % | {:.1} % | {} |\n",
             r.case.label(),
             r.elements,
             r.threads,
@@ -252,6 +289,7 @@ pub fn markdown(rows: &[BenchRow], peak_gflops: f64) -> String {
             r.gflops,
             100.0 * r.gflops / peak,
             400.0 * r.gflops / peak,
+            r.speedup_over_one_thread.map_or("–".to_string(), |x| format!("{x:.2}×")),
         ));
     }
     s
@@ -265,7 +303,8 @@ pub fn peak_gflops_per_core() -> f64 {
 
 /// Untimed frames before the timed ones (the beam starts at rest and sags).
 pub const WARMUP_FRAMES: usize = 5;
-/// Timed work per configuration after which no more frames are timed (at least 3 are), seconds.
+/// Timed work per case (all its configurations together) after which no more rounds are timed
+/// (at least 3 are), seconds.
 pub const BUDGET_SECS: f64 = 10.0;
 
 /// The case labelled `filter`, or else every case whose label contains it, ignoring case (a whole
@@ -294,8 +333,8 @@ fn matching(cases: &'static [BenchCase], filter: &str) -> Vec<&'static BenchCase
 /// Measures the case labelled `filter`, or else every case whose label contains it (ignoring
 /// case), on each of `threads` with each of `sweeps` (the element-order sweep runs on one
 /// thread whatever the pool, so it is measured on one thread only; the colour sweep on each of
-/// `lanes`, or the CPU's widest when empty), reporting each row to `progress` as it is measured
-/// (what `hox bench` runs).
+/// `lanes`, or the CPU's widest when empty), every configuration of a case side by side
+/// ([`measure_side_by_side`]), reporting each row to `progress` (what `hox bench` runs).
 pub fn run(
     filter: &str,
     threads: &[usize],
@@ -306,6 +345,7 @@ pub fn run(
 ) -> Result<Vec<BenchRow>, SceneError> {
     let mut rows = Vec::new();
     for case in matching_cases(filter) {
+        let mut configs = Vec::new();
         for &t in threads {
             for &sweep in sweeps {
                 if sweep == Sweep::Element && t > 1 {
@@ -317,11 +357,16 @@ pub fn run(
                     vec![None]
                 };
                 for l in widths {
-                    let row = measure(case, t, sweep, l, WARMUP_FRAMES, frames, BUDGET_SECS)?;
-                    progress(&row);
-                    rows.push(row);
+                    let config = BenchConfig { threads: t.max(1), sweep, lanes: l };
+                    if !configs.contains(&config) {
+                        configs.push(config);
+                    }
                 }
             }
+        }
+        for row in measure_side_by_side(case, &configs, WARMUP_FRAMES, frames, BUDGET_SECS)? {
+            progress(&row);
+            rows.push(row);
         }
     }
     Ok(rows)
@@ -330,6 +375,30 @@ pub fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every configuration of a case is timed side by side, one row each in the order given; the
+    /// speed-up over one thread is on the rows with more threads only, taken from the
+    /// one-thread row of the same sweep, and printed in the table's last column.
+    #[test]
+    fn configurations_are_timed_side_by_side_with_the_speed_up_frame_by_frame() {
+        let case = BenchCase { scene: "bending", element: "p1", grid: [4, 1, 1], refine: 0, paper_ms_per_frame: None };
+        let configs = [
+            BenchConfig { threads: 1, sweep: Sweep::Colour, lanes: None },
+            BenchConfig { threads: 2, sweep: Sweep::Colour, lanes: None },
+            BenchConfig { threads: 1, sweep: Sweep::Element, lanes: None },
+        ];
+        let rows = measure_side_by_side(&case, &configs, 1, 3, 600.0).unwrap();
+        let got: Vec<(usize, Sweep)> = rows.iter().map(|r| (r.threads, r.sweep)).collect();
+        assert_eq!(got, [(1, Sweep::Colour), (2, Sweep::Colour), (1, Sweep::Element)]);
+        assert!(rows.iter().all(|r| r.ms_per_frame > 0.0 && r.elements == 20));
+        assert_eq!(rows[0].speedup_over_one_thread, None);
+        let speedup = rows[1].speedup_over_one_thread.expect("a two-thread row has its speed-up");
+        assert!(speedup.is_finite() && speedup > 0.0, "{speedup}");
+        assert_eq!((rows[2].speedup_over_one_thread, rows[2].lanes), (None, None));
+        let table = markdown(&rows, 40.0);
+        let two = table.lines().find(|l| l.contains("| 2 | colour |")).unwrap();
+        assert!(two.trim_end().ends_with(&format!("{speedup:.2}× |")), "{two}");
+    }
 
     /// The benchmark's beam is the bending scene's: its box, material, settings and effects come
     /// from `assets/scenes/bending.toml`; a case changes only the element type, grid, refinement

@@ -34,7 +34,7 @@ const SOLVER_FILES_STATED: &[&[&str]] = &[
     &["newton_core"],
     &[SOLVERS],
     &["statics"],
-    &["registry"],
+    &["registry", "node_loops"],
     &["simulation"],
 ];
 

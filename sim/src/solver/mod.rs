@@ -68,14 +68,17 @@ pub mod statics;
 
 mod registry;
 
+mod node_loops;
+
 mod simulation;
 
 pub use error::{SimError, SolverCounters};
 pub use integrator::{INFO as INTEGRATORS, Integrator, IntegratorInfo};
 pub use method::{INFO as METHODS, Method, MethodInfo, SweepsPerStep};
+pub use node_loops::NODE_LOOP_MIN_NODES_PER_THREAD;
 pub use residual::StaticResidual;
 pub use settings::{NewtonSettings, SolverSettings, Sweep, VbdInit, VbdSettings};
-pub use simulation::{NODE_LOOP_MIN_NODES_PER_THREAD, Simulation};
+pub use simulation::Simulation;
 
 #[cfg(test)]
 mod implicit_tests;

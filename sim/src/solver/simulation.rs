@@ -7,9 +7,10 @@
 use super::error::{SimError, SolverCounters};
 use super::integrator::{History, Integrator};
 use super::method::Method;
+use super::node_loops;
 use super::registry;
 use super::residual::{StaticResidual, static_residual};
-use super::settings::{SolverSettings, Sweep};
+use super::settings::SolverSettings;
 use super::stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
 use super::step::{Hooks, StepInput, StepSolver};
 use super::xpbd::Xpbd;
@@ -510,29 +511,9 @@ impl Simulation {
         }
         hook!(before_prediction);
         // the node loops of the substep on every thread for large meshes (the colour sweep's
-        // threads would otherwise wait on them: 19 k nodes are ≈ 10 % of a substep of the
-        // 81,920-tetrahedron beam on two threads); each node on its own, so the same bits
-        let chunks = node_chunks(self.positions.len(), self.settings.sweep);
-        // nodes per chunk (all of them when serial)
-        let c = self.positions.len().div_ceil(chunks).max(1);
-        if chunks > 1 {
-            use rayon::prelude::*;
-            self.prev_positions
-                .par_chunks_mut(c)
-                .zip(self.positions.par_chunks_mut(c))
-                .zip(self.velocities.par_chunks(c))
-                .for_each(|((p, x), v)| {
-                    p.copy_from_slice(x);
-                    for (x, v) in x.iter_mut().zip(v) {
-                        *x += v * h;
-                    }
-                });
-        } else {
-            self.prev_positions.copy_from_slice(&self.positions);
-            for (x, v) in self.positions.iter_mut().zip(&self.velocities) {
-                *x += v * h;
-            }
-        }
+        // threads would otherwise wait on them); each node on its own, so the same bits
+        let chunks = node_loops::chunks(self.positions.len(), self.settings.sweep);
+        node_loops::predict(&mut self.prev_positions, &mut self.positions, &self.velocities, h, chunks);
         let inertia_h = if integrator == Integrator::Euler {
             h
         } else {
@@ -605,33 +586,11 @@ impl Simulation {
                 &mut self.velocities,
                 &self.inv_mass,
             );
-        } else if chunks > 1 {
-            use rayon::prelude::*;
-            self.velocities
-                .par_chunks_mut(c)
-                .zip(self.positions.par_chunks(c))
-                .zip(self.prev_positions.par_chunks(c))
-                .for_each(|((v, x), xp)| {
-                    for ((v, x), xp) in v.iter_mut().zip(x).zip(xp) {
-                        *v = (x - xp) * inv_h;
-                    }
-                });
         } else {
-            for ((v, x), xp) in self.velocities.iter_mut().zip(&self.positions).zip(&self.prev_positions) {
-                *v = (x - xp) * inv_h;
-            }
+            node_loops::update_velocities(&mut self.velocities, &self.positions, &self.prev_positions, inv_h, chunks);
         }
         hook!(after_velocity_update);
-        let all_finite = chunks > 1 && {
-            use rayon::prelude::*;
-            self.positions.par_chunks(c).zip(self.velocities.par_chunks(c)).all(|(x, v)| {
-                let mut check = 0.0;
-                for (x, v) in x.iter().zip(v) {
-                    check += (x.x + x.y + x.z + v.x + v.y + v.z) * 0.0;
-                }
-                check == 0.0
-            })
-        };
+        let all_finite = node_loops::all_finite(&self.positions, &self.velocities, chunks);
         if all_finite {
             return Ok(());
         }
@@ -661,21 +620,6 @@ impl Simulation {
     pub fn displacements(&self) -> Vec<Vec3> {
         self.positions.iter().zip(&self.mesh.rest_positions).map(|(x, x0)| x - x0).collect()
     }
-}
-
-/// Fewest nodes per thread for which the substep's node loops (prediction, velocity update, the
-/// finite check) run on every thread of rayon's pool: below, one pass on the calling thread costs
-/// less than waking the others.
-pub const NODE_LOOP_MIN_NODES_PER_THREAD: usize = 8192;
-
-/// How many chunks the substep's node loops are cut into for `nodes` nodes: one (serial) for the
-/// element-order sweep or a small mesh, else one per thread of the current pool. The cut only
-/// shares out the work: each node's update is its own, so the result does not depend on it.
-fn node_chunks(nodes: usize, sweep: Sweep) -> usize {
-    if !sweep.is_colour() {
-        return 1;
-    }
-    rayon::current_num_threads().min(nodes / NODE_LOOP_MIN_NODES_PER_THREAD).max(1)
 }
 
 /// Refuses effects `method` cannot honour, naming the first one and the methods that can.

@@ -370,6 +370,23 @@ fn slab_sweep_is_bitwise_the_same_on_one_and_two_threads() {
     assert_eq!(one, run(2));
 }
 
+/// A block too thin for the slab count its size asks for is cut into fewer slabs, not left whole:
+/// 16 cells along the beam cannot hold 16 slabs (one cell each, so two slabs of a phase would
+/// share the nodes of the odd slab between them) but hold 8.
+#[test]
+fn a_block_too_thin_for_its_slab_count_is_cut_into_fewer_slabs() {
+    use crate::xpbd::kernels::Partition;
+    let sim = sagging_p1_beam();
+    let (block, geometry) = (&sim.mesh().blocks[0], &sim.geometry()[0]);
+    let colours = &sim.xpbd_solver().unwrap().colours[0];
+    let rest = &sim.mesh().rest_positions;
+    assert!(Partition::new(block, geometry, colours, rest, 32, 4).is_none());
+    let cut = Partition::largest(block, geometry, colours, rest, 32, 4).expect("a partition");
+    assert!(cut.slabs.len() >= crate::xpbd::kernels::MIN_SLABS && cut.slabs.len() < 32, "{}", cut.slabs.len());
+    assert!(Partition::new(block, geometry, colours, rest, cut.slabs.len() * 2, 4).is_none());
+    assert_eq!(cut.slabs.iter().map(|s| s.len()).sum::<usize>(), sim.mesh().num_elements());
+}
+
 /// The slab count is the block's alone: none below two slabs' worth, then two, more only for
 /// blocks large enough (powers of two up to the cap).
 #[test]
@@ -378,7 +395,8 @@ fn the_slab_count_depends_on_the_block_size_alone() {
     assert_eq!(slab_count(1_280, 1024), 1);
     assert_eq!(slab_count(4_095, 1024), 1);
     assert_eq!(slab_count(4_096, 1024), MIN_SLABS);
-    assert_eq!(slab_count(81_920, 1024), 4);
+    assert_eq!(slab_count(10_240, 1024), 4);
+    assert_eq!(slab_count(81_920, 1024), 16);
     assert_eq!(slab_count(8 * ELEMENTS_PER_EXTRA_SLAB, 1024), 8);
     assert_eq!(slab_count(15 * ELEMENTS_PER_EXTRA_SLAB, 1024), 8);
     assert_eq!(slab_count(usize::MAX / 2, 1024), MAX_SLABS);

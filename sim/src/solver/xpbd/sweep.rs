@@ -119,7 +119,8 @@ impl Xpbd {
                 let size = crate::xpbd::kernels::p1_equivalents(block.len(), n, s.geometry[bi].points_per_element);
                 let slabs = crate::xpbd::kernels::slab_count(size, self.partition_min_per_slab);
                 if slabs >= 2 && self.partitions[bi].0 != slabs {
-                    let partition = crate::xpbd::kernels::Partition::new(
+                    // a block too thin for its slab count is cut into fewer rather than not at all
+                    let partition = crate::xpbd::kernels::Partition::largest(
                         block,
                         &s.geometry[bi],
                         &self.colours[bi],

@@ -37,8 +37,14 @@ pub const GENERIC_MIN_ELEMENTS_PER_TASK: usize = 64;
 pub const PARTITION_MIN_ELEMENTS_PER_SLAB: usize = 1024;
 
 /// Elements per slab, in [`p1_equivalents`], past which a block is cut into more than
-/// [`MIN_SLABS`] slabs (up to [`MAX_SLABS`]).
-pub const ELEMENTS_PER_EXTRA_SLAB: usize = 32_768;
+/// [`MIN_SLABS`] slabs (up to [`MAX_SLABS`]). More slabs than threads per phase let a thread that
+/// finishes early take another slab (rayon's work stealing): two threads of a shared machine do
+/// not run at one speed (on the 81,920-tetrahedron beam with two slabs per phase, one thread's
+/// slabs took 25 ms per frame and the other's 34 ms, and every phase waited for the slower; with
+/// eight per phase both threads finished each phase within a slab's time of each other).
+/// 4,096 cuts that beam into 16 slabs of 5,120 tetrahedra, ≈ 100 µs each per sweep, far above a
+/// steal's cost (docs/PERFORMANCE.md, session 26).
+pub const ELEMENTS_PER_EXTRA_SLAB: usize = 4_096;
 
 /// The fewest slabs a cut block has: two phases of two slabs each.
 pub const MIN_SLABS: usize = 4;
@@ -244,6 +250,27 @@ impl Partition {
                 .map(|s| PackedBlock::in_colour_order_with_lanes(block, geometry, &restricted(s), lanes))
                 .collect(),
         })
+    }
+
+    /// `block` cut into `slabs` slabs ([`Partition::new`]), or, where it is too thin for that
+    /// many, into half as many, and so on down to [`MIN_SLABS`]: None only when even that fails.
+    /// Still a function of the block alone.
+    pub fn largest(
+        block: &ElementBlock,
+        geometry: &BlockGeometry,
+        colours: &[Vec<u32>],
+        rest: &[Vec3],
+        slabs: usize,
+        lanes: usize,
+    ) -> Option<Self> {
+        let mut count = slabs;
+        while count >= MIN_SLABS {
+            if let Some(partition) = Self::new(block, geometry, colours, rest, count, lanes) {
+                return Some(partition);
+            }
+            count /= 2;
+        }
+        None
     }
 }
 
