@@ -32,11 +32,14 @@ impl Effect for Gravity {
     }
     fn before_prediction(&mut self, s: &mut EffectState<'_>) {
         let dv = self.acceleration_m_s2 * s.dt_secs;
-        for (v, w) in s.velocities.iter_mut().zip(s.inv_mass) {
-            if *w > 0.0 {
-                *v += dv;
+        let chunks = crate::math::par::chunks(s.velocities.len());
+        crate::math::par::zip_chunks(s.velocities, s.inv_mass, chunks, |v, w| {
+            for (v, w) in v.iter_mut().zip(w) {
+                if *w > 0.0 {
+                    *v += dv;
+                }
             }
-        }
+        });
         self.nodes_accelerated += s.velocities.len() as u64;
     }
     fn work_count(&self) -> u64 {

@@ -1,11 +1,13 @@
 //! The number types below every other room: the lane a point law is written over ([`lane`]: one
 //! `f64` or a SIMD register), the SIMD register types behind one trait ([`wide`]) — four lanes
 //! on AVX2 ([`f64x4`]) and eight on AVX-512 ([`f64x8`]), each with the runtime check that the
-//! CPU can run it — and the raw shared pointer parallel sweeps write through ([`shared`]).
+//! CPU can run it — the raw shared pointer parallel sweeps write through ([`shared`]), and how a
+//! pass over the nodes is cut between threads ([`par`]).
 //! It reads no other room (as Rapier keeps its SIMD number type in a `math` module below
 //! `dynamics`): the materials, the XPBD kernels and the solvers all build on it.
 
 pub mod lane;
+pub mod par;
 pub mod shared;
 
 #[cfg(target_arch = "x86_64")]

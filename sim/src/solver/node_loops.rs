@@ -8,25 +8,16 @@ use super::settings::Sweep;
 use crate::Vec3;
 use rayon::prelude::*;
 
-/// Fewest nodes per thread for which the substep's node loops run on every thread of rayon's
-/// pool: below, one pass on the calling thread costs less than waking the others. A pass costs
-/// ≈ 2 ns per node here; the colour sweep's threads are usually still awake when it comes (they
-/// have just finished a phase), so a few thousand nodes per thread pay (on the 16,225-node beam,
-/// 8,192 had left the loops serial: docs/PERFORMANCE.md, session 26).
-pub const NODE_LOOP_MIN_NODES_PER_THREAD: usize = 4096;
+pub use crate::math::par::NODE_LOOP_MIN_NODES_PER_THREAD;
+use crate::math::par::chunk_len;
 
 /// How many chunks the substep's node loops are cut into for `nodes` nodes: one (serial) for the
-/// element-order sweep or a small mesh, else one per thread of the current pool.
+/// element-order sweep (the serial reference), else [`crate::math::par::chunks`].
 pub(super) fn chunks(nodes: usize, sweep: Sweep) -> usize {
     if !sweep.is_colour() {
         return 1;
     }
-    rayon::current_num_threads().min(nodes / NODE_LOOP_MIN_NODES_PER_THREAD).max(1)
-}
-
-/// Nodes per chunk when `nodes` are cut into `chunks` (all of them when serial).
-fn chunk_len(nodes: usize, chunks: usize) -> usize {
-    nodes.div_ceil(chunks.max(1)).max(1)
+    crate::math::par::chunks(nodes)
 }
 
 /// `prev = x; x += h v`, in one pass per node.

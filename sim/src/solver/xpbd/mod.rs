@@ -88,7 +88,7 @@ impl StepSolver for Xpbd {
         hooks: &mut Hooks<'_>,
         counters: &mut SolverCounters,
     ) -> Result<(), BadElement> {
-        self.lambdas.iter_mut().for_each(|l| l.fill(0.0));
+        self.lambdas.iter_mut().for_each(|l| crate::math::par::fill(l, 0.0));
         for _ in 0..input.settings.iterations {
             self.project_elements(input, positions, counters)?;
             hooks.after_projection(positions, None);
