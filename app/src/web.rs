@@ -9,6 +9,9 @@
 //!   reads from the servers: a browser orbits, scrubs and hovers its own copy of the data.
 //! - **Clear refusals:** a port in use or an address that is not this machine's is refused by
 //!   name before anything starts; a browser that closes is nothing to the server.
+//! - **Read-only for viewers:** Rerun's gRPC server runs on the loopback address only; the port
+//!   students reach is [`read_only`]'s proxy, which forwards reads and refuses every write, so
+//!   no browser or program on the network can push data into what the others see.
 //! - **Bounded memory:** the gRPC proxy keeps at most [`ServeArgs::history_mb`] of history for
 //!   browsers that connect late (Rerun's `ServerOptions::memory_limit`); beyond it the oldest
 //!   frames are dropped (static data — topology, rest shape, labels, blueprint — never is).
@@ -18,6 +21,8 @@
 use anyhow::{Context, Result, bail};
 use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener, UdpSocket};
 use std::path::PathBuf;
+
+pub mod read_only;
 
 /// The web viewer's files (`app/build.rs`): a zip archive, empty when the build did not find
 /// them.
@@ -48,10 +53,14 @@ impl Default for ServeArgs {
     }
 }
 
-/// The web viewer's HTTP server; it stops when dropped. The gRPC server lives in the recording
-/// stream's sink ([`serve_recording`]) or in [`serve_messages`]'s.
+/// The web viewer's HTTP server and the data stream's read-only door; they stop when dropped.
+/// The gRPC server behind the door lives in the recording stream's sink ([`serve_recording`])
+/// or in [`serve_messages`]'s.
 pub struct WebServer {
     _http: re_web_viewer_server::WebViewerServer,
+    _door: read_only::ReadOnlyDoor,
+    /// The port browsers read the data stream from (the door's).
+    pub data_port: u16,
     /// What students open: the page with the data stream's address in it.
     pub url: String,
     /// The bound on the history kept for late browsers, bytes.
@@ -61,7 +70,14 @@ pub struct WebServer {
 /// A port to listen on: `port` itself if it is free on `ip`, any free one for 0; a clear error
 /// otherwise.
 fn free_port(ip: IpAddr, port: u16, what: &str, flag: &str) -> Result<u16> {
-    let listener = TcpListener::bind(SocketAddr::new(ip, port)).map_err(|e| {
+    let listener = listen(ip, port, what, flag)?;
+    Ok(listener.local_addr().map(|a| a.port()).unwrap_or(port))
+}
+
+/// A listener on `ip`:`port` (any free port for 0), or a clear error naming the address, the
+/// cause and the flag that chooses another.
+fn listen(ip: IpAddr, port: u16, what: &str, flag: &str) -> Result<TcpListener> {
+    TcpListener::bind(SocketAddr::new(ip, port)).map_err(|e| {
         let why = match e.kind() {
             std::io::ErrorKind::AddrInUse => "the port is in use (another hox, or another program)".to_string(),
             std::io::ErrorKind::AddrNotAvailable => format!("{ip} is not an address of this machine"),
@@ -71,8 +87,7 @@ fn free_port(ip: IpAddr, port: u16, what: &str, flag: &str) -> Result<u16> {
         anyhow::anyhow!(
             "cannot serve the {what} on {ip}:{port}: {why}; choose another with {flag}, or 0 for any free port"
         )
-    })?;
-    Ok(listener.local_addr().map(|a| a.port()).unwrap_or(port))
+    })
 }
 
 /// The host name browsers reach the servers by (module docs).
@@ -112,7 +127,10 @@ fn viewer_archive() -> Result<PathBuf> {
         std::env::temp_dir().join(format!("hox-{}-web-viewer-{}.zip", env!("CARGO_PKG_VERSION"), VIEWER_ARCHIVE.len()));
     let current = std::fs::metadata(&path).map(|m| m.len() == VIEWER_ARCHIVE.len() as u64).unwrap_or(false);
     if !current {
-        let partial = path.with_extension(format!("zip.{}", std::process::id()));
+        // unique per call: two servers starting at once in one process must not share it
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let partial = path.with_extension(format!("zip.{}.{call}", std::process::id()));
         std::fs::write(&partial, VIEWER_ARCHIVE)
             .and_then(|()| std::fs::rename(&partial, &path))
             .with_context(|| format!("cannot write the web viewer's files to {}", path.display()))?;
@@ -135,18 +153,25 @@ fn server_options(args: &ServeArgs, host: &str, web_port: u16) -> rerun::ServerO
     }
 }
 
-/// Checks the ports, starts the web viewer's server, and returns it with the gRPC address to
-/// serve on and the gRPC server's options.
+/// Where Rerun's gRPC server listens: the loopback address only (the door forwards to it).
+const UPSTREAM_HOST: &str = "127.0.0.1";
+
+/// Checks the ports, starts the web viewer's server and the data stream's read-only door, and
+/// returns them with the loopback port Rerun's gRPC server is to listen on and its options.
 fn start_http(args: &ServeArgs) -> Result<(WebServer, u16, rerun::ServerOptions)> {
     if args.history_mb == 0 {
         bail!("--history-mb must be at least 1 (the static data alone needs room)");
     }
-    let archive = viewer_archive()?;
-    let grpc_port = free_port(args.bind, args.grpc_port, "data stream", "--grpc-port")?;
-    let web_port = free_port(args.bind, args.web_port, "web page", "--web-port")?;
-    if grpc_port == web_port {
-        bail!("--web-port and --grpc-port must differ (both are {web_port})");
+    if args.grpc_port != 0 && args.grpc_port == args.web_port {
+        bail!("--web-port and --grpc-port must differ (both are {})", args.web_port);
     }
+    let archive = viewer_archive()?;
+    let door_listener = listen(args.bind, args.grpc_port, "data stream", "--grpc-port")?;
+    let grpc_port = door_listener.local_addr().map(|a| a.port()).unwrap_or(args.grpc_port);
+    let web_port = free_port(args.bind, args.web_port, "web page", "--web-port")?;
+    let upstream_port = free_port(IpAddr::V4(Ipv4Addr::LOCALHOST), 0, "data stream's server", "--grpc-port")?;
+    let upstream = SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), upstream_port);
+    let door = read_only::start(door_listener, upstream)?;
     let http = re_web_viewer_server::WebViewerServer::with_archive(
         &args.bind.to_string(),
         re_web_viewer_server::WebViewerServerPort(web_port),
@@ -158,16 +183,16 @@ fn start_http(args: &ServeArgs) -> Result<(WebServer, u16, rerun::ServerOptions)
     let url = format!("http://{host}:{web_port}/?url={}", percent_encoded(&grpc));
     let options = server_options(args, &host, web_port);
     let history_bytes = options.memory_limit.as_bytes();
-    Ok((WebServer { _http: http, url, history_bytes }, grpc_port, options))
+    Ok((WebServer { _http: http, _door: door, data_port: grpc_port, url, history_bytes }, upstream_port, options))
 }
 
 /// A recording stream named `name` whose data every browser at [`WebServer::url`] sees live.
 pub fn serve_recording(name: &str, args: &ServeArgs) -> Result<(rerun::RecordingStream, WebServer)> {
-    let (web, grpc_port, options) = start_http(args)?;
+    let (web, upstream_port, options) = start_http(args)?;
     let rec = rerun::RecordingStreamBuilder::new("hox")
         .recording_name(name)
-        .serve_grpc_opts(args.bind.to_string(), grpc_port, options)
-        .with_context(|| format!("cannot serve the data stream on {}:{grpc_port}", args.bind))?;
+        .serve_grpc_opts(UPSTREAM_HOST, upstream_port, options)
+        .with_context(|| format!("cannot serve the data stream on {UPSTREAM_HOST}:{upstream_port}"))?;
     Ok((rec, web))
 }
 
@@ -178,9 +203,9 @@ pub fn serve_messages(
     messages: Vec<rerun::log::LogMsg>,
 ) -> Result<(rerun::grpc_server::GrpcServerSink, WebServer)> {
     use rerun::sink::LogSink as _;
-    let (web, grpc_port, options) = start_http(args)?;
-    let sink = rerun::grpc_server::GrpcServerSink::new(&args.bind.to_string(), grpc_port, options)
-        .with_context(|| format!("cannot serve the data stream on {}:{grpc_port}", args.bind))?;
+    let (web, upstream_port, options) = start_http(args)?;
+    let sink = rerun::grpc_server::GrpcServerSink::new(UPSTREAM_HOST, upstream_port, options)
+        .with_context(|| format!("cannot serve the data stream on {UPSTREAM_HOST}:{upstream_port}"))?;
     for msg in messages {
         sink.send(msg);
     }
@@ -230,8 +255,9 @@ mod tests {
     #[test]
     fn the_page_names_the_data_stream_it_reads() {
         let args = ServeArgs { web_port: 0, grpc_port: 0, ..ServeArgs::default() };
-        let (web, grpc_port, options) = start_http(&args).unwrap();
-        let expected = percent_encoded(&format!("rerun+http://127.0.0.1:{grpc_port}/proxy"));
+        let (web, upstream_port, options) = start_http(&args).unwrap();
+        let expected = percent_encoded(&format!("rerun+http://127.0.0.1:{}/proxy", web.data_port));
+        assert_ne!(upstream_port, web.data_port, "the page reads through the door, not from Rerun's server");
         assert!(web.url.starts_with("http://127.0.0.1:") && web.url.ends_with(&expected), "{}", web.url);
         assert_eq!(web.history_bytes, 256_000_000);
         assert_eq!(options.memory_limit.as_bytes(), 256_000_000);

@@ -36,9 +36,11 @@ pub fn serve(args: &ServeFileArgs) -> Result<()> {
     let (_sink, web) = serve_messages(&args.serve, messages)?;
     println!("{}", web.url);
     eprintln!(
-        "serving {} ({count} messages) to browsers at the URL above (history bound {} MB)",
+        "serving {} ({count} messages) to browsers at the URL above (history bound {} MB; the data \
+         stream on port {} is read-only)",
         path.display(),
-        web.history_bytes / 1_000_000
+        web.history_bytes / 1_000_000,
+        web.data_port
     );
     match args.seconds {
         Some(s) => std::thread::sleep(std::time::Duration::from_secs_f64(s)),
