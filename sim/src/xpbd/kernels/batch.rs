@@ -20,9 +20,8 @@
 //! kernel forms `F = I + (Σ_i u_i ⊗ ∇_r N_i) J⁻¹` and `∇_i U += (V P J⁻ᵀ) ∇_r N_i`, the reference
 //! gradients `∇_r N_i(r_q)` being the same for every element of the block (one small table,
 //! [`super::PackedBlock::ref_grads`], read as broadcasts from L1) and `J⁻¹`, `V` the element's
-//! own: 10 doubles per point and lane instead of `3N + 1`. Two 3×3 products per point more, against a P3 batch at 14 points reading 4.5 kB instead of 27 kB per sweep: on
-//! beams larger than the cache the stored gradients made the sweep wait on memory.
-//!
+//! own: 10 doubles per point and lane instead of `3N + 1`. Two 3×3 products per point more,
+//! against a P3 batch at 14 points reading 4.5 kB instead of 27 kB per sweep: on
 //! beams larger than the cache the stored gradients made the sweep wait on memory (Q2 32×8×8:
 //! 162 → 72 ms per frame), while for Q1 the two extra products cost more than they save (1.36 →
 //! 1.72 ms on 256 elements; release `bench_table`, one thread, same machine, one run).
@@ -101,7 +100,7 @@ unsafe fn batches_wide<W: Wide, const N: usize, L: BatchLaw>(
         let nodes = &io.nodes[b * width * N..(b + 1) * width * N];
         // SAFETY: forwarded from the caller.
         let Some(gathered) =
-            (unsafe { gather::<W, N>(io.positions, io.rest, io.inv_mass, nodes, io.valid(b, batches)) })
+            (unsafe { gather::<W, N, true>(io.positions, io.rest, io.inv_mass, nodes, io.valid(b, batches)) })
         else {
             continue;
         };

@@ -123,7 +123,8 @@ pub struct Gathered<W: Wide, const N: usize> {
 }
 
 /// Gathers the batch whose `WIDTH N` node indices are `nodes`, or None when all its elements
-/// are pinned. Only the lanes set in `valid` are elements (a colour's last batch may be
+/// are pinned. The displacements `u` only with `DISPLACEMENTS` (else zero, and `rest` not read:
+/// the P1 batch forms `F` from the positions alone). Only the lanes set in `valid` are elements (a colour's last batch may be
 /// partial): the others count as pinned, so they are never updated nor written.
 ///
 /// # Safety
@@ -131,7 +132,7 @@ pub struct Gathered<W: Wide, const N: usize> {
 /// `positions.len()`, `rest.len()` and `inv_mass.len()` (checked once per colour sweep, not
 /// here); `positions` valid for the call, no other thread writing these nodes.
 #[inline(always)]
-pub unsafe fn gather<W: Wide, const N: usize>(
+pub unsafe fn gather<W: Wide, const N: usize, const DISPLACEMENTS: bool>(
     positions: Positions,
     rest: &[Vec3],
     inv_mass: &[f64],
@@ -158,14 +159,12 @@ pub unsafe fn gather<W: Wide, const N: usize>(
     let mut u = [[zero; 3]; N];
     for i in 0..N {
         // SAFETY: indices below the lengths (the caller's promise).
-        let (xi, ri) = unsafe {
-            (
-                W::gather_rows(positions.ptr(), &index[i][..W::WIDTH]),
-                W::gather_rows(rest.as_ptr(), &index[i][..W::WIDTH]),
-            )
-        };
-        x[i] = xi;
-        u[i] = [xi[0].sub(ri[0]), xi[1].sub(ri[1]), xi[2].sub(ri[2])];
+        x[i] = unsafe { W::gather_rows(positions.ptr(), &index[i][..W::WIDTH]) };
+        if DISPLACEMENTS {
+            // SAFETY: as above.
+            let ri = unsafe { W::gather_rows(rest.as_ptr(), &index[i][..W::WIDTH]) };
+            u[i] = [x[i][0].sub(ri[0]), x[i][1].sub(ri[1]), x[i][2].sub(ri[2])];
+        }
     }
     Some(Gathered { w, x, u, free })
 }

@@ -2,7 +2,8 @@
 //! elements of one colour (they share no node) projected together, one element per 64-bit lane.
 //!
 //! Per lane this is [`super::project_p1`] followed by the scatter and the
-//! non-finite check of the scalar sweep: `F = I + [u₁−u₀, u₂−u₀, u₃−u₀] G`, `(ψ, P)` by the one
+//! non-finite check of the scalar sweep: `F = [x₁−x₀, x₂−x₀, x₃−x₀] G` (`D_s D_m⁻¹`: the rest
+//! positions are not gathered), `(ψ, P)` by the one
 //! point law on lanes ([`BatchLaw`]: StVK written over lanes, any other model lane by lane),
 //! `[∇₁U ∇₂U ∇₃U] = V P Gᵀ`, `∇₀U = −Σ`, `C = √(2 max(VΨ, 0))` and the update of
 //! [`crate::xpbd::constraint::xpbd_step`] with its guards (no update where `Σ w|∇U|² + α̃C² ≤
@@ -92,17 +93,17 @@ unsafe fn batches_wide<W: Wide, L: BatchLaw>(
             && io.values.len() >= batches * per_batch
             && io.element_ids.len() >= batches * width
     );
-    let (one, zero) = (W::splat(1.0), W::zero());
+    let zero = W::zero();
     let mut projected = 0u64;
     for b in 0..batches {
         let nodes = &io.nodes[b * 4 * width..(b + 1) * 4 * width];
         // SAFETY: forwarded from the caller.
         let Some(gathered) =
-            (unsafe { gather::<W, 4>(io.positions, io.rest, io.inv_mass, nodes, io.valid(b, batches)) })
+            (unsafe { gather::<W, 4, false>(io.positions, io.rest, io.inv_mass, nodes, io.valid(b, batches)) })
         else {
             continue;
         };
-        let u = &gathered.u;
+        let x = &gathered.x;
         let vals = &io.values[b * per_batch..(b + 1) * per_batch];
         let mut g = [[zero; 3]; 3];
         for r in 0..3 {
@@ -112,19 +113,18 @@ unsafe fn batches_wide<W: Wide, L: BatchLaw>(
             }
         }
         let v = unsafe { W::load(vals.as_ptr().add(9 * width)) };
-        // du[a][r] = (u_{r+1} − u_0)_a
-        let mut du = [[zero; 3]; 3];
+        // the deformed edges dx[a][r] = (x_{r+1} − x_0)_a
+        let mut dx = [[zero; 3]; 3];
         for a in 0..3 {
             for r in 0..3 {
-                du[a][r] = u[r + 1][a].sub(u[0][a]);
+                dx[a][r] = x[r + 1][a].sub(x[0][a]);
             }
         }
-        // F = I + du G (as mul3: ((du_a0 g_0b) + du_a1 g_1b) + du_a2 g_2b, then + I)
+        // F = dx G (as mul3: ((dx_a0 g_0b) + dx_a1 g_1b) + dx_a2 g_2b)
         let mut f = [[zero; 3]; 3];
         for a in 0..3 {
             for c in 0..3 {
-                let m = du[a][2].mul_add(g[2][c], du[a][1].mul_add(g[1][c], du[a][0].mul(g[0][c])));
-                f[a][c] = if a == c { one.add(m) } else { m };
+                f[a][c] = dx[a][2].mul_add(g[2][c], dx[a][1].mul_add(g[1][c], dx[a][0].mul(g[0][c])));
             }
         }
         // SAFETY: compiled with W's target features.

@@ -125,21 +125,20 @@ unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMateria
         // SAFETY: node indices are checked against the length; the caller guarantees no other
         // thread touches these nodes and this multiplier.
         let mut x: [Vec3; N] = std::array::from_fn(|i| unsafe { positions.read(nodes[i] as usize) });
-        let d: [Vec3; N] = std::array::from_fn(|i| x[i] - rest[nodes[i] as usize]);
         let lambda = unsafe { &mut *lambdas.ptr().add(e) };
         let grads = &data.grads[k * q * 3 * P..(k + 1) * q * 3 * P];
         let volumes = &data.volumes[k * q..(k + 1) * q];
         if N == 4 && q == 1 {
             // the linear tetrahedron: one point, constant gradients
             let x4: &mut [Vec3; 4] = (&mut x[..]).try_into().expect("4 nodes");
-            let (d4, w4): (&[Vec3; 4], &[f64; 4]) =
-                (d[..].try_into().expect("4 nodes"), w[..].try_into().expect("4 nodes"));
-            project_p1::<FMA, M>(x4, d4, w4, grads, volumes[0], material, inv_dt2, lambda);
+            let w4: &[f64; 4] = w[..].try_into().expect("4 nodes");
+            project_p1::<FMA, M>(x4, w4, grads, volumes[0], material, inv_dt2, lambda);
         } else {
             let mut u = [[0.0; P]; 3];
             for i in 0..N {
+                let d = x[i] - rest[nodes[i] as usize];
                 for a in 0..3 {
-                    u[a][i] = d[i][a];
+                    u[a][i] = d[a];
                 }
             }
             project_energy::<N, P, FMA, M>(&mut x, &u, &w, grads, volumes, material, inv_dt2, lambda);
@@ -163,15 +162,15 @@ unsafe fn sweep<const N: usize, const P: usize, const FMA: bool, M: PointMateria
 }
 
 /// [`project_energy`] for the linear tetrahedron (one quadrature point, constant gradients
-/// `g_i = ∇_X N_i`, `Σ_i g_i = 0`): `F = I + Σ_{i=1..3} (u_i − u_0) ⊗ g_i` (the paper's
-/// `F = D_s D_m⁻¹` written in displacements), `∇_i U = V P g_i` for `i = 1..3` and
+/// `g_i = ∇_X N_i`, `Σ_i g_i = 0`): `F = Σ_{i=1..3} (x_i − x_0) ⊗ g_i`, the paper's
+/// `F = D_s D_m⁻¹` (the rows `g_i` of `D_m⁻¹`; equal to `I + Σ (u_i − u_0) ⊗ g_i` in
+/// displacements, without reading the rest positions), `∇_i U = V P g_i` for `i = 1..3` and
 /// `∇_0 U = −Σ_{i≥1} ∇_i U` (Bender et al.'s FEM tetrahedron), all as 3×3 products.
 /// `grads` is the point's `3 × 4` structure-of-arrays block; `v` its volume.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn project_p1<const FMA: bool, M: PointMaterial>(
     x: &mut [Vec3; 4],
-    u: &[Vec3; 4],
     w: &[f64; 4],
     grads: &[f64],
     v: f64,
@@ -181,8 +180,8 @@ pub fn project_p1<const FMA: bool, M: PointMaterial>(
 ) -> f64 {
     // g[(i − 1, b)] = ∂N_i/∂X_b
     let g = Mat3::new(grads[1], grads[5], grads[9], grads[2], grads[6], grads[10], grads[3], grads[7], grads[11]);
-    let du = Mat3::from_columns(&[u[1] - u[0], u[2] - u[0], u[3] - u[0]]);
-    let f = Mat3::identity() + mul3::<FMA>(&du, &g);
+    let ds = Mat3::from_columns(&[x[1] - x[0], x[2] - x[0], x[3] - x[0]]);
+    let f = mul3::<FMA>(&ds, &g);
     let (psi, p) = material.energy_and_pk1::<FMA>(&f);
     // columns: ∇_1 U, ∇_2 U, ∇_3 U
     let h = mul3::<FMA>(&(p * v), &g.transpose());

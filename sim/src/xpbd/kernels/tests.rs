@@ -192,6 +192,31 @@ fn p1_colour_sweep_matches_the_generic_kernel() {
     }
 }
 
+/// The P1 sweeps form `F = D_s D_m⁻¹` from the positions alone (not `I + (D_s − D_m) D_m⁻¹`): a
+/// beam at rest, batched and scalar, every material, stays at rest to round-off, and a beam
+/// moved rigidly (translated and rotated) keeps its shape: no energy is made from nothing.
+#[test]
+fn a_p1_body_at_rest_or_moved_rigidly_stays_undeformed_without_the_rest_positions_in_f() {
+    let (mesh, _, _, packed) = p1_beam(1);
+    let rest = &mesh.rest_positions;
+    let w: Vec<f64> = rest.iter().map(|p| if p.x < 1e-12 { 0.0 } else { 1.0 }).collect();
+    let (c, s) = (0.6f64.cos(), 0.6f64.sin());
+    let rigid: Vec<Vec3> =
+        rest.iter().map(|p| Vec3::new(c * p.x - s * p.y + 3.0, s * p.x + c * p.y - 1.0, p.z + 7.0)).collect();
+    for material in materials() {
+        for batched in [false, true] {
+            for start in [rest.clone(), rigid.clone()] {
+                let mut x = start.clone();
+                let mut lambdas = vec![0.0; mesh.blocks[0].len()];
+                sweep_colours_of(4, &material, &packed, rest, &w, &mut x, &mut lambdas, batched).unwrap();
+                let moved = x.iter().zip(&start).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+                assert!(moved <= 1e-12, "{:?}, batched {batched}: moved {moved:e} m", material.model);
+                assert!(lambdas.iter().all(|l| l.abs() <= 1e-9), "{:?}, batched {batched}", material.model);
+            }
+        }
+    }
+}
+
 /// Every colour of `packed` (`n` nodes per element) through [`colour_sweep`] with `material`,
 /// batched or not; the first error stops.
 #[allow(clippy::too_many_arguments)]
