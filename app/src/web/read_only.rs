@@ -74,6 +74,7 @@ pub fn start(listener: TcpListener, upstream: SocketAddr) -> Result<ReadOnlyDoor
         .build()
         .context("cannot start the data stream's proxy")?;
     let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+    let upstream_up = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let thread = std::thread::Builder::new()
         .name("hox-read-only-door".into())
         .spawn(move || {
@@ -90,11 +91,11 @@ pub fn start(listener: TcpListener, upstream: SocketAddr) -> Result<ReadOnlyDoor
                     // a failed accept (a client gone before it was taken) concerns that client only
                     let Ok((stream, _peer)) = accepted else { continue };
                     let _ = stream.set_nodelay(true);
-                    let (http1, http2) = (http1.clone(), http2.clone());
+                    let (http1, http2, upstream_up) = (http1.clone(), http2.clone(), upstream_up.clone());
                     tokio::spawn(async move {
                         let service = hyper::service::service_fn(move |request| {
                             let client = if request.version() == hyper::Version::HTTP_2 { &http2 } else { &http1 };
-                            forward(client.clone(), upstream, request)
+                            forward(client.clone(), upstream, upstream_up.clone(), request)
                         });
                         // a browser that closes is nothing to the server: the error is its own
                         let _ = hyper_util::server::conn::auto::Builder::new(TokioExecutor::new())
@@ -109,15 +110,37 @@ pub fn start(listener: TcpListener, upstream: SocketAddr) -> Result<ReadOnlyDoor
     Ok(ReadOnlyDoor { stop: Some(stop), thread: Some(thread) })
 }
 
+/// How long a request waits for Rerun's server to listen when the door opened first (the
+/// server starts on its own thread): a browser opened at once is served, not turned away.
+const UPSTREAM_START_SECS: f64 = 10.0;
+
+/// Waits until Rerun's server at `upstream` accepts connections (once: `up` remembers it), for
+/// at most [`UPSTREAM_START_SECS`].
+async fn wait_for_upstream(upstream: SocketAddr, up: &std::sync::atomic::AtomicBool) {
+    use std::sync::atomic::Ordering;
+    let deadline = tokio::time::Instant::now() + std::time::Duration::from_secs_f64(UPSTREAM_START_SECS);
+    while !up.load(Ordering::Relaxed) {
+        if tokio::net::TcpStream::connect(upstream).await.is_ok() {
+            up.store(true, Ordering::Relaxed);
+        } else if tokio::time::Instant::now() >= deadline {
+            return;
+        } else {
+            tokio::time::sleep(std::time::Duration::from_millis(50)).await;
+        }
+    }
+}
+
 /// One request: refused here if it writes, else forwarded to `upstream`.
 async fn forward(
     client: Client<HttpConnector, Incoming>,
     upstream: SocketAddr,
+    upstream_up: std::sync::Arc<std::sync::atomic::AtomicBool>,
     request: Request<Incoming>,
 ) -> Result<Response<ProxyBody>, std::convert::Infallible> {
     if is_write(request.uri().path()) {
         return Ok(refusal(&request));
     }
+    wait_for_upstream(upstream, &upstream_up).await;
     let (mut parts, body) = request.into_parts();
     let path = parts.uri.path_and_query().map_or("/", |p| p.as_str());
     let Ok(uri) = format!("http://{upstream}{path}").parse() else {
@@ -131,7 +154,7 @@ async fn forward(
             strip_hop_by_hop(&mut parts.headers);
             Ok(Response::from_parts(parts, body.boxed()))
         }
-        // Rerun's server not up yet, or gone: the viewer retries
+        // Rerun's server gone, or not up within UPSTREAM_START_SECS: the viewer retries
         Err(_) => Ok(status_only(hyper::StatusCode::BAD_GATEWAY)),
     }
 }
@@ -234,6 +257,24 @@ mod tests {
             assert!(write.starts_with("http/1.1 200") && write.contains("grpc-status: 7"), "{method}: {write}");
             assert!(write.contains("read-only%3a%20viewers%20cannot%20write"), "{method}: {write}");
         }
+    }
+
+    /// Seen in CI: the door answered 502 to a browser that came before Rerun's server (started
+    /// on its own thread) listened.
+    #[test]
+    fn a_browser_that_comes_before_the_data_server_listens_is_served_not_turned_away() {
+        let door_listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let port = door_listener.local_addr().unwrap().port();
+        let upstream_port = TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+        let _door = start(door_listener, SocketAddr::from(([127, 0, 0, 1], upstream_port))).unwrap();
+        let late_server = std::thread::spawn(move || {
+            std::thread::sleep(std::time::Duration::from_millis(700));
+            rerun::grpc_server::GrpcServerSink::new("127.0.0.1", upstream_port, rerun::ServerOptions::default())
+                .unwrap()
+        });
+        let read = grpc_web_head(port, "ReadMessages");
+        let _sink = late_server.join().unwrap();
+        assert!(read.starts_with("http/1.1 200"), "{read}");
     }
 
     #[test]
