@@ -70,8 +70,12 @@ pub struct WebServer {
 /// A port to listen on: `port` itself if it is free on `ip`, any free one for 0; a clear error
 /// otherwise.
 fn free_port(ip: IpAddr, port: u16, what: &str, flag: &str) -> Result<u16> {
-    let listener = listen(ip, port, what, flag)?;
-    Ok(listener.local_addr().map(|a| a.port()).unwrap_or(port))
+    Ok(port_of(&listen(ip, port, what, flag)?, port))
+}
+
+/// The port `listener` took (`asked` unless that was 0).
+fn port_of(listener: &TcpListener, asked: u16) -> u16 {
+    listener.local_addr().map(|a| a.port()).unwrap_or(asked)
 }
 
 /// A listener on `ip`:`port` (any free port for 0), or a clear error naming the address, the
@@ -154,7 +158,7 @@ fn server_options(args: &ServeArgs, host: &str, web_port: u16) -> rerun::ServerO
 }
 
 /// Where Rerun's gRPC server listens: the loopback address only (the door forwards to it).
-const UPSTREAM_HOST: &str = "127.0.0.1";
+const UPSTREAM_IP: Ipv4Addr = Ipv4Addr::LOCALHOST;
 
 /// Checks the ports, starts the web viewer's server and the data stream's read-only door, and
 /// returns them with the loopback port Rerun's gRPC server is to listen on and its options.
@@ -167,10 +171,10 @@ fn start_http(args: &ServeArgs) -> Result<(WebServer, u16, rerun::ServerOptions)
     }
     let archive = viewer_archive()?;
     let door_listener = listen(args.bind, args.grpc_port, "data stream", "--grpc-port")?;
-    let grpc_port = door_listener.local_addr().map(|a| a.port()).unwrap_or(args.grpc_port);
+    let grpc_port = port_of(&door_listener, args.grpc_port);
     let web_port = free_port(args.bind, args.web_port, "web page", "--web-port")?;
-    let upstream_port = free_port(IpAddr::V4(Ipv4Addr::LOCALHOST), 0, "data stream's server", "--grpc-port")?;
-    let upstream = SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), upstream_port);
+    let upstream_port = free_port(IpAddr::V4(UPSTREAM_IP), 0, "data stream's server", "--grpc-port")?;
+    let upstream = SocketAddr::new(IpAddr::V4(UPSTREAM_IP), upstream_port);
     let door = read_only::start(door_listener, upstream)?;
     let http = re_web_viewer_server::WebViewerServer::with_archive(
         &args.bind.to_string(),
@@ -191,8 +195,8 @@ pub fn serve_recording(name: &str, args: &ServeArgs) -> Result<(rerun::Recording
     let (web, upstream_port, options) = start_http(args)?;
     let rec = rerun::RecordingStreamBuilder::new("hox")
         .recording_name(name)
-        .serve_grpc_opts(UPSTREAM_HOST, upstream_port, options)
-        .with_context(|| format!("cannot serve the data stream on {UPSTREAM_HOST}:{upstream_port}"))?;
+        .serve_grpc_opts(UPSTREAM_IP.to_string(), upstream_port, options)
+        .with_context(|| format!("cannot serve the data stream on {UPSTREAM_IP}:{upstream_port}"))?;
     Ok((rec, web))
 }
 
@@ -204,8 +208,8 @@ pub fn serve_messages(
 ) -> Result<(rerun::grpc_server::GrpcServerSink, WebServer)> {
     use rerun::sink::LogSink as _;
     let (web, upstream_port, options) = start_http(args)?;
-    let sink = rerun::grpc_server::GrpcServerSink::new(UPSTREAM_HOST, upstream_port, options)
-        .with_context(|| format!("cannot serve the data stream on {UPSTREAM_HOST}:{upstream_port}"))?;
+    let sink = rerun::grpc_server::GrpcServerSink::new(&UPSTREAM_IP.to_string(), upstream_port, options)
+        .with_context(|| format!("cannot serve the data stream on {UPSTREAM_IP}:{upstream_port}"))?;
     for msg in messages {
         sink.send(msg);
     }
