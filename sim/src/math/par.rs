@@ -43,3 +43,103 @@ pub fn fill(v: &mut [f64], value: f64) {
         v.fill(value);
     }
 }
+
+/// Runs `f` (on the calling thread's place in rayon's current pool: the calling worker, or
+/// worker 0 for a thread outside the pool) while every other worker of the pool waits for work
+/// awake, taking each job `f` shares out as soon as it is queued, instead of going to sleep
+/// between two of `f`'s parallel loops.
+///
+/// Why: a rayon worker with nothing to do sleeps after a few dozen rounds of looking, and waking
+/// it costs a system call and, in a virtual machine, an interrupt between processors; a substep of
+/// the colour sweep has about seven parallel loops, and on a shared 2-core machine the wake-ups
+/// cost more than the second thread gained (docs/PERFORMANCE.md, session 28). The waiting
+/// workers keep looking (yielding their core to any other thread ready on it between two looks,
+/// as rayon does before it sleeps) for as long as `f` runs, so call it around a stretch of many
+/// short parallel loops (a frame), not around long serial work.
+///
+/// Safe from deadlock: each waiting worker runs its wait as the first job of its own broadcast
+/// queue, which a worker takes before it steals any of `f`'s jobs, so a wait never sits inside a
+/// job `f` waits for. One thread, or a pool of one: `f` alone.
+pub fn with_pool_awake<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    if rayon::current_num_threads() < 2 {
+        return f();
+    }
+    struct SetOnDrop<'a>(&'a AtomicBool);
+    impl Drop for SetOnDrop<'_> {
+        fn drop(&mut self) {
+            self.0.store(true, Ordering::Release);
+        }
+    }
+    let done = AtomicBool::new(false);
+    let task = Mutex::new(Some(f));
+    let result = Mutex::new(None);
+    let runner = rayon::current_thread_index().unwrap_or(0);
+    rayon::broadcast(|ctx| {
+        if ctx.index() == runner {
+            // the waiting workers stop even when f panics (the panic then reaches the caller)
+            let _done = SetOnDrop(&done);
+            let f = task.lock().unwrap_or_else(|e| e.into_inner()).take();
+            if let Some(f) = f {
+                let r = f();
+                *result.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+            }
+        } else {
+            while !done.load(Ordering::Acquire) {
+                if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                    // as rayon's own rounds before sleep: another thread ready on this core
+                    // (the app's painting) runs first
+                    std::thread::yield_now();
+                }
+            }
+        }
+    });
+    result.into_inner().unwrap_or_else(|e| e.into_inner()).expect("the runner ran f")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `f`'s result comes back, its own parallel loops run (shared with the waiting workers), and
+    /// on any pool size, from a worker of the pool or from a thread outside it.
+    #[test]
+    fn with_pool_awake_returns_what_f_computes_with_its_parallel_loops() {
+        let expected: u64 = (0..100_000u64).map(|i| i * i % 7).sum();
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let got = pool.install(|| {
+                with_pool_awake(|| {
+                    (0..50).map(|_| (0..100_000u64).into_par_iter().map(|i| i * i % 7).sum::<u64>()).max().unwrap()
+                })
+            });
+            assert_eq!(got, expected, "{threads} threads");
+        }
+        // from a thread outside any pool: the global pool's worker 0 runs f
+        let got = std::thread::spawn(move || {
+            with_pool_awake(|| (0..100_000u64).into_par_iter().map(|i| i * i % 7).sum::<u64>())
+        })
+        .join()
+        .unwrap();
+        assert_eq!(got, expected);
+    }
+
+    /// A panic in `f` reaches the caller, and the waiting workers are let go: the pool runs the
+    /// next parallel loop.
+    #[test]
+    fn a_panic_inside_with_pool_awake_reaches_the_caller_and_frees_the_pool() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let caught = pool.install(|| {
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                with_pool_awake(|| {
+                    let _: u64 = (0..10_000u64).into_par_iter().sum();
+                    panic!("inside the frame")
+                })
+            }))
+        });
+        assert!(caught.is_err());
+        let after: u64 = pool.install(|| (0..10_000u64).into_par_iter().sum());
+        assert_eq!(after, 49_995_000);
+    }
+}

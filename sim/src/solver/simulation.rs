@@ -464,11 +464,32 @@ impl Simulation {
             if let Some(e) = &self.failure {
                 return Err(e.clone());
             }
-            self.watched_frame()?;
+            if self.frame_shares_work() {
+                crate::math::par::with_pool_awake(|| self.watched_frame())?;
+            } else {
+                self.watched_frame()?;
+            }
         }
         self.frames += 1;
         self.substeps_in_frame = 0;
         Ok(())
+    }
+
+    /// Whether an XPBD frame shares its work between the threads of rayon's current pool: the
+    /// colour sweep on several threads, over nodes enough for the node loops to be cut or a block
+    /// large enough to be swept by slabs. Such a frame keeps the pool awake while it runs
+    /// ([`crate::math::par::with_pool_awake`]).
+    pub(crate) fn frame_shares_work(&self) -> bool {
+        use crate::xpbd::kernels::{p1_equivalents, slab_count};
+        let Some(xpbd) = self.solver.as_any().downcast_ref::<Xpbd>() else { return false };
+        if rayon::current_num_threads() < 2 || !self.settings.sweep.is_colour() {
+            return false;
+        }
+        let slabbed = self.mesh.blocks.iter().zip(&self.geometry).any(|(b, g)| {
+            let size = p1_equivalents(b.len(), b.nodes_per_element(), g.points_per_element);
+            slab_count(size, xpbd.partition_min_per_slab) >= 2
+        });
+        slabbed || node_loops::chunks(self.positions.len(), self.settings.sweep) > 1
     }
 
     /// Advances one substep of `h = 1/(fps · substeps_per_frame)`.

@@ -259,6 +259,28 @@ fn parallel_projection_is_deterministic_for_any_thread_count() {
     }
 }
 
+/// A frame that keeps rayon's pool awake while it runs (the colour sweep by slabs on several
+/// threads: `with_pool_awake`) gives the same bits as the same frames on one thread: the waiting
+/// workers only take the frame's own jobs, so nothing but who runs them changes.
+#[test]
+fn a_frame_with_the_pool_kept_awake_gives_the_same_bits_as_on_one_thread() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut sim = beam_sim(true, Formulation::Energy);
+            sim.set_partition_threshold(8);
+            assert_eq!(sim.frame_shares_work(), threads > 1, "{threads} threads");
+            for _ in 0..20 {
+                sim.step_frame().unwrap();
+            }
+            sim.positions
+        })
+    };
+    let one = run(1);
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(3));
+}
+
 /// Serial and parallel sweeps visit the elements in different orders (Gauss–Seidel), so they
 /// differ slightly along the way and settle on the same static answer: for `mesh` clamped at
 /// x = 0, the serial sweep against the parallel sweep on each `(threads, partition threshold)`.
