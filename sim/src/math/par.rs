@@ -44,24 +44,25 @@ pub fn fill(v: &mut [f64], value: f64) {
     }
 }
 
-/// Runs `f` (on the calling thread's place in rayon's current pool: the calling worker, or
-/// worker 0 for a thread outside the pool) while every other worker of the pool waits for work
-/// awake, taking each job `f` shares out as soon as it is queued, instead of going to sleep
-/// between two of `f`'s parallel loops.
+/// Runs `f` while one other worker of rayon's current pool waits for its jobs awake, taking each
+/// job `f` shares out as soon as it is queued, instead of going to sleep between two of `f`'s
+/// parallel loops.
 ///
 /// Why: a rayon worker with nothing to do sleeps after a few dozen rounds of looking, and waking
 /// it costs a system call and, in a virtual machine, an interrupt between processors; a substep of
 /// the colour sweep has about seven parallel loops, and on a shared 2-core machine the wake-ups
-/// cost more than the second thread gained (docs/PERFORMANCE.md, session 28). The waiting
-/// workers keep looking (yielding their core to any other thread ready on it between two looks,
-/// as rayon does before it sleeps) for as long as `f` runs, so call it around a stretch of many
-/// short parallel loops (a frame), not around long serial work.
+/// cost more than the second thread gained (docs/PERFORMANCE.md, session 28). The waiting worker
+/// keeps looking (yielding its core to any other thread ready on it between two looks, as rayon
+/// does before it sleeps) for as long as `f` runs, so call it around a stretch of many short
+/// parallel loops (a frame), not around long serial work.
 ///
-/// Safe from deadlock: each waiting worker runs its wait as the first job of its own broadcast
-/// queue, which a worker takes before it steals any of `f`'s jobs, so a wait never sits inside a
-/// job `f` waits for. One thread, or a pool of one: `f` alone.
+/// How: `rayon::join(f, wait)`. `wait` is queued before any job of `f`, so the first worker to
+/// steal from this thread takes it (a thief takes the oldest job) and waits there until `f` ends;
+/// it never sits inside one of `f`'s jobs, so `f` never waits for it. If no worker takes it, the
+/// calling thread finds it after `f` and it returns at once. Nothing is allocated (a frame must
+/// not allocate: `scenes/tests/no_alloc.rs`); a panic in `f` ends the wait and reaches the
+/// caller. On a pool of more than two threads the others sleep and wake as before.
 pub fn with_pool_awake<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    use std::sync::Mutex;
     use std::sync::atomic::{AtomicBool, Ordering};
     if rayon::current_num_threads() < 2 {
         return f();
@@ -73,29 +74,24 @@ pub fn with_pool_awake<R: Send>(f: impl FnOnce() -> R + Send) -> R {
         }
     }
     let done = AtomicBool::new(false);
-    let task = Mutex::new(Some(f));
-    let result = Mutex::new(None);
-    let runner = rayon::current_thread_index().unwrap_or(0);
-    rayon::broadcast(|ctx| {
-        if ctx.index() == runner {
-            // the waiting workers stop even when f panics (the panic then reaches the caller)
+    let (result, ()) = rayon::join_context(
+        |_| {
+            // the waiting worker stops even when f panics (the panic then reaches the caller)
             let _done = SetOnDrop(&done);
-            let f = task.lock().unwrap_or_else(|e| e.into_inner()).take();
-            if let Some(f) = f {
-                let r = f();
-                *result.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+            f()
+        },
+        |ctx| {
+            if !ctx.migrated() {
+                return; // run by the calling thread after f: nothing to wait for
             }
-        } else {
             while !done.load(Ordering::Acquire) {
                 if rayon::yield_now() != Some(rayon::Yield::Executed) {
-                    // as rayon's own rounds before sleep: another thread ready on this core
-                    // (the app's painting) runs first
                     std::thread::yield_now();
                 }
             }
-        }
-    });
-    result.into_inner().unwrap_or_else(|e| e.into_inner()).expect("the runner ran f")
+        },
+    );
+    result
 }
 
 #[cfg(test)]
