@@ -98,7 +98,7 @@ pub fn with_pool_awake<R: Send>(f: impl FnOnce() -> R + Send) -> R {
 mod tests {
     use super::*;
 
-    /// `f`'s result comes back, its own parallel loops run (shared with the waiting workers), and
+    /// `f`'s result comes back, its own parallel loops run (shared with the waiting worker), and
     /// on any pool size, from a worker of the pool or from a thread outside it.
     #[test]
     fn with_pool_awake_returns_what_f_computes_with_its_parallel_loops() {
@@ -112,7 +112,7 @@ mod tests {
             });
             assert_eq!(got, expected, "{threads} threads");
         }
-        // from a thread outside any pool: the global pool's worker 0 runs f
+        // from a thread outside any pool: a worker of the global pool runs f
         let got = std::thread::spawn(move || {
             with_pool_awake(|| (0..100_000u64).into_par_iter().map(|i| i * i % 7).sum::<u64>())
         })
@@ -121,7 +121,7 @@ mod tests {
         assert_eq!(got, expected);
     }
 
-    /// A panic in `f` reaches the caller, and the waiting workers are let go: the pool runs the
+    /// A panic in `f` reaches the caller, and the waiting worker is let go: the pool runs the
     /// next parallel loop.
     #[test]
     fn a_panic_inside_with_pool_awake_reaches_the_caller_and_frees_the_pool() {

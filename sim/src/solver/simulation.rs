@@ -480,15 +480,16 @@ impl Simulation {
     /// large enough to be swept by slabs. Such a frame keeps the pool awake while it runs
     /// ([`crate::math::par::with_pool_awake`]).
     pub(crate) fn frame_shares_work(&self) -> bool {
-        use crate::xpbd::kernels::{p1_equivalents, slab_count};
         let Some(xpbd) = self.solver.as_any().downcast_ref::<Xpbd>() else { return false };
         if rayon::current_num_threads() < 2 || !self.settings.sweep.is_colour() {
             return false;
         }
-        let slabbed = self.mesh.blocks.iter().zip(&self.geometry).any(|(b, g)| {
-            let size = p1_equivalents(b.len(), b.nodes_per_element(), g.points_per_element);
-            slab_count(size, xpbd.partition_min_per_slab) >= 2
-        });
+        let slabbed = self
+            .mesh
+            .blocks
+            .iter()
+            .zip(&self.geometry)
+            .any(|(b, g)| super::xpbd::block_slab_count(b, g, xpbd.partition_min_per_slab) >= 2);
         slabbed || node_loops::chunks(self.positions.len(), self.settings.sweep) > 1
     }
 

@@ -261,7 +261,7 @@ fn parallel_projection_is_deterministic_for_any_thread_count() {
 
 /// A frame that keeps rayon's pool awake while it runs (the colour sweep by slabs on several
 /// threads: `with_pool_awake`) gives the same bits as the same frames on one thread: the waiting
-/// workers only take the frame's own jobs, so nothing but who runs them changes.
+/// worker only takes the frame's own jobs, so nothing but who runs them changes.
 #[test]
 fn a_frame_with_the_pool_kept_awake_gives_the_same_bits_as_on_one_thread() {
     let run = |threads: usize| {

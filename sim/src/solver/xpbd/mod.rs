@@ -80,6 +80,18 @@ impl Xpbd {
     }
 }
 
+/// How many slabs the colour sweep cuts `block` into (1: none, swept colour by colour), at
+/// least `min_per_slab` elements each: the block's size alone decides
+/// ([`crate::xpbd::kernels::slab_count`]).
+pub(crate) fn block_slab_count(
+    block: &crate::mesh::ElementBlock,
+    geometry: &BlockGeometry,
+    min_per_slab: usize,
+) -> usize {
+    use crate::xpbd::kernels::{p1_equivalents, slab_count};
+    slab_count(p1_equivalents(block.len(), block.nodes_per_element(), geometry.points_per_element), min_per_slab)
+}
+
 impl StepSolver for Xpbd {
     fn solve_step(
         &mut self,

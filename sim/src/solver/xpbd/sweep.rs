@@ -116,8 +116,7 @@ impl Xpbd {
                 // pointer, and nothing else touches them meanwhile.
                 let all = unsafe { positions.slice_mut(0, positions.len()) };
                 use crate::xpbd::kernels::BlockSweep;
-                let size = crate::xpbd::kernels::p1_equivalents(block.len(), n, s.geometry[bi].points_per_element);
-                let slabs = crate::xpbd::kernels::slab_count(size, self.partition_min_per_slab);
+                let slabs = super::block_slab_count(block, &s.geometry[bi], self.partition_min_per_slab);
                 if slabs >= 2 && self.partitions[bi].0 != slabs {
                     // a block too thin for its slab count is cut into fewer rather than not at all
                     let partition = crate::xpbd::kernels::Partition::largest(
