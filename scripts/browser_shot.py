@@ -96,6 +96,10 @@ class WebSocket:
                 return message.decode()
 
 
+class CallTimeout(Exception):
+    """A DevTools call that got no answer in time."""
+
+
 class Page:
     def __init__(self, ws):
         self.ws = ws
@@ -107,18 +111,32 @@ class Page:
         # (folder, start time) where every frame is also written (--frames)
         self.keep_frames = None
 
-    def call(self, method, **params):
+    def call(self, method, timeout=120.0, **params):
+        """Sends `method` and returns its answer, noting the events that come before it;
+        raises CallTimeout when no answer comes within `timeout` seconds (an answer that
+        comes later is read and ignored like any event)."""
         if os.environ.get("BROWSER_SHOT_DEBUG"):
             print(f"{time.strftime('%X')} {method}", file=sys.stderr)
         self.next_id += 1
         self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
-        while True:
-            msg = json.loads(self.ws.recv())
-            if msg.get("id") == self.next_id:
-                if "error" in msg:
-                    raise RuntimeError(f"{method}: {msg['error']}")
-                return msg.get("result", {})
-            self.note(msg)
+        end = time.time() + timeout
+        try:
+            while True:
+                left = end - time.time()
+                if left <= 0:
+                    raise CallTimeout(f"{method}: no answer in {timeout:.0f} s")
+                self.ws.sock.settimeout(left)
+                try:
+                    msg = json.loads(self.ws.recv())
+                except (socket.timeout, TimeoutError):
+                    raise CallTimeout(f"{method}: no answer in {timeout:.0f} s") from None
+                if msg.get("id") == self.next_id:
+                    if "error" in msg:
+                        raise RuntimeError(f"{method}: {msg['error']}")
+                    return msg.get("result", {})
+                self.note(msg)
+        finally:
+            self.ws.sock.settimeout(120)
 
     def send(self, method, **params):
         """A call whose answer is not waited for (read later and ignored)."""
@@ -151,6 +169,22 @@ class Page:
             except (socket.timeout, TimeoutError):
                 pass
         self.ws.sock.settimeout(120)
+
+
+def next_screencast_frame(page, width, height, streaming):
+    """The first frame the page's screencast streams after this call (starting the screencast
+    unless `streaming`), the page nudged to repaint by pointer moves over its top bar."""
+    if not streaming:
+        page.call("Page.startScreencast", format="png", maxWidth=width, maxHeight=height)
+    seen = page.frames
+    end = time.time() + 90
+    while page.frames == seen and time.time() < end:
+        for x in (width // 2, width // 2 + 1):
+            page.send("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=14)
+        page.sleep(1.0)
+    if page.frames == seen:
+        sys.exit("browser_shot: no new frame of the page in 90 s")
+    return page.frame
 
 
 def chromium():
@@ -206,6 +240,7 @@ def main():
         page.call("Runtime.enable")
         page.call("Page.enable")
         page.call("Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1, mobile=False)
+        streaming = args.frames is not None
         if args.frames:
             os.makedirs(args.frames, exist_ok=True)
             page.keep_frames = (args.frames, time.time())
@@ -213,6 +248,9 @@ def main():
         page.call("Page.navigate", url=args.url)
         page.sleep(args.wait)
         base, ext = os.path.splitext(args.out)
+        # how long the first picture's capture may take before the screencast stands in
+        # (an environment variable so that the fallback itself can be tried)
+        capture_secs = float(os.environ.get("BROWSER_SHOT_CAPTURE_SECS", "30"))
         for k in range(args.shots):
             if k > 0:
                 page.sleep(args.every)
@@ -220,29 +258,29 @@ def main():
                 # returns once and then never again: the later pictures of the same open page
                 # are frames its screencast streams (each acknowledged as it comes), the first
                 # one painted after this picture was asked for
-                seen = page.frames
-                end = time.time() + 90
-                while page.frames == seen and time.time() < end:
-                    for x in (width // 2, width // 2 + 1):
-                        page.send("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=14)
-                    page.sleep(1.0)
-                if page.frames == seen:
-                    sys.exit(f"browser_shot: no new frame of the open page for picture {k + 1} in 90 s")
                 path = f"{base}-{k + 1}{ext}"
                 with open(path, "wb") as f:
-                    f.write(page.frame)
+                    f.write(next_screencast_frame(page, width, height, True))
                 print(path)
                 continue
             # the viewer paints only when something changes: a pointer move over the empty
             # middle of its top bar makes it paint now, so the capture has a frame to take
             for x in (width // 2, width // 2 + 1):
                 page.call("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=14)
-            shot = page.call("Page.captureScreenshot", format="png")
             path = args.out if args.shots == 1 else f"{base}-{k + 1}{ext}"
+            try:
+                png = base64.b64decode(page.call("Page.captureScreenshot", timeout=capture_secs, format="png")["data"])
+            except CallTimeout as e:
+                # seen in CI once (a page opened while the app streams, software WebGL): the
+                # capture never answers; the page's screencast still streams its frames
+                print(f"browser_shot: {e}; taking the picture from the page's screencast", file=sys.stderr)
+                png = next_screencast_frame(page, width, height, streaming)
+                streaming = True
             with open(path, "wb") as f:
-                f.write(base64.b64decode(shot["data"]))
+                f.write(png)
             print(path)
-            if args.shots > 1 and not args.frames:
+            if args.shots > 1 and not streaming:
+                streaming = True
                 page.call("Page.startScreencast", format="png", maxWidth=width, maxHeight=height)
         for e in page.errors:
             print(f"browser_shot: page error: {e}", file=sys.stderr)
