@@ -1,35 +1,24 @@
 //! Colour classes of the P1 benchmark beams (issue #37 item 4): per beam, the number of colours,
 //! their sizes, and how far apart in memory the four elements of a batch reach (the node-index
-//! span a batch's gathers touch); then the colour sweep timed on the beam as built and with its
-//! nodes renumbered along x (a test of the L1 working-set hypothesis of docs/PERFORMANCE.md,
-//! session 22), on one and two threads, alternately: `cargo run --release -p hox-scenes --example colour_stats`.
+//! span a batch's gathers touch); then the colour sweep timed on the beam as built (its nodes
+//! numbered along x, the slab axis, since session 29) and with its nodes renumbered along z
+//! (z slowest, as the generator numbered them before: docs/PERFORMANCE.md, sessions 22 and 28),
+//! on one and two threads, alternately: `cargo run --release -p hox-scenes --example colour_stats`.
 
-use hox_sim::Vec3;
 use hox_sim::effect::{Clamp, Effect, Gravity};
-use hox_sim::mesh::{ElementBlock, Mesh};
 use hox_sim::solver::Simulation;
 
-/// The same beam with its nodes numbered by increasing x (then y, z): an element's nodes close
-/// in memory, a colour's gathers walking the beam from one end to the other.
+/// The same beam with its nodes numbered by increasing z (then y, x): across the slabs the
+/// colour sweep cuts along x.
 fn renumbered(sim: &Simulation) -> Result<Simulation, Box<dyn std::error::Error>> {
     let mesh = sim.mesh();
     let mut order: Vec<u32> = (0..mesh.num_nodes() as u32).collect();
     let p = &mesh.rest_positions;
     order.sort_by(|&a, &b| {
         let (a, b) = (p[a as usize], p[b as usize]);
-        a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)).then(a.z.total_cmp(&b.z))
+        a.z.total_cmp(&b.z).then(a.y.total_cmp(&b.y)).then(a.x.total_cmp(&b.x))
     });
-    let mut new_of = vec![0u32; order.len()];
-    for (new, &old) in order.iter().enumerate() {
-        new_of[old as usize] = new as u32;
-    }
-    let rest: Vec<Vec3> = order.iter().map(|&old| p[old as usize]).collect();
-    let blocks = mesh
-        .blocks
-        .iter()
-        .map(|b| ElementBlock::new(b.element_type, b.connectivity.iter().map(|&n| new_of[n as usize]).collect()))
-        .collect();
-    let mesh = Mesh { rest_positions: rest, blocks };
+    let mesh = mesh.with_nodes_in_order(&order);
     let clamped = mesh.nodes_where(|q| q.x.abs() < 1e-12);
     let effects: Vec<Box<dyn Effect>> =
         vec![Box::new(Clamp { nodes: clamped }), Box::new(Gravity::new(sim.body_acceleration_m_s2()))];
@@ -85,7 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             elem_span
         );
         let mut built = hox_scenes::bench::bending_beam(case, hox_sim::solver::Sweep::Colour)?;
-        let mut along_x = renumbered(&built)?;
+        let mut along_z = renumbered(&built)?;
         let frames = if block.len() > 50_000 { 6 } else { 20 };
         for threads in [1, 2] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
@@ -93,12 +82,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             for _ in 0..3 {
                 pairs.push(pool.install(|| -> Result<(f64, f64), String> {
                     let time = |sim: &mut Simulation| ms_per_frame(sim, frames).map_err(|e| e.to_string());
-                    Ok((time(&mut built)?, time(&mut along_x)?))
+                    Ok((time(&mut built)?, time(&mut along_z)?))
                 })?);
             }
             let ratios: Vec<String> =
                 pairs.iter().map(|(a, b)| format!("{a:.2} -> {b:.2} ms ({:.2})", b / a)).collect();
-            println!("  colour sweep, {threads} thread(s), as built -> numbered along x: {}", ratios.join(", "));
+            println!(
+                "  colour sweep, {threads} thread(s), as built (along x) -> numbered along z: {}",
+                ratios.join(", ")
+            );
         }
     }
     Ok(())

@@ -136,6 +136,44 @@ impl Mesh {
         (lo, hi)
     }
 
+    /// The same mesh with its nodes renumbered in order of their rest coordinate along the
+    /// longest axis of the bounding box (nodes at the same coordinate keep their order); the
+    /// elements and their order are unchanged.
+    ///
+    /// The XPBD colour sweep cuts a block into slabs along that axis
+    /// ([`crate::xpbd::kernels::slab_count`]), and its node passes (prediction, velocities,
+    /// the finite check) cut the nodes by index: numbered so, the nodes a thread's slabs move
+    /// are the ones its node passes write, and an element's nodes lie close in memory. Measured
+    /// on the 81,920-element beam: two threads over one 1.79–1.84× → 1.86–1.93× (docs/PERFORMANCE.md,
+    /// sessions 28–29). Node numbers change, not the physics: the element colouring (by element
+    /// order) is the same, so a step gives the same result up to the order of sums over nodes.
+    pub fn with_nodes_along_longest_axis(self) -> Mesh {
+        let (lo, hi) = self.bounding_box();
+        let axis = (hi - lo).iamax();
+        let p = &self.rest_positions;
+        let mut order: Vec<u32> = (0..self.num_nodes() as u32).collect();
+        order.sort_by(|&a, &b| p[a as usize][axis].total_cmp(&p[b as usize][axis]));
+        self.with_nodes_in_order(&order)
+    }
+
+    /// The same mesh with node `order[k]` renumbered `k` (`order` a permutation of the nodes);
+    /// the elements and their order are unchanged.
+    pub fn with_nodes_in_order(&self, order: &[u32]) -> Mesh {
+        let p = &self.rest_positions;
+        debug_assert_eq!(order.len(), p.len(), "a permutation of the nodes");
+        let mut new_of = vec![0u32; order.len()];
+        for (new, &old) in order.iter().enumerate() {
+            new_of[old as usize] = new as u32;
+        }
+        let rest_positions = order.iter().map(|&old| p[old as usize]).collect();
+        let blocks = self
+            .blocks
+            .iter()
+            .map(|b| ElementBlock::new(b.element_type, b.connectivity.iter().map(|&n| new_of[n as usize]).collect()))
+            .collect();
+        Mesh { rest_positions, blocks }
+    }
+
     /// Nodes whose rest position satisfies `predicate`.
     pub fn nodes_where(&self, predicate: impl Fn(&Vec3) -> bool) -> Vec<u32> {
         (0..self.num_nodes() as u32).filter(|&i| predicate(&self.rest_positions[i as usize])).collect()

@@ -12,6 +12,8 @@
 //! Tetrahedral meshes can be refined 1-to-8 (each tetrahedron into four corner tetrahedra and
 //! four around the shortest diagonal of the inner octahedron) before P2/P3 nodes are added by
 //! [`super::high_order::raise_order`]. Every element is oriented to a positive Jacobian.
+//! The nodes of the finished mesh are numbered along the box's longest axis
+//! ([`Mesh::with_nodes_along_longest_axis`]): where the colour sweep cuts its slabs.
 
 use super::high_order::raise_order;
 use super::{ElementBlock, Mesh, MeshError};
@@ -179,7 +181,7 @@ impl BoxMeshSpec {
             }
         };
         orient_positively(&mut mesh);
-        let mesh = raise_order(&mesh, self.element_type)?;
+        let mesh = raise_order(&mesh, self.element_type)?.with_nodes_along_longest_axis();
         mesh.validate()?;
         Ok(mesh)
     }

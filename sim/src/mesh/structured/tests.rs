@@ -89,3 +89,58 @@ fn bad_requests_are_errors() {
     flat.grid.max_m.z = 0.0;
     assert!(flat.build().unwrap_err().to_string().contains("positive finite size"));
 }
+
+/// The nodes of every box mesh are numbered along its longest axis, where the colour sweep cuts
+/// its slabs (`Mesh::with_nodes_along_longest_axis`), and renumbering moves no element: each
+/// element keeps its node positions in its node order.
+#[test]
+fn box_nodes_are_numbered_along_the_longest_axis_and_each_element_keeps_its_nodes() {
+    for et in ElementType::all() {
+        let refine = usize::from(et.shape() == ReferenceShape::Tetrahedron && et.order() == 1);
+        let m = BoxMeshSpec {
+            grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(2.0, 0.5, 0.5), cells: [6, 2, 3] },
+            element_type: et,
+            split: TetSplit::Five,
+            refine,
+        }
+        .build()
+        .unwrap();
+        assert!(m.rest_positions.windows(2).all(|w| w[0].x <= w[1].x), "{et}: nodes not in order of x");
+        // along y when y is the longest side
+        let tall = BoxMeshSpec {
+            grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(0.3, 2.0, 0.5), cells: [2, 6, 2] },
+            element_type: et,
+            split: TetSplit::Five,
+            refine: 0,
+        }
+        .build()
+        .unwrap();
+        assert!(tall.rest_positions.windows(2).all(|w| w[0].y <= w[1].y), "{et}: nodes not in order of y");
+    }
+    // the same elements in the same order, each with the same node positions
+    let m = beam("p2", [4, 2, 2], TetSplit::Six, 0, 2.0);
+    let shuffled = Mesh {
+        rest_positions: m.rest_positions.iter().rev().copied().collect(),
+        blocks: m
+            .blocks
+            .iter()
+            .map(|b| {
+                let last = m.num_nodes() as u32 - 1;
+                ElementBlock::new(b.element_type, b.connectivity.iter().map(|&n| last - n).collect())
+            })
+            .collect(),
+    };
+    let renumbered = shuffled.clone().with_nodes_along_longest_axis();
+    assert_eq!(renumbered.num_nodes(), shuffled.num_nodes());
+    for (b, (before, after)) in shuffled.blocks.iter().zip(&renumbered.blocks).enumerate() {
+        assert_eq!(before.len(), after.len(), "block {b}");
+        for (e, (x, y)) in before.elements().zip(after.elements()).enumerate() {
+            for (&old, &new) in x.iter().zip(y) {
+                assert_eq!(
+                    shuffled.rest_positions[old as usize], renumbered.rest_positions[new as usize],
+                    "block {b} element {e}"
+                );
+            }
+        }
+    }
+}
