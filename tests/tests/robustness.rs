@@ -1344,6 +1344,7 @@ fn every_implicit_solver_on_inverted_starts() {
             "p2 newton euler",
             "p2 newton bdf2",
             "p3 vbd newmark",
+            "p3 newton euler",
             "p3 newton newmark",
             "p3 newton bdf2",
             "q2 vbd bdf2",
@@ -1371,7 +1372,6 @@ fn every_implicit_solver_on_inverted_starts() {
             "p1 newton newmark",
             "p2 vbd euler",
             "p2 vbd newmark",
-            "p2 vbd bdf2",
             "p2 newton newmark",
             "p3 vbd newmark",
             "p3 newton newmark",
@@ -1391,9 +1391,10 @@ fn every_implicit_solver_on_inverted_starts() {
 #[ignore = "release: CI runs it with --release --ignored"]
 fn every_implicit_solver_near_incompressibility() {
     // (BDF2's energy is not monotone step by step: its first step after the release raised H by
-    // 0.02 % (Q2, Newton) and 0.9 % (prism, VBD) over the bound of "not above its value at
-    // release", where the check stops the run)
-    let mut problems = near_incompressible(SNH, &implicit(), &[(0.499, &["q2 newton bdf2", "prism vbd bdf2"])]);
+    // 0.02 % (Q2, Newton) over the bound of "not above its value at release", where the check
+    // stops the run; the prism under VBD did too by 0.9 % until session 29, when the box's nodes
+    // were renumbered: round-off, docs/STABILITY.md)
+    let mut problems = near_incompressible(SNH, &implicit(), &[(0.499, &["q2 newton bdf2"])]);
     problems.extend(near_incompressible(STVK, &implicit(), &[]));
     none(&problems);
 }
@@ -1497,7 +1498,7 @@ fn every_implicit_solver_under_extreme_drives() {
 fn every_implicit_solver_with_mass_and_size_ratios() {
     let configs = implicit();
     let mut problems = heavy_node(&configs, &[]);
-    problems.extend(sizes(&element_types(), &configs, &["p3 vbd newmark", "p3 newton newmark", "q2 newton newmark"]));
+    problems.extend(sizes(&element_types(), &configs, &["p3 vbd newmark", "p3 newton newmark"]));
     none(&problems);
 }
 
