@@ -84,9 +84,11 @@ fn why_high_order_p2_160_beats_p1_1280_in_accuracy_and_cost() {
     assert!(error[0] > 20.0 * error[1], "{error:?}");
     assert!((0.04..0.07).contains(&error[0]) && error[1] < 2e-3, "{error:?}");
     // measured side by side in one run: a ratio, not a time. It depends on the processor: 2.6
-    // on an AVX-512 EPYC, 1.31-1.47 on an AVX2-only one (three runs), so the bound is loose
+    // on an AVX-512 EPYC, 1.31-1.47 on an AVX2-only one (three runs), 1.15-1.20 on an AVX-512
+    // Intel Xeon (six runs, session 29; 1.147 once in CI beside another test), so the bound is
+    // loose: P2 cheaper, by a margin the noise does not cross
     let ms = step("why-high-order", 3);
-    assert!(ms[0] > 1.15 * ms[1], "ms per frame {ms:?}");
+    assert!(ms[0] > 1.05 * ms[1], "ms per frame {ms:?}");
 }
 
 #[test]
