@@ -9,7 +9,8 @@ Opens URL, waits --wait seconds (the Rerun web viewer compiles 42 MB of WebAssem
 then writes --shots screenshots --every seconds apart: OUT.png, or OUT-1.png, OUT-2.png, ...
 when there are several, all of the one page kept open (the first captured, the others taken
 from the page's screencast, the frames it streams as it repaints). The page's console errors are printed to stderr. Exit 0 when every
-screenshot was written."""
+screenshot was written. A first capture that gets no answer within BROWSER_SHOT_CAPTURE_SECS
+(default 30) is taken from the screencast too."""
 
 import argparse
 import base64
@@ -207,6 +208,15 @@ def main():
                     "opened, as DIR/frame-SECONDS.png (seconds since the page was asked for)")
     args = ap.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
+    # how long the first picture's capture may take before the screencast stands in
+    # (an environment variable so that the fallback itself can be tried)
+    try:
+        capture_secs = float(os.environ.get("BROWSER_SHOT_CAPTURE_SECS", "30"))
+    except ValueError:
+        sys.exit("browser_shot: BROWSER_SHOT_CAPTURE_SECS must be a number of seconds, "
+                 f"not {os.environ['BROWSER_SHOT_CAPTURE_SECS']!r}")
+    if not capture_secs > 0:
+        sys.exit(f"browser_shot: BROWSER_SHOT_CAPTURE_SECS must be positive, not {capture_secs}")
     profile = tempfile.mkdtemp(prefix="hox-chromium-")
     browser = subprocess.Popen(
         [
@@ -248,9 +258,6 @@ def main():
         page.call("Page.navigate", url=args.url)
         page.sleep(args.wait)
         base, ext = os.path.splitext(args.out)
-        # how long the first picture's capture may take before the screencast stands in
-        # (an environment variable so that the fallback itself can be tried)
-        capture_secs = float(os.environ.get("BROWSER_SHOT_CAPTURE_SECS", "30"))
         for k in range(args.shots):
             if k > 0:
                 page.sleep(args.every)
