@@ -18,6 +18,9 @@ use crate::material::{Material, contract, contract_left, contract_right};
 use crate::mesh::Mesh;
 use nalgebra::DMatrix;
 
+mod fixed;
+pub use fixed::point_energy_and_gradient;
+
 /// `U_e` for gathered positions `x` (one per element node); `grads` holds the material
 /// gradients of all quadrature points (`points × nodes`), `volumes` one entry per point.
 pub fn element_energy(x: &[Vec3], rest: &[Vec3], grads: &[Vec3], volumes: &[f64], material: &Material) -> f64 {
@@ -175,28 +178,41 @@ pub fn for_each_element(
     positions: &[Vec3],
     mut visit: impl FnMut(&GatheredElement),
 ) {
-    let (mut x, mut rest) = (Vec::new(), Vec::new());
-    for (block, (b, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
-        x.resize(b.nodes_per_element(), Vec3::zeros());
-        rest.resize(b.nodes_per_element(), Vec3::zeros());
-        for (element, nodes) in b.elements().enumerate() {
-            gather(positions, nodes, &mut x);
-            gather(&mesh.rest_positions, nodes, &mut rest);
-            visit(&GatheredElement { block, element, nodes, geometry: g, x: &x, rest: &rest });
-        }
+    for (block, g) in geometry.iter().enumerate().take(mesh.blocks.len()) {
+        for_each_block_element(mesh, block, g, positions, &mut visit);
     }
 }
 
-/// Total elastic energy of the mesh at `positions`.
+/// [`for_each_element`] over block `block` only (`geometry` its geometry).
+fn for_each_block_element(
+    mesh: &Mesh,
+    block: usize,
+    geometry: &BlockGeometry,
+    positions: &[Vec3],
+    mut visit: impl FnMut(&GatheredElement),
+) {
+    let b = &mesh.blocks[block];
+    let (mut x, mut rest) = (vec![Vec3::zeros(); b.nodes_per_element()], vec![Vec3::zeros(); b.nodes_per_element()]);
+    for (element, nodes) in b.elements().enumerate() {
+        gather(positions, nodes, &mut x);
+        gather(&mesh.rest_positions, nodes, &mut rest);
+        visit(&GatheredElement { block, element, nodes, geometry, x: &x, rest: &rest });
+    }
+}
+
+/// Total elastic energy of the mesh at `positions`: block by block through the kernel of
+/// [`fixed`] for its node count (every element type of the project), else the generic one.
 pub fn total_energy(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, positions: &[Vec3]) -> f64 {
     let mut total = 0.0;
-    for_each_element(mesh, geometry, positions, |el| {
-        total += element_energy(el.x, el.rest, el.grads(), el.volumes(), material);
-    });
+    for (bi, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
+        total +=
+            fixed::block_energy_and_gradient::<false>(block, g, &mesh.rest_positions, positions, material, &mut [])
+                .unwrap_or_else(|| generic_block_energy(mesh, bi, g, material, positions));
+    }
     total
 }
 
-/// Total elastic energy and its gradient (`gradient_out` is overwritten).
+/// Total elastic energy and its gradient (`gradient_out` is overwritten), as [`total_energy`].
 pub fn total_energy_and_gradient(
     mesh: &Mesh,
     geometry: &[BlockGeometry],
@@ -205,15 +221,86 @@ pub fn total_energy_and_gradient(
     gradient_out: &mut [Vec3],
 ) -> f64 {
     gradient_out.iter_mut().for_each(|g| *g = Vec3::zeros());
+    let mut total = 0.0;
+    for (bi, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
+        total += match fixed::block_energy_and_gradient::<true>(
+            block,
+            g,
+            &mesh.rest_positions,
+            positions,
+            material,
+            gradient_out,
+        ) {
+            Some(e) => e,
+            None => generic_block_energy_and_gradient(mesh, bi, g, material, positions, gradient_out),
+        };
+    }
+    total
+}
+
+/// [`total_energy`] element by element with [`element_energy`] (the generic kernel: any node
+/// count, nalgebra's sums), one block.
+fn generic_block_energy(
+    mesh: &Mesh,
+    block: usize,
+    geometry: &BlockGeometry,
+    material: &Material,
+    positions: &[Vec3],
+) -> f64 {
+    let mut total = 0.0;
+    for_each_block_element(mesh, block, geometry, positions, |el| {
+        total += element_energy(el.x, el.rest, el.grads(), el.volumes(), material);
+    });
+    total
+}
+
+/// [`total_energy_and_gradient`] with [`element_energy_and_gradient`], one block (the gradient
+/// added to `gradient_out`).
+fn generic_block_energy_and_gradient(
+    mesh: &Mesh,
+    block: usize,
+    geometry: &BlockGeometry,
+    material: &Material,
+    positions: &[Vec3],
+    gradient_out: &mut [Vec3],
+) -> f64 {
     let mut ge = Vec::new();
     let mut total = 0.0;
-    for_each_element(mesh, geometry, positions, |el| {
+    for_each_block_element(mesh, block, geometry, positions, |el| {
         ge.resize(el.nodes.len(), Vec3::zeros());
         total += element_energy_and_gradient(el.x, el.rest, el.grads(), el.volumes(), material, &mut ge);
         for (&n, gi) in el.nodes.iter().zip(&ge) {
             gradient_out[n as usize] += gi;
         }
     });
+    total
+}
+
+/// The generic kernels' mesh passes, element by element ([`element_energy`],
+/// [`element_energy_and_gradient`]): what [`total_energy`] and [`total_energy_and_gradient`]
+/// compute up to round-off, kept as the reference the specialised kernel is tested against.
+pub fn total_energy_generic(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, positions: &[Vec3]) -> f64 {
+    geometry
+        .iter()
+        .enumerate()
+        .take(mesh.blocks.len())
+        .map(|(b, g)| generic_block_energy(mesh, b, g, material, positions))
+        .sum()
+}
+
+/// See [`total_energy_generic`].
+pub fn total_energy_and_gradient_generic(
+    mesh: &Mesh,
+    geometry: &[BlockGeometry],
+    material: &Material,
+    positions: &[Vec3],
+    gradient_out: &mut [Vec3],
+) -> f64 {
+    gradient_out.iter_mut().for_each(|g| *g = Vec3::zeros());
+    let mut total = 0.0;
+    for (b, g) in geometry.iter().enumerate().take(mesh.blocks.len()) {
+        total += generic_block_energy_and_gradient(mesh, b, g, material, positions, gradient_out);
+    }
     total
 }
 

@@ -41,6 +41,7 @@ mod testing;
 
 pub use crate::math::lane;
 pub mod neo_hookean;
+pub mod point_law;
 mod psd;
 pub mod stable_neo_hookean;
 pub mod stable_neo_hookean_log;

@@ -9,6 +9,7 @@
 pub mod lane;
 pub mod par;
 pub mod shared;
+pub mod soa;
 
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod f64x4;

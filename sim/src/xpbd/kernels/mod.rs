@@ -19,9 +19,10 @@
 //! element-indexed colour sweep).
 //!
 //! Files, one concern each: `sweep.rs` the sweep and the per-element projections
-//! ([`energy_sweep`], [`colour_sweep`], [`project_p1`], [`project_energy`]); `point_law.rs` the
-//! material law it is generic over ([`PointMaterial`], [`Stvk`]); `simd.rs` the lane helpers
-//! ([`mul3`], [`LANES`]); `shared.rs` the raw shared pointers ([`SharedMut`]); `pack.rs` the
+//! ([`energy_sweep`], [`colour_sweep`], [`project_p1`], [`project_energy`]); the
+//! material law it is generic over ([`PointMaterial`], [`Stvk`]) is `crate::material::point_law`
+//! and the lane helpers ([`mul3`], [`LANES`]) `crate::math::soa`, both shared with the element
+//! energy and gradient of `crate::fem::energy`; `shared.rs` the raw shared pointers ([`SharedMut`]); `pack.rs` the
 //! packed element data ([`PackedBlock`]); `schedule.rs` the parallel schedules and every
 //! threshold that cuts work between threads ([`parallel_energy_block`], [`Partition`]);
 //! [`p1`] the linear tetrahedron a register at a time, [`batch`] any other type (`lanes.rs`: what
@@ -30,10 +31,10 @@
 //! is chosen at packing ([`PackedBlock::lanes`]: the widest the CPU has, or as asked).
 
 mod pack;
-mod point_law;
+use crate::material::point_law;
+use crate::math::soa as simd;
 mod schedule;
 mod shared;
-mod simd;
 mod sweep;
 
 #[cfg(target_arch = "x86_64")]
@@ -71,15 +72,15 @@ pub fn lanes_available(_lanes: usize) -> bool {
     false
 }
 
+pub use crate::material::point_law::{AnyMaterial, PointMaterial, Stvk};
+pub use crate::math::soa::{LANES, mul3, padded};
 pub use pack::{BlockData, EIGHT_LANE_BATCH_COST, P1_VALUES_PER_LANE, PackedBlock, SolverData, auto_lanes};
-pub use point_law::{AnyMaterial, PointMaterial, Stvk};
 pub use schedule::{
     BlockSweep, ELEMENTS_PER_EXTRA_SLAB, GENERIC_MIN_ELEMENTS_PER_TASK, MAX_SLABS, MIN_SLABS,
     PARTITION_MIN_ELEMENTS_PER_SLAB, Partition, SWEEP_MIN_ELEMENTS_PER_THREAD, flops_per_element, p1_equivalents,
     parallel_energy_block, slab_count,
 };
 pub use shared::{Multipliers, Positions, SharedMut};
-pub use simd::{LANES, mul3, padded};
 pub use sweep::{NonFiniteElement, SPECIALISED_NODE_COUNTS, colour_sweep, energy_sweep, project_energy, project_p1};
 
 #[cfg(test)]

@@ -6,8 +6,9 @@
 use super::pack::{BlockData, PackedBlock};
 use super::point_law::{AnyMaterial, PointMaterial, Stvk};
 use super::shared::{Multipliers, Positions};
-use super::simd::{LANES, axpy_lanes, fma_lanes, mul3};
+use super::simd::mul3;
 use crate::Vec3;
+use crate::fem::energy::point_energy_and_gradient;
 use crate::material::{FastLaw, Mat3, Material};
 use crate::xpbd::constraint::xpbd_step;
 
@@ -220,38 +221,9 @@ pub fn project_energy<const N: usize, const P: usize, const FMA: bool, M: PointM
 ) -> f64 {
     let mut grad = [[0.0; P]; 3];
     let mut energy = 0.0;
-    for (gq, v) in grads.chunks_exact(3 * P).zip(volumes) {
+    for (gq, &v) in grads.chunks_exact(3 * P).zip(volumes) {
         let g: [&[f64; P]; 3] = std::array::from_fn(|b| gq[b * P..(b + 1) * P].try_into().expect("P gradients"));
-        // F_ab = δ_ab + Σ_i u_ai g_bi, summed in LANES partial sums (one vector register)
-        let mut acc = [[[0.0; LANES]; 3]; 3];
-        for c in 0..P / LANES {
-            for a in 0..3 {
-                for b in 0..3 {
-                    let r = c * LANES..(c + 1) * LANES;
-                    fma_lanes::<FMA>(&mut acc[a][b], &u[a][r.clone()], &g[b][r]);
-                }
-            }
-        }
-        let mut f = Mat3::identity();
-        for a in 0..3 {
-            for b in 0..3 {
-                let s = &acc[a][b];
-                f[(a, b)] += (s[0] + s[1]) + (s[2] + s[3]);
-            }
-        }
-        let (psi, p) = material.energy_and_pk1::<FMA>(&f);
-        energy += v * psi;
-        let vp = p * *v;
-        for a in 0..3 {
-            let (p0, p1, p2) = (vp[(a, 0)], vp[(a, 1)], vp[(a, 2)]);
-            for c in 0..P / LANES {
-                let r = c * LANES..(c + 1) * LANES;
-                let out: &mut [f64; LANES] = (&mut grad[a][r.clone()]).try_into().expect("LANES");
-                for (pb, gb) in [p0, p1, p2].into_iter().zip(g) {
-                    axpy_lanes::<FMA>(out, pb, &gb[r.clone()]);
-                }
-            }
-        }
+        energy += point_energy_and_gradient::<P, FMA, true, M>(u, g, v, material, &mut grad);
     }
     // as the generic kernel: the stable Neo-Hookean energy can dip below its rest value
     let energy = energy.max(0.0);

@@ -1,13 +1,14 @@
-//! The material law the sweep is generic over ([`PointMaterial`]): `(ψ(F), P(F))` at one
-//! quadrature point. [`Stvk`] is Saint-Venant–Kirchhoff with its Lamé parameters computed once
-//! per sweep (bit for bit [`crate::material::stvk::energy_and_pk1`], tested); every
+//! The material law the per-element kernels are generic over ([`PointMaterial`]): `(ψ(F), P(F))`
+//! at one quadrature point (XPBD's sweep, `crate::xpbd::kernels`; the element energy and
+//! gradient, `crate::fem::energy`). [`Stvk`] is Saint-Venant–Kirchhoff with its Lamé parameters
+//! computed once per sweep or mesh pass (bit for bit [`crate::material::stvk::energy_and_pk1`], tested); every
 //! other model goes through [`AnyMaterial`] (its registered law: one indirect call per point).
 
 use crate::material::{Mat3, Material};
 
 /// `(ψ(F), P(F))` at one quadrature point: the material law the kernel is generic over.
 pub trait PointMaterial: Sync {
-    /// `FMA`: products may use fused multiply–adds ([`mul3`](super::mul3)).
+    /// `FMA`: products may use fused multiply–adds ([`mul3`](crate::math::soa::mul3)).
     fn energy_and_pk1<const FMA: bool>(&self, f: &Mat3) -> (f64, Mat3);
 }
 
@@ -27,7 +28,7 @@ impl PointMaterial for Stvk {
     #[inline(always)]
     fn energy_and_pk1<const FMA: bool>(&self, f: &Mat3) -> (f64, Mat3) {
         let h = f - Mat3::identity();
-        let e = (h + h.transpose() + super::simd::tr_mul3::<FMA>(&h, &h)) * 0.5;
+        let e = (h + h.transpose() + crate::math::soa::tr_mul3::<FMA>(&h, &h)) * 0.5;
         let tr = e.trace();
         let mut s = e * (2.0 * self.mu_pa);
         let lt = self.lambda_pa * tr;
@@ -35,7 +36,7 @@ impl PointMaterial for Stvk {
         s[(1, 1)] += lt;
         s[(2, 2)] += lt;
         let psi = self.mu_pa * e.norm_squared() + 0.5 * self.lambda_pa * tr * tr;
-        (psi, super::simd::mul3::<FMA>(f, &s))
+        (psi, crate::math::soa::mul3::<FMA>(f, &s))
     }
 }
 
