@@ -1339,6 +1339,7 @@ fn every_implicit_solver_on_inverted_starts() {
     let mut problems = mirrored_snh(
         &configs,
         &[
+            "p1 newton euler",
             "p2 vbd euler",
             "p2 vbd bdf2",
             "p2 newton euler",
