@@ -11,6 +11,13 @@
 //!   diagonal block `∂²U_e/∂x_a∂x_a`, without the rest of the element Hessian.
 //!
 //! For the linear tetrahedron this is Bender et al.'s `V_0 P(F) D_m⁻ᵀ` (the paper, §2).
+//!
+//! The mesh passes ([`total_energy`], [`total_energy_and_gradient`]: what Newton, the static
+//! solver and the residuals evaluate) run the kernel of `fixed.rs`, whose node count is a
+//! compile-time constant for every element type of the project (the per-point sum XPBD's
+//! specialised sweep shares); the generic per-element functions here are its tested reference
+//! ([`total_energy_generic`], [`total_energy_and_gradient_generic`]) and serve any other node
+//! count.
 
 use crate::Vec3;
 use crate::fem::geometry::{BlockGeometry, deformation_gradient};
