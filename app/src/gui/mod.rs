@@ -91,6 +91,10 @@ pub struct HoxApp {
     gl_available: bool,
     /// The OpenGL renderer's name (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"), if known.
     pub renderer: Option<String>,
+    /// While playing, paint when the next simulated frame is due instead of at once: set for a
+    /// software renderer (no vertical sync paces it) unless `--no-vsync` asks for the most
+    /// frames (frame-rate measurements); off in the headless UI tests.
+    pub pace_paint: bool,
     /// Frames to step once this frame's UI is built (in the background while the window paints).
     deferred_frames: usize,
     /// Sessions being stepped in the background, and how many frames.
@@ -161,6 +165,7 @@ impl HoxApp {
             measure: args.measure_secs.map(Measure::new),
             gl_available: false,
             renderer: None,
+            pace_paint: false,
             deferred_frames: 0,
             background: None,
             lesson: None,

@@ -27,6 +27,12 @@ impl Playback {
         Playback { playing, time_scale, frame_budget_secs: 0.0, last_clock_frame: false, was_settling: false }
     }
 
+    /// Real time until the next frame of `frame_secs` is due, at the time scale.
+    pub(super) fn until_next_frame(&self, frame_secs: f64) -> std::time::Duration {
+        let secs = (frame_secs - self.frame_budget_secs).max(0.0) / self.time_scale.max(1e-6);
+        std::time::Duration::from_secs_f64(secs.min(frame_secs / self.time_scale.max(1e-6)).min(0.25))
+    }
+
     /// The frames of `frame_secs` due after `real_dt_secs` of real time (at most 4); the
     /// remainder, less than a frame, is kept for the next call.
     fn frames_due(&mut self, real_dt_secs: f64, frame_secs: f64) -> usize {
@@ -123,6 +129,16 @@ impl HoxApp {
 
     /// Steps as much simulated time as passed in real time × time scale (at most 4 frames per
     /// displayed frame, so a slow configuration slows down instead of freezing the window).
+    /// How long to wait before painting the next frame while playing ([`HoxApp::pace_paint`]):
+    /// until the next simulated frame is due; None (paint at once) when pacing is off, while
+    /// settling (as many frames as the CPU allows) or measuring the frame rate.
+    pub(super) fn paint_pace(&self) -> Option<std::time::Duration> {
+        if !self.pace_paint || self.settling() || self.measure.is_some() || self.sessions.is_empty() {
+            return None;
+        }
+        Some(self.playback.until_next_frame(1.0 / self.sessions[0].config.frames_per_second))
+    }
+
     pub(super) fn advance(&mut self, real_dt_secs: f64) {
         self.playback.was_settling |= self.settling();
         if !self.playback.playing || self.sessions.iter().all(|s| s.failure.is_some()) {

@@ -85,6 +85,10 @@ pub fn run(args: AppArgs) -> anyhow::Result<()> {
             match HoxApp::new(&args, saved) {
                 Ok(mut app) => {
                     app.renderer = renderer;
+                    // a software renderer has no vertical sync to wait for (Xvfb, a remote
+                    // desktop, a machine without a graphics driver): while playing, the window
+                    // paints when a simulated frame is due, not as fast as the CPU allows
+                    app.pace_paint = software && !args.no_vsync;
                     Ok(Box::new(app) as Box<dyn eframe::App>)
                 }
                 Err(e) => {

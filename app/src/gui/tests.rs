@@ -1092,3 +1092,58 @@ fn export_figure_writes_the_papers_figure_of_the_configurations_on_screen() {
     h.run_steps(2);
     assert!(h.get_by_label("Export figure").accesskit_node().is_disabled(), "the export is off for the tube");
 }
+
+/// A software renderer has no vertical sync: while playing, the window waits until the next
+/// simulated frame is due before painting again (a display running at 120 Hz without vsync waits
+/// a frame of 1/60 s or what is left of it), paints at once while settling or measuring the
+/// frame rate, and not at all paced in a window with vsync (`pace_paint` off).
+#[test]
+fn with_a_software_renderer_the_playing_window_paints_when_a_simulated_frame_is_due() {
+    let frame = 1.0 / 60.0;
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .allow_missing_glyphs()
+        .with_step_dt(1.0 / 120.0)
+        .build_ui_state(
+            |ui, app: &mut HoxApp| app.ui_all(ui),
+            HoxApp::new(&AppArgs { fresh: true, play: true, ..Default::default() }, None).unwrap(),
+        );
+    assert_eq!(h.state().paint_pace(), None, "a window with vsync is not paced");
+    h.state_mut().pace_paint = true;
+    let t0 = h.state().sessions[0].instance.sim.time_secs();
+    let mut waits = Vec::new();
+    for _ in 0..40 {
+        h.run_steps(1);
+        waits.push(h.state().paint_pace().expect("paced while playing").as_secs_f64());
+    }
+    assert!(waits.iter().all(|w| *w > 0.0 && *w <= frame + 1e-6), "{waits:?}");
+    assert!(waits.iter().any(|w| (w - frame).abs() < 1e-6), "just after a frame: a whole frame to wait, {waits:?}");
+    let t = h.state().sessions[0].instance.sim.time_secs() - t0;
+    assert!((t - 40.0 / 120.0).abs() <= frame + 1e-9, "simulated time follows the clock: {t} s in 1/3 s");
+    // settling goes as fast as the CPU allows
+    h.key_press(egui::Key::E);
+    h.run_steps(1);
+    assert!(h.state().settling());
+    assert_eq!(h.state().paint_pace(), None, "settling is not paced");
+    // measuring the frame rate is not paced either
+    let mut m =
+        HoxApp::new(&AppArgs { fresh: true, play: true, measure_secs: Some(1.0), ..Default::default() }, None).unwrap();
+    m.pace_paint = true;
+    assert_eq!(m.paint_pace(), None, "a frame-rate measurement is not paced");
+}
+
+#[test]
+fn the_wait_for_the_next_frame_follows_the_clock_s_remainder_and_the_time_scale() {
+    let frame = 1.0 / 60.0;
+    let mut p = playback::Playback::new(true, 1.0);
+    assert!((p.until_next_frame(frame).as_secs_f64() - frame).abs() < 1e-6);
+    p.frame_budget_secs = 0.75 * frame;
+    assert!((p.until_next_frame(frame).as_secs_f64() - 0.25 * frame).abs() < 1e-6);
+    p.frame_budget_secs = frame;
+    assert_eq!(p.until_next_frame(frame).as_secs_f64(), 0.0, "a frame owed: paint now");
+    let mut slow = playback::Playback::new(true, 0.25);
+    slow.frame_budget_secs = 0.0;
+    assert!((slow.until_next_frame(frame).as_secs_f64() - 4.0 * frame).abs() < 1e-6, "a quarter of real time");
+    let crawl = playback::Playback::new(true, 0.001);
+    assert_eq!(crawl.until_next_frame(frame).as_secs_f64(), 0.25, "at most a quarter second between paints");
+}

@@ -195,8 +195,13 @@ impl HoxApp {
             let offsets = self.offsets();
             self.viewport.ui(ui, &mut self.sessions, &offsets, &self.view, self.gl_available);
         });
-        if self.playback.playing || self.sessions.iter().any(|s| s.drag.is_some()) {
+        if self.sessions.iter().any(|s| s.drag.is_some()) {
             ctx.request_repaint();
+        } else if self.playback.playing {
+            match self.paint_pace() {
+                Some(wait) => ctx.request_repaint_after(wait),
+                None => ctx.request_repaint(),
+            }
         }
         let ms = now.elapsed().as_secs_f64() * 1e3;
         self.times.app_part(ms);
