@@ -210,13 +210,7 @@ fn for_each_block_element(
 /// Total elastic energy of the mesh at `positions`: block by block through the kernel of
 /// [`fixed`] for its node count (every element type of the project), else the generic one.
 pub fn total_energy(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, positions: &[Vec3]) -> f64 {
-    let mut total = 0.0;
-    for (bi, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
-        total +=
-            fixed::block_energy_and_gradient::<false>(block, g, &mesh.rest_positions, positions, material, &mut [])
-                .unwrap_or_else(|| generic_block_energy(mesh, bi, g, material, positions));
-    }
-    total
+    mesh_pass(mesh, geometry, material, positions, None, true)
 }
 
 /// Total elastic energy and its gradient (`gradient_out` is overwritten), as [`total_energy`].
@@ -227,19 +221,53 @@ pub fn total_energy_and_gradient(
     positions: &[Vec3],
     gradient_out: &mut [Vec3],
 ) -> f64 {
-    gradient_out.iter_mut().for_each(|g| *g = Vec3::zeros());
+    mesh_pass(mesh, geometry, material, positions, Some(gradient_out), true)
+}
+
+/// The generic kernels' mesh passes, element by element ([`element_energy`],
+/// [`element_energy_and_gradient`]): what [`total_energy`] and [`total_energy_and_gradient`]
+/// compute up to round-off, kept as the reference the specialised kernel is tested against.
+pub fn total_energy_generic(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, positions: &[Vec3]) -> f64 {
+    mesh_pass(mesh, geometry, material, positions, None, false)
+}
+
+/// See [`total_energy_generic`].
+pub fn total_energy_and_gradient_generic(
+    mesh: &Mesh,
+    geometry: &[BlockGeometry],
+    material: &Material,
+    positions: &[Vec3],
+    gradient_out: &mut [Vec3],
+) -> f64 {
+    mesh_pass(mesh, geometry, material, positions, Some(gradient_out), false)
+}
+
+/// The one mesh pass behind the four above: `Σ_e U_e` block by block, with the gradient into
+/// `gradient_out` (overwritten) when given; each block through [`fixed`]'s kernel when
+/// `specialised` and its node count has one, else element by element with the generic kernel.
+fn mesh_pass(
+    mesh: &Mesh,
+    geometry: &[BlockGeometry],
+    material: &Material,
+    positions: &[Vec3],
+    mut gradient_out: Option<&mut [Vec3]>,
+    specialised: bool,
+) -> f64 {
+    if let Some(g) = gradient_out.as_deref_mut() {
+        g.iter_mut().for_each(|v| *v = Vec3::zeros());
+    }
     let mut total = 0.0;
     for (bi, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
-        total += match fixed::block_energy_and_gradient::<true>(
-            block,
-            g,
-            &mesh.rest_positions,
-            positions,
-            material,
-            gradient_out,
-        ) {
-            Some(e) => e,
-            None => generic_block_energy_and_gradient(mesh, bi, g, material, positions, gradient_out),
+        let pass = fixed::Pass { block, geometry: g, rest: &mesh.rest_positions, x: positions };
+        total += match gradient_out.as_deref_mut() {
+            Some(grad) => specialised
+                .then(|| fixed::block_energy_and_gradient::<true>(pass, material, grad))
+                .flatten()
+                .unwrap_or_else(|| generic_block_energy_and_gradient(mesh, bi, g, material, positions, grad)),
+            None => specialised
+                .then(|| fixed::block_energy_and_gradient::<false>(pass, material, &mut []))
+                .flatten()
+                .unwrap_or_else(|| generic_block_energy(mesh, bi, g, material, positions)),
         };
     }
     total
@@ -280,34 +308,6 @@ fn generic_block_energy_and_gradient(
             gradient_out[n as usize] += gi;
         }
     });
-    total
-}
-
-/// The generic kernels' mesh passes, element by element ([`element_energy`],
-/// [`element_energy_and_gradient`]): what [`total_energy`] and [`total_energy_and_gradient`]
-/// compute up to round-off, kept as the reference the specialised kernel is tested against.
-pub fn total_energy_generic(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, positions: &[Vec3]) -> f64 {
-    geometry
-        .iter()
-        .enumerate()
-        .take(mesh.blocks.len())
-        .map(|(b, g)| generic_block_energy(mesh, b, g, material, positions))
-        .sum()
-}
-
-/// See [`total_energy_generic`].
-pub fn total_energy_and_gradient_generic(
-    mesh: &Mesh,
-    geometry: &[BlockGeometry],
-    material: &Material,
-    positions: &[Vec3],
-    gradient_out: &mut [Vec3],
-) -> f64 {
-    gradient_out.iter_mut().for_each(|g| *g = Vec3::zeros());
-    let mut total = 0.0;
-    for (b, g) in geometry.iter().enumerate().take(mesh.blocks.len()) {
-        total += generic_block_energy_and_gradient(mesh, b, g, material, positions, gradient_out);
-    }
     total
 }
 

@@ -63,18 +63,26 @@ pub fn point_energy_and_gradient<const P: usize, const FMA: bool, const GRAD: bo
     v * psi
 }
 
-/// `Σ_e U_e` over `block` at `x` (rest positions `rest`), and with `GRAD` each element's
-/// `∇_i U_e` added to `grad_out` in element order; the material gradients read from the
-/// geometry's node-major layout into one point's rows at a time.
+/// One block's mesh pass: its elements, their geometry, the rest positions and the positions.
+#[derive(Clone, Copy)]
+pub(super) struct Pass<'a> {
+    pub block: &'a ElementBlock,
+    pub geometry: &'a BlockGeometry,
+    pub rest: &'a [Vec3],
+    pub x: &'a [Vec3],
+}
+
+/// `Σ_e U_e` over the pass's block, and with `GRAD` each element's `∇_i U_e` added to
+/// `grad_out` in element order; the material gradients read from the geometry's node-major
+/// layout into one point's rows at a time (not kept packed: the static solver's 100k-unknown P3
+/// would hold a second, padded copy of them).
 #[inline(always)]
 fn block_pass<const N: usize, const P: usize, const FMA: bool, const GRAD: bool, M: PointMaterial>(
-    block: &ElementBlock,
-    geometry: &BlockGeometry,
-    rest: &[Vec3],
-    x: &[Vec3],
+    pass: Pass<'_>,
     material: &M,
     grad_out: &mut [Vec3],
 ) -> f64 {
+    let Pass { block, geometry, rest, x } = pass;
     let mut total = 0.0;
     for (e, nodes) in block.elements().enumerate() {
         let nodes: &[u32; N] = nodes.try_into().expect("N nodes");
@@ -114,14 +122,11 @@ fn block_pass<const N: usize, const P: usize, const FMA: bool, const GRAD: bool,
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn block_pass_avx2<const N: usize, const P: usize, const GRAD: bool, M: PointMaterial>(
-    block: &ElementBlock,
-    geometry: &BlockGeometry,
-    rest: &[Vec3],
-    x: &[Vec3],
+    pass: Pass<'_>,
     material: &M,
     grad_out: &mut [Vec3],
 ) -> f64 {
-    block_pass::<N, P, true, GRAD, M>(block, geometry, rest, x, material, grad_out)
+    block_pass::<N, P, true, GRAD, M>(pass, material, grad_out)
 }
 
 /// [`block_pass`] for this block's node count and `material` (StVK through [`Stvk`], any other
@@ -129,27 +134,17 @@ unsafe fn block_pass_avx2<const N: usize, const P: usize, const GRAD: bool, M: P
 /// when the node count has no specialised kernel (the caller takes the generic one). With
 /// `GRAD`, `grad_out` (one entry per mesh node) must be as long as the mesh's nodes.
 pub(super) fn block_energy_and_gradient<const GRAD: bool>(
-    block: &ElementBlock,
-    geometry: &BlockGeometry,
-    rest: &[Vec3],
-    x: &[Vec3],
+    pass: Pass<'_>,
     material: &Material,
     grad_out: &mut [Vec3],
 ) -> Option<f64> {
-    #[cfg(target_arch = "x86_64")]
-    let wide = crate::math::f64x4::available();
-    #[cfg(not(target_arch = "x86_64"))]
-    let wide = false;
-    block_energy_and_gradient_fused::<GRAD>(block, geometry, rest, x, material, grad_out, wide)
+    block_energy_and_gradient_fused::<GRAD>(pass, material, grad_out, true)
 }
 
-/// [`block_energy_and_gradient`] with fused multiply–adds or not as `fma` says (true only where
-/// the CPU has AVX2 and FMA; the tests run both).
+/// [`block_energy_and_gradient`] with fused multiply–adds where `fma` allows them (they run
+/// only where the CPU has AVX2 and FMA; the tests run both ways).
 pub(super) fn block_energy_and_gradient_fused<const GRAD: bool>(
-    block: &ElementBlock,
-    geometry: &BlockGeometry,
-    rest: &[Vec3],
-    x: &[Vec3],
+    pass: Pass<'_>,
     material: &Material,
     grad_out: &mut [Vec3],
     fma: bool,
@@ -164,14 +159,14 @@ pub(super) fn block_energy_and_gradient_fused<const GRAD: bool>(
             #[cfg(target_arch = "x86_64")]
             if wide {
                 // SAFETY: AVX2 and FMA were detected.
-                return Some(unsafe { block_pass_avx2::<$n, $p, GRAD, _>(block, geometry, rest, x, &law, grad_out) });
+                return Some(unsafe { block_pass_avx2::<$n, $p, GRAD, _>(pass, &law, grad_out) });
             }
-            Some(block_pass::<$n, $p, false, GRAD, _>(block, geometry, rest, x, &law, grad_out))
+            Some(block_pass::<$n, $p, false, GRAD, _>(pass, &law, grad_out))
         }};
     }
     macro_rules! dispatch {
         ($(($n:literal, $p:literal)),*) => {
-            match block.nodes_per_element() {
+            match pass.block.nodes_per_element() {
                 $($n => if let Some(FastLaw::StVenantKirchhoff(l)) = material.fast_law() {
                     with_law!($n, $p, Stvk { mu_pa: l.mu_pa, lambda_pa: l.lambda_pa })
                 } else {

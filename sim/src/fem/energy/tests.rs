@@ -110,13 +110,11 @@ fn the_fixed_node_count_kernel_matches_the_generic_one_for_every_element_type_an
             let name = format!("{et} {:?}", material.model);
             for fma in [false, true] {
                 let mut g = vec![Vec3::zeros(); x.len()];
-                let (block, rest) = (&mesh.blocks[0], &mesh.rest_positions);
-                let e =
-                    fixed::block_energy_and_gradient_fused::<true>(block, &geo[0], rest, &x, &material, &mut g, fma)
-                        .unwrap_or_else(|| panic!("{name}: no specialised kernel"));
-                let e_only =
-                    fixed::block_energy_and_gradient_fused::<false>(block, &geo[0], rest, &x, &material, &mut [], fma)
-                        .expect("specialised");
+                let pass = fixed::Pass { block: &mesh.blocks[0], geometry: &geo[0], rest: &mesh.rest_positions, x: &x };
+                let e = fixed::block_energy_and_gradient_fused::<true>(pass, &material, &mut g, fma)
+                    .unwrap_or_else(|| panic!("{name}: no specialised kernel"));
+                let e_only = fixed::block_energy_and_gradient_fused::<false>(pass, &material, &mut [], fma)
+                    .expect("specialised");
                 assert!((e - e_ref).abs() <= 1e-12 * e_ref, "{name} fma {fma}: U {e} against {e_ref}");
                 assert_eq!(e.to_bits(), e_only.to_bits(), "{name} fma {fma}: the energy-only pass");
                 for (i, (a, b)) in g.iter().zip(&g_ref).enumerate() {
