@@ -8,7 +8,7 @@ over the DevTools protocol with the standard library only (no pip package).
 Opens URL, waits --wait seconds (the Rerun web viewer compiles 42 MB of WebAssembly first),
 then writes --shots screenshots --every seconds apart: OUT.png, or OUT-1.png, OUT-2.png, ...
 when there are several, all of the one page kept open (the first captured, the others taken
-from the page's screencast, the frames it streams as it repaints). The page's console errors are printed to stderr. Exit 0 when every
+from the page's screencast, the frames it streams as it repaints). The page's errors (console errors, uncaught exceptions) are printed to stderr. Exit 0 when every
 screenshot was written. A first capture that gets no answer within BROWSER_SHOT_CAPTURE_SECS
 (default 30) is taken from the screencast too."""
 
@@ -105,7 +105,6 @@ class Page:
     def __init__(self, ws):
         self.ws = ws
         self.next_id = 0
-        self.errors = []
         # the screencast's frames: the latest one's PNG bytes and how many have come
         self.frame = None
         self.frames = 0
@@ -119,7 +118,10 @@ class Page:
         if os.environ.get("BROWSER_SHOT_DEBUG"):
             print(f"{time.strftime('%X')} {method}", file=sys.stderr)
         self.next_id += 1
-        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
+        # this call's own id: an event noted while waiting may send (an acknowledgement), which
+        # takes the next id, and the answer to wait for is still this one
+        call_id = self.next_id
+        self.ws.send(json.dumps({"id": call_id, "method": method, "params": params}))
         end = time.time() + timeout
         try:
             while True:
@@ -131,7 +133,7 @@ class Page:
                     msg = json.loads(self.ws.recv())
                 except (socket.timeout, TimeoutError):
                     raise CallTimeout(f"{method}: no answer in {timeout:.0f} s") from None
-                if msg.get("id") == self.next_id:
+                if msg.get("id") == call_id:
                     if "error" in msg:
                         raise RuntimeError(f"{method}: {msg['error']}")
                     return msg.get("result", {})
@@ -154,11 +156,6 @@ class Page:
                 with open(os.path.join(folder, f"frame-{time.time() - start:07.3f}.png"), "wb") as f:
                     f.write(self.frame)
             self.send("Page.screencastFrameAck", sessionId=msg["params"]["sessionId"])
-        if method == "Runtime.exceptionThrown":
-            self.errors.append(msg["params"]["exceptionDetails"].get("text", "exception"))
-        elif method == "Runtime.consoleAPICalled" and msg["params"].get("type") == "error":
-            args = msg["params"].get("args", [])
-            self.errors.append(" ".join(str(a.get("value", a.get("description", ""))) for a in args))
 
     def sleep(self, secs):
         """Waits, reading the events meanwhile (a pause in the protocol stalls nothing)."""
@@ -186,6 +183,28 @@ def next_screencast_frame(page, width, height, streaming):
     if page.frames == seen:
         sys.exit("browser_shot: no new frame of the page in 90 s")
     return page.frame
+
+
+# Run in the page before its own scripts: keeps its console errors, uncaught exceptions and
+# unhandled rejections in a list read at the end (page_errors), each still reaching the console.
+PAGE_ERRORS = """(() => {
+  const errors = [];
+  window.__hox_page_errors = errors;
+  const error = console.error.bind(console);
+  console.error = (...args) => { errors.push(args.map(String).join(" ")); error(...args); };
+  addEventListener("error", (e) => errors.push(e.message || String(e.error)));
+  addEventListener("unhandledrejection", (e) => errors.push("unhandled rejection: " + String(e.reason)));
+})();"""
+
+
+def page_errors(page):
+    """The errors PAGE_ERRORS kept (none if the page never ran it)."""
+    try:
+        result = page.call("Runtime.evaluate", timeout=30,
+                           expression="JSON.stringify(window.__hox_page_errors || [])", returnByValue=True)
+        return json.loads(result.get("result", {}).get("value") or "[]")
+    except (CallTimeout, RuntimeError, ValueError) as e:
+        return [f"the page's errors could not be read: {e}"]
 
 
 def chromium():
@@ -247,8 +266,13 @@ def main():
         targets = json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list"))
         page_target = next(t for t in targets if t.get("type") == "page")
         page = Page(WebSocket(page_target["webSocketDebuggerUrl"]))
-        page.call("Runtime.enable")
+        # the page's errors are noted by the page itself (PAGE_ERRORS) and read at the end: the
+        # DevTools console (Runtime.enable) would make the browser serialise and send every
+        # console message as it comes, and the web viewer writes about 20,000 debug lines
+        # while it compiles its shaders, which kept the page from painting for seconds: a cost
+        # a student's browser, with no DevTools attached, does not pay
         page.call("Page.enable")
+        page.call("Page.addScriptToEvaluateOnNewDocument", source=PAGE_ERRORS)
         page.call("Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1, mobile=False)
         streaming = args.frames is not None
         if args.frames:
@@ -289,7 +313,7 @@ def main():
             if args.shots > 1 and not streaming:
                 streaming = True
                 page.call("Page.startScreencast", format="png", maxWidth=width, maxHeight=height)
-        for e in page.errors:
+        for e in page_errors(page):
             print(f"browser_shot: page error: {e}", file=sys.stderr)
     finally:
         browser.terminate()
