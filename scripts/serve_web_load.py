@@ -6,7 +6,7 @@ and close it. The app's resident memory is sampled every second; its own frame-r
 printed at the end. The app is pinned to CPU 0 and the browsers to CPU 1 (taskset) so that the
 browsers' software WebGL does not take the app's core: what is left is the server's own cost.
 
-    scripts/serve_web_load.py [--secs 150] [--connections 10] [--each 8] [--history-mb 64]
+    scripts/serve_web_load.py [--secs 150] [--connections 10] [--each 8] [--history-mb 64] [--hox BIN]
 
 Run it twice, with --connections 0 and 10, and compare (docs/WEB.md)."""
 
@@ -50,9 +50,11 @@ def main():
     ap.add_argument("--connections", type=int, default=10)
     ap.add_argument("--each", type=float, default=8)
     ap.add_argument("--history-mb", type=int, default=64)
+    ap.add_argument("--hox", help="the hox binary (default: the release build in CARGO_TARGET_DIR), "
+                    "to compare two builds side by side")
     args = ap.parse_args()
     target = os.environ.get("CARGO_TARGET_DIR", os.path.expanduser("~/.cache/hox-target"))
-    hox = os.path.join(target, "release", "hox")
+    hox = args.hox or os.path.join(target, "release", "hox")
     home = f"/tmp/hox-load-home-{os.getpid()}"
     os.makedirs(home, exist_ok=True)
     app = subprocess.Popen(

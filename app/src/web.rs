@@ -190,11 +190,27 @@ fn start_http(args: &ServeArgs) -> Result<(WebServer, u16, rerun::ServerOptions)
     Ok((WebServer { _http: http, _door: door, data_port: grpc_port, url, history_bytes }, upstream_port, options))
 }
 
+/// How often the served stream's rows are cut into messages (chunks, one per entity). Rerun's
+/// default for a served stream is every 8 ms, a message per entity per frame: about 900 a second
+/// for the P2 bending beam at 60 frames. A browser takes in messages for 10 ms per paint, and
+/// one without a graphics card paints about twice a second, so it fell further behind the
+/// stream with every second (31.9 s behind after 30 s; 23.6 s with 250 ms; docs/WEB.md). At
+/// 100 ms a message carries several frames, and the view still moves ten times a second.
+pub const SERVED_FLUSH_TICK: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// The served stream's batching: [`SERVED_FLUSH_TICK`], Rerun's other limits; Rerun's
+/// `RERUN_FLUSH_TICK_SECS` (and its other `RERUN_FLUSH_*` variables) still override it.
+fn served_batcher_config() -> rerun::log::ChunkBatcherConfig {
+    let config = rerun::log::ChunkBatcherConfig { flush_tick: SERVED_FLUSH_TICK, ..Default::default() };
+    config.apply_env().unwrap_or(config)
+}
+
 /// A recording stream named `name` whose data every browser at [`WebServer::url`] sees live.
 pub fn serve_recording(name: &str, args: &ServeArgs) -> Result<(rerun::RecordingStream, WebServer)> {
     let (web, upstream_port, options) = start_http(args)?;
     let rec = rerun::RecordingStreamBuilder::new("hox")
         .recording_name(name)
+        .batcher_config(served_batcher_config())
         .serve_grpc_opts(UPSTREAM_IP.to_string(), upstream_port, options)
         .with_context(|| format!("cannot serve the data stream on {UPSTREAM_IP}:{upstream_port}"))?;
     Ok((rec, web))

@@ -79,6 +79,8 @@ pub struct HoxApp {
     pub figure_folder: String,
     /// Where the class's browsers are served (`--bind`, the ports, the history bound).
     pub serve: crate::web::ServeArgs,
+    /// `--serve-fps`: frames a second sent to browsers at most (0: every frame).
+    pub serve_fps: u32,
     rerun: Option<RerunLink>,
     generation: u64,
     /// Text being edited in numeric fields, by control.
@@ -156,6 +158,7 @@ impl HoxApp {
             rerun_file: saved.as_ref().map_or_else(|| "hox.rrd".into(), |s| s.rerun_file.clone()),
             figure_folder: "figures".into(),
             serve: args.serve.clone(),
+            serve_fps: args.serve_fps,
             rerun: None,
             generation: 0,
             edits: Default::default(),

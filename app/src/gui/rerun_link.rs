@@ -2,12 +2,21 @@
 //! class's browsers with the Rerun web viewer: `web.rs`) through the logging module it shares
 //! with `hox record`. While a lesson is open its step text (question, numbers, answer once
 //! revealed) is logged to `lesson/step` and shown above the legend.
+//!
+//! Served to browsers, the stream carries at most `--serve-fps` frames a second ([`FrameCap`];
+//! 30 by default against the 60 the app simulates): a student's browser takes in each message
+//! in a budget of 10 ms per paint, and one without a graphics card paints about twice a second,
+//! so every frame sent is one more it may fall behind on. A frame held back while playing is
+//! replaced by a later one; the one the app stops on (pause, the end of a settle) is always
+//! sent, as are rebuilds (a lesson's new step is one) at once. While the app is paused a change
+//! of the lesson's text (the answer revealed) is sent as it happens.
 
 use super::HoxApp;
 use super::session::Session;
 use crate::recording::{Configuration, LogSettings, Recorder};
 use hox_sim::Vec3;
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 /// Where the live output goes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,7 +38,48 @@ pub(super) struct RerunLink {
     /// The web viewer's server when serving browsers (its page's URL is `web.url`).
     web: Option<crate::web::WebServer>,
     /// The lesson text logged last (logged again only when it changes).
-    lesson_text: Option<String>,
+    pub(super) lesson_text: Option<String>,
+    /// The bound on the frames sent per second (browsers only).
+    cap: Option<FrameCap>,
+    /// The simulation frame of the first configuration logged last, and how many were.
+    pub(super) last_logged_frame: Option<u64>,
+    pub(super) frames_logged: u64,
+}
+
+/// At most so many frames a second: a frame is admitted when the one admitted before it is
+/// at least nine tenths of the interval old (so that 60 simulated frames a second capped at 30
+/// send every other one despite the paints' jitter); the others are held back, and the link
+/// remembers that the newest frame is still unsent ([`FrameCap::pending`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct FrameCap {
+    interval: Duration,
+    last: Option<Instant>,
+    /// A frame was held back and none admitted since.
+    pub pending: bool,
+}
+
+impl FrameCap {
+    /// `fps` frames a second at most; `None` (every frame) for 0.
+    pub fn new(fps: u32) -> Option<FrameCap> {
+        (fps > 0).then(|| FrameCap { interval: Duration::from_secs(1) / fps, last: None, pending: false })
+    }
+
+    /// Whether the frame at `now` is sent; a frame held back is remembered as pending.
+    pub fn admit(&mut self, now: Instant) -> bool {
+        let due = self.last.is_none_or(|last| now.saturating_duration_since(last) >= self.interval.mul_f64(0.9));
+        if due {
+            self.sent(now);
+        } else {
+            self.pending = true;
+        }
+        due
+    }
+
+    /// A frame was sent at `now` whatever the cap (a rebuild, a lesson step, the last frame).
+    pub fn sent(&mut self, now: Instant) {
+        self.last = Some(now);
+        self.pending = false;
+    }
 }
 
 impl RerunLink {
@@ -40,9 +90,11 @@ impl RerunLink {
         url: &str,
         file: &str,
         serve: &crate::web::ServeArgs,
+        serve_fps: u32,
     ) -> Result<RerunLink, String> {
         let builder = rerun::RecordingStreamBuilder::new("hox").recording_name(name.clone());
         let mut web = None;
+        let cap = if target == RerunTarget::Browsers { FrameCap::new(serve_fps) } else { None };
         let (rec, target) = match target {
             RerunTarget::File => {
                 let path = PathBuf::from(file);
@@ -62,7 +114,17 @@ impl RerunLink {
             }
         };
         match rec {
-            Ok(rec) => Ok(RerunLink { rec, recorder: None, generation: u64::MAX, target, web, lesson_text: None }),
+            Ok(rec) => Ok(RerunLink {
+                rec,
+                recorder: None,
+                generation: u64::MAX,
+                target,
+                web,
+                lesson_text: None,
+                cap,
+                last_logged_frame: None,
+                frames_logged: 0,
+            }),
             Err(e) => Err(format!("Rerun: {e}")),
         }
     }
@@ -73,17 +135,33 @@ impl RerunLink {
         format!("Rerun: stopped ({})", self.target)
     }
 
+    /// Whether a frame held back by the cap is still unsent.
+    pub(super) fn pending(&self) -> bool {
+        self.cap.is_some_and(|c| c.pending)
+    }
+
     /// Logs the current frame of `sessions` (drawn at `offsets`), preceded by their static data
-    /// when `generation` is not the one logged last (something was rebuilt).
+    /// when `generation` is not the one logged last (something was rebuilt). Held back by the
+    /// cap unless `force`d or something was rebuilt (a lesson's new step is).
     fn log(
         &mut self,
         sessions: &[Session],
         offsets: &[Vec3],
         generation: u64,
         lesson_text: Option<String>,
+        force: bool,
     ) -> Result<(), rerun::RecordingStreamError> {
         let lesson_changed = lesson_text.is_some() != self.lesson_text.is_some();
-        if self.generation != generation || self.recorder.is_none() || lesson_changed {
+        let rebuilt = self.generation != generation || self.recorder.is_none() || lesson_changed;
+        if let Some(cap) = &mut self.cap {
+            let now = Instant::now();
+            if force || rebuilt {
+                cap.sent(now);
+            } else if !cap.admit(now) {
+                return Ok(());
+            }
+        }
+        if rebuilt {
             let configs: Vec<Configuration<'_>> = sessions
                 .iter()
                 .zip(offsets)
@@ -107,6 +185,8 @@ impl RerunLink {
         if let Some(r) = &mut self.recorder {
             r.log_frame(&self.rec, &instances, &ms)?;
         }
+        self.last_logged_frame = sessions.first().map(|s| s.instance.sim.frames());
+        self.frames_logged += 1;
         if lesson_text != self.lesson_text {
             if let Some(text) = &lesson_text {
                 self.rec.log("lesson/step", &rerun::TextDocument::from_markdown(text.as_str()))?;
@@ -125,7 +205,7 @@ impl HoxApp {
         }
         let Some(target) = target else { return };
         let name = format!("hox app {}", self.scene.label());
-        match RerunLink::start(name, target, &self.rerun_url, &self.rerun_file, &self.serve) {
+        match RerunLink::start(name, target, &self.rerun_url, &self.rerun_file, &self.serve, self.serve_fps) {
             Ok(link) => {
                 self.message = Some(format!("Rerun: {}", link.target));
                 self.rerun = Some(link);
@@ -144,14 +224,68 @@ impl HoxApp {
         self.rerun.as_ref().and_then(|l| l.web.as_ref()).map(|w| w.url.as_str())
     }
 
-    /// Logs the sessions' current frame to the live link, if any; an error closes the link.
+    /// Logs the sessions' current frame to the live link, if any (browsers: unless the frame
+    /// cap holds it back); an error closes the link.
     pub(super) fn log_rerun(&mut self) {
+        self.log_rerun_now(false);
+    }
+
+    /// While the app is not playing (paused, a settle ended), sends the frame the cap held
+    /// back last, and the lesson's text when it changed (the answer revealed): called after
+    /// each update's steps, so browsers always end on what the app shows.
+    pub(super) fn flush_rerun(&mut self) {
+        if self.playback.playing {
+            return;
+        }
+        let Some(link) = &self.rerun else { return };
+        let text = self.lesson.as_ref().map(|l| l.step_markdown(&self.sessions));
+        if link.pending() || text != link.lesson_text {
+            self.log_rerun_now(true);
+        }
+    }
+
+    fn log_rerun_now(&mut self, force: bool) {
         let offsets = self.offsets();
         let lesson_text = self.lesson.as_ref().map(|l| l.step_markdown(&self.sessions));
         let Some(link) = &mut self.rerun else { return };
-        if let Err(e) = link.log(&self.sessions, &offsets, self.generation, lesson_text) {
+        if let Err(e) = link.log(&self.sessions, &offsets, self.generation, lesson_text, force) {
             self.message = Some(format!("Rerun: {e}"));
             self.rerun = None;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_frame_cap_sends_every_other_frame_of_sixty_at_thirty_despite_jitter_and_remembers_the_one_held_back() {
+        let start = Instant::now();
+        let mut cap = FrameCap::new(30).unwrap();
+        // 60 frames a second, each paint up to 3 ms early or late
+        let jitter = [0.0, 3.0, -3.0, 2.0, -2.0, 1.0, -1.0, 3.0, -3.0, 0.0];
+        let sent: Vec<bool> = (0..60)
+            .map(|k| {
+                let ms = k as f64 * 1000.0 / 60.0 + jitter[k % jitter.len()];
+                cap.admit(start + Duration::from_secs_f64(ms.max(0.0) / 1000.0))
+            })
+            .collect();
+        assert_eq!(sent.iter().filter(|&&s| s).count(), 30, "{sent:?}");
+        assert!(sent.iter().step_by(2).all(|&s| s), "every other frame: {sent:?}");
+        assert!(cap.pending, "the 60th frame was held back");
+        cap.sent(start + Duration::from_secs(1));
+        assert!(!cap.pending);
+        assert!(FrameCap::new(0).is_none(), "0: every frame");
+    }
+
+    #[test]
+    fn a_frame_sent_out_of_turn_restarts_the_interval() {
+        let start = Instant::now();
+        let mut cap = FrameCap::new(10).unwrap();
+        assert!(cap.admit(start));
+        cap.sent(start + Duration::from_millis(50)); // a rebuild
+        assert!(!cap.admit(start + Duration::from_millis(120)), "70 ms after the rebuild's frame");
+        assert!(cap.admit(start + Duration::from_millis(150)));
     }
 }

@@ -1056,6 +1056,58 @@ fn serving_browsers_shows_the_address_beside_the_view_and_a_busy_port_is_a_messa
     assert!(h.query_by_label("Follow in your browser:").is_none());
 }
 
+/// Issue #38: the browsers get at most `--serve-fps` frames a second, and always the frame the
+/// app stops on: played, then paused with Space, the frame logged last is the frame shown, also
+/// when the cap held it back (sent once the app paused); every frame with `--serve-fps 0`.
+#[test]
+fn served_browsers_end_on_the_frame_the_app_paused_on() {
+    let logged = |h: &Harness<'_, HoxApp>| h.state().rerun.as_ref().and_then(|l| l.last_logged_frame);
+    let frame = |h: &Harness<'_, HoxApp>| h.state().sessions[0].instance.sim.frames();
+    for fps in [1, 0] {
+        let free = crate::web::ServeArgs { web_port: 0, grpc_port: 0, ..Default::default() };
+        let mut h = harness(AppArgs { serve_web: true, serve: free, serve_fps: fps, ..Default::default() });
+        h.run_steps(2);
+        assert_eq!(logged(&h), Some(0), "the first frame is sent at once");
+        h.get_all_by_label("Play").next().unwrap().click();
+        h.run_steps(20);
+        assert!(frame(&h) >= 18, "played {} frames", frame(&h));
+        if fps == 0 {
+            assert_eq!(logged(&h), Some(frame(&h)), "every frame sent while playing");
+        }
+        h.key_press(egui::Key::Space);
+        h.run_steps(2);
+        assert!(!h.state().playback.playing);
+        assert_eq!(logged(&h), Some(frame(&h)), "--serve-fps {fps}: the browsers end on the frame paused on");
+        assert!(!h.state().rerun.as_ref().unwrap().pending());
+        let count = h.state().rerun.as_ref().unwrap().frames_logged;
+        h.run_steps(10);
+        assert_eq!(h.state().rerun.as_ref().unwrap().frames_logged, count, "nothing new is sent while paused");
+    }
+}
+
+/// Issue #38: with a lesson open and the app paused, revealing the answer reaches the browsers
+/// at once (the step's text logged again), once.
+#[test]
+fn revealing_the_answer_while_paused_reaches_the_browsers() {
+    let free = crate::web::ServeArgs { web_port: 0, grpc_port: 0, ..Default::default() };
+    let args = AppArgs { lesson: Some("why-high-order".into()), serve_web: true, serve: free, ..Default::default() };
+    let mut h = harness(args);
+    h.run_steps(3);
+    h.key_press(egui::Key::Space);
+    h.run_steps(2);
+    assert!(!h.state().playback.playing, "paused");
+    let sent = |h: &Harness<'_, HoxApp>| h.state().rerun.as_ref().unwrap().lesson_text.clone().unwrap_or_default();
+    let before = sent(&h);
+    assert!(!before.is_empty(), "the step's text is sent");
+    h.state_mut().lesson.as_mut().unwrap().revealed = true;
+    h.run_steps(2);
+    let after = sent(&h);
+    assert_ne!(after, before, "the revealed answer is sent while paused");
+    let count = h.state().rerun.as_ref().unwrap().frames_logged;
+    h.run_steps(5);
+    assert_eq!(h.state().rerun.as_ref().unwrap().frames_logged, count, "once");
+}
+
 /// Issue #39: *Export figure* draws the configurations on screen — here A and B of the torsion
 /// scene in compare mode, after a few frames — in the paper's figure style against the reference
 /// of their physics, as SVG and PNG in the folder named; on a scene that is not one of the

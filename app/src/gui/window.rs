@@ -203,6 +203,9 @@ impl HoxApp {
                 None => ctx.request_repaint(),
             }
         }
+        // paused or settled in this frame (a button, a shortcut, the settle's end): the browsers
+        // get the frame the app stopped on, if the frame cap held it back
+        self.flush_rerun();
         let ms = now.elapsed().as_secs_f64() * 1e3;
         self.times.app_part(ms);
         self.after_frame(&ctx, now);
