@@ -340,6 +340,14 @@ fn every_lesson_records_with_its_blueprint_and_step_texts() {
                 .any(|k| k.starts_with("lesson/measure/") && k.contains("/step_1/")),
             "{name}: no measurement series"
         );
+        // each step's bodies are cleared when it ends, but the last step's: the recording (and
+        // a page following the lesson live) ends on them, not on an empty 3D view
+        for (entity, info) in checked["entities"].as_object().unwrap() {
+            let Some(config) = entity.strip_prefix("world/").filter(|c| !c.contains('/')) else { continue };
+            let step: usize = config[1..config.find('_').unwrap()].parse().unwrap();
+            let cleared = info["frames_per_component"].get("Clear:is_recursive").is_some();
+            assert_eq!(cleared, step < steps, "{name}: {entity} of step {step} of {steps}");
+        }
     }
     // an unknown lesson is named
     let out = hox(&["lesson", "nope"]);

@@ -204,7 +204,9 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
 
 /// Logs step `k` as a segment starting at `offset` (advanced past it): its configurations side
 /// by side frame by frame, its text (question first, the answer and the numbers at the end), and
-/// its measurement as a time series; its bodies are cleared when it ends.
+/// its measurement as a time series; its bodies are cleared when it ends, but for the last
+/// step's, which the recording ends on (a page following the lesson live, or opened once it has
+/// run, shows them beside the last answer rather than an empty view).
 fn record_step(
     rec: &rerun::RecordingStream,
     lesson: &Lesson,
@@ -278,7 +280,9 @@ fn record_step(
     let pause = (30i64, 0.5f64);
     rec.set_time_sequence("frame", offset.0 + end.0 + pause.0);
     rec.set_duration_secs("sim_time", offset.1 + end.1 + pause.1);
-    recorder.clear(rec)?;
+    if k + 1 < lesson.steps.len() {
+        recorder.clear(rec)?;
+    }
     *offset = (offset.0 + end.0 + pause.0 + 1, offset.1 + end.1 + pause.1 + 1.0 / 60.0);
     Ok(measured)
 }
