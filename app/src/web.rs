@@ -194,8 +194,9 @@ fn start_http(args: &ServeArgs) -> Result<(WebServer, u16, rerun::ServerOptions)
 /// default for a served stream is every 8 ms, a message per entity per frame: about 900 a second
 /// for the P2 bending beam at 60 frames. A browser takes in messages for 10 ms per paint, and
 /// one without a graphics card paints about twice a second, so it fell further behind the
-/// stream with every second (31.9 s behind after 30 s; 23.6 s with 250 ms; docs/WEB.md). At
-/// 100 ms a message carries several frames, and the view still moves ten times a second.
+/// stream with every second: 30 s after opening, such a page showed 0.9 s of the run. At 100 ms
+/// a message carries several frames and the same page showed 6 s (docs/WEB.md); the view still
+/// moves ten times a second.
 pub const SERVED_FLUSH_TICK: std::time::Duration = std::time::Duration::from_millis(100);
 
 /// The served stream's batching: [`SERVED_FLUSH_TICK`], Rerun's other limits; Rerun's

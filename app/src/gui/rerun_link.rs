@@ -4,9 +4,9 @@
 //! revealed) is logged to `lesson/step` and shown above the legend.
 //!
 //! Served to browsers, the stream carries at most `--serve-fps` frames a second ([`FrameCap`];
-//! 30 by default against the 60 the app simulates): a student's browser takes in each message
-//! in a budget of 10 ms per paint, and one without a graphics card paints about twice a second,
-//! so every frame sent is one more it may fall behind on. A frame held back while playing is
+//! 30 by default against the 60 the app simulates): every browser is sent every frame, so the
+//! classroom network carries the frame rate times the class (the P2 beam: about 10 Mbit/s per
+//! browser at 30 frames; docs/WEB.md). A frame held back while playing is
 //! replaced by a later one; the one the app stops on (pause, the end of a settle) is always
 //! sent, as are rebuilds (a lesson's new step is one) at once. While the app is paused a change
 //! of the lesson's text (the answer revealed) is sent as it happens.
