@@ -227,7 +227,10 @@ impl HoxApp {
     /// Logs the sessions' current frame to the live link, if any (browsers: unless the frame
     /// cap holds it back); an error closes the link.
     pub(super) fn log_rerun(&mut self) {
-        self.log_rerun_now(false);
+        if self.rerun.is_some() {
+            let lesson_text = self.lesson_text();
+            self.log_rerun_now(false, lesson_text);
+        }
     }
 
     /// While the app is not playing (paused, a settle ended), sends the frame the cap held
@@ -238,15 +241,19 @@ impl HoxApp {
             return;
         }
         let Some(link) = &self.rerun else { return };
-        let text = self.lesson.as_ref().map(|l| l.step_markdown(&self.sessions));
+        let text = self.lesson_text();
         if link.pending() || text != link.lesson_text {
-            self.log_rerun_now(true);
+            self.log_rerun_now(true, text);
         }
     }
 
-    fn log_rerun_now(&mut self, force: bool) {
+    /// The open lesson's step as the browsers show it.
+    fn lesson_text(&self) -> Option<String> {
+        self.lesson.as_ref().map(|l| l.step_markdown(&self.sessions))
+    }
+
+    fn log_rerun_now(&mut self, force: bool, lesson_text: Option<String>) {
         let offsets = self.offsets();
-        let lesson_text = self.lesson.as_ref().map(|l| l.step_markdown(&self.sessions));
         let Some(link) = &mut self.rerun else { return };
         if let Err(e) = link.log(&self.sessions, &offsets, self.generation, lesson_text, force) {
             self.message = Some(format!("Rerun: {e}"));
