@@ -27,7 +27,7 @@ use hox_sim::mesh::Mesh;
 use hox_sim::solver::Simulation;
 
 /// The axis configurations are laid apart along, so that none hides another from the camera:
-/// across the line of sight ([`crate::gui::viewport::ViewPreset::layout_axis`]).
+/// across the line of sight ([`crate::gui::presets::ViewPreset::layout_axis`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LayoutAxis {
     X,

@@ -41,7 +41,7 @@ pub struct AppArgs {
     pub view: Option<StartView>,
     /// The camera preset at start (keys 1–4 in the app).
     #[arg(long, value_enum)]
-    pub camera: Option<super::viewport::ViewPreset>,
+    pub camera: Option<super::presets::ViewPreset>,
     /// Open on a built-in lesson (`hox lessons` lists them).
     #[arg(long, conflicts_with = "lesson_file")]
     pub lesson: Option<String>,

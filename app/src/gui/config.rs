@@ -3,6 +3,29 @@
 
 use hox_scenes::Scene;
 pub use hox_scenes::params::Invalidates;
+use std::path::PathBuf;
+
+/// Where the scene comes from.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum SceneSource {
+    Builtin(String),
+    File(PathBuf),
+}
+
+impl SceneSource {
+    pub fn load(&self) -> Result<Scene, String> {
+        match self {
+            SceneSource::Builtin(name) => hox_scenes::by_name(name).map_err(|e| e.to_string()),
+            SceneSource::File(path) => Scene::load(path).map_err(|e| e.to_string()),
+        }
+    }
+    pub fn label(&self) -> String {
+        match self {
+            SceneSource::Builtin(name) => name.clone(),
+            SceneSource::File(path) => path.display().to_string(),
+        }
+    }
+}
 
 /// Every live control of one simulation: the parameter table's values. Persisted across runs.
 pub type Config = hox_scenes::Params;

@@ -15,9 +15,8 @@
 //! - **After**: a frame that took more than [`SLOW_FRAME_MS`] pauses the app (a slow frame then
 //!   runs only on Step), so the window stays usable and typing is not lost.
 
-use super::HoxApp;
 use super::config::Config;
-use eframe::egui;
+use super::session::Session;
 #[cfg(doc)]
 use hox_sim::solver::MethodInfo;
 use hox_sim::solver::{Simulation, SolverSettings, SweepsPerStep};
@@ -76,83 +75,51 @@ pub fn estimated_ms_with(current: &Simulation, current_ms: f64, settings: &Solve
     current_ms * sweeps(settings, substeps) / sweeps(current.settings(), current.substeps_per_frame()).max(1e-9)
 }
 
-impl HoxApp {
-    /// Whether `new` for the active configuration would be slow: the estimate in words, or
-    /// None (cheap enough, not measurable yet, or not buildable: `apply` says why).
-    pub(super) fn too_slow(&self, new: &Config) -> Option<String> {
-        use super::config::Invalidates;
-        let s = &self.sessions[self.active];
-        if s.ms_per_frame <= 0.0 {
-            return None;
-        }
-        let what = s.config.invalidated_by(new);
-        let scene = match what {
-            // a new material may raise the guard's substeps: a slow frame then pauses (below)
-            Invalidates::Nothing | Invalidates::Material => return None,
-            Invalidates::Settings | Invalidates::Mesh => super::config::resolve(new, &s.base).ok()?,
-        };
-        // the same mesh: estimated from the settings alone; a new mesh is built to be counted
-        let (ms, elements, work) = if what == Invalidates::Settings {
-            let settings = scene.settings();
-            let ms = estimated_ms_with(&s.instance.sim, s.ms_per_frame, &settings);
-            (ms, s.instance.sim.mesh().num_elements(), format!("{} solver", settings.method.name()))
-        } else {
-            let candidate = hox_scenes::Instance::new(scene).ok()?;
-            let ms = estimated_ms(&s.instance.sim, s.ms_per_frame, &candidate.sim);
-            (ms, candidate.sim.mesh().num_elements(), candidate.sim.work_summary())
-        };
-        (ms > SLOW_FRAME_MS).then(|| {
-            format!(
-                "{elements} elements, {work}: about {} per frame on this machine (now {:.1} ms), {}.",
-                if ms >= 1000.0 { format!("{:.1} s", ms / 1e3) } else { format!("{ms:.0} ms") },
-                s.ms_per_frame,
-                if ms >= 1000.0 {
-                    "under one frame per second".to_string()
-                } else {
-                    format!("about {:.0} frames per second", 1000.0 / ms)
-                }
-            )
-        })
+/// Whether `new` for `s` would be slow: the estimate in words, or None (cheap enough, not
+/// measurable yet, or not buildable: applying it says why).
+pub fn too_slow(s: &Session, new: &Config) -> Option<String> {
+    use super::config::Invalidates;
+    if s.ms_per_frame <= 0.0 {
+        return None;
     }
-
-    /// After stepping: a frame slower than [`SLOW_FRAME_MS`] pauses the app, saying why.
-    pub(super) fn pause_if_slow(&mut self) {
-        let slowest = self.sessions.iter().map(|s| s.ms_per_frame).fold(0.0, f64::max);
-        if self.playback.playing && !self.settling() && slowest > SLOW_FRAME_MS {
-            self.playback.playing = false;
-            self.message = Some(format!(
-                "Paused: a frame takes {:.1} s, too slow to play (Step, S, advances one frame; fewer elements or substeps play).",
-                slowest / 1e3
-            ));
-        }
-    }
+    let what = s.config.invalidated_by(new);
+    let scene = match what {
+        // a new material may raise the guard's substeps: a slow frame then pauses (below)
+        Invalidates::Nothing | Invalidates::Material => return None,
+        Invalidates::Settings | Invalidates::Mesh => super::config::resolve(new, &s.base).ok()?,
+    };
+    // the same mesh: estimated from the settings alone; a new mesh is built to be counted
+    let (ms, elements, work) = if what == Invalidates::Settings {
+        let settings = scene.settings();
+        let ms = estimated_ms_with(&s.instance.sim, s.ms_per_frame, &settings);
+        (ms, s.instance.sim.mesh().num_elements(), format!("{} solver", settings.method.name()))
+    } else {
+        let candidate = hox_scenes::Instance::new(scene).ok()?;
+        let ms = estimated_ms(&s.instance.sim, s.ms_per_frame, &candidate.sim);
+        (ms, candidate.sim.mesh().num_elements(), candidate.sim.work_summary())
+    };
+    (ms > SLOW_FRAME_MS).then(|| {
+        format!(
+            "{elements} elements, {work}: about {} per frame on this machine (now {:.1} ms), {}.",
+            if ms >= 1000.0 { format!("{:.1} s", ms / 1e3) } else { format!("{ms:.0} ms") },
+            s.ms_per_frame,
+            if ms >= 1000.0 {
+                "under one frame per second".to_string()
+            } else {
+                format!("about {:.0} frames per second", 1000.0 / ms)
+            }
+        )
+    })
 }
 
-/// The question about a held-back change: apply it (paused) or keep the current one.
-pub fn pending_change_ui(app: &mut HoxApp, ctx: &egui::Context) {
-    let Some(pending) = &app.pending_change else { return };
-    let mut answer = None;
-    egui::Window::new("This change is slow")
-        .collapsible(false)
-        .anchor(egui::Align2::CENTER_CENTER, egui::vec2(0.0, 0.0))
-        .show(ctx, |ui| {
-            ui.label(format!("{}: {}", pending.control, pending.estimate));
-            ui.label("The window would stay usable (paused, Step advances a frame), but it would not play.");
-            ui.horizontal(|ui| {
-                if ui.button("Apply, paused").clicked() {
-                    answer = Some(true);
-                }
-                if ui.button("Keep the current configuration").clicked() {
-                    answer = Some(false);
-                }
-            });
-        });
-    // either answer ends the question; only "apply" changes anything
-    if let Some(apply) = answer
-        && let Some(p) = app.pending_change.take()
-        && apply
-    {
-        app.playback.playing = false;
-        app.apply_now(&p.control, p.config);
-    }
+/// After stepping while playing: the message that pauses the app when a frame took more than
+/// [`SLOW_FRAME_MS`], or None.
+pub fn slow_frame(sessions: &[Session]) -> Option<String> {
+    let slowest = sessions.iter().map(|s| s.ms_per_frame).fold(0.0, f64::max);
+    (slowest > SLOW_FRAME_MS).then(|| {
+        format!(
+            "Paused: a frame takes {:.1} s, too slow to play (Step, S, advances one frame; fewer elements or substeps play).",
+            slowest / 1e3
+        )
+    })
 }

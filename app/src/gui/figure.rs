@@ -4,7 +4,8 @@
 //! the reference field the app already holds (the error field's), else the static solution on
 //! the figure's coarse Q2 grid, solved on the spot (under a second).
 
-use super::HoxApp;
+use super::model::Model;
+use super::session::Session;
 use hox_scenes::paper::{FigureKind, Panel, draw_figure, panel_of, reference_panel, sample};
 use hox_scenes::reference::ReferenceField;
 use hox_sim::Vec3;
@@ -13,8 +14,8 @@ use std::path::{Path, PathBuf};
 /// Writes the figure of the configurations on screen to `folder` (`fig2-torsion.svg` and `.png`,
 /// …) and returns the files written; the message says what went wrong (not a paper scene, an
 /// unwritable folder).
-pub fn export_figure(app: &HoxApp, folder: &Path) -> Result<Vec<PathBuf>, String> {
-    let first = &app.sessions[app.active];
+pub fn export_figure(model: &Model, folder: &Path) -> Result<Vec<PathBuf>, String> {
+    let first = model.active_session();
     let name = first.base.name().to_string();
     let kind = FigureKind::of_scene(&name).ok_or_else(|| {
         format!("the figure export draws the paper's scenes (tension, torsion, bending); this is {name}")
@@ -28,10 +29,10 @@ pub fn export_figure(app: &HoxApp, folder: &Path) -> Result<Vec<PathBuf>, String
     let params = first.instance.scene.params();
     let (lo, hi) = (Vec3::from(params.box_min_m), Vec3::from(params.box_max_m));
     let (points, nu, nv) = kind.samples(lo, hi, false);
-    let shown: Vec<usize> = if app.compare { (0..app.sessions.len()).collect() } else { vec![app.active] };
+    let shown: Vec<usize> = if model.compare() { (0..model.sessions().len()).collect() } else { vec![model.active()] };
     let mut panels: Vec<Panel> = Vec::new();
     for &k in &shown {
-        let s = &app.sessions[k];
+        let s = &model.sessions()[k];
         let label =
             if shown.len() > 1 { format!("{}: {}", ["A", "B", "C", "D"][k.min(3)], s.label()) } else { s.label() };
         let settled = s.rest.settled() || s.rest.at_rest();
@@ -41,7 +42,7 @@ pub fn export_figure(app: &HoxApp, folder: &Path) -> Result<Vec<PathBuf>, String
                 .map_err(|e| e.to_string())?,
         );
     }
-    panels.push(reference_of(app, first, kind, &points)?);
+    panels.push(reference_of(first, kind, &points)?);
     let figure = draw_figure(kind, panels, &points, nu, nv);
     let png = crate::output::svg_to_png(&figure.svg).map_err(|e| format!("{e:#}"))?;
     std::fs::write(&svg_path, &figure.svg).map_err(|e| format!("cannot write {}: {e}", svg_path.display()))?;
@@ -50,7 +51,7 @@ pub fn export_figure(app: &HoxApp, folder: &Path) -> Result<Vec<PathBuf>, String
 }
 
 /// The reference panel: the session's reference field when it has one, else solved.
-fn reference_of(_app: &HoxApp, s: &super::Session, kind: FigureKind, points: &[Vec3]) -> Result<Panel, String> {
+fn reference_of(s: &Session, kind: FigureKind, points: &[Vec3]) -> Result<Panel, String> {
     let field = s.reference.reference().and_then(|r| r.field.as_ref());
     let mesh = s.instance.sim.mesh();
     let deformed: Option<Vec<Vec3>> = match field {

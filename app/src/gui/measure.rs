@@ -1,25 +1,23 @@
 //! Frame-rate measurement: the running frame times the status line shows, and the
 //! `--measure-secs` run that prints them with the frame counts as JSON and closes the window.
 
-use super::HoxApp;
-use eframe::egui;
 use std::time::Instant;
 
 /// Running averages of the displayed frames' times, milliseconds (the status line shows them).
 #[derive(Default)]
-pub(super) struct FrameTimes {
+pub struct FrameTimes {
     /// Wall time between displayed frames, milliseconds.
-    pub(super) ui_frame_ms: f64,
+    pub ui_frame_ms: f64,
     /// Wall time of our own part of a frame (stepping, controls, viewport, plots), milliseconds.
-    pub(super) app_ms: f64,
+    pub app_ms: f64,
     /// CPU time of a whole frame (ours, egui's layout and painting; not waiting for vsync), ms.
-    pub(super) frame_cpu_ms: f64,
+    pub frame_cpu_ms: f64,
     last_ui_frame: Option<Instant>,
 }
 
 impl FrameTimes {
     /// A displayed frame starts at `now`.
-    pub(super) fn frame_started(&mut self, now: Instant) {
+    pub fn frame_started(&mut self, now: Instant) {
         let dt = self.last_ui_frame.map_or(0.0, |t| now.duration_since(t).as_secs_f64());
         self.last_ui_frame = Some(now);
         if dt > 0.0 {
@@ -28,12 +26,12 @@ impl FrameTimes {
     }
 
     /// Our own part of a frame took `ms`.
-    pub(super) fn app_part(&mut self, ms: f64) {
+    pub fn app_part(&mut self, ms: f64) {
         smooth(&mut self.app_ms, ms);
     }
 
     /// A whole frame took `ms` of CPU time.
-    pub(super) fn whole_frame_cpu(&mut self, ms: f64) {
+    pub fn whole_frame_cpu(&mut self, ms: f64) {
         smooth(&mut self.frame_cpu_ms, ms);
     }
 }
@@ -44,63 +42,46 @@ fn smooth(average: &mut f64, ms: f64) {
 }
 
 /// Frame-rate measurement for `--measure-secs`.
-pub(super) struct Measure {
+pub struct Measure {
     until_secs: f64,
     started: Option<Instant>,
     frames: u64,
-    pub(super) sim_frames: u64,
+    /// The model's frames stepped when the measurement started.
+    sim_frames_at_start: Option<u64>,
     frame_ms: Vec<f64>,
     last: Option<Instant>,
 }
 
-impl Measure {
-    /// A measurement of `until_secs` seconds, starting at the first frame.
-    pub(super) fn new(until_secs: f64) -> Measure {
-        Measure { until_secs, started: None, frames: 0, sim_frames: 0, frame_ms: Vec::new(), last: None }
-    }
+/// A finished measurement.
+pub struct Measured {
+    pub seconds: f64,
+    pub display_frames: u64,
+    pub median_display_frame_ms: f64,
+    pub sim_frames: u64,
 }
 
-impl HoxApp {
-    /// Measurement bookkeeping after a frame: once `--measure-secs` have passed, prints the
-    /// measurement and closes the window (unless a screenshot is still to be taken).
-    pub(super) fn measure_after_frame(&mut self, ctx: &egui::Context, now: Instant) {
-        if let Some(m) = &mut self.measure {
-            let started = *m.started.get_or_insert(now);
-            if let Some(last) = m.last {
-                m.frame_ms.push(now.duration_since(last).as_secs_f64() * 1e3);
-            }
-            m.last = Some(now);
-            m.frames += 1;
-            let secs = now.duration_since(started).as_secs_f64();
-            if secs >= m.until_secs {
-                let mut ms = m.frame_ms.clone();
-                let median = hox_scenes::median(&mut ms);
-                let s = &self.sessions[0];
-                println!(
-                    "{}",
-                    serde_json::json!({
-                        "configuration": s.label(),
-                        "seconds": secs,
-                        "display_frames": m.frames,
-                        "display_fps": m.frames as f64 / secs,
-                        "median_display_frame_ms": median,
-                        "sim_frames": m.sim_frames,
-                        "sim_ms_per_frame": s.ms_per_frame,
-                        "render_ms": self.viewport.render_ms,
-                        "app_ms": self.times.app_ms,
-                        "frame_cpu_ms": self.times.frame_cpu_ms,
-                        "window_points": ctx.input(|i| i.viewport().inner_rect.map(|r| [r.width(), r.height()])),
-                        "pixels_per_point": ctx.pixels_per_point(),
-                        "renderer": self.renderer,
-                        "feathering": ctx.tessellation_options(|o| o.feathering),
-                    })
-                );
-                if self.screenshot.is_none() {
-                    ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-                }
-                self.measure = None;
-            }
-            ctx.request_repaint();
+impl Measure {
+    /// A measurement of `until_secs` seconds, starting at the first frame.
+    pub fn new(until_secs: f64) -> Measure {
+        Measure { until_secs, started: None, frames: 0, sim_frames_at_start: None, frame_ms: Vec::new(), last: None }
+    }
+
+    /// A displayed frame ended at `now` with `frames_stepped` simulated frames stepped since the
+    /// start (the model's count); the measurement once its seconds have passed.
+    pub fn after_frame(&mut self, now: Instant, frames_stepped: u64) -> Option<Measured> {
+        let started = *self.started.get_or_insert(now);
+        let at_start = *self.sim_frames_at_start.get_or_insert(frames_stepped);
+        if let Some(last) = self.last {
+            self.frame_ms.push(now.duration_since(last).as_secs_f64() * 1e3);
         }
+        self.last = Some(now);
+        self.frames += 1;
+        let seconds = now.duration_since(started).as_secs_f64();
+        (seconds >= self.until_secs).then(|| Measured {
+            seconds,
+            display_frames: self.frames,
+            median_display_frame_ms: hox_scenes::median(&mut self.frame_ms.clone()),
+            sim_frames: frames_stepped - at_start,
+        })
     }
 }

@@ -1,35 +1,12 @@
 //! What the app keeps across runs (scene, configurations, links, view, camera, time scale, Rerun
-//! targets), where the scene comes from, and eframe's storage of it.
+//! targets), and eframe's storage of it.
 
-use super::HoxApp;
-use super::config::Config;
+use super::config::{Config, SceneSource};
 use super::links::Links;
+use super::model::Model;
+use super::presets::ViewOptions;
 use super::raster;
-use super::viewport::ViewOptions;
-use hox_scenes::Scene;
-use std::path::PathBuf;
-
-/// Where the scene comes from.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub enum SceneSource {
-    Builtin(String),
-    File(PathBuf),
-}
-
-impl SceneSource {
-    pub fn load(&self) -> Result<Scene, String> {
-        match self {
-            SceneSource::Builtin(name) => hox_scenes::by_name(name).map_err(|e| e.to_string()),
-            SceneSource::File(path) => Scene::load(path).map_err(|e| e.to_string()),
-        }
-    }
-    pub fn label(&self) -> String {
-        match self {
-            SceneSource::Builtin(name) => name.clone(),
-            SceneSource::File(path) => path.display().to_string(),
-        }
-    }
-}
+use super::ui_state::UiState;
 
 /// What persists across runs.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -62,21 +39,21 @@ impl Persisted {
     }
 }
 
-impl HoxApp {
-    /// What of the app persists, as it is now.
-    pub fn persisted(&self) -> Persisted {
+impl Persisted {
+    /// What of `model` and the UI's `state` persists, as they are now.
+    pub fn of(model: &Model, state: &UiState) -> Persisted {
         Persisted {
-            scene: self.scene.clone(),
-            configs: self.sessions.iter().map(|s| s.config.clone()).collect(),
-            compare: self.compare,
-            links: self.links.clone(),
-            view: self.view.clone(),
-            camera: Some(self.viewport.camera),
-            time_scale: self.playback.time_scale,
-            show_reference_element: self.show_reference_element,
-            rerun_url: self.rerun_url.clone(),
-            rerun_file: self.rerun_file.clone(),
-            presenter_at_exit: self.presenter,
+            scene: model.scene().clone(),
+            configs: model.sessions().iter().map(|s| s.config.clone()).collect(),
+            compare: model.compare(),
+            links: model.links().clone(),
+            view: model.view().clone(),
+            camera: Some(state.viewport.camera),
+            time_scale: model.playback().time_scale,
+            show_reference_element: model.show_reference_element(),
+            rerun_url: state.rerun_url.clone(),
+            rerun_file: state.rerun_file.clone(),
+            presenter_at_exit: model.presenter(),
         }
     }
 }

@@ -1,19 +1,11 @@
 //! The bottom panel: the probe displacement and the energies over simulated time, and the
 //! study's accuracy-versus-time chart with the running configuration(s) marked.
 
-use super::HoxApp;
 use super::readout::Readout;
 use super::study_chart::{StudyPoint, study_chart_ui};
+use super::ui_state::{Ctx, Tab};
 use eframe::egui;
 use egui_plot::{Line, Plot, PlotPoints};
-
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Tab {
-    #[default]
-    Probe,
-    Energy,
-    Study,
-}
 
 /// Most points per plotted line: a long run keeps 20,000 samples, which would cost the
 /// renderer more than the rest of the window; min/max pairs per bucket keep the envelope.
@@ -88,42 +80,37 @@ fn legend_row_ui(ui: &mut egui::Ui, entries: &[(String, egui::Color32, bool)]) {
     });
 }
 
-/// Which displacement components the probe plot shows: the user's choice, else all three for
-/// one configuration and u_z alone when comparing (six lines would bury each other).
-pub fn probe_axes(app: &HoxApp) -> [bool; 3] {
-    app.probe_axes.unwrap_or(if app.compare { [false, false, true] } else { [true, true, true] })
-}
-
-pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
+pub fn plots_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
+    let model = cx.model;
     ui.horizontal(|ui| {
-        ui.selectable_value(&mut app.bottom_tab, Tab::Probe, "Probe displacement").on_hover_text("The first probe's displacement components over simulated time, metres.");
-        ui.selectable_value(&mut app.bottom_tab, Tab::Energy, "Energies").on_hover_text("Kinetic and elastic energy over simulated time, joules.");
-        ui.selectable_value(&mut app.bottom_tab, Tab::Study, "Accuracy vs time").on_hover_text("The study's probe error against the reference solution versus milliseconds per frame; the running configurations are marked.");
-        if app.bottom_tab == Tab::Probe {
+        ui.selectable_value(&mut cx.state.bottom_tab, Tab::Probe, "Probe displacement").on_hover_text("The first probe's displacement components over simulated time, metres.");
+        ui.selectable_value(&mut cx.state.bottom_tab, Tab::Energy, "Energies").on_hover_text("Kinetic and elastic energy over simulated time, joules.");
+        ui.selectable_value(&mut cx.state.bottom_tab, Tab::Study, "Accuracy vs time").on_hover_text("The study's probe error against the reference solution versus milliseconds per frame; the running configurations are marked.");
+        if cx.state.bottom_tab == Tab::Probe {
             ui.separator();
-            let mut axes = probe_axes(app);
+            let mut axes = cx.state.probe_axes(model.compare());
             for (k, name) in ["u_x", "u_y", "u_z"].iter().enumerate() {
                 ui.checkbox(&mut axes[k], *name);
             }
-            if axes != probe_axes(app) {
-                app.probe_axes = Some(axes);
+            if axes != cx.state.probe_axes(model.compare()) {
+                cx.state.probe_axes = Some(axes);
             }
         }
     });
     let names = ["A", "B"];
-    match app.bottom_tab {
+    match cx.state.bottom_tab {
         Tab::Probe => {
-            let probe = app.sessions[0].instance.probes.first().map_or("probe".to_string(), |p| p.name.clone());
-            let axes = probe_axes(app);
+            let probe = model.sessions()[0].instance.probes.first().map_or("probe".to_string(), |p| p.name.clone());
+            let axes = cx.state.probe_axes(model.compare());
             let mut entries = Vec::new();
-            for (k, s) in app.sessions.iter().enumerate() {
+            for (k, s) in model.sessions().iter().enumerate() {
                 for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate().filter(|(a, _)| axes[*a]) {
                     let name =
-                        if app.compare { format!("{} {} {label}", names[k], s.label()) } else { label.to_string() };
-                    entries.push((name, line_colour(app.compare, k, axis), false));
+                        if model.compare() { format!("{} {} {label}", names[k], s.label()) } else { label.to_string() };
+                    entries.push((name, line_colour(model.compare(), k, axis), false));
                 }
             }
-            let first = &app.sessions[0];
+            let first = &model.sessions()[0];
             let reference = first.reference.reference().and_then(|r| r.probes.get(&probe)).copied();
             if reference.is_some() && axes[2] {
                 entries.push(("reference u_z (static)".to_string(), REFERENCE_COLOUR, true));
@@ -138,17 +125,17 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                 .x_axis_label("t (s)")
                 .y_axis_label(format!("{probe} u (m)"))
                 .show(ui, |plot| {
-                    for (k, s) in app.sessions.iter().enumerate() {
+                    for (k, s) in model.sessions().iter().enumerate() {
                         let h = &s.history;
                         for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate().filter(|(a, _)| axes[*a]) {
                             let points =
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.probe_m[i][axis], MAX_PLOT_POINTS));
-                            let name = if app.compare {
+                            let name = if model.compare() {
                                 format!("{} {} {label}", names[k], s.label())
                             } else {
                                 label.to_string()
                             };
-                            plot.line(Line::new(name, points).color(line_colour(app.compare, k, axis)));
+                            plot.line(Line::new(name, points).color(line_colour(model.compare(), k, axis)));
                         }
                     }
                     let h = &first.history;
@@ -184,39 +171,39 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
         }
         Tab::Energy => {
             let mut entries = Vec::new();
-            for k in 0..app.sessions.len() {
-                let prefix = if app.compare { format!("{} ", names[k]) } else { String::new() };
-                entries.push((format!("{prefix}kinetic"), line_colour(app.compare, k, 0), false));
-                entries.push((format!("{prefix}elastic"), line_colour(app.compare, k, 2), false));
+            for k in 0..model.sessions().len() {
+                let prefix = if model.compare() { format!("{} ", names[k]) } else { String::new() };
+                entries.push((format!("{prefix}kinetic"), line_colour(model.compare(), k, 0), false));
+                entries.push((format!("{prefix}elastic"), line_colour(model.compare(), k, 2), false));
             }
             legend_row_ui(ui, &entries);
             Plot::new("energy").show_background(false).x_axis_label("t (s)").y_axis_label("energy (J)").show(
                 ui,
                 |plot| {
-                    for (k, s) in app.sessions.iter().enumerate() {
+                    for (k, s) in model.sessions().iter().enumerate() {
                         let h = &s.history;
-                        let prefix = if app.compare { format!("{} ", names[k]) } else { String::new() };
+                        let prefix = if model.compare() { format!("{} ", names[k]) } else { String::new() };
                         plot.line(
                             Line::new(
                                 format!("{prefix}kinetic"),
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.kinetic_j[i], MAX_PLOT_POINTS)),
                             )
-                            .color(line_colour(app.compare, k, 0)),
+                            .color(line_colour(model.compare(), k, 0)),
                         );
                         plot.line(
                             Line::new(
                                 format!("{prefix}elastic"),
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.elastic_j[i], MAX_PLOT_POINTS)),
                             )
-                            .color(line_colour(app.compare, k, 2)),
+                            .color(line_colour(model.compare(), k, 2)),
                         );
                     }
                 },
             );
         }
         Tab::Study => {
-            let current: Vec<StudyPoint> = app
-                .sessions
+            let current: Vec<StudyPoint> = model
+                .sessions()
                 .iter()
                 .filter_map(|s| {
                     // a settled state or the mean of the motion, never an instantaneous value
@@ -233,7 +220,7 @@ pub fn plots_ui(app: &mut HoxApp, ui: &mut egui::Ui) {
                     })
                 })
                 .collect();
-            study_chart_ui(ui, app.sessions[0].base.name(), &current);
+            study_chart_ui(ui, model.sessions()[0].base.name(), &current);
         }
     }
 }

@@ -11,26 +11,16 @@
 //! sent, as are rebuilds (a lesson's new step is one) at once. While the app is paused a change
 //! of the lesson's text (the answer revealed) is sent as it happens.
 
-use super::HoxApp;
+use super::action::RerunTarget;
+use super::model::Model;
 use super::session::Session;
 use crate::recording::{Configuration, LogSettings, Recorder};
 use hox_sim::Vec3;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-/// Where the live output goes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RerunTarget {
-    /// A running Rerun viewer at the URL of the Rerun section.
-    Viewer,
-    /// The .rrd file of the Rerun section.
-    File,
-    /// The class's browsers: the web viewer served on the addresses of `--bind` and the ports.
-    Browsers,
-}
-
 /// Live Rerun output through the shared logging module.
-pub(super) struct RerunLink {
+struct RerunLink {
     rec: rerun::RecordingStream,
     recorder: Option<Recorder>,
     generation: u64,
@@ -38,12 +28,12 @@ pub(super) struct RerunLink {
     /// The web viewer's server when serving browsers (its page's URL is `web.url`).
     web: Option<crate::web::WebServer>,
     /// The lesson text logged last (logged again only when it changes).
-    pub(super) lesson_text: Option<String>,
+    lesson_text: Option<String>,
     /// The bound on the frames sent per second (browsers only).
     cap: Option<FrameCap>,
     /// The simulation frame of the first configuration logged last, and how many were.
-    pub(super) last_logged_frame: Option<u64>,
-    pub(super) frames_logged: u64,
+    last_logged_frame: Option<u64>,
+    frames_logged: u64,
 }
 
 /// At most so many frames a second: a frame is admitted when the one admitted before it is
@@ -136,7 +126,7 @@ impl RerunLink {
     }
 
     /// Whether a frame held back by the cap is still unsent.
-    pub(super) fn pending(&self) -> bool {
+    fn pending(&self) -> bool {
         self.cap.is_some_and(|c| c.pending)
     }
 
@@ -197,69 +187,105 @@ impl RerunLink {
     }
 }
 
-impl HoxApp {
-    /// Starts live Rerun output to `target` (stopping any), or stops it (`None`).
-    pub fn set_rerun(&mut self, target: Option<RerunTarget>) {
-        if let Some(link) = self.rerun.take() {
-            self.message = Some(link.stop());
-        }
-        let Some(target) = target else { return };
-        let name = format!("hox app {}", self.scene.label());
-        match RerunLink::start(name, target, &self.rerun_url, &self.rerun_file, &self.serve, self.serve_fps) {
+/// The live Rerun output as a service of the app: at most one link open, fed the model's frames.
+pub struct Rerun {
+    link: Option<RerunLink>,
+    /// Where the class's browsers are served (`--bind`, the ports, the history bound).
+    serve: crate::web::ServeArgs,
+    /// `--serve-fps`: frames a second sent to browsers at most (0: every frame).
+    serve_fps: u32,
+}
+
+impl Rerun {
+    pub fn new(serve: crate::web::ServeArgs, serve_fps: u32) -> Rerun {
+        Rerun { link: None, serve, serve_fps }
+    }
+
+    /// Starts live output of `model` to `target` (stopping any), or stops it (`None`), the viewer's
+    /// URL and the file as given; the message to show.
+    pub fn set(&mut self, target: Option<RerunTarget>, model: &Model, url: &str, file: &str) -> Option<String> {
+        let stopped = self.link.take().map(RerunLink::stop);
+        let Some(target) = target else { return stopped };
+        let name = format!("hox app {}", model.scene().label());
+        match RerunLink::start(name, target, url, file, &self.serve, self.serve_fps) {
             Ok(link) => {
-                self.message = Some(format!("Rerun: {}", link.target));
-                self.rerun = Some(link);
-                self.log_rerun();
+                let started = format!("Rerun: {}", link.target);
+                self.link = Some(link);
+                Some(self.log(model).unwrap_or(started))
             }
-            Err(message) => self.message = Some(message),
+            Err(e) => Some(e),
         }
     }
 
-    pub fn rerun_target(&self) -> Option<&str> {
-        self.rerun.as_ref().map(|l| l.target.as_str())
+    pub fn is_open(&self) -> bool {
+        self.link.is_some()
+    }
+
+    pub fn target(&self) -> Option<&str> {
+        self.link.as_ref().map(|l| l.target.as_str())
     }
 
     /// The page the class's browsers open, while serving them.
     pub fn web_url(&self) -> Option<&str> {
-        self.rerun.as_ref().and_then(|l| l.web.as_ref()).map(|w| w.url.as_str())
+        self.link.as_ref().and_then(|l| l.web.as_ref()).map(|w| w.url.as_str())
     }
 
-    /// Logs the sessions' current frame to the live link, if any (browsers: unless the frame
-    /// cap holds it back); an error closes the link.
-    pub(super) fn log_rerun(&mut self) {
-        if self.rerun.is_some() {
-            let lesson_text = self.lesson_text();
-            self.log_rerun_now(false, lesson_text);
+    /// The address browsers are served on.
+    pub fn bind(&self) -> String {
+        self.serve.bind.to_string()
+    }
+
+    /// Logs the model's current frame to the link, if any (browsers: unless the frame cap holds
+    /// it back); an error closes the link and is returned.
+    pub fn log(&mut self, model: &Model) -> Option<String> {
+        self.link.as_ref()?;
+        self.log_now(model, false, model.lesson_text())
+    }
+
+    /// While the model is not playing (paused, a settle ended), sends the frame the cap held back
+    /// last, and the lesson's text when it changed (the answer revealed): called after each
+    /// frame's steps, so browsers always end on what the app shows.
+    pub fn flush(&mut self, model: &Model) -> Option<String> {
+        if model.playing() {
+            return None;
+        }
+        let link = self.link.as_ref()?;
+        let text = model.lesson_text();
+        if link.pending() || text != link.lesson_text { self.log_now(model, true, text) } else { None }
+    }
+
+    fn log_now(&mut self, model: &Model, force: bool, lesson_text: Option<String>) -> Option<String> {
+        let link = self.link.as_mut()?;
+        let offsets = model.offsets();
+        match link.log(model.sessions(), &offsets, model.generation(), lesson_text, force) {
+            Ok(()) => None,
+            Err(e) => {
+                self.link = None;
+                Some(format!("Rerun: {e}"))
+            }
         }
     }
 
-    /// While the app is not playing (paused, a settle ended), sends the frame the cap held
-    /// back last, and the lesson's text when it changed (the answer revealed): called after
-    /// each update's steps, so browsers always end on what the app shows.
-    pub(super) fn flush_rerun(&mut self) {
-        if self.playback.playing {
-            return;
-        }
-        let Some(link) = &self.rerun else { return };
-        let text = self.lesson_text();
-        if link.pending() || text != link.lesson_text {
-            self.log_rerun_now(true, text);
-        }
+    /// What the open link sent (the UI tests read it).
+    #[cfg(test)]
+    pub fn sent(&self) -> Option<Sent> {
+        self.link.as_ref().map(|l| Sent {
+            frames_logged: l.frames_logged,
+            last_logged_frame: l.last_logged_frame,
+            pending: l.pending(),
+            lesson_text: l.lesson_text.clone(),
+        })
     }
+}
 
-    /// The open lesson's step as the browsers show it.
-    fn lesson_text(&self) -> Option<String> {
-        self.lesson.as_ref().map(|l| l.step_markdown(&self.sessions))
-    }
-
-    fn log_rerun_now(&mut self, force: bool, lesson_text: Option<String>) {
-        let offsets = self.offsets();
-        let Some(link) = &mut self.rerun else { return };
-        if let Err(e) = link.log(&self.sessions, &offsets, self.generation, lesson_text, force) {
-            self.message = Some(format!("Rerun: {e}"));
-            self.rerun = None;
-        }
-    }
+/// What a link sent: how many frames, the first configuration's frame logged last, whether a
+/// frame is held back, the lesson text logged last.
+#[cfg(test)]
+pub struct Sent {
+    pub frames_logged: u64,
+    pub last_logged_frame: Option<u64>,
+    pub pending: bool,
+    pub lesson_text: Option<String>,
 }
 
 #[cfg(test)]

@@ -1,60 +1,16 @@
-//! The class's browsers in the app (issue #38): `hox app --serve-web` starts serving at once
-//! (the address printed on stdout); in presenter mode the address is shown with its QR code in
-//! the 3D view's top right corner, for students to scan from the projection.
+//! The class's browsers in presenter mode (issue #38): `hox app --serve-web` starts serving at
+//! once (the app prints the address on stdout; the serving itself is `rerun_link.rs`); in
+//! presenter mode this panel shows the address with its QR code at the right of the 3D view, for
+//! students to scan from the projection.
 
-use super::HoxApp;
-use super::lesson::LessonState;
-use super::rerun_link::RerunTarget;
-use super::session::Session;
+use super::ui_state::Ctx;
 use eframe::egui;
-
-impl HoxApp {
-    /// `--serve-web`: serves the class's browsers from the start. A refusal (a port in use, an
-    /// address not of this machine) is printed and shown, and the app runs on without serving.
-    pub(super) fn serve_web_at_start(&mut self) {
-        self.set_rerun(Some(RerunTarget::Browsers));
-        match self.web_url() {
-            Some(url) => {
-                println!("{url}");
-                eprintln!("serving the class's browsers: open {url}");
-            }
-            None => eprintln!("warning: not serving browsers: {}", self.message.as_deref().unwrap_or("unknown error")),
-        }
-    }
-}
-
-impl LessonState {
-    /// The step as the browsers' "Lesson" view shows it: title, question, the numbers as the
-    /// app's panel shows them, the answer once revealed.
-    pub fn step_markdown(&self, sessions: &[Session]) -> String {
-        let step = &self.lesson.steps[self.step];
-        let mut text = format!(
-            "# {}\n\n## Step {} of {}: {}\n\n{}\n\n",
-            self.lesson.title,
-            self.step + 1,
-            self.lesson.steps.len(),
-            step.title,
-            step.question
-        );
-        if self.preparing() {
-            text += &format!("*{}*\n", super::lesson::PREPARING);
-            return text;
-        }
-        for (k, m) in self.measured(sessions).iter().enumerate() {
-            text += &format!("- **{}**: {}\n", ["A", "B"][k.min(1)], m.text);
-        }
-        if self.revealed {
-            text += &format!("\n**Answer:** {}\n", step.answer);
-        }
-        text
-    }
-}
 
 /// Presenter mode while serving: the address and its QR code in a narrow panel at the right of
 /// the 3D view (dark modules on white, with the quiet zone a scanner needs), beside the bodies,
 /// never over them (issue #35's rule: no text over a body).
-pub fn address_ui(app: &HoxApp, ui: &mut egui::Ui) {
-    let Some(url) = app.web_url() else { return };
+pub fn address_ui(cx: &Ctx, ui: &mut egui::Ui) {
+    let Some(url) = cx.status.web_url.as_deref() else { return };
     let Some((width, modules)) = crate::web::qr_modules(url) else { return };
     let side = ui.available_width().clamp(120.0, 220.0);
     let module = (side / (width as f32 + 8.0)).floor().max(2.0);

@@ -1,13 +1,14 @@
-//! One running configuration in the app: the simulation, its display surface, its history for
-//! the plots, its reference solution and its readout against it ([`super::readout`]), and the
-//! *Settle* action.
+//! One running configuration in the app (the run, part of the model): the simulation, its
+//! history for the plots, its reference solution and its readout against it
+//! ([`super::readout`]), the *Settle* action and the drag. How it is drawn (its display
+//! surface, held nodes, colour field) is its view, kept by the viewport
+//! ([`super::session_view::SessionView`]), which follows the revisions counted here.
 //!
 //! A configuration change rebuilds only what it invalidates ([`Invalidates`]): a material or
 //! solver change keeps the current positions and velocities; a mesh change rebuilds from rest.
 
 use super::config::{self, Config, Invalidates};
 use super::readout::{Readout, ReferenceState, last_oscillation};
-use crate::display::FieldSource;
 use hox_scenes::reference::physics_key;
 use hox_scenes::study::motion::Motion;
 use hox_scenes::{Instance, Scene};
@@ -15,7 +16,7 @@ use hox_scenes::{RestWatch, SettleState, Settler};
 use hox_sim::Vec3;
 use hox_sim::effect::Attachment;
 use hox_sim::measure::field::Field;
-use hox_sim::measure::surface::{PointMap, Surface};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Samples kept for the time plots (older ones are dropped).
@@ -57,6 +58,18 @@ pub struct Drag {
 /// Compliance of the mouse attachment, m/N (stiff, but not rigid).
 const DRAG_COMPLIANCE_M_PER_N: f64 = 1e-6;
 
+/// Mesh builds, numbered across every session (a view is of one build).
+static BUILDS: AtomicU64 = AtomicU64::new(1);
+
+/// What a view of a session follows: the mesh build, and revisions of the solver settings (the
+/// quadrature points drawn) and of the reference (the error field's).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Revisions {
+    pub build: u64,
+    pub settings: u64,
+    pub reference: u64,
+}
+
 /// How many frames' wall times a session keeps ([`Session::frame_ms`]).
 pub const FRAME_MS_KEPT: usize = 10_000;
 
@@ -64,7 +77,6 @@ pub struct Session {
     pub base: Scene,
     pub config: Config,
     pub instance: Instance,
-    pub surface: Surface,
     pub history: History,
     /// The reference of the physics on screen (committed, computing or computed).
     pub reference: ReferenceState,
@@ -100,19 +112,8 @@ pub struct Session {
     pub drag: Option<Drag>,
     /// The attachment currently in the simulation (follows `drag` at the next step).
     attached: Option<Drag>,
-    /// The display vertices at rest (the ghost) and which mesh nodes are element corners;
-    /// fixed for a mesh, so computed when it is built.
-    pub rest_vertices: Vec<Vec3>,
-    pub corner_nodes: Vec<bool>,
-    /// Nodes held by clamps and moved by prescribed motions (for display).
-    pub clamped: Vec<u32>,
-    pub driven: Vec<u32>,
-    /// The surface's element edges on clamped and on driven faces ([`Surface::edges_between`]).
-    pub clamped_edges: Vec<usize>,
-    pub driven_edges: Vec<usize>,
-    /// What the surface is coloured by ([`crate::display::FieldSource`]).
-    pub field_source: FieldSource,
-    quadrature: std::cell::OnceCell<PointMap>,
+    /// What its view follows ([`Revisions`]).
+    revisions: Revisions,
 }
 
 impl Session {
@@ -126,7 +127,6 @@ impl Session {
     pub fn new(base: Scene, config: Config) -> Result<Session, String> {
         let scene = config::resolve(&config, &base)?;
         let instance = Instance::new(scene).map_err(|e| e.to_string())?;
-        let surface = Surface::new(instance.sim.mesh(), config.tessellation);
         let field = crate::display::fields(&config)[0];
         let reference = ReferenceState::for_scene(&instance.scene, field == Field::Error);
         let rest = RestWatch::new(&instance);
@@ -135,7 +135,6 @@ impl Session {
             base,
             config,
             instance,
-            surface,
             history: History::default(),
             reference,
             rest,
@@ -153,14 +152,7 @@ impl Session {
             failure: None,
             drag: None,
             attached: None,
-            rest_vertices: Vec::new(),
-            corner_nodes: Vec::new(),
-            clamped: Vec::new(),
-            driven: Vec::new(),
-            clamped_edges: Vec::new(),
-            driven_edges: Vec::new(),
-            field_source: FieldSource::new(field),
-            quadrature: std::cell::OnceCell::new(),
+            revisions: Revisions::default(),
         };
         s.mesh_changed();
         s.residual = s.force_residual();
@@ -179,9 +171,7 @@ impl Session {
         let scene = config::resolve(&new, &self.base)?;
         match what {
             Invalidates::Mesh => {
-                let instance = Instance::new(scene).map_err(|e| e.to_string())?;
-                self.surface = Surface::new(instance.sim.mesh(), new.tessellation);
-                self.instance = instance;
+                self.instance = Instance::new(scene).map_err(|e| e.to_string())?;
                 self.history = History::default();
                 self.failure = None;
                 self.drag = None;
@@ -204,60 +194,28 @@ impl Session {
             Invalidates::Settings => {
                 self.instance.sim.set_settings(scene.settings()).map_err(|e| e.to_string())?;
                 self.instance.scene = scene;
-                self.quadrature = std::cell::OnceCell::new();
+                self.revisions.settings += 1;
             }
             Invalidates::Nothing => self.instance.scene = scene,
-        }
-        if what != Invalidates::Mesh && new.tessellation != self.config.tessellation {
-            self.set_segments(new.tessellation);
         }
         self.config = new;
         // another ν, E, ρ or model: another equilibrium, another reference
         let field = crate::display::fields(&self.config)[0];
-        self.field_source.field = field;
         self.reference.follow(&self.instance.scene, field == Field::Error);
-        self.sync_reference_field();
+        self.revisions.reference += 1;
         self.refresh_readout();
         Ok(what)
     }
 
-    /// After a (re)build: the boundary-condition node sets, the first history sample.
+    /// After a (re)build: a new build for the views, the first history sample.
     fn mesh_changed(&mut self) {
-        (self.clamped, self.driven) = crate::display::held_nodes(&self.instance);
-        self.quadrature = std::cell::OnceCell::new();
-        self.corner_nodes = self.instance.sim.mesh().vertex_nodes();
-        self.surface_changed();
+        self.revisions.build = BUILDS.fetch_add(1, Ordering::Relaxed);
         self.record();
     }
 
-    /// After the surface was rebuilt: its rest vertices, held edges and field data.
-    fn surface_changed(&mut self) {
-        let mesh = self.instance.sim.mesh();
-        self.surface.vertices.eval_into(&mesh.rest_positions, &mut self.rest_vertices);
-        let n = mesh.num_nodes();
-        self.clamped_edges = self.surface.edges_between(&crate::display::node_flags(&self.clamped, n));
-        self.driven_edges = self.surface.edges_between(&crate::display::node_flags(&self.driven, n));
-        self.field_source.surface_changed();
-        self.sync_reference_field();
-    }
-
-    /// Gives the field source the reference's displacement field, when there is one.
-    fn sync_reference_field(&mut self) {
-        let field = self.reference.reference().and_then(|r| r.field.as_ref());
-        self.field_source.set_reference(&self.surface, self.instance.sim.mesh(), field);
-    }
-
-    /// Every quadrature point as a material point (computed on first use).
-    pub fn quadrature_points(&self) -> &PointMap {
-        self.quadrature.get_or_init(|| {
-            hox_sim::measure::surface::quadrature_points(self.instance.sim.mesh(), self.instance.sim.geometry())
-        })
-    }
-
-    /// Changes the display tessellation.
-    fn set_segments(&mut self, segments: usize) {
-        self.surface = Surface::new(self.instance.sim.mesh(), segments);
-        self.surface_changed();
+    /// What a view of this session follows.
+    pub fn revisions(&self) -> Revisions {
+        self.revisions
     }
 
     /// Back to the rest state at t = 0.
@@ -331,10 +289,8 @@ impl Session {
 
     /// Takes a reference computed in the background in (non-blocking), and with it the readout.
     pub fn poll_reference(&mut self) {
-        let field_waiting =
-            !self.field_source.has_reference() && self.reference.reference().is_some_and(|r| r.field.is_some());
-        if self.reference.poll() || field_waiting {
-            self.sync_reference_field();
+        if self.reference.poll() {
+            self.revisions.reference += 1;
             self.refresh_readout();
         }
     }
@@ -566,14 +522,16 @@ mod tests {
         let mut s = bending();
         s.step(3);
         let positions = s.instance.sim.positions.clone();
-        let vertices = s.surface.vertices.len();
+        let mut view = super::super::session_view::SessionView::new(&s);
+        let vertices = view.surface.vertices.len();
         let mut c = s.config.clone();
         c.tessellation = 6;
         c.quadrature_points = true;
         assert_eq!(s.apply(c.clone()), Ok(Invalidates::Nothing));
         assert_eq!(s.config, c);
-        assert!(s.surface.vertices.len() > vertices, "{} vs {vertices}", s.surface.vertices.len());
-        assert_eq!(s.rest_vertices.len(), s.surface.vertices.len());
+        view.follow(&s);
+        assert!(view.surface.vertices.len() > vertices, "{} vs {vertices}", view.surface.vertices.len());
+        assert_eq!(view.rest_vertices.len(), view.surface.vertices.len());
         assert_eq!(s.instance.sim.positions, positions);
         let mut bad = c.clone();
         bad.tessellation = 0;

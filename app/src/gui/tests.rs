@@ -1,6 +1,10 @@
 //! Headless UI tests of the app (egui_kittest: the real widgets, driven through AccessKit; no
 //! window, no GPU).
 
+use super::action::Action;
+use super::app::HoxApp;
+use super::config::SceneSource;
+use super::presets::ViewPreset;
 use super::*;
 use eframe::egui;
 use egui_kittest::Harness;
@@ -41,7 +45,7 @@ fn type_into(h: &mut Harness<'_, HoxApp>, label: &str, value: &str) {
 fn app_starts_on_bending_with_its_p2_beam() {
     let mut h = harness(AppArgs::default());
     h.run_steps(3);
-    assert_eq!(h.state().scene, SceneSource::Builtin("bending".into()));
+    assert_eq!(*h.state().model().scene(), SceneSource::Builtin("bending".into()));
     let s = status(&h);
     assert!(s.starts_with("P2 8×2×2 five: 393 nodes, 160 el"), "{s}");
     h.get_by_label("Young's modulus E (Pa)");
@@ -58,28 +62,28 @@ fn switching_element_type_rebuilds_the_mesh_and_the_node_count_shown() {
     h.run_steps(3);
     let s = status(&h);
     assert!(s.starts_with("Q2 8×2×2: 425 nodes, 32 el"), "{s}");
-    assert_eq!(h.state().sessions[0].instance.sim.mesh().num_nodes(), 17 * 5 * 5);
+    assert_eq!(h.state().model().sessions()[0].instance.sim.mesh().num_nodes(), 17 * 5 * 5);
 }
 
 #[test]
 fn play_advances_time_and_space_pauses() {
     let mut h = harness(AppArgs::default());
     h.run_steps(2);
-    assert_eq!(h.state().sessions[0].instance.sim.time_secs(), 0.0);
+    assert_eq!(h.state().model().sessions()[0].instance.sim.time_secs(), 0.0);
     h.get_all_by_label("Play").next().unwrap().click();
     h.run_steps(30);
-    let t = h.state().sessions[0].instance.sim.time_secs();
+    let t = h.state().model().sessions()[0].instance.sim.time_secs();
     // the app follows the test's clock (1/60 s per step), whatever the build's speed
     let frames = (t * 60.0).round();
     assert!((28.0..=30.0).contains(&frames), "30 displayed frames at 60 Hz advance 30 simulated frames, got {t} s");
     h.key_press(egui::Key::Space);
     h.run_steps(2);
-    let paused = h.state().sessions[0].instance.sim.time_secs();
+    let paused = h.state().model().sessions()[0].instance.sim.time_secs();
     h.run_steps(10);
-    assert_eq!(h.state().sessions[0].instance.sim.time_secs(), paused, "space paused");
+    assert_eq!(h.state().model().sessions()[0].instance.sim.time_secs(), paused, "space paused");
     h.key_press(egui::Key::S);
     h.run_steps(2);
-    let stepped = h.state().sessions[0].instance.sim.time_secs();
+    let stepped = h.state().model().sessions()[0].instance.sim.time_secs();
     assert!((stepped - paused - 1.0 / 60.0).abs() < 1e-9, "S steps exactly one frame");
 }
 
@@ -93,28 +97,28 @@ fn a_bad_value_is_refused_with_the_reason_and_changes_nothing() {
     // in the panel's words, not the scene file's internals (issue #35)
     assert!(refusal.starts_with("refused: Poisson ratio ν = 0.5: "), "{refusal}");
     assert!(!refusal.contains("builtin:") && !refusal.contains("material.poisson_ratio"), "{refusal}");
-    assert_eq!(h.state().sessions[0].config.poisson_ratio, 0.35);
-    assert_eq!(h.state().sessions[0].instance.sim.material().poisson_ratio, 0.35);
+    assert_eq!(h.state().model().sessions()[0].config.poisson_ratio, 0.35);
+    assert_eq!(h.state().model().sessions()[0].instance.sim.material().poisson_ratio, 0.35);
 }
 
 #[test]
 fn compare_mode_links_controls_and_shows_both_errors() {
     let mut h = harness(AppArgs { compare: vec![String::new()], ..Default::default() });
     h.run_steps(2);
-    let labels: Vec<String> = h.state().sessions.iter().map(|s| s.label()).collect();
+    let labels: Vec<String> = h.state().model().sessions().iter().map(|s| s.label()).collect();
     assert_eq!(labels, ["P1 8×2×2 five r1", "P2 8×2×2 five"]);
     // a linked material change reaches both; an unlinked element change only the active one
     let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
+    let mut c = app.model().sessions()[0].config.clone();
     c.youngs_modulus_pa = 6e6;
-    app.apply("youngs", c);
-    assert!(app.sessions.iter().all(|s| s.instance.sim.material().youngs_modulus_pa == 6e6));
-    let mut c = app.sessions[0].config.clone();
+    app.act(Action::change("youngs", c));
+    assert!(app.model().sessions().iter().all(|s| s.instance.sim.material().youngs_modulus_pa == 6e6));
+    let mut c = app.model().sessions()[0].config.clone();
     c.element = hox_sim::element::ElementType::from_name("p3").unwrap();
     c.refine = 0;
-    app.apply("element", c);
-    assert_eq!(app.sessions[0].config.element.name(), "p3");
-    assert_eq!(app.sessions[1].config.element.name(), "p2");
+    app.act(Action::change("element", c));
+    assert_eq!(app.model().sessions()[0].config.element.name(), "p3");
+    assert_eq!(app.model().sessions()[1].config.element.name(), "p2");
     h.run_steps(2);
     assert!(status_count(&h) == 2);
 }
@@ -127,18 +131,18 @@ fn compare_mode_links_controls_and_shows_both_errors() {
 fn a_curved_part_compares_its_orders_and_switches_between_them() {
     let mut h = harness(AppArgs { scene: Some("tube".into()), compare: vec![String::new()], ..Default::default() });
     h.run_steps(2);
-    let labels: Vec<String> = h.state().sessions.iter().map(|s| s.label()).collect();
+    let labels: Vec<String> = h.state().model().sessions().iter().map(|s| s.label()).collect();
     assert_eq!(labels, ["P1 tube", "P2 tube"]);
-    let nodes: Vec<usize> = h.state().sessions.iter().map(|s| s.instance.sim.mesh().num_nodes()).collect();
+    let nodes: Vec<usize> = h.state().model().sessions().iter().map(|s| s.instance.sim.mesh().num_nodes()).collect();
     assert_eq!(nodes, [829, 4911]);
     assert!(h.query_by_label("Refine").is_none(), "no box parameters for a part");
     let app = h.state_mut();
-    let mut c = app.sessions[1].config.clone();
+    let mut c = app.model().sessions()[1].config.clone();
     c.element = hox_sim::element::ElementType::from_name("p3").unwrap();
-    app.active = 1;
-    app.apply_now("element", c);
-    assert_eq!(app.sessions[1].instance.sim.mesh().num_nodes(), 14670, "P3 from its own file");
-    assert_eq!(app.sessions[0].instance.sim.mesh().num_nodes(), 829, "the element type is not linked");
+    app.act(Action::SetActive(1));
+    app.act(Action::ChangeNow { control: "element".into(), config: Box::new(c) });
+    assert_eq!(app.model().sessions()[1].instance.sim.mesh().num_nodes(), 14670, "P3 from its own file");
+    assert_eq!(app.model().sessions()[0].instance.sim.mesh().num_nodes(), 829, "the element type is not linked");
     h.run_steps(2);
     assert_eq!(status_count(&h), 2);
 }
@@ -146,7 +150,7 @@ fn a_curved_part_compares_its_orders_and_switches_between_them() {
 /// Waits until the lesson step asked for is prepared and installed.
 fn lesson_ready(h: &mut Harness<'_, HoxApp>) {
     h.run_steps(1);
-    h.state_mut().poll_lesson(true);
+    h.state_mut().act(Action::Poll { wait_for_lesson: true });
     h.run_steps(2);
 }
 
@@ -158,14 +162,19 @@ fn status_count(h: &Harness<'_, HoxApp>) -> usize {
 fn open_mesh_runs_a_gmsh_file_with_its_clamp_group() {
     let beam = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/meshes/beam-tet10.msh");
     let mut app = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap();
-    let scene = controls::mesh_scene_file(&beam, "clamp").expect("a scene for the mesh");
-    app.load_scene(SceneSource::File(scene), None).unwrap();
-    let sim = &app.sessions[0].instance.sim;
+    let scene = dialogs::mesh_scene_file(&beam, "clamp").expect("a scene for the mesh");
+    let scene_path = scene.clone();
+    app.act(Action::LoadScene(SceneSource::File(scene)));
+    assert_eq!(*app.model().scene(), SceneSource::File(scene_path));
+    let sim = &app.model().sessions()[0].instance.sim;
     assert_eq!((sim.mesh().num_nodes(), sim.mesh().num_elements()), (495, 218));
-    assert!(!app.sessions[0].clamped.is_empty(), "the clamp group holds nodes");
+    assert!(
+        !crate::display::held_nodes(&app.model().sessions()[0].instance).0.is_empty(),
+        "the clamp group holds nodes"
+    );
     app.step(5);
-    assert!(app.sessions[0].instance.sim.time_secs() > 0.0);
-    let err = controls::mesh_scene_file(&beam, "no-such-group").unwrap_err();
+    assert!(app.model().sessions()[0].instance.sim.time_secs() > 0.0);
+    let err = dialogs::mesh_scene_file(&beam, "no-such-group").unwrap_err();
     assert!(err.contains("no-such-group"), "{err}");
 }
 
@@ -175,17 +184,17 @@ fn stepping_in_the_background_while_the_window_paints_gives_the_same_motion() {
     let mut h = harness(AppArgs { play: true, ..Default::default() });
     h.state_mut().gl_available = true;
     h.run_steps(20);
-    assert!(h.state().background.is_some(), "the last frame's step runs in the background");
-    h.state_mut().join_background();
+    assert!(h.state().model().stepping_in_background(), "the last frame's step runs in the background");
+    h.state_mut().act(Action::Poll { wait_for_lesson: false });
     let app = h.state();
-    let t = app.sessions[0].instance.sim.time_secs();
+    let t = app.model().sessions()[0].instance.sim.time_secs();
     assert!(t > 0.1, "{t}");
     // the same number of frames stepped in place
     let mut reference = harness(AppArgs::default());
     reference.state_mut().step((t * 60.0).round() as usize);
-    let r = &reference.state().sessions[0].instance.sim;
+    let r = &reference.state().model().sessions()[0].instance.sim;
     assert!((r.time_secs() - t).abs() < 1e-12);
-    assert_eq!(r.positions, app.sessions[0].instance.sim.positions);
+    assert_eq!(r.positions, app.model().sessions()[0].instance.sim.positions);
 }
 
 /// Drags the free top corner of the beam's tip through the 3D view, drawn by the CPU rasteriser
@@ -197,7 +206,7 @@ fn drag_the_tip(gl: bool) {
     h.run_steps(3);
     let (node, at) = {
         let app = h.state();
-        let sim = &app.sessions[0].instance.sim;
+        let sim = &app.model().sessions()[0].instance.sim;
         let tip = sim
             .positions
             .iter()
@@ -210,7 +219,7 @@ fn drag_the_tip(gl: bool) {
                 d(a.1).total_cmp(&d(b.1))
             })
             .expect("free nodes");
-        (tip.0 as u32, app.viewport.screen_position(*tip.1).expect("the tip is in view"))
+        (tip.0 as u32, app.ui_state().viewport.screen_position(*tip.1).expect("the tip is in view"))
     };
     h.hover_at(at);
     h.run_steps(1);
@@ -220,13 +229,13 @@ fn drag_the_tip(gl: bool) {
         h.hover_at(at + egui::vec2(0.0, -8.0 * k as f32));
         h.run_steps(1);
     }
-    let drag = h.state().sessions[0].drag.expect("a node is being dragged");
+    let drag = h.state().model().sessions()[0].drag.expect("a node is being dragged");
     assert_eq!(drag.node, node, "the node under the cursor is picked");
-    let start = h.state().sessions[0].instance.sim.positions[node as usize];
+    let start = h.state().model().sessions()[0].instance.sim.positions[node as usize];
     assert!(drag.target_m.z > start.z, "dragging upwards on screen pulls the node up: {drag:?} from {start}");
     h.drop_at(at + egui::vec2(0.0, -40.0));
     h.run_steps(2);
-    assert!(h.state().sessions[0].drag.is_none(), "the attachment exists only while dragging");
+    assert!(h.state().model().sessions()[0].drag.is_none(), "the attachment exists only while dragging");
 }
 
 #[test]
@@ -248,12 +257,12 @@ fn a_stiff_material_at_one_substep_runs_under_the_stability_guard_shown_in_the_s
     h.run_steps(2);
     assert!(!status(&h).contains("(guard)"), "{}", status(&h));
     let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
+    let mut c = app.model().sessions()[0].config.clone();
     c.substeps = 1;
-    app.apply("substeps", c);
+    app.act(Action::change("substeps", c));
     h.run_steps(1);
     type_into(&mut h, "Young's modulus E (Pa)", "1e9");
-    let sim = &h.state().sessions[0].instance.sim;
+    let sim = &h.state().model().sessions()[0].instance.sim;
     assert_eq!(sim.material().youngs_modulus_pa, 1e9);
     let taken = sim.substeps_per_frame();
     assert!(taken > 100, "{taken}");
@@ -261,12 +270,12 @@ fn a_stiff_material_at_one_substep_runs_under_the_stability_guard_shown_in_the_s
     assert!(s.contains(&format!("{taken} substeps (guard)")), "{s}");
     // the checkbox of the Solver section (below the visible part of the panel at this size)
     let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
+    let mut c = app.model().sessions()[0].config.clone();
     c.stability_guard = false;
-    app.apply("guard", c);
+    app.act(Action::change("guard", c));
     h.run_steps(3);
-    assert!(!h.state().sessions[0].config.stability_guard);
-    assert_eq!(h.state().sessions[0].instance.sim.substeps_per_frame(), 1);
+    assert!(!h.state().model().sessions()[0].config.stability_guard);
+    assert_eq!(h.state().model().sessions()[0].instance.sim.substeps_per_frame(), 1);
     assert!(!status(&h).contains("(guard)"), "{}", status(&h));
 }
 
@@ -274,11 +283,11 @@ fn a_stiff_material_at_one_substep_runs_under_the_stability_guard_shown_in_the_s
 fn settle_all(h: &mut Harness<'_, HoxApp>, max_steps: usize) {
     for _ in 0..max_steps {
         h.run_steps(1);
-        if !h.state().settling() {
+        if !h.state().model().settling() {
             break;
         }
     }
-    assert!(!h.state().settling(), "still settling after {max_steps} displayed frames");
+    assert!(!h.state().model().settling(), "still settling after {max_steps} displayed frames");
     h.run_steps(2);
 }
 
@@ -291,8 +300,8 @@ fn settle_shows_the_settled_errors_that_simulate_settle_gives() {
     h.run_steps(2);
     h.key_press(egui::Key::E);
     settle_all(&mut h, 3000);
-    assert!(!h.state().playback.playing, "the app pauses on the settled state");
-    for s in &h.state().sessions {
+    assert!(!h.state().model().playing(), "the app pauses on the settled state");
+    for s in h.state().model().sessions() {
         assert!(matches!(s.settle_outcome, Some(hox_scenes::SettleState::Settled | hox_scenes::SettleState::AtRest)));
         let readout = s.readout();
         let Readout::Settled { error_m, .. } = readout else { panic!("{}: {readout:?}", s.label()) };
@@ -308,8 +317,8 @@ fn settle_shows_the_settled_errors_that_simulate_settle_gives() {
         );
         assert!(!s.instance.sim.effects().iter().any(|e| e.name() == hox_scenes::SETTLE_DAMPING_NAME));
     }
-    let (p1, p2) = (&h.state().sessions[0], &h.state().sessions[1]);
-    let e = |s: &Session| s.readout().error_with_uncertainty_m().unwrap().0;
+    let (p1, p2) = (&h.state().model().sessions()[0], &h.state().model().sessions()[1]);
+    let e = |s: &session::Session| s.readout().error_with_uncertainty_m().unwrap().0;
     // settled, P2 160 is far nearer the reference than P1 1,280 (about 1.3 mm against 5.4 cm)
     assert!(e(p1) > 10.0 * e(p2), "P1 {} vs P2 {}", e(p1), e(p2));
     assert_eq!(h.query_all_by_label_contains("settled error").count(), 2, "both status lines say settled");
@@ -323,7 +332,7 @@ fn a_swinging_beam_reads_out_the_mean_of_its_motion() {
     h.run_steps(1);
     h.state_mut().step(150);
     h.run_steps(1);
-    let s = &h.state().sessions[0];
+    let s = &h.state().model().sessions()[0];
     let Readout::Moving { error_m, amplitude_m, period_secs, .. } = s.readout() else { panic!("{:?}", s.readout()) };
     // the tip swings about 0.3 m around its sag; the mean is much nearer the reference than
     // the swing (an instantaneous value would be off by up to the amplitude)
@@ -338,23 +347,24 @@ fn a_swinging_beam_reads_out_the_mean_of_its_motion() {
 fn the_reference_follows_the_poisson_ratio() {
     let mut h = harness(AppArgs::default());
     h.run_steps(2);
-    let committed = h.state().sessions[0].reference.reference().cloned().expect("bending's committed reference");
+    let committed =
+        h.state().model().sessions()[0].reference.reference().cloned().expect("bending's committed reference");
     assert_eq!(committed.origin, hox_scenes::reference::Origin::Committed);
     type_into(&mut h, "Poisson ratio ν", "0.49");
-    assert_eq!(h.state().sessions[0].instance.sim.material().poisson_ratio, 0.49);
+    assert_eq!(h.state().model().sessions()[0].instance.sim.material().poisson_ratio, 0.49);
     // (another test may have computed ν = 0.49 already: the memory cache is the process's)
     assert!(
-        h.state().sessions[0].reference.reference().is_none_or(|r| r.poisson_ratio == 0.49),
+        h.state().model().sessions()[0].reference.reference().is_none_or(|r| r.poisson_ratio == 0.49),
         "the ν = 0.35 reference is withdrawn at once"
     );
-    h.state_mut().sessions[0].reference.wait();
+    h.state_mut().model_mut().sessions_mut()[0].reference.wait();
     h.run_steps(2);
-    let r = h.state().sessions[0].reference.reference().cloned().expect("computed");
+    let r = h.state().model().sessions()[0].reference.reference().cloned().expect("computed");
     assert_eq!((r.origin, r.poisson_ratio), (hox_scenes::reference::Origin::Computed, 0.49));
     assert!(r.probes["tip"][2] > committed.probes["tip"][2], "a nearly incompressible beam sags less");
     assert!(r.estimated_error_m.is_some());
     type_into(&mut h, "Poisson ratio ν", "0.35");
-    assert_eq!(h.state().sessions[0].reference.reference(), Some(&committed));
+    assert_eq!(h.state().model().sessions()[0].reference.reference(), Some(&committed));
 }
 
 /// Issue #20: the surface can be coloured by every field, from the "Colour by" menu or key F;
@@ -365,35 +375,36 @@ fn the_colour_field_switches_and_its_range_follows() {
     use hox_sim::measure::field::Field;
     let mut h = harness(AppArgs::default());
     h.run_steps(2);
-    assert_eq!(h.state().viewport.colour_range().map(|r| r.field), Some(Field::Displacement));
+    assert_eq!(h.state().ui_state().viewport.colour_range().map(|r| r.field), Some(Field::Displacement));
     // the "Colour by" menu of the Display section (below the visible part of the panel here)
     let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
+    let mut c = app.model().sessions()[0].config.clone();
     c.field = vec![Field::VonMises];
-    app.apply("field", c);
+    app.act(Action::change("field", c));
     h.run_steps(2);
-    assert_eq!(h.state().sessions[0].config.field, [Field::VonMises]);
+    assert_eq!(h.state().model().sessions()[0].config.field, [Field::VonMises]);
     h.state_mut().step(20);
     h.run_steps(2);
-    let r = h.state().viewport.colour_range().unwrap();
+    let r = h.state().ui_state().viewport.colour_range().unwrap();
     assert_eq!((r.field, r.field.unit(), r.automatic), (Field::VonMises, "Pa", true));
     // a bending beam of E = 3 MPa is stressed by some kPa to a few hundred kPa
     assert!((1e3..1e7).contains(&r.max), "{r:?}");
     // F walks through the fields in order
     h.key_press(egui::Key::F);
     h.run_steps(2);
-    assert_eq!(h.state().viewport.colour_range().unwrap().field, Field::Strain);
+    assert_eq!(h.state().ui_state().viewport.colour_range().unwrap().field, Field::Strain);
     h.key_press(egui::Key::F);
     h.run_steps(2);
-    let det = h.state().viewport.colour_range().unwrap();
+    let det = h.state().ui_state().viewport.colour_range().unwrap();
     assert!(det.field == Field::DetF && det.min < 1.0 && det.max > 1.0, "{det:?}");
     // the error field: the reference's displacement field is solved in the background
-    h.state_mut().set_field(Field::Error);
-    h.state_mut().sessions[0].reference.wait();
+    h.state_mut().act(Action::SetField(Field::Error));
+    h.state_mut().model_mut().sessions_mut()[0].reference.wait();
     h.run_steps(2);
-    let s = &h.state().sessions[0];
-    assert!(s.field_source.has_reference(), "{}", s.reference.status());
-    let r = h.state().viewport.colour_range().unwrap();
+    let s = &h.state().model().sessions()[0];
+    let view = h.state().ui_state().viewport.view(0).expect("drawn");
+    assert!(view.field_source.has_reference(), "{}", s.reference.status());
+    let r = h.state().ui_state().viewport.colour_range().unwrap();
     assert_eq!((r.field, r.field.unit()), (Field::Error, "m"));
 }
 
@@ -402,7 +413,7 @@ fn the_colour_field_switches_and_its_range_follows() {
 /// extents do not overlap.
 #[test]
 fn camera_presets_lay_compared_bodies_apart() {
-    use super::viewport::ViewPreset;
+    use super::presets::ViewPreset;
     let mut h = harness(AppArgs { compare: vec![String::new()], ..Default::default() });
     h.run_steps(2);
     // every preset is a key; the last one also from the View menu
@@ -410,12 +421,13 @@ fn camera_presets_lay_compared_bodies_apart() {
         h.key_press([egui::Key::Num1, egui::Key::Num2, egui::Key::Num3, egui::Key::Num4][k]);
         h.run_steps(3);
         let app = h.state();
-        assert_eq!(app.viewport.preset, preset);
-        assert_eq!((app.viewport.camera.yaw, app.viewport.camera.pitch), preset.yaw_pitch());
+        assert_eq!(app.ui_state().viewport.preset, preset);
+        assert_eq!((app.ui_state().viewport.camera.yaw, app.ui_state().viewport.camera.pitch), preset.yaw_pitch());
         // each body's screen rectangle (its bounding box's corners, offset)
-        let offsets = app.offsets();
+        let offsets = app.model().offsets();
         let rects: Vec<egui::Rect> = app
-            .sessions
+            .model()
+            .sessions()
             .iter()
             .zip(&offsets)
             .map(|(s, o)| {
@@ -426,7 +438,7 @@ fn camera_presets_lay_compared_bodies_apart() {
                         if c & 2 == 0 { lo.y } else { hi.y },
                         if c & 4 == 0 { lo.z } else { hi.z },
                     );
-                    app.viewport.screen_position(p + o)
+                    app.ui_state().viewport.screen_position(p + o)
                 });
                 egui::Rect::from_points(&corners.collect::<Vec<_>>())
             })
@@ -438,7 +450,7 @@ fn camera_presets_lay_compared_bodies_apart() {
     h.run_steps(2);
     h.get_by_label("Front view").click();
     h.run_steps(3);
-    assert_eq!(h.state().viewport.preset, ViewPreset::Front);
+    assert_eq!(h.state().ui_state().viewport.preset, ViewPreset::Front);
 }
 
 /// Issue #20: what a teacher prepared starts from the command line — two configurations as
@@ -462,13 +474,13 @@ fn a_prepared_comparison_starts_from_flags_and_reads_cleanly() {
     let mut h = harness(args);
     h.run_steps(3);
     let app = h.state();
-    let labels: Vec<String> = app.sessions.iter().map(|s| s.label()).collect();
+    let labels: Vec<String> = app.model().sessions().iter().map(|s| s.label()).collect();
     assert_eq!(labels, ["P1 8×2×2 five r1", "P2 8×2×2 five"]);
-    assert!(app.compare && app.sessions.iter().all(|s| s.config.poisson_ratio == 0.3));
-    assert_eq!(app.viewport.preset, super::viewport::ViewPreset::Front);
-    assert_eq!(app.viewport.colour_range().unwrap().field, Field::VonMises);
+    assert!(app.model().compare() && app.model().sessions().iter().all(|s| s.config.poisson_ratio == 0.3));
+    assert_eq!(app.ui_state().viewport.preset, ViewPreset::Front);
+    assert_eq!(app.ui_state().viewport.colour_range().unwrap().field, Field::VonMises);
     // the probe plot shows u_z per configuration, its legend a row above the plot
-    assert_eq!(super::plots::probe_axes(app), [false, false, true]);
+    assert_eq!(app.ui_state().probe_axes(app.model().compare()), [false, false, true]);
     let legend = h.get_by_label("A P1 8×2×2 five r1 u_z").rect();
     let tab = h.get_by_label("Probe displacement").rect();
     let statuses: Vec<egui::Rect> = h.query_all_by_label_contains("nodes,").map(|n| n.rect()).collect();
@@ -491,16 +503,16 @@ fn a_prepared_comparison_starts_from_flags_and_reads_cleanly() {
 /// presenter mode (the interface scaled up, the panels away, the caption over the view).
 #[test]
 fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
-    use super::viewport::ViewPreset;
+    use super::presets::ViewPreset;
     let mut h = harness(args::parse_for_test(&["--lesson", "mesh-bias"]));
     h.run_steps(3);
     h.get_by_label_contains("Step 1 of 3: Five against six");
     // the parameters the lesson's steps change (issue #35)
     h.get_by_label_contains("A: Element p1 · Tet split five");
     h.get_by_label_contains("Question: Does either tip move sideways");
-    let labels: Vec<String> = h.state().sessions.iter().map(|s| s.label()).collect();
+    let labels: Vec<String> = h.state().model().sessions().iter().map(|s| s.label()).collect();
     assert_eq!(labels, ["P1 8×2×2 five", "P1 8×2×2 six"]);
-    assert_eq!(h.state().viewport.preset, ViewPreset::Top);
+    assert_eq!(h.state().ui_state().viewport.preset, ViewPreset::Top);
     // the static step shows the equilibrium at once: the six-split tip sits 2.7 cm sideways
     let six = text(&h, "B P1 8×2×2 six: 0.0");
     assert!(six.contains("0.027"), "{six}");
@@ -512,12 +524,12 @@ fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
     h.run_steps(1);
     // issue #35: while the step is prepared the panel says so, with neither numbers nor answer
     h.get_by_label_contains("Step 2 of 3: Does high order help?");
-    if h.state().lesson.as_ref().unwrap().preparing() {
+    if h.state().model().lesson().unwrap().preparing() {
         h.get_by_label_contains("Preparing this step");
         assert!(h.query_by_label_contains("Answer: B does").is_none(), "the last step's answer is gone");
     }
     lesson_ready(&mut h);
-    assert!(h.state().sessions.iter().all(|s| s.config.element.name() == "p2"));
+    assert!(h.state().model().sessions().iter().all(|s| s.config.element.name() == "p2"));
     assert!(h.query_by_label_contains("Answer:").is_none(), "a new step hides its answer");
     h.key_press(egui::Key::ArrowLeft);
     lesson_ready(&mut h);
@@ -525,7 +537,7 @@ fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
     // presenter mode: no side panels; the caption carries the numbers
     h.key_press(egui::Key::P);
     h.run_steps(3);
-    assert!(h.state().presenter);
+    assert!(h.state().model().presenter());
     assert!(h.query_by_label_contains("Compare two configurations").is_none(), "the controls are hidden");
     h.get_by_label_contains("Mesh bias — Five against six");
     h.get_by_label_contains("B: 0.027");
@@ -537,19 +549,22 @@ fn a_lesson_steps_through_with_its_live_measurement_and_answer() {
 fn lessons_play_their_seconds_are_listed_and_offered_at_first_start() {
     let mut h = harness(args::parse_for_test(&["--lesson", "why-high-order"]));
     h.run_steps(2);
-    assert!(h.state().playback.playing);
+    assert!(h.state().model().playing());
     // the first step plays 0.45 s (27 frames) and pauses there
     h.state_mut().step(27);
     h.run_steps(3);
-    assert!(!h.state().playback.playing, "paused at the bottom of the swing");
+    assert!(!h.state().model().playing(), "paused at the bottom of the swing");
     h.get_by_role_and_label(egui::accesskit::Role::Button, "Lessons").click();
     h.run_steps(2);
     // every lesson is in the menu (the open one's title is also the panel's heading)
     for l in hox_scenes::lesson::registry().unwrap() {
         assert!(h.query_all_by_label(&l.title).count() >= 1, "{}", l.title);
     }
-    assert!(HoxApp::new(&AppArgs::default(), None).unwrap().offer_lessons, "the first start offers the lessons");
-    assert!(!HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap().offer_lessons);
+    assert!(
+        HoxApp::new(&AppArgs::default(), None).unwrap().ui_state().offer_lessons,
+        "the first start offers the lessons"
+    );
+    assert!(!HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap().ui_state().offer_lessons);
     let bad = std::env::temp_dir().join(format!("hox-bad-lesson-{}.toml", std::process::id()));
     std::fs::write(&bad, "title = \"t\"\ngoal = \"g\"\n[[steps]]\ntitle = \"s\"\nscene = \"bending\"\nmeasure = \"tip-uz\"\ntext = \"x\"\nquestion = \"q\"\nanswer = \"a\"\na = { poisson = 0.7 }\n").unwrap();
     let err =
@@ -569,7 +584,7 @@ fn presenter_scale_does_not_leak_into_the_next_start() {
     *h.state_mut() = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap();
     h.run_steps(2);
     assert_eq!(h.ctx.zoom_factor(), 1.0, "an ordinary start is at the ordinary scale");
-    assert!(!h.state().presenter);
+    assert!(!h.state().model().presenter());
     // 2560×1440 on a 1600×900 screen is shrunk to fit; a window that fits is left alone
     let fitted = window::fitted_inner_size(egui::vec2(2560.0, 1440.0), egui::vec2(1600.0, 900.0)).unwrap();
     assert!(fitted.x <= 1600.0 && fitted.y <= 900.0, "{fitted:?}");
@@ -587,9 +602,9 @@ fn another_solvers_typed_fields_are_greyed() {
     assert!(disabled(&h, "Chebyshev ρ"), "Chebyshev ρ active under XPBD");
     assert!(disabled(&h, "Newton tolerance"), "Newton tolerance active under XPBD");
     assert!(!disabled(&h, "Young's modulus E (Pa)"), "a material field is always active");
-    let mut c = h.state().sessions[0].config.clone();
+    let mut c = h.state().model().sessions()[0].config.clone();
     c.method = hox_sim::solver::Method::Newton;
-    h.state_mut().apply("solver", c);
+    h.state_mut().act(Action::change("solver", c));
     h.run_steps(2);
     assert!(!disabled(&h, "Newton tolerance"), "Newton's own field under Newton");
     assert!(disabled(&h, "Chebyshev ρ"), "VBD's field under Newton");
@@ -601,10 +616,10 @@ fn another_solvers_typed_fields_are_greyed() {
 fn the_status_line_says_paused_instead_of_a_frame_rate() {
     let mut h = harness(AppArgs::default());
     h.run_steps(3);
-    assert!(!h.state().playback.playing);
+    assert!(!h.state().model().playing());
     h.get_by_label("paused");
     assert!(h.query_by_label_contains(" fps").is_none(), "no frame rate while paused");
-    h.state_mut().playback.playing = true;
+    h.state_mut().act(Action::SetPlaying(true));
     h.run_steps(3);
     h.get_by_label_contains(" fps");
     assert!(h.query_by_label("paused").is_none());
@@ -615,7 +630,7 @@ fn the_status_line_says_paused_instead_of_a_frame_rate() {
 #[test]
 fn the_labels_above_the_bodies_name_a_and_b() {
     let h = harness(AppArgs { compare: vec![String::new()], ..Default::default() });
-    let s = &h.state().sessions;
+    let s = &h.state().model().sessions();
     let a = viewport::body_label(0, &s[0].label(), "x");
     let b = viewport::body_label(1, &s[1].label(), "y");
     assert!(a.starts_with(&format!("A: {}", s[0].label())) && a.ends_with("\nx"), "{a}");
@@ -635,7 +650,7 @@ fn a_beam_not_yet_run_is_not_called_moving() {
     // stepped while paused: it is mid-swing, and says it is paused (it read "moving")
     let s = status(&h);
     assert!(s.contains("paused mid-swing") && !s.contains("not started") && !s.contains("moving"), "{s}");
-    h.state_mut().playback.playing = true;
+    h.state_mut().act(Action::SetPlaying(true));
     h.run_steps(2);
     let s = status(&h);
     assert!(s.contains("moving") && !s.contains("paused mid-swing"), "{s}");
@@ -644,9 +659,9 @@ fn a_beam_not_yet_run_is_not_called_moving() {
 /// Changes configuration A's `key` as a user's control would, and draws two frames.
 fn change_a(h: &mut Harness<'_, HoxApp>, key: &str, change: impl FnOnce(&mut crate::gui::config::Config)) {
     let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
+    let mut c = app.model().sessions()[0].config.clone();
     change(&mut c);
-    app.apply(key, c);
+    app.act(Action::change(key, c));
     h.run_steps(2);
 }
 
@@ -672,7 +687,7 @@ fn the_solver_says_what_it_does_to_the_motion_and_a_static_step_says_static() {
     h.get_by_label_contains("implicit Euler: First order; damps every mode");
     let mut h = harness(args::parse_for_test(&["--lesson", "mesh-bias"]));
     h.run_steps(3);
-    for s in &h.state().sessions {
+    for s in h.state().model().sessions() {
         assert!(s.readout_label().starts_with("static equilibrium: error"), "{}", s.readout_label());
     }
     assert_eq!(h.query_all_by_label_contains("static, error").count(), 2, "both status lines say static");
@@ -691,7 +706,8 @@ fn a_refined_p1_and_p2_at_nu_0_49_both_get_a_reference() {
     // one computation for the shared physics, not two at half speed each
     let jobs: Vec<_> = h
         .state()
-        .sessions
+        .model()
+        .sessions()
         .iter()
         .map(|s| match &s.reference {
             readout::ReferenceState::Computing { job, .. } => Some(std::sync::Arc::as_ptr(job)),
@@ -700,7 +716,7 @@ fn a_refined_p1_and_p2_at_nu_0_49_both_get_a_reference() {
         .collect();
     let live: Vec<_> = jobs.iter().flatten().collect();
     assert!(live.windows(2).all(|w| w[0] == w[1]), "{jobs:?}");
-    for s in &h.state().sessions {
+    for s in h.state().model().sessions() {
         let label = s.readout_label();
         assert!(!label.contains("no reference"), "{label}");
         // computing (a fast machine may have finished the small test levels already)
@@ -713,15 +729,15 @@ fn a_refined_p1_and_p2_at_nu_0_49_both_get_a_reference() {
         assert!(!line.contains("no reference"), "{line}");
     }
     for k in 0..2 {
-        h.state_mut().sessions[k].reference.wait();
+        h.state_mut().model_mut().sessions_mut()[k].reference.wait();
     }
     h.state_mut().step(150);
     h.run_steps(2);
-    let references: Vec<_> = h.state().sessions.iter().map(|s| s.reference.reference().cloned()).collect();
+    let references: Vec<_> = h.state().model().sessions().iter().map(|s| s.reference.reference().cloned()).collect();
     let a = references[0].clone().expect("the refined P1 has a reference");
     assert_eq!((a.origin, a.poisson_ratio, a.refining), (hox_scenes::reference::Origin::Computed, 0.485, None));
     assert_eq!(references[1].as_ref(), Some(&a), "one reference for the shared physics");
-    for s in &h.state().sessions {
+    for s in h.state().model().sessions() {
         assert!(matches!(s.readout(), Readout::Moving { .. }), "{}: {:?}", s.label(), s.readout());
         assert!(s.readout_label().starts_with("mean error"), "{}", s.readout_label());
     }
@@ -772,7 +788,7 @@ fn a_reference_no_longer_wanted_stops_computing() {
     let mut h = harness(AppArgs::default());
     h.run_steps(2);
     let scene = |nu: f64| {
-        let s = &h.state().sessions[0].instance.scene;
+        let s = &h.state().model().sessions()[0].instance.scene;
         s.with_overrides(&hox_scenes::SceneOverrides { poisson_ratio: Some(nu), ..Default::default() }).unwrap()
     };
     // a state made now is computing (nothing is cached for ν = 0.471), and a second state for
@@ -792,8 +808,8 @@ fn a_reference_no_longer_wanted_stops_computing() {
     drop(wanted);
     assert!(abandoned.upgrade().is_none(), "no one holds the ν = 0.471 computation");
     type_into(&mut h, "Poisson ratio ν", "0.46");
-    h.state_mut().sessions[0].reference.wait();
-    let r = h.state().sessions[0].reference.reference().cloned().expect("ν = 0.46 computed");
+    h.state_mut().model_mut().sessions_mut()[0].reference.wait();
+    let r = h.state().model().sessions()[0].reference.reference().cloned().expect("ν = 0.46 computed");
     assert_eq!((r.poisson_ratio, r.refining), (0.46, None));
 }
 
@@ -801,12 +817,10 @@ fn a_reference_no_longer_wanted_stops_computing() {
 /// pauses (its seconds played, or settled).
 fn play_step_to_its_end(app: &mut HoxApp) {
     for _ in 0..200_000 {
-        if !app.playback.playing {
+        if !app.model().playing() {
             return;
         }
-        app.advance(1.0 / 60.0);
-        app.join_background();
-        app.lesson_after_advance();
+        app.act(Action::Tick { real_dt_secs: 1.0 / 60.0, one_frame_per_tick: false, in_background: false });
     }
     panic!("the step never ended");
 }
@@ -831,19 +845,19 @@ fn every_lesson_shows_the_same_numbers_in_the_app_as_headlessly() {
         let mut runs = Vec::new();
         for _ in 0..2 {
             let mut app = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap();
-            app.open_lesson(lesson.clone());
+            app.act(Action::OpenLesson(Box::new(lesson.clone())));
             let mut shown = Vec::new();
             for (k, step) in lesson.steps.iter().enumerate() {
-                app.go_to_step(k);
-                assert!(app.lesson.as_ref().unwrap().preparing());
-                app.poll_lesson(true);
+                app.act(Action::GoToStep(k));
+                assert!(app.model().lesson().unwrap().preparing());
+                app.act(Action::Poll { wait_for_lesson: true });
                 play_step_to_its_end(&mut app);
                 if let Run::Seconds(secs) = step.run {
-                    let t = app.sessions[0].instance.sim.time_secs();
+                    let t = app.model().sessions()[0].instance.sim.time_secs();
                     assert!((t - secs).abs() < 1e-9, "{} step {}: ended at {t} s, not {secs} s", lesson.name, k + 1);
                 }
-                let state = app.lesson.as_ref().unwrap();
-                shown.push(state.measured(&app.sessions).into_iter().map(|m| m.text).collect::<Vec<_>>());
+                let state = app.model().lesson().unwrap();
+                shown.push(state.measured(app.model().sessions()).into_iter().map(|m| m.text).collect::<Vec<_>>());
             }
             runs.push(shown);
         }
@@ -872,47 +886,47 @@ fn a_change_too_slow_to_play_asks_first_and_a_slow_frame_pauses() {
     let mut h = harness(AppArgs::default());
     h.run_steps(2);
     // as measured on a machine where the P2 beam takes 5 ms per frame
-    h.state_mut().sessions[0].ms_per_frame = 5.0;
+    h.state_mut().model_mut().sessions_mut()[0].ms_per_frame = 5.0;
     let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
+    let mut c = app.model().sessions()[0].config.clone();
     c.refine = 2;
-    app.apply("refine", c.clone());
-    assert!(app.pending_change.is_some(), "64 times the elements: asked first");
-    assert_eq!(app.sessions[0].instance.sim.mesh().num_elements(), 160, "nothing changed yet");
+    app.act(Action::change("refine", c.clone()));
+    assert!(app.model().pending_change().is_some(), "64 times the elements: asked first");
+    assert_eq!(app.model().sessions()[0].instance.sim.mesh().num_elements(), 160, "nothing changed yet");
     h.run_steps(2);
     let question = text(&h, "elements, ");
     assert!(question.contains("10240 elements") && question.contains("per frame"), "{question}");
     h.get_by_label("Keep the current configuration").click();
     h.run_steps(2);
-    assert!(h.state().pending_change.is_none());
-    assert_eq!(h.state().sessions[0].config.refine, 0);
-    h.state_mut().apply("refine", c);
+    assert!(h.state().model().pending_change().is_none());
+    assert_eq!(h.state().model().sessions()[0].config.refine, 0);
+    h.state_mut().act(Action::change("refine", c));
     h.run_steps(1);
     h.get_by_label("Apply, paused").click();
     h.run_steps(2);
-    assert_eq!(h.state().sessions[0].instance.sim.mesh().num_elements(), 10240);
-    assert!(!h.state().playback.playing);
+    assert_eq!(h.state().model().sessions()[0].instance.sim.mesh().num_elements(), 10240);
+    assert!(!h.state().model().playing());
     // a solver setting is estimated on the current mesh: 100 times the substeps of a 5 ms frame
-    h.state_mut().pending_change = None;
-    h.state_mut().sessions[0].ms_per_frame = 5.0;
+    h.state_mut().act(Action::AnswerPending(false));
+    h.state_mut().model_mut().sessions_mut()[0].ms_per_frame = 5.0;
     let app = h.state_mut();
-    let mut c = app.sessions[0].config.clone();
-    c.substeps = 100 * app.sessions[0].instance.sim.substeps_per_frame();
-    app.apply("substeps", c);
-    assert!(app.pending_change.as_ref().is_some_and(|p| p.estimate.contains("xpbd solver")), "asked first");
-    h.state_mut().pending_change = None;
+    let mut c = app.model().sessions()[0].config.clone();
+    c.substeps = 100 * app.model().sessions()[0].instance.sim.substeps_per_frame();
+    app.act(Action::change("substeps", c));
+    assert!(app.model().pending_change().as_ref().is_some_and(|p| p.estimate.contains("xpbd solver")), "asked first");
+    h.state_mut().act(Action::AnswerPending(false));
     // a frame slower than the limit pauses a playing app, saying why
-    h.state_mut().playback.playing = true;
-    h.state_mut().sessions[0].ms_per_frame = 2.0 * super::cost::SLOW_FRAME_MS;
+    h.state_mut().act(Action::SetPlaying(true));
+    h.state_mut().model_mut().sessions_mut()[0].ms_per_frame = 2.0 * super::cost::SLOW_FRAME_MS;
     h.run_steps(1);
-    assert!(!h.state().playback.playing, "paused");
-    assert!(h.state().message.as_deref().is_some_and(|m| m.starts_with("Paused: a frame takes")));
+    assert!(!h.state().model().playing(), "paused");
+    assert!(h.state().model().message().is_some_and(|m| m.starts_with("Paused: a frame takes")));
 }
 
 /// The drawn labels, legend and bodies of the view: every label inside the view, clear of the
 /// legend, the other label and both bodies; every body inside the view (issue #35, symptom 5).
 fn assert_layout_fits(h: &Harness<'_, HoxApp>, what: &str) {
-    let d = &h.state().viewport.drawn;
+    let d = &h.state().ui_state().viewport.drawn;
     let view = d.view.expect("the view was drawn");
     let legend = d.legend.expect("the legend was drawn");
     assert!(view.contains_rect(legend), "{what}: legend {legend:?} outside the view {view:?}");
@@ -941,7 +955,7 @@ fn harness_sized(args: AppArgs, size: egui::Vec2) -> Harness<'static, HoxApp> {
 /// Plays until the app pauses (a settle ends, a lesson step ends), as the window would.
 fn play_until_paused(h: &mut Harness<'_, HoxApp>) {
     for _ in 0..2_000 {
-        if !h.state().playback.playing {
+        if !h.state().model().playing() {
             return;
         }
         h.run_steps(1);
@@ -960,20 +974,20 @@ fn a_classroom_session_at_projector_and_full_hd_sizes() {
         let mut h = harness_sized(AppArgs { compare: vec![String::new()], ..Default::default() }, size);
         h.run_steps(3);
         assert_layout_fits(&h, &at("start"));
-        assert_eq!(h.state().viewport.drawn.labels.len(), 2, "{}", at("both bodies labelled"));
+        assert_eq!(h.state().ui_state().viewport.drawn.labels.len(), 2, "{}", at("both bodies labelled"));
         // ν typed: both say what the reference is doing, never "no reference"
         type_into(&mut h, "Poisson ratio ν", "0.45");
-        for s in &h.state().sessions {
+        for s in h.state().model().sessions() {
             assert!(!s.readout_label().contains("no reference"), "{}: {}", at("ν typed"), s.readout_label());
         }
         for k in 0..2 {
-            h.state_mut().sessions[k].reference.wait();
+            h.state_mut().model_mut().sessions_mut()[k].reference.wait();
         }
         // settle: both read their settled error, the app pauses
-        h.state_mut().settle();
+        h.state_mut().act(Action::Settle);
         play_until_paused(&mut h);
         h.run_steps(2);
-        for s in &h.state().sessions {
+        for s in h.state().model().sessions() {
             assert!(s.readout_label().starts_with("settled: error"), "{}: {}", at("settled"), s.readout_label());
         }
         assert_layout_fits(&h, &at("settled"));
@@ -981,7 +995,7 @@ fn a_classroom_session_at_projector_and_full_hd_sizes() {
         choose_newton_for_a(&mut h);
         // a lesson, forward and back, with its answer
         let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "locking").unwrap();
-        h.state_mut().open_lesson(lesson);
+        h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
         lesson_ready(&mut h);
         h.get_by_label_contains("A: Element p1 · Grid 8x2x2 · Poisson ratio ν 0.3");
         assert_layout_fits(&h, &at("lesson step 1"));
@@ -1001,7 +1015,7 @@ fn a_classroom_session_at_projector_and_full_hd_sizes() {
         h.run_steps(3);
         h.key_press(egui::Key::A);
         h.run_steps(3);
-        assert!(h.state().presenter);
+        assert!(h.state().model().presenter());
         assert_layout_fits(&h, &at("presenter, answered"));
         h.key_press(egui::Key::P);
         h.run_steps(3);
@@ -1020,7 +1034,7 @@ fn a_classroom_session_at_projector_and_full_hd_sizes() {
 #[test]
 fn a_lesson_opens_on_the_step_asked_for() {
     let h = harness(args::parse_for_test(&["--lesson", "why-high-order", "--lesson-step", "3"]));
-    let state = h.state().lesson.as_ref().unwrap();
+    let state = h.state().model().lesson().unwrap();
     assert_eq!((state.step, state.preparing()), (2, false));
     let err = HoxApp::new(&args::parse_for_test(&["--lesson", "why-high-order", "--lesson-step", "9"]), None)
         .err()
@@ -1039,7 +1053,7 @@ fn serving_browsers_shows_the_address_beside_the_view_and_a_busy_port_is_a_messa
     let args = AppArgs { presenter: true, serve_web: true, serve: free, ..Default::default() };
     let mut h = harness(args);
     h.run_steps(4);
-    let url = h.state().web_url().expect("serving from the start").to_string();
+    let url = h.state().rerun.web_url().expect("serving from the start").to_string();
     assert!(url.starts_with("http://127.0.0.1:") && url.contains("?url=rerun"), "{url}");
     let qr = h.get_by_label("Follow in your browser:").rect();
     let width = h.ctx.content_rect().width();
@@ -1050,8 +1064,8 @@ fn serving_browsers_shows_the_address_beside_the_view_and_a_busy_port_is_a_messa
     let busy = crate::web::ServeArgs { web_port: port, grpc_port: 0, ..Default::default() };
     let mut h = harness(AppArgs { serve_web: true, serve: busy, ..Default::default() });
     h.run_steps(3);
-    assert!(h.state().web_url().is_none());
-    let message = h.state().message.clone().unwrap_or_default();
+    assert!(h.state().rerun.web_url().is_none());
+    let message = h.state().model().message().unwrap_or_default().to_string();
     assert!(message.contains(&format!("127.0.0.1:{port}")) && message.contains("in use"), "{message}");
     assert!(h.query_by_label("Follow in your browser:").is_none());
 }
@@ -1061,8 +1075,8 @@ fn serving_browsers_shows_the_address_beside_the_view_and_a_busy_port_is_a_messa
 /// when the cap held it back (sent once the app paused); every frame with `--serve-fps 0`.
 #[test]
 fn served_browsers_end_on_the_frame_the_app_paused_on() {
-    let logged = |h: &Harness<'_, HoxApp>| h.state().rerun.as_ref().and_then(|l| l.last_logged_frame);
-    let frame = |h: &Harness<'_, HoxApp>| h.state().sessions[0].instance.sim.frames();
+    let logged = |h: &Harness<'_, HoxApp>| h.state().rerun.sent().and_then(|l| l.last_logged_frame);
+    let frame = |h: &Harness<'_, HoxApp>| h.state().model().sessions()[0].instance.sim.frames();
     for fps in [1, 0] {
         let free = crate::web::ServeArgs { web_port: 0, grpc_port: 0, ..Default::default() };
         let mut h = harness(AppArgs { serve_web: true, serve: free, serve_fps: fps, ..Default::default() });
@@ -1076,12 +1090,12 @@ fn served_browsers_end_on_the_frame_the_app_paused_on() {
         }
         h.key_press(egui::Key::Space);
         h.run_steps(2);
-        assert!(!h.state().playback.playing);
+        assert!(!h.state().model().playing());
         assert_eq!(logged(&h), Some(frame(&h)), "--serve-fps {fps}: the browsers end on the frame paused on");
-        assert!(!h.state().rerun.as_ref().unwrap().pending());
-        let count = h.state().rerun.as_ref().unwrap().frames_logged;
+        assert!(!h.state().rerun.sent().unwrap().pending);
+        let count = h.state().rerun.sent().unwrap().frames_logged;
         h.run_steps(10);
-        assert_eq!(h.state().rerun.as_ref().unwrap().frames_logged, count, "nothing new is sent while paused");
+        assert_eq!(h.state().rerun.sent().unwrap().frames_logged, count, "nothing new is sent while paused");
     }
 }
 
@@ -1095,17 +1109,17 @@ fn revealing_the_answer_while_paused_reaches_the_browsers() {
     h.run_steps(3);
     h.key_press(egui::Key::Space);
     h.run_steps(2);
-    assert!(!h.state().playback.playing, "paused");
-    let sent = |h: &Harness<'_, HoxApp>| h.state().rerun.as_ref().unwrap().lesson_text.clone().unwrap_or_default();
+    assert!(!h.state().model().playing(), "paused");
+    let sent = |h: &Harness<'_, HoxApp>| h.state().rerun.sent().unwrap().lesson_text.unwrap_or_default();
     let before = sent(&h);
     assert!(!before.is_empty(), "the step's text is sent");
-    h.state_mut().lesson.as_mut().unwrap().revealed = true;
+    h.state_mut().act(Action::RevealAnswer);
     h.run_steps(2);
     let after = sent(&h);
     assert_ne!(after, before, "the revealed answer is sent while paused");
-    let count = h.state().rerun.as_ref().unwrap().frames_logged;
+    let count = h.state().rerun.sent().unwrap().frames_logged;
     h.run_steps(5);
-    assert_eq!(h.state().rerun.as_ref().unwrap().frames_logged, count, "once");
+    assert_eq!(h.state().rerun.sent().unwrap().frames_logged, count, "once");
 }
 
 /// Issue #39: *Export figure* draws the configurations on screen — here A and B of the torsion
@@ -1119,17 +1133,17 @@ fn export_figure_writes_the_papers_figure_of_the_configurations_on_screen() {
     let mut h = harness(AppArgs { scene: Some("torsion".into()), compare: vec![String::new()], ..Default::default() });
     h.run_steps(2);
     h.state_mut().step(20);
-    h.state_mut().figure_folder = folder.display().to_string();
+    h.state_mut().ui.figure_folder = folder.display().to_string();
     h.get_by_label("Export figure").scroll_to_me();
     h.run_steps(2);
     h.get_by_label("Export figure").click_accesskit();
     h.run_steps(1);
     h.run_steps(1);
-    let message = h.state().message.clone().unwrap_or_default();
+    let message = h.state().model().message().unwrap_or_default().to_string();
     assert!(message.starts_with("wrote ") && message.contains("fig2-torsion.png"), "{message}");
     let svg = std::fs::read_to_string(folder.join("fig2-torsion.svg")).expect("the SVG");
     assert!(svg.contains(r##"stroke="#e00000""##), "the reference's outline in red");
-    let labels: Vec<String> = h.state().sessions.iter().map(|s| s.label()).collect();
+    let labels: Vec<String> = h.state().model().sessions().iter().map(|s| s.label()).collect();
     for (k, label) in labels.iter().enumerate() {
         let panel = format!(">{}: {label}<", ["A", "B"][k]);
         assert!(svg.contains(&panel), "no panel {panel} in the figure");
@@ -1162,7 +1176,7 @@ fn with_a_software_renderer_the_playing_window_paints_when_a_simulated_frame_is_
         );
     assert_eq!(h.state().paint_pace(), None, "a window with vsync is not paced");
     h.state_mut().pace_paint = true;
-    let t0 = h.state().sessions[0].instance.sim.time_secs();
+    let t0 = h.state().model().sessions()[0].instance.sim.time_secs();
     let mut waits = Vec::new();
     for _ in 0..40 {
         h.run_steps(1);
@@ -1170,12 +1184,12 @@ fn with_a_software_renderer_the_playing_window_paints_when_a_simulated_frame_is_
     }
     assert!(waits.iter().all(|w| *w > 0.0 && *w <= frame + 1e-6), "{waits:?}");
     assert!(waits.iter().any(|w| (w - frame).abs() < 1e-6), "just after a frame: a whole frame to wait, {waits:?}");
-    let t = h.state().sessions[0].instance.sim.time_secs() - t0;
+    let t = h.state().model().sessions()[0].instance.sim.time_secs() - t0;
     assert!((t - 40.0 / 120.0).abs() <= frame + 1e-9, "simulated time follows the clock: {t} s in 1/3 s");
     // settling goes as fast as the CPU allows
     h.key_press(egui::Key::E);
     h.run_steps(1);
-    assert!(h.state().settling());
+    assert!(h.state().model().settling());
     assert_eq!(h.state().paint_pace(), None, "settling is not paced");
     // measuring the frame rate is not paced either
     let mut m =

@@ -10,8 +10,10 @@
 //! ([`hox_sim::measure::surface`]), so curved high-order faces and edges bend as the elements do.
 
 use super::gl_view::{GlScene, GlState, paint_callback};
+use super::presets::{ViewOptions, ViewPreset};
 use super::raster::{BACKGROUND, Camera, Image, Overlay, TriangleLayer, shade};
 use super::session::{Drag, Session};
+use super::session_view::SessionView;
 use crate::colour::{ColourRange, FieldScale};
 use crate::display::SurfaceFrame;
 pub use crate::display::f32s;
@@ -20,70 +22,6 @@ use hox_sim::Vec3;
 use hox_sim::measure::field::Field;
 use std::sync::Arc;
 use std::time::Instant;
-
-/// What the viewport shows.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct ViewOptions {
-    pub edges: bool,
-    pub nodes: bool,
-    pub boundary_conditions: bool,
-    pub ghost: bool,
-    pub probes: bool,
-}
-
-impl Default for ViewOptions {
-    fn default() -> Self {
-        Self { edges: true, nodes: false, boundary_conditions: true, ghost: true, probes: true }
-    }
-}
-
-/// A camera preset: where the view looks from, and the axis compared configurations are laid
-/// apart along so neither hides the other from there.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
-pub enum ViewPreset {
-    /// Three-quarter view from the front, above.
-    #[default]
-    Iso,
-    /// Looking along +y at the x–z plane: a beam's bending.
-    Front,
-    /// Looking along −x at the y–z plane: a beam's cross-section, its twist and sideways bend.
-    Side,
-    /// Looking down −z at the x–y plane: a sideways bend (the tet split's bias).
-    Top,
-}
-
-impl ViewPreset {
-    pub const ALL: [ViewPreset; 4] = [ViewPreset::Iso, ViewPreset::Front, ViewPreset::Side, ViewPreset::Top];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            ViewPreset::Iso => "iso",
-            ViewPreset::Front => "front",
-            ViewPreset::Side => "side",
-            ViewPreset::Top => "top",
-        }
-    }
-
-    /// The camera's (yaw, pitch), radians ([`Camera`]): the eye's direction from the target.
-    pub fn yaw_pitch(self) -> (f32, f32) {
-        use std::f32::consts::FRAC_PI_2;
-        match self {
-            ViewPreset::Iso => (-1.2, 0.45),
-            ViewPreset::Front => (-FRAC_PI_2, 0.0),
-            ViewPreset::Side => (0.0, 0.0),
-            // straight down, x to the right
-            ViewPreset::Top => (-FRAC_PI_2, FRAC_PI_2 - 1e-3),
-        }
-    }
-
-    /// The axis across the line of sight that configurations are laid apart along.
-    pub fn layout_axis(self) -> crate::display::LayoutAxis {
-        match self {
-            ViewPreset::Side => crate::display::LayoutAxis::Y,
-            _ => crate::display::LayoutAxis::X,
-        }
-    }
-}
 
 pub const CORNER_NODE: [u8; 4] = [250, 250, 250, 255];
 pub const HIGH_ORDER_NODE: [u8; 4] = [40, 220, 240, 255];
@@ -99,6 +37,8 @@ pub struct Viewport {
     image: Image,
     texture: Option<egui::TextureHandle>,
     layers: Vec<TriangleLayer>,
+    /// How each session is drawn ([`SessionView`]), following it.
+    views: Vec<SessionView>,
     /// The display frame of each session (shared with the recording, [`crate::display`]).
     frames: Vec<SurfaceFrame>,
     /// Wall time of the last render (rasterise + upload), milliseconds.
@@ -155,6 +95,7 @@ impl Viewport {
             image: Image::new(1, 1),
             texture: None,
             layers: Vec::new(),
+            views: Vec::new(),
             frames: Vec::new(),
             render_ms: 0.0,
             dragging: None,
@@ -213,7 +154,7 @@ impl Viewport {
     /// Takes this frame's field values of every session into the shared scale: the first
     /// session's field and range settings for all, started again when a run restarts or they
     /// change.
-    fn update_fields(&mut self, sessions: &mut [Session]) -> ColourRange {
+    fn update_fields(&mut self, sessions: &[Session]) -> ColourRange {
         let Some(first) = sessions.first() else { return ColourRange::metres(1.0) };
         let field = crate::display::fields(&first.config)[0];
         let want = crate::display::field_scale(Some(first.instance.sim.mesh()), &first.config, field);
@@ -229,10 +170,10 @@ impl Viewport {
             scale.reset();
         }
         self.frames.resize_with(sessions.len(), SurfaceFrame::default);
-        for (s, frame) in sessions.iter_mut().zip(&mut self.frames) {
-            s.field_source.field = field;
-            frame.update(&s.surface, &s.instance.sim);
-            frame.update_field(&s.surface, &s.instance.sim, &mut s.field_source);
+        for ((s, v), frame) in sessions.iter().zip(&mut self.views).zip(&mut self.frames) {
+            v.field_source.field = field;
+            frame.update(&v.surface, &s.instance.sim);
+            frame.update_field(&v.surface, &s.instance.sim, &mut v.field_source);
             scale.observe(&frame.values);
         }
         let range = scale.range();
@@ -242,9 +183,36 @@ impl Viewport {
         range
     }
 
+    /// The views follow `sessions` (one each, rebuilt for a new mesh, caught up otherwise).
+    pub fn follow(&mut self, sessions: &[Session]) {
+        self.views.truncate(sessions.len());
+        for (k, s) in sessions.iter().enumerate() {
+            match self.views.get_mut(k) {
+                Some(v) => v.follow(s),
+                None => self.views.push(SessionView::new(s)),
+            }
+        }
+    }
+
+    /// The view of session `k`, as drawn last.
+    #[cfg(test)]
+    pub fn view(&self, k: usize) -> Option<&SessionView> {
+        self.views.get(k)
+    }
+
     /// Shows the view; `gl` says whether the frame has an OpenGL context to draw it with (else,
-    /// or if the GL view failed to build, the CPU rasteriser draws it).
-    pub fn ui(&mut self, ui: &mut egui::Ui, sessions: &mut [Session], offsets: &[Vec3], opts: &ViewOptions, gl: bool) {
+    /// or if the GL view failed to build, the CPU rasteriser draws it). Returns a change of the
+    /// mouse drag: the session and its new drag (None: released).
+    pub fn ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        sessions: &[Session],
+        offsets: &[Vec3],
+        opts: &ViewOptions,
+        gl: bool,
+    ) -> Option<(usize, Option<Drag>)> {
+        self.follow(sessions);
+        let mut drag_change = None;
         let use_gl = gl && self.gl_error().is_none();
         if !self.fitted {
             self.reset_camera(sessions, offsets);
@@ -297,7 +265,7 @@ impl Viewport {
                     let px = to_px(pos);
                     if let Some(world) = self.image.unproject(px[0], px[1], depth) {
                         let target = Vec3::new(world[0] as f64, world[1] as f64, world[2] as f64) - offsets[k];
-                        sessions[k].drag = Some(Drag { node, target_m: target });
+                        drag_change = Some((k, Some(Drag { node, target_m: target })));
                     }
                 }
                 _ if shift => {
@@ -318,7 +286,7 @@ impl Viewport {
         if (response.drag_stopped() || !ui.input(|i| i.pointer.primary_down()))
             && let Some((k, _, _)) = self.dragging.take()
         {
-            sessions[k].drag = None;
+            drag_change = Some((k, None));
         }
 
         // --- scene
@@ -327,14 +295,16 @@ impl Viewport {
         self.layers.resize_with(sessions.len(), TriangleLayer::default);
         let mut overlay = Overlay::default();
         let mut x = Vec::new();
-        for (((s, layer), frame), o) in sessions.iter().zip(&mut self.layers).zip(&self.frames).zip(offsets) {
+        for ((((s, v), layer), frame), o) in
+            sessions.iter().zip(&self.views).zip(&mut self.layers).zip(&self.frames).zip(offsets)
+        {
             let sim = &s.instance.sim;
             layer.positions = frame.positions_m.iter().map(|p| f32s(&(p + o))).collect();
             layer.normals = frame.normals.iter().map(f32s).collect();
             layer.colours.clone_from(&frame.colours);
-            layer.triangles.clone_from(&s.surface.triangles);
+            layer.triangles.clone_from(&v.surface.triangles);
             if opts.edges {
-                for e in &s.surface.edges {
+                for e in &v.surface.edges {
                     for pair in e.windows(2) {
                         overlay.lines.push((
                             layer.positions[pair[0] as usize],
@@ -345,8 +315,8 @@ impl Viewport {
                 }
             }
             if opts.ghost {
-                let rest = &s.rest_vertices;
-                for e in &s.surface.edges {
+                let rest = &v.rest_vertices;
+                for e in &v.surface.edges {
                     for pair in e.windows(2) {
                         overlay.lines.push((
                             f32s(&(rest[pair[0] as usize] + o)),
@@ -358,14 +328,14 @@ impl Viewport {
             }
             if opts.nodes {
                 for (i, p) in sim.positions.iter().enumerate() {
-                    let (half, c) = if s.corner_nodes[i] { (3.0, CORNER_NODE) } else { (2.5, HIGH_ORDER_NODE) };
+                    let (half, c) = if v.corner_nodes[i] { (3.0, CORNER_NODE) } else { (2.5, HIGH_ORDER_NODE) };
                     overlay.points.push((f32s(&(p + o)), half, c));
                 }
             }
             if opts.boundary_conditions {
-                for (edges, colour) in [(&s.clamped_edges, CLAMPED), (&s.driven_edges, DRIVEN)] {
+                for (edges, colour) in [(&v.clamped_edges, CLAMPED), (&v.driven_edges, DRIVEN)] {
                     for &k in edges {
-                        for pair in s.surface.edges[k].windows(2) {
+                        for pair in v.surface.edges[k].windows(2) {
                             overlay.lines.push((
                                 layer.positions[pair[0] as usize],
                                 layer.positions[pair[1] as usize],
@@ -374,15 +344,15 @@ impl Viewport {
                         }
                     }
                 }
-                for &n in &s.clamped {
+                for &n in &v.clamped {
                     overlay.points.push((f32s(&(sim.positions[n as usize] + o)), 2.0, CLAMPED));
                 }
-                for &n in &s.driven {
+                for &n in &v.driven {
                     overlay.points.push((f32s(&(sim.positions[n as usize] + o)), 2.0, DRIVEN));
                 }
             }
             if s.config.quadrature_points {
-                let q = s.quadrature_points();
+                let q = v.quadrature_points(s);
                 q.eval_into(&sim.positions, &mut x);
                 overlay.points.extend(x.iter().map(|p| (f32s(&(p + o)), 2.0, QUADRATURE_POINT)));
             }
@@ -474,15 +444,16 @@ impl Viewport {
         }
         self.drawn = drawn;
         let values: Vec<f64> = self.frames.iter().flat_map(|f| f.values.iter().copied()).collect();
-        let note = sessions.first().and_then(|s| {
-            (colours.field == Field::Error && !s.field_source.has_reference())
+        let note = sessions.first().zip(self.views.first()).and_then(|(s, v)| {
+            (colours.field == Field::Error && !v.field_source.has_reference())
                 .then(|| format!("no reference field: {}", s.reference.status()))
         });
         let held = (
-            opts.boundary_conditions && sessions.iter().any(|s| !s.clamped_edges.is_empty()),
-            opts.boundary_conditions && sessions.iter().any(|s| !s.driven_edges.is_empty()),
+            opts.boundary_conditions && self.views.iter().any(|v| !v.clamped_edges.is_empty()),
+            opts.boundary_conditions && self.views.iter().any(|v| !v.driven_edges.is_empty()),
         );
         legend_ui(&painter, rect, &colours, &values, note.as_deref(), held);
+        drag_change
     }
 
     /// Draws the view with the CPU rasteriser and shows it as a texture.
@@ -558,13 +529,13 @@ impl Viewport {
     fn pick_node(&self, sessions: &[Session], offsets: &[Vec3], px: [f32; 2]) -> Option<(usize, u32, f32)> {
         let radius_px = 12.0 * self.image.width as f32 / 1000.0_f32.max(self.image.width as f32) + 8.0;
         let mut best: Option<(f32, (usize, u32, f32))> = None;
-        for (k, (s, o)) in sessions.iter().zip(offsets).enumerate() {
+        for (k, ((s, view), o)) in sessions.iter().zip(&self.views).zip(offsets).enumerate() {
             let sim = &s.instance.sim;
-            for (v, kind) in s.surface.node_kind.iter().enumerate() {
+            for (v, kind) in view.surface.node_kind.iter().enumerate() {
                 if kind.is_none() {
                     continue;
                 }
-                let Some(node) = s.surface.vertices.single_node(v) else { continue };
+                let Some(node) = view.surface.vertices.single_node(v) else { continue };
                 if sim.inv_mass()[node as usize] == 0.0 {
                     continue; // clamped or driven: not draggable
                 }

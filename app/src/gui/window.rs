@@ -1,7 +1,13 @@
-//! The window's contents, frame by frame: the panels around the 3D view, the status line, the
-//! bookkeeping after a frame (screenshot, measurement), and the `eframe::App` the window runs.
+//! The window's frame: the model polled and ticked by egui's clock, the panels laid out around
+//! the 3D view (each returning commands, carried out once the frame is built), the repaints
+//! asked for, the bookkeeping after a frame (screenshot, measurement), and the `eframe::App` the
+//! window runs.
 
-use super::{HoxApp, controls, plots};
+use super::action::{Action, Commands};
+use super::app::HoxApp;
+use super::readout::ReferenceState;
+use super::ui_state::Ctx;
+use super::{controls, dialogs, lesson_panel, menu, plots, serve_web, status};
 use eframe::egui;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -34,77 +40,16 @@ impl HoxApp {
     /// a few frames after the start: eframe reports the monitor and the window in the points of
     /// the scale of an earlier frame, which the start's own scale may have just changed.
     fn fit_window_to_screen(&mut self, ctx: &egui::Context) {
-        if self.fit_to_screen_in_frames > 0 {
-            self.fit_to_screen_in_frames -= 1;
+        if self.ui.fit_to_screen_in_frames > 0 {
+            self.ui.fit_to_screen_in_frames -= 1;
             return;
         }
         let (monitor, inner) = ctx.input(|i| (i.viewport().monitor_size, i.viewport().inner_rect));
         let (Some(monitor), Some(inner)) = (monitor, inner) else { return };
-        self.fit_to_screen = false;
+        self.ui.fit_to_screen = false;
         if let Some(size) = fitted_inner_size(inner.size(), monitor) {
             ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(size));
         }
-    }
-
-    fn status_line_ui(&self, ui: &mut egui::Ui) {
-        ui.horizontal_wrapped(|ui| {
-            for (k, s) in self.sessions.iter().enumerate() {
-                let sim = &s.instance.sim;
-                let solver = sim.work_summary();
-                // one short line per configuration; the details on hover
-                let mut text = format!(
-                    "{}{}: {} nodes, {} el, {:.1} ms/frame, {}",
-                    if self.compare { ["A ", "B "][k] } else { "" },
-                    s.label(),
-                    sim.mesh().num_nodes(),
-                    sim.mesh().num_elements(),
-                    s.ms_per_frame,
-                    s.readout().error_text()
-                );
-                if s.settler.is_some() {
-                    text += " (settling…)";
-                }
-                let raised = sim.substeps_per_frame() > s.config.substeps;
-                if raised {
-                    text += &format!(", {} substeps (guard)", sim.substeps_per_frame());
-                }
-                // the reference's state on hover: the line stays one line (the labels carry it)
-                let details = format!(
-                    "{} nodes, {} elements, {solver}, residual {:.1e}, t = {:.2} s\n{}\n{}",
-                    sim.mesh().num_nodes(),
-                    sim.mesh().num_elements(),
-                    s.residual,
-                    sim.time_secs(),
-                    s.readout().text(),
-                    s.reference.status()
-                );
-                let label = ui.label(egui::RichText::new(text).monospace()).on_hover_text(details);
-                if raised {
-                    label.on_hover_text(format!(
-                        "The stability guard takes {} substeps per frame instead of {}: the stiffest element's fastest mode needs h·ω_max ≤ {} (docs/STABILITY.md). Switch it off under Solver to see the instability.",
-                        sim.substeps_per_frame(),
-                        s.config.substeps,
-                        hox_sim::solver::stability::GUARD_H_OMEGA
-                    ));
-                }
-                if let Some(f) = &s.failure {
-                    ui.colored_label(egui::Color32::from_rgb(255, 90, 80), f);
-                }
-                ui.separator();
-            }
-            // paused, the window repaints only on input: a frame rate then means nothing (issue
-            // #35: "0–1 fps" whenever paused)
-            let rate = if self.playback.playing || self.settling() {
-                format!("{:.0} fps", 1000.0 / self.times.ui_frame_ms.max(1e-3))
-            } else {
-                "paused".to_string()
-            };
-            ui.label(egui::RichText::new(rate).monospace())
-                .on_hover_text(format!("Displayed frames per second; view {:.1} ms and app {:.1} ms of CPU per frame (the 3D view's preparation and the app's whole frame). Renderer: {}.", self.viewport.render_ms, self.times.app_ms, self.renderer.as_deref().unwrap_or("none (no OpenGL: CPU rasteriser)")));
-            if let Some(e) = self.viewport.gl_error() {
-                ui.colored_label(egui::Color32::from_rgb(255, 170, 60), format!("OpenGL view unavailable, drawn on the CPU: {e}"));
-            }
-        });
     }
 
     /// The whole window (also driven by the headless UI tests).
@@ -112,92 +57,86 @@ impl HoxApp {
         let ctx = ui.ctx().clone();
         let now = Instant::now();
         self.times.frame_started(now);
-        self.join_background();
+        self.act(Action::Poll { wait_for_lesson: false });
         // a reference computed in the background arrives; until then its progress is shown
-        let mut computing = false;
-        for s in &mut self.sessions {
-            s.poll_reference();
-            computing |= matches!(s.reference, super::readout::ReferenceState::Computing { .. });
-        }
-        if computing {
+        if self.model.sessions().iter().any(|s| matches!(s.reference, ReferenceState::Computing { .. })) {
             ctx.request_repaint_after(std::time::Duration::from_millis(250));
         }
-        if self.lesson.as_ref().is_some_and(|l| l.preparing()) {
+        if self.model.lesson().is_some_and(|l| l.preparing()) {
             // a lesson step being prepared: look again soon
-            self.poll_lesson(false);
             ctx.request_repaint_after(std::time::Duration::from_millis(50));
         }
-        self.shortcuts(&ctx);
-        self.lesson_shortcuts(&ctx);
-        if let Some(z) = self.zoom_wanted.take() {
+        let status = self.status();
+        let mut keys = Commands::default();
+        menu::shortcuts(&mut Ctx { model: &self.model, state: &mut self.ui, status: &status, out: &mut keys }, &ctx);
+        self.act_all(keys);
+        if let Some(z) = self.ui.zoom_wanted.take() {
             ctx.set_zoom_factor(z);
         }
-        if self.fit_to_screen {
+        if self.ui.fit_to_screen {
             self.fit_window_to_screen(&ctx);
         }
         // Simulated time follows egui's clock (the window's: wall time between frames; the
         // headless tests': exactly their step), never the wall clock read here, so a test plays
-        // the same frames in a slow debug build and a fast release one.
-        let clock_dt = f64::from(ctx.input(|i| i.unstable_dt));
-        self.advance(if self.playback.last_clock_frame { clock_dt } else { 0.0 });
-        self.lesson_after_advance();
-        self.pause_if_slow();
-        self.playback.last_clock_frame = true;
-        let paused = !self.playback.playing && !self.settling();
-        for s in &mut self.sessions {
-            s.paused = paused;
-        }
+        // the same frames in a slow debug build and a fast release one. With an OpenGL context and
+        // no live Rerun link (which logs every frame in order) the frames are stepped on the
+        // stepper while the window paints.
+        let real_dt_secs = f64::from(ctx.input(|i| i.unstable_dt));
+        let in_background = self.gl_available && !self.rerun.is_open();
+        self.act(Action::Tick { real_dt_secs, one_frame_per_tick: self.measure.is_some(), in_background });
 
+        let status = self.status();
+        let mut out = Commands::default();
+        let gl = self.gl_available;
+        let mut cx = Ctx { model: &self.model, state: &mut self.ui, status: &status, out: &mut out };
         // The panels are not filled: the window is cleared to the panel colour (`clear_color`), and
         // a software renderer pays per blended pixel for each fill (docs/APP.md).
         let frame = egui::Frame::side_top_panel(ui.style()).fill(egui::Color32::TRANSPARENT);
-        egui::Panel::top("menu").frame(frame).show(ui, |ui| controls::menu_bar_ui(self, ui));
-        egui::Panel::bottom("status").frame(frame).show(ui, |ui| self.status_line_ui(ui));
+        let presenter = cx.model.presenter();
+        egui::Panel::top("menu").frame(frame).show(ui, |ui| menu::menu_bar_ui(&mut cx, ui));
+        egui::Panel::bottom("status").frame(frame).show(ui, |ui| status::status_line_ui(&cx, ui));
         // presenter mode: the 3D view fills the window, the lesson's caption in a panel below it
-        if self.presenter && self.lesson.is_some() {
-            egui::Panel::bottom("caption").frame(frame).show(ui, |ui| super::lesson::caption_ui(self, ui));
+        if presenter && cx.model.lesson().is_some() {
+            egui::Panel::bottom("caption").frame(frame).show(ui, |ui| lesson_panel::caption_ui(&cx, ui));
         }
         // presenter mode while serving the class's browsers: the address and its QR code beside
         // the view
-        if self.presenter && self.web_url().is_some() {
+        if presenter && cx.status.web_url.is_some() {
             egui::Panel::right("serve_web").frame(frame).resizable(false).default_size(230.0).show(ui, |ui| {
-                super::serve_web::address_ui(self, ui);
+                serve_web::address_ui(&cx, ui);
             });
         }
-        if !self.presenter {
+        if !presenter {
             egui::Panel::bottom("plots")
                 .frame(frame)
                 .resizable(true)
                 .default_size(230.0)
-                .show(ui, |ui| plots::plots_ui(self, ui));
-            if self.lesson.is_some() {
+                .show(ui, |ui| plots::plots_ui(&mut cx, ui));
+            if cx.model.lesson().is_some() {
                 egui::Panel::right("lesson").frame(frame).resizable(true).default_size(380.0).show(ui, |ui| {
-                    egui::ScrollArea::vertical().show(ui, |ui| super::lesson::lesson_panel_ui(self, ui));
+                    egui::ScrollArea::vertical().show(ui, |ui| lesson_panel::lesson_panel_ui(&mut cx, ui));
                 });
             }
             egui::Panel::left("controls").frame(frame).resizable(true).default_size(330.0).show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| controls::controls_ui(self, ui));
+                egui::ScrollArea::vertical().show(ui, |ui| controls::controls_ui(&mut cx, ui));
             });
         }
-        super::lesson::welcome_ui(self, &ctx);
-        if self.show_reference_element {
-            let mut open = true;
-            egui::Window::new("Reference element")
-                .open(&mut open)
-                .default_size([420.0, 460.0])
-                .show(&ctx, |ui| self.reference_element.ui(ui));
-            self.show_reference_element = open;
-        }
-        controls::open_dialog_ui(self, &ctx);
-        super::cost::pending_change_ui(self, &ctx);
+        lesson_panel::welcome_ui(&mut cx, &ctx);
+        dialogs::reference_element_ui(&mut cx, &ctx);
+        dialogs::open_dialog_ui(&mut cx, &ctx);
+        dialogs::pending_change_ui(&mut cx, &ctx);
         egui::CentralPanel::no_frame().show(ui, |ui| {
-            self.viewport.short_labels = self.presenter && self.lesson.is_some();
-            let offsets = self.offsets();
-            self.viewport.ui(ui, &mut self.sessions, &offsets, &self.view, self.gl_available);
+            cx.state.viewport.short_labels = presenter && cx.model.lesson().is_some();
+            let offsets = cx.model.offsets();
+            let drag = cx.state.viewport.ui(ui, cx.model.sessions(), &offsets, cx.model.view(), gl);
+            if let Some((session, drag)) = drag {
+                cx.out.push(Action::Drag { session, drag });
+            }
         });
-        if self.sessions.iter().any(|s| s.drag.is_some()) {
+        self.act_all(out);
+        if self.model.sessions().iter().any(|s| s.drag.is_some()) {
             ctx.request_repaint();
-        } else if self.playback.playing {
+        } else if self.model.playing() {
             match self.paint_pace() {
                 Some(wait) => ctx.request_repaint_after(wait),
                 None => ctx.request_repaint(),
@@ -205,16 +144,48 @@ impl HoxApp {
         }
         // paused or settled in this frame (a button, a shortcut, the settle's end): the browsers
         // get the frame the app stopped on, if the frame cap held it back
-        self.flush_rerun();
+        let flushed = self.rerun.flush(&self.model);
+        if let Some(e) = flushed {
+            self.act(Action::Say(e));
+        }
         let ms = now.elapsed().as_secs_f64() * 1e3;
         self.times.app_part(ms);
         self.after_frame(&ctx, now);
-        self.start_background_step();
+        self.act(Action::StepDeferred);
     }
 
-    /// Screenshot and measurement bookkeeping.
+    /// Screenshot and measurement bookkeeping: once `--measure-secs` have passed, prints the
+    /// measurement and closes the window (unless a screenshot is still to be taken).
     fn after_frame(&mut self, ctx: &egui::Context, now: Instant) {
-        self.measure_after_frame(ctx, now);
+        if let Some(m) = &mut self.measure {
+            if let Some(done) = m.after_frame(now, self.model.frames_stepped()) {
+                let s = &self.model.sessions()[0];
+                println!(
+                    "{}",
+                    serde_json::json!({
+                        "configuration": s.label(),
+                        "seconds": done.seconds,
+                        "display_frames": done.display_frames,
+                        "display_fps": done.display_frames as f64 / done.seconds,
+                        "median_display_frame_ms": done.median_display_frame_ms,
+                        "sim_frames": done.sim_frames,
+                        "sim_ms_per_frame": s.ms_per_frame,
+                        "render_ms": self.ui.viewport.render_ms,
+                        "app_ms": self.times.app_ms,
+                        "frame_cpu_ms": self.times.frame_cpu_ms,
+                        "window_points": ctx.input(|i| i.viewport().inner_rect.map(|r| [r.width(), r.height()])),
+                        "pixels_per_point": ctx.pixels_per_point(),
+                        "renderer": self.renderer,
+                        "feathering": ctx.tessellation_options(|o| o.feathering),
+                    })
+                );
+                if self.screenshot.is_none() {
+                    ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                }
+                self.measure = None;
+            }
+            ctx.request_repaint();
+        }
         if let Some(shot) = &mut self.screenshot {
             ctx.request_repaint();
             if !shot.requested && shot.started.elapsed().as_secs_f64() >= shot.after_secs && self.measure.is_none() {
@@ -260,7 +231,8 @@ impl eframe::App for HoxApp {
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        self.join_background();
+        // the sessions back from the stepper first
+        self.act(Action::Poll { wait_for_lesson: false });
         self.persisted().save(storage);
     }
 }

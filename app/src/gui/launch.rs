@@ -1,7 +1,9 @@
 //! Opening the native window: `hox app`'s checks of its options, eframe's window and renderer
 //! settings, and the app built on the saved settings.
 
-use super::{AppArgs, HoxApp, Persisted};
+use super::app::HoxApp;
+use super::args::AppArgs;
+use super::persist::Persisted;
 use eframe::egui;
 use hox_scenes::Scene;
 

@@ -1,0 +1,281 @@
+//! [`HoxApp`]: the model ([`Model`]), the UI's state ([`UiState`]) and the services — the live
+//! Rerun link, the frame clock and measurements, the window's renderer — and the one place a
+//! [`Command`] is carried out: an action goes to the model (every frame stepped in place is logged
+//! to the Rerun link), a service's request to its service, whose outcome the model is told. The
+//! window's frame itself is `window.rs`.
+
+use super::action::{Action, Command, Commands};
+use super::args::{self, AppArgs};
+use super::background::{Background, ThreadStepper};
+use super::config::SceneSource;
+use super::measure::{FrameTimes, Measure};
+use super::model::{Model, Start};
+use super::persist::Persisted;
+use super::rerun_link::Rerun;
+use super::ui_state::{Status, UiState};
+use super::viewport::Viewport;
+use super::window::Screenshot;
+
+/// The app: the model, the UI's state and the services.
+pub struct HoxApp {
+    pub(super) model: Model,
+    pub(super) ui: UiState,
+    pub(super) rerun: Rerun,
+    pub(super) times: FrameTimes,
+    pub(super) measure: Option<Measure>,
+    pub(super) screenshot: Option<Screenshot>,
+    /// The window has an OpenGL context (false in the headless UI tests).
+    pub(super) gl_available: bool,
+    /// The OpenGL renderer's name (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"), if known.
+    pub(super) renderer: Option<String>,
+    /// While playing, paint when the next simulated frame is due instead of at once: set for a
+    /// software renderer (no vertical sync paces it) unless `--no-vsync` asks for the most
+    /// frames (frame-rate measurements); off in the headless UI tests.
+    pub(super) pace_paint: bool,
+}
+
+impl HoxApp {
+    /// The app on `scene` (or the saved settings), from `args`.
+    pub fn new(args: &AppArgs, saved: Option<Persisted>) -> Result<HoxApp, String> {
+        let saved = if args.fresh { None } else { saved };
+        let scene = match (&args.scene, &args.scene_file) {
+            (Some(name), _) => SceneSource::Builtin(name.clone()),
+            (_, Some(path)) => SceneSource::File(path.clone()),
+            _ => saved.as_ref().map(|s| s.scene.clone()).unwrap_or(SceneSource::Builtin("bending".into())),
+        };
+        let same_scene = saved.as_ref().is_some_and(|s| s.scene == scene);
+        let start = Start {
+            links: saved.as_ref().map(|s| s.links.clone()).unwrap_or_default(),
+            view: saved.as_ref().map(|s| s.view.clone()).unwrap_or_default(),
+            playing: args.play,
+            time_scale: saved.as_ref().map_or(1.0, |s| s.time_scale),
+            show_reference_element: saved.as_ref().is_some_and(|s| s.show_reference_element),
+            background: Background::Threads,
+            stepper: Box::new(ThreadStepper::default()),
+        };
+        // the very first start (no saved settings) offers the lessons
+        let offer_lessons = saved.is_none()
+            && !args.fresh
+            && args.lesson.is_none()
+            && args.lesson_file.is_none()
+            && args.screenshot.is_none()
+            && args.measure_secs.is_none();
+        let ui = UiState::new(
+            Viewport::new(saved.as_ref().filter(|_| same_scene).and_then(|s| s.camera)),
+            saved.as_ref().map_or_else(|| "rerun+http://127.0.0.1:9876/proxy".into(), |s| s.rerun_url.clone()),
+            saved.as_ref().map_or_else(|| "hox.rrd".into(), |s| s.rerun_file.clone()),
+            offer_lessons,
+        );
+        let configs = saved.filter(|_| same_scene).map(|s| (s.configs, s.compare));
+        let model = Model::new(scene, configs, start)?;
+        let mut app = HoxApp {
+            model,
+            ui,
+            rerun: Rerun::new(args.serve.clone(), args.serve_fps),
+            times: FrameTimes::default(),
+            measure: args.measure_secs.map(Measure::new),
+            screenshot: args.screenshot.clone().map(|p| Screenshot::new(p, args.after_secs)),
+            gl_available: false,
+            renderer: None,
+            pace_paint: false,
+        };
+        app.start_configurations(args)?;
+        if let Some(v) = args.view {
+            app.act(Action::ShowReferenceElement(v == args::StartView::ReferenceElement));
+        }
+        if let Some(preset) = args.camera {
+            app.act(Action::SetPreset(preset));
+        }
+        if args.lesson_step.is_some() && args.lesson.is_none() && args.lesson_file.is_none() {
+            return Err("--lesson-step needs a lesson: --lesson NAME or --lesson-file FILE".into());
+        }
+        if args.lesson.is_some() || args.lesson_file.is_some() {
+            let lesson = crate::config::load_lesson(args.lesson.as_deref(), args.lesson_file.as_deref())
+                .map_err(|e| format!("{e:#}"))?;
+            let steps = lesson.steps.len();
+            app.act(Action::OpenLesson(Box::new(lesson)));
+            if let Some(n) = args.lesson_step {
+                if !(1..=steps).contains(&n) {
+                    return Err(format!("--lesson-step {n}: the lesson has steps 1 to {steps}"));
+                }
+                app.act(Action::GoToStep(n - 1));
+            }
+            app.act(Action::Poll { wait_for_lesson: true });
+        }
+        if args.presenter {
+            app.act(Action::SetPresenter(true));
+        }
+        if args.serve_web {
+            app.serve_web_at_start();
+        }
+        if app.measure.is_some() {
+            app.act(Action::SetPlaying(true));
+        }
+        Ok(app)
+    }
+
+    /// The configurations the command line asks for: its overrides on the scene's own
+    /// configuration, and `--compare` (alone: the default pair; with values: exactly two
+    /// configurations). Nothing given keeps the saved ones. Errors name the option.
+    fn start_configurations(&mut self, args: &AppArgs) -> Result<(), String> {
+        let o = crate::config::overrides(&args.mesh, Some(&args.physics)).merged(&args.display.overrides);
+        let specs: Vec<&String> = args.compare.iter().filter(|s| !s.trim().is_empty()).collect();
+        let wants_pair = !args.compare.is_empty();
+        if o.iter().next().is_some() || !specs.is_empty() {
+            let overrides = match specs.len() {
+                0 => vec![(None, o)],
+                2 => specs
+                    .iter()
+                    .map(|s| {
+                        crate::config::parse_compare(s, &o)
+                            .map(|o| (Some(s.to_string()), o))
+                            .map_err(|e| format!("{e:#}"))
+                    })
+                    .collect::<Result<Vec<_>, _>>()?,
+                n => {
+                    return Err(format!("--compare with values needs exactly two configurations for the app, got {n}"));
+                }
+            };
+            self.model.apply(Action::Configure(overrides))?;
+        }
+        if wants_pair && !self.model.compare() {
+            self.act(Action::SetCompare(true));
+        }
+        self.ui.follow(&self.model);
+        Ok(())
+    }
+
+    /// `--serve-web`: serves the class's browsers from the start. A refusal (a port in use, an
+    /// address not of this machine) is printed and shown, and the app runs on without serving.
+    fn serve_web_at_start(&mut self) {
+        self.act(Command::Rerun(Some(super::action::RerunTarget::Browsers)));
+        match self.rerun.web_url() {
+            Some(url) => {
+                println!("{url}");
+                eprintln!("serving the class's browsers: open {url}");
+            }
+            None => {
+                eprintln!("warning: not serving browsers: {}", self.model.message().unwrap_or("unknown error"))
+            }
+        }
+    }
+
+    /// The model (read only: it changes through [`HoxApp::act`]).
+    #[cfg(test)]
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The model to change directly: tests only.
+    #[cfg(test)]
+    pub fn model_mut(&mut self) -> &mut Model {
+        &mut self.model
+    }
+
+    /// The UI's state.
+    #[cfg(test)]
+    pub fn ui_state(&self) -> &UiState {
+        &self.ui
+    }
+
+    /// Carries out `command`: an action changes the model (each frame stepped in place is
+    /// logged to the Rerun link), a service's request goes to its service and the model is told
+    /// the outcome; the UI's state then follows the model.
+    pub fn act(&mut self, command: impl Into<Command>) {
+        match command.into() {
+            Command::Model(action) => {
+                let loading = matches!(action, Action::LoadScene(_));
+                let rerun = &mut self.rerun;
+                let mut link_error = None;
+                let result = self.model.apply_observed(action, &mut |m: &Model| {
+                    if let Some(e) = rerun.log(m) {
+                        link_error = Some(e);
+                    }
+                });
+                if let (true, Err(e)) = (loading, result) {
+                    self.say(Some(e));
+                }
+                self.say(link_error);
+            }
+            Command::Rerun(target) => {
+                let message = self.rerun.set(target, &self.model, &self.ui.rerun_url, &self.ui.rerun_file);
+                self.say(message);
+            }
+            Command::ExportFigure => {
+                let folder = std::path::PathBuf::from(&self.ui.figure_folder);
+                let message = match super::figure::export_figure(&self.model, &folder) {
+                    Ok(files) => format!(
+                        "wrote {}",
+                        files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(" and ")
+                    ),
+                    Err(e) => e,
+                };
+                self.say(Some(message));
+            }
+            Command::OpenFile { mesh, path, clamp_group } => {
+                let source = if mesh {
+                    super::dialogs::mesh_scene_file(&path, &clamp_group).map(SceneSource::File)
+                } else {
+                    Ok(SceneSource::File(path))
+                };
+                match source.and_then(|s| self.model.apply(Action::LoadScene(s))) {
+                    Ok(()) => self.ui.open_dialog = None,
+                    Err(e) => {
+                        if let Some(d) = &mut self.ui.open_dialog {
+                            d.error = Some(e);
+                        }
+                    }
+                }
+            }
+        }
+        self.ui.follow(&self.model);
+    }
+
+    /// Carries out a frame's commands, in order.
+    pub(super) fn act_all(&mut self, commands: Commands) {
+        for c in commands.0 {
+            self.act(c);
+        }
+    }
+
+    /// Tells the model a service's message.
+    fn say(&mut self, message: Option<String>) {
+        if let Some(m) = message {
+            let _ = self.model.apply(Action::Say(m));
+        }
+    }
+
+    /// What the services report, for the panels.
+    pub(super) fn status(&self) -> Status {
+        Status {
+            rerun_target: self.rerun.target().map(String::from),
+            web_url: self.rerun.web_url().map(String::from),
+            bind: self.rerun.bind(),
+            ui_frame_ms: self.times.ui_frame_ms,
+            app_ms: self.times.app_ms,
+            renderer: self.renderer.clone(),
+        }
+    }
+
+    /// What of the app persists, as it is now.
+    pub fn persisted(&self) -> Persisted {
+        Persisted::of(&self.model, &self.ui)
+    }
+
+    /// How long to wait before painting the next frame while playing ([`HoxApp::pace_paint`]):
+    /// until the next simulated frame is due; None (paint at once) when pacing is off, while
+    /// settling (as many frames as the CPU allows) or measuring the frame rate.
+    pub(super) fn paint_pace(&self) -> Option<std::time::Duration> {
+        let sessions = self.model.sessions();
+        if !self.pace_paint || self.model.settling() || self.measure.is_some() || sessions.is_empty() {
+            return None;
+        }
+        Some(self.model.playback().until_next_frame(1.0 / sessions[0].config.frames_per_second))
+    }
+
+    /// Steps `frames` frames now (logged to the Rerun link), as the Step button does.
+    #[cfg(test)]
+    pub fn step(&mut self, frames: usize) {
+        self.act(Action::Step(frames));
+    }
+}

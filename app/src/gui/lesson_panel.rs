@@ -1,0 +1,126 @@
+//! The lesson as the class sees it (issue #21): a panel with the step's text, its question, the
+//! live measurement of each configuration beside it and, on demand, the answer; in presenter mode
+//! (P, or `--presenter`: the interface scaled up for a projector, the side panel and plots hidden)
+//! the step's caption and numbers below the 3D view; the first start's offer of the lessons.
+
+use super::action::Action;
+use super::lesson::PREPARING;
+use super::ui_state::Ctx;
+use eframe::egui;
+
+/// The lesson panel: title, step, text, question, the live measurement of A and B, the answer
+/// on demand, and the step buttons.
+pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
+    let model = cx.model;
+    let Some(state) = model.lesson() else { return };
+    let step = &state.lesson.steps[state.step];
+    let measured = state.measured(model.sessions());
+    let n = state.lesson.steps.len();
+    ui.heading(&state.lesson.title);
+    ui.label(egui::RichText::new(&state.lesson.goal).italics());
+    ui.separator();
+    ui.label(egui::RichText::new(format!("Step {} of {n}: {}", state.step + 1, step.title)).strong().size(18.0));
+    for line in state.parameter_lines() {
+        ui.label(egui::RichText::new(line).monospace());
+    }
+    ui.label(&step.text);
+    ui.add_space(6.0);
+    ui.label(egui::RichText::new(format!("Question: {}", step.question)).strong());
+    ui.add_space(6.0);
+    ui.label(egui::RichText::new(step.measure.title()).underline());
+    if state.preparing() {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            ui.label(PREPARING);
+        });
+    } else {
+        for (k, (m, s)) in measured.iter().zip(model.sessions()).enumerate() {
+            ui.label(egui::RichText::new(format!("{} {}: {}", ["A", "B"][k.min(1)], s.label(), m.text)).monospace());
+        }
+    }
+    if let Some(p) = &state.problem {
+        ui.colored_label(egui::Color32::from_rgb(255, 120, 90), p);
+    }
+    ui.add_space(6.0);
+    // no answer while the step is prepared: the numbers it speaks of are not there yet
+    let (revealed, preparing) = (state.revealed, state.preparing());
+    let (at, answer) = (state.step, step.answer.clone());
+    if preparing {
+        ui.label(egui::RichText::new("(the answer once the step is ready)").weak());
+    } else if revealed {
+        ui.label(egui::RichText::new(format!("Answer: {answer}")).color(egui::Color32::from_rgb(250, 220, 120)));
+    } else if ui.button("Reveal the answer (A)").clicked() {
+        cx.out.push(Action::RevealAnswer);
+    }
+    ui.add_space(6.0);
+    ui.horizontal(|ui| {
+        if ui.add_enabled(at > 0, egui::Button::new("< Previous (left arrow)")).clicked() {
+            cx.out.push(Action::LessonStep(-1));
+        }
+        if ui.add_enabled(at + 1 < n, egui::Button::new("Next (right arrow) >")).clicked() {
+            cx.out.push(Action::LessonStep(1));
+        }
+        if ui.button("Close lesson").clicked() {
+            cx.out.push(Action::CloseLesson);
+        }
+    });
+}
+
+/// In presenter mode: the step's caption and numbers in a panel below the 3D view (issue #35:
+/// laid over the view, the answer covered both bodies' labels at 1280×720).
+pub fn caption_ui(cx: &Ctx, ui: &mut egui::Ui) {
+    let Some(state) = cx.model.lesson() else { return };
+    let step = &state.lesson.steps[state.step];
+    let measured = state.measured(cx.model.sessions());
+    ui.label(
+        egui::RichText::new(format!("{} — {}", state.lesson.title, step.title)).strong().color(egui::Color32::WHITE),
+    );
+    for line in state.parameter_lines() {
+        ui.label(egui::RichText::new(line).monospace().color(egui::Color32::from_rgb(200, 200, 200)));
+    }
+    ui.label(egui::RichText::new(&step.question).color(egui::Color32::WHITE));
+    if state.preparing() {
+        ui.label(egui::RichText::new(PREPARING).color(egui::Color32::from_rgb(250, 220, 120)));
+        return;
+    }
+    for (k, m) in measured.iter().enumerate() {
+        ui.label(
+            egui::RichText::new(format!("{}: {}", ["A", "B"][k.min(1)], m.text))
+                .monospace()
+                .color(egui::Color32::from_rgb(250, 220, 120)),
+        );
+    }
+    if state.revealed {
+        ui.label(egui::RichText::new(&step.answer).color(egui::Color32::from_rgb(180, 230, 255)));
+    }
+}
+
+/// The first start's offer: the lessons, or the free app.
+pub fn welcome_ui(cx: &mut Ctx, ctx: &egui::Context) {
+    if !cx.state.offer_lessons {
+        return;
+    }
+    let mut open = true;
+    // centred in the window, below the menu bar it used to cover (issue #35)
+    egui::Window::new("Welcome to hox")
+        .collapsible(false)
+        .anchor(egui::Align2::CENTER_CENTER, egui::vec2(0.0, 0.0))
+        .open(&mut open)
+        .show(ctx, |ui| {
+            ui.label("Start with a guided lesson, or explore freely (the Lessons menu has them all).");
+            if let Ok(all) = hox_scenes::lesson::registry() {
+                for l in all {
+                    if ui.button(&l.title).on_hover_text(&l.goal).clicked() {
+                        cx.out.push(Action::OpenLesson(Box::new(l)));
+                        cx.state.offer_lessons = false;
+                    }
+                }
+            }
+            if ui.button("Explore freely").clicked() {
+                cx.state.offer_lessons = false;
+            }
+        });
+    if !open {
+        cx.state.offer_lessons = false;
+    }
+}

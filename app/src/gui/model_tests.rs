@@ -1,0 +1,138 @@
+//! The model alone, without a window and without threads of its own (the jobs it hands off run
+//! in place: [`Background::Inline`], [`InlineStepper`]), driven through a classroom session of
+//! actions: compare P1 with P2, play, change a linked material mid-run, a refused value, the
+//! camera's layout, frames stepped "in the background" and in place giving the same motion, a
+//! settle, a lesson stepped through with its answer, a reset.
+
+use super::action::Action;
+use super::background::{Background, InlineStepper};
+use super::config::SceneSource;
+use super::model::{Model, Start};
+use super::presets::{ViewOptions, ViewPreset};
+
+fn model(scene: &str) -> Model {
+    let start = Start {
+        links: Default::default(),
+        view: ViewOptions::default(),
+        playing: false,
+        time_scale: 1.0,
+        show_reference_element: false,
+        background: Background::Inline,
+        stepper: Box::new(InlineStepper::default()),
+    };
+    Model::new(SceneSource::Builtin(scene.into()), None, start).expect("the scene loads")
+}
+
+/// A tick of the window's clock at 60 Hz.
+fn tick(m: &mut Model, in_background: bool) {
+    m.apply(Action::Tick { real_dt_secs: 1.0 / 60.0, one_frame_per_tick: false, in_background }).unwrap();
+    if in_background {
+        // the window hands the deferred frames over once its frame is built, and takes them
+        // back at the next
+        m.apply(Action::StepDeferred).unwrap();
+        m.apply(Action::Poll { wait_for_lesson: false }).unwrap();
+    }
+}
+
+fn time(m: &Model) -> f64 {
+    m.sessions()[0].instance.sim.time_secs()
+}
+
+#[test]
+fn a_classroom_session_of_actions_runs_on_the_model_alone() {
+    let mut m = model("bending");
+    let labels = |m: &Model| m.sessions().iter().map(|s| s.label()).collect::<Vec<_>>();
+    assert_eq!(labels(&m), ["P2 8×2×2 five"]);
+    let layout = m.layout();
+
+    // the teacher compares P1 refined once with P2, and plays
+    m.apply(Action::SetCompare(true)).unwrap();
+    assert_eq!(labels(&m), ["P1 8×2×2 five r1", "P2 8×2×2 five"]);
+    assert!(m.layout() > layout, "a new layout: the camera frames both bodies");
+    m.apply(Action::SetPlaying(true)).unwrap();
+    for _ in 0..31 {
+        tick(&mut m, false);
+    }
+    // the first tick is no real interval; thirty at 60 Hz step thirty frames
+    assert!((time(&m) * 60.0 - 30.0).abs() < 1e-6, "t = {}", time(&m));
+    assert_eq!(m.frames_stepped(), 30);
+
+    // a stiffer material mid-run: linked, both change, the motion goes on from where it was
+    let positions = m.sessions()[1].instance.sim.positions.clone();
+    let mut c = m.sessions()[0].config.clone();
+    c.youngs_modulus_pa = 6e6;
+    m.apply(Action::change("youngs", c)).unwrap();
+    assert!(m.sessions().iter().all(|s| s.instance.sim.material().youngs_modulus_pa == 6e6));
+    assert_eq!(m.sessions()[1].instance.sim.positions, positions, "a material change keeps the state");
+
+    // ν = 0.5 is refused with the reason, for the control, and changes nothing
+    let mut c = m.sessions()[0].config.clone();
+    c.poisson_ratio = 0.5;
+    let reason = m.apply(Action::change("poisson", c)).unwrap_err();
+    assert!(reason.starts_with("Poisson ratio ν = 0.5: "), "{reason}");
+    assert_eq!(m.refusal().map(|r| r.0.as_str()), Some("poisson"));
+    assert!(m.sessions().iter().all(|s| s.config.poisson_ratio == 0.35));
+
+    // the front view lays the bodies apart along x
+    m.apply(Action::SetPreset(ViewPreset::Front)).unwrap();
+    let offsets = m.offsets();
+    assert!(offsets[1].x > offsets[0].x && offsets[0].y == offsets[1].y, "{offsets:?}");
+
+    // frames handed to the stepper give the same motion as frames stepped in place
+    let mut twin = model("bending");
+    for a in [Action::SetCompare(true), Action::SetPlaying(true), Action::Step(30)] {
+        twin.apply(a).unwrap();
+    }
+    let mut c = twin.sessions()[0].config.clone();
+    c.youngs_modulus_pa = 6e6;
+    twin.apply(Action::change("youngs", c)).unwrap();
+    for _ in 0..12 {
+        tick(&mut m, true);
+    }
+    twin.apply(Action::Step(m.frames_stepped() as usize - 30)).unwrap();
+    assert_eq!(time(&m), time(&twin));
+    for (a, b) in m.sessions().iter().zip(twin.sessions()) {
+        assert!(a.instance.sim.positions == b.instance.sim.positions, "the same motion either way");
+    }
+
+    // Settle: damped to rest, then paused on the settled state
+    m.apply(Action::Settle).unwrap();
+    assert!(m.settling() && m.playing());
+    let mut ticks = 0;
+    while m.settling() || m.playing() {
+        tick(&mut m, false);
+        ticks += 1;
+        assert!(ticks < 2000, "still settling after {ticks} ticks");
+    }
+    assert!(m.sessions().iter().all(|s| s.settle_outcome.is_some()));
+
+    // the class opens a lesson: its first step is prepared in place, installed at the next poll
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "why-high-order").unwrap();
+    m.apply(Action::OpenLesson(Box::new(lesson))).unwrap();
+    m.apply(Action::Poll { wait_for_lesson: false }).unwrap();
+    let state = m.lesson().expect("a lesson is open");
+    assert!(!state.preparing(), "prepared in place");
+    assert_eq!((state.step, m.preset()), (0, ViewPreset::Front));
+    assert_eq!(time(&m), 0.0, "the step's own configurations, from rest");
+    // the step plays its 0.45 s and pauses on its last frame
+    assert!(m.playing());
+    while m.playing() {
+        tick(&mut m, false);
+    }
+    assert!((time(&m) - 0.45).abs() < 1e-9, "paused at {} s", time(&m));
+    m.apply(Action::RevealAnswer).unwrap();
+    assert!(m.lesson().unwrap().revealed);
+    assert!(m.lesson_text().unwrap().contains("**Answer:**"));
+    m.apply(Action::LessonStep(1)).unwrap();
+    m.apply(Action::Poll { wait_for_lesson: false }).unwrap();
+    let state = m.lesson().unwrap();
+    assert_eq!((state.step, state.revealed), (1, false));
+    assert!(m.settling(), "the second step settles");
+
+    // closing the lesson and resetting: back to t = 0
+    m.apply(Action::CloseLesson).unwrap();
+    m.apply(Action::Reset).unwrap();
+    assert!(m.lesson().is_none());
+    assert_eq!(time(&m), 0.0);
+    assert!(!m.stepping_in_background());
+}

@@ -1,0 +1,67 @@
+//! The status line: one short line per configuration (its label, size, time per frame and
+//! readout; the details on hover), the stability guard's substeps, a failure, and the frame rate.
+
+use super::ui_state::Ctx;
+use eframe::egui;
+
+pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
+    let model = cx.model;
+    ui.horizontal_wrapped(|ui| {
+        for (k, s) in model.sessions().iter().enumerate() {
+            let sim = &s.instance.sim;
+            let solver = sim.work_summary();
+            // one short line per configuration; the details on hover
+            let mut text = format!(
+                "{}{}: {} nodes, {} el, {:.1} ms/frame, {}",
+                if model.compare() { ["A ", "B "][k] } else { "" },
+                s.label(),
+                sim.mesh().num_nodes(),
+                sim.mesh().num_elements(),
+                s.ms_per_frame,
+                s.readout().error_text()
+            );
+            if s.settler.is_some() {
+                text += " (settling…)";
+            }
+            let raised = sim.substeps_per_frame() > s.config.substeps;
+            if raised {
+                text += &format!(", {} substeps (guard)", sim.substeps_per_frame());
+            }
+            // the reference's state on hover: the line stays one line (the labels carry it)
+            let details = format!(
+                "{} nodes, {} elements, {solver}, residual {:.1e}, t = {:.2} s\n{}\n{}",
+                sim.mesh().num_nodes(),
+                sim.mesh().num_elements(),
+                s.residual,
+                sim.time_secs(),
+                s.readout().text(),
+                s.reference.status()
+            );
+            let label = ui.label(egui::RichText::new(text).monospace()).on_hover_text(details);
+            if raised {
+                label.on_hover_text(format!(
+                    "The stability guard takes {} substeps per frame instead of {}: the stiffest element's fastest mode needs h·ω_max ≤ {} (docs/STABILITY.md). Switch it off under Solver to see the instability.",
+                    sim.substeps_per_frame(),
+                    s.config.substeps,
+                    hox_sim::solver::stability::GUARD_H_OMEGA
+                ));
+            }
+            if let Some(f) = &s.failure {
+                ui.colored_label(egui::Color32::from_rgb(255, 90, 80), f);
+            }
+            ui.separator();
+        }
+        // paused, the window repaints only on input: a frame rate then means nothing (issue
+        // #35: "0–1 fps" whenever paused)
+        let rate = if model.playing() || model.settling() {
+            format!("{:.0} fps", 1000.0 / cx.status.ui_frame_ms.max(1e-3))
+        } else {
+            "paused".to_string()
+        };
+        ui.label(egui::RichText::new(rate).monospace())
+            .on_hover_text(format!("Displayed frames per second; view {:.1} ms and app {:.1} ms of CPU per frame (the 3D view's preparation and the app's whole frame). Renderer: {}.", cx.state.viewport.render_ms, cx.status.app_ms, cx.status.renderer.as_deref().unwrap_or("none (no OpenGL: CPU rasteriser)")));
+        if let Some(e) = cx.state.viewport.gl_error() {
+            ui.colored_label(egui::Color32::from_rgb(255, 170, 60), format!("OpenGL view unavailable, drawn on the CPU: {e}"));
+        }
+    });
+}
