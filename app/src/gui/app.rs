@@ -8,13 +8,12 @@ use super::action::{Action, Command, Commands};
 use super::args::{self, AppArgs};
 use super::background::{Background, ThreadStepper};
 use super::config::SceneSource;
-use super::measure::{FrameTimes, Measure};
+use super::measure::{FrameTimes, Measure, Screenshot};
 use super::model::{Model, Start};
 use super::persist::Persisted;
 use super::rerun_link::Rerun;
 use super::ui_state::{Status, UiState};
 use super::viewport::Viewport;
-use super::window::Screenshot;
 
 /// The app: the model, the UI's state and the services.
 pub struct HoxApp {

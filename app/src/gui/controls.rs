@@ -7,6 +7,7 @@
 
 use super::action::Action;
 use super::config::{Config, SceneSource};
+use super::sections::label;
 use super::ui_state::Ctx;
 use eframe::egui;
 use hox_scenes::params::{self, Group, Kind, Param, Value};
@@ -69,11 +70,6 @@ pub fn controls_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
     super::sections::rerun_ui(cx, ui);
     ui.separator();
     super::sections::figure_ui(cx, ui);
-}
-
-/// A row label with a tooltip.
-pub(super) fn label(ui: &mut egui::Ui, text: &str, tip: &str) -> egui::Response {
-    ui.label(text).on_hover_text(tip)
 }
 
 /// The reason a control's last change was refused, under it.

@@ -1,5 +1,6 @@
-//! Frame-rate measurement: the running frame times the status line shows, and the
-//! `--measure-secs` run that prints them with the frame counts as JSON and closes the window.
+//! The app's clock and measurements: the running frame times the status line shows, the
+//! `--measure-secs` run that prints them with the frame counts as JSON and closes the window, and
+//! the `--screenshot` taken some seconds after the start.
 
 use std::time::Instant;
 
@@ -83,5 +84,20 @@ impl Measure {
             median_display_frame_ms: hox_scenes::median(&mut self.frame_ms.clone()),
             sim_frames: frames_stepped - at_start,
         })
+    }
+}
+
+/// A screenshot to save some seconds after the start (`--screenshot`); the window closes then.
+pub struct Screenshot {
+    pub path: std::path::PathBuf,
+    pub after_secs: f64,
+    /// When the app started.
+    pub started: Instant,
+    pub requested: bool,
+}
+
+impl Screenshot {
+    pub fn new(path: std::path::PathBuf, after_secs: f64) -> Screenshot {
+        Screenshot { path, after_secs, started: Instant::now(), requested: false }
     }
 }

@@ -3,10 +3,14 @@
 //! and returns commands ([`Ctx`]).
 
 use super::action::{Action, Command, RerunTarget};
-use super::controls::label;
 use super::presets::ViewPreset;
 use super::ui_state::Ctx;
 use eframe::egui;
+
+/// A row label with a tooltip.
+pub fn label(ui: &mut egui::Ui, text: &str, tip: &str) -> egui::Response {
+    ui.label(text).on_hover_text(tip)
+}
 
 /// *Settle* (E): run to rest with the settle damping, as `hox simulate --settle` does.
 pub fn settle_button_ui(cx: &mut Ctx, ui: &mut egui::Ui) {

@@ -9,23 +9,7 @@ use super::readout::ReferenceState;
 use super::ui_state::Ctx;
 use super::{controls, dialogs, lesson_panel, menu, plots, serve_web, status};
 use eframe::egui;
-use std::path::PathBuf;
 use std::time::Instant;
-
-/// A screenshot to save some seconds after the start (`--screenshot`); the window closes then.
-pub(super) struct Screenshot {
-    path: PathBuf,
-    after_secs: f64,
-    /// When the app started.
-    started: Instant,
-    requested: bool,
-}
-
-impl Screenshot {
-    pub(super) fn new(path: PathBuf, after_secs: f64) -> Screenshot {
-        Screenshot { path, after_secs, started: Instant::now(), requested: false }
-    }
-}
 
 /// The inner size of a window of size `inner` that fits on a monitor of size `monitor` (both in
 /// the same points, with room for the window's decorations), or None when it already fits.
