@@ -18,7 +18,10 @@ pub mod motion;
 pub mod pareto;
 pub mod solver_axis;
 
-use crate::{Instance, RunMode, SceneError, SceneOverrides, run};
+use crate::error::SceneError;
+use crate::instance::Instance;
+use crate::params::SceneOverrides;
+use crate::run::{RunMode, run};
 use hox_sim::Vec3;
 use hox_sim::element::{ElementType, ReferenceShape};
 use hox_sim::mesh::structured::TetSplit;
@@ -136,11 +139,11 @@ pub struct StudyRow {
     pub settled: bool,
 }
 
-/// Probe displacements of a paper scene's committed reference ([`crate::reference::committed`]).
+/// Probe displacements of a paper scene's committed reference ([`crate::lab::reference::committed`]).
 pub fn reference(scene: &str) -> Result<Vec<(String, Vec3)>, SceneError> {
     let unknown = || SceneError::Unknown { name: scene.to_string(), available: "bending, tension, torsion".into() };
-    let built = crate::by_name(scene).map_err(|_| unknown())?;
-    let committed = crate::reference::committed(&built)?.ok_or_else(unknown)?;
+    let built = crate::scene::builtin::by_name(scene).map_err(|_| unknown())?;
+    let committed = crate::lab::reference::committed(&built)?.ok_or_else(unknown)?;
     Ok(committed.probes.into_iter().map(|(name, u)| (name, Vec3::from(u))).collect())
 }
 
@@ -161,7 +164,7 @@ fn probes_of(instance: &Instance, positions: &[Vec3]) -> Vec<(String, Vec3)> {
 
 /// The settled probe displacements of a run, or, when it never settled (XPBD can keep a small
 /// oscillation going), their mean over the last simulated second.
-fn settled_probes(report: &crate::RunReport) -> Vec<(String, Vec3)> {
+fn settled_probes(report: &crate::run::RunReport) -> Vec<(String, Vec3)> {
     let source = if report.settled || report.at_rest { &report.probes } else { &report.probes_last_second_mean };
     source.iter().map(|(n, u)| (n.clone(), Vec3::from(*u))).collect()
 }
@@ -180,7 +183,7 @@ pub fn study_one(
 ) -> Result<StudyRow, SceneError> {
     let reference = reference(scene_name)?;
     let reference_size = reference.iter().map(|(_, u)| u.norm()).fold(0.0, f64::max);
-    let base = crate::by_name(scene_name)?;
+    let base = crate::scene::builtin::by_name(scene_name)?;
     let scene = base.with_overrides(&config.overrides())?;
     let label = config.label();
     let fail = |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label}"), message: m };
@@ -188,7 +191,7 @@ pub fn study_one(
     // 1. the static solution on this mesh
     progress(&format!("{scene_name} {label}: static solution"));
     let mut instance = Instance::new(scene.clone())?;
-    let statics = crate::solve_static(&scene, instance.sim.mesh(), 1e-8, 1, &mut |_, _, _| {})
+    let statics = crate::instance::solve_static(&scene, instance.sim.mesh(), 1e-8, 1, &mut |_, _, _| {})
         .map_err(|e| fail(e.to_string()))?;
     let static_probes = probes_of(&instance, &statics.positions);
 
@@ -264,7 +267,7 @@ pub fn study_one(
 /// Runs the study over the paper scenes (`quick`: without the heavy configurations).
 pub fn run_study(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<StudyRow>, SceneError> {
     let mut rows = Vec::new();
-    for scene in crate::PAPER_SCENES {
+    for scene in crate::scene::builtin::PAPER_SCENES {
         for config in configurations(scene).iter().filter(|c| !(quick && c.heavy)) {
             rows.push(study_one(scene, config, progress)?);
         }
@@ -333,12 +336,13 @@ fn static_tip_z(
 ) -> Result<(f64, usize), SceneError> {
     let label = config.label();
     progress(&format!("locking: {scene_name} {label} at ν = {nu}: static solution"));
-    let scene = crate::by_name(scene_name)?
+    let scene = crate::scene::builtin::by_name(scene_name)?
         .with_overrides(&SceneOverrides { poisson_ratio: Some(nu), ..config.overrides() })?;
     let mesh = scene.build_mesh()?;
     let fail =
         |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label} at ν = {nu}"), message: m };
-    let solution = crate::solve_static(&scene, &mesh, 1e-8, 4, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
+    let solution =
+        crate::instance::solve_static(&scene, &mesh, 1e-8, 4, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
     let tip = scene
         .file
         .probes
@@ -402,7 +406,7 @@ pub fn markdown(rows: &[StudyRow], quick: bool) -> String {
         "Produced by `hox study{}`. Settings: the paper's (StVK, 50 substeps × 1 iteration, 60 fps, energy formulation), settled; errors at the probes against the fine Q2 reference (`assets/reference/`), in metres and in % of the reference displacement. *Discretisation*: static solution on the mesh vs reference. *Solver*: settled XPBD vs static solution on the same mesh. *Substeps for 1 %*: the substeps that bring the solver error under 1 %, and the ms per frame that costs. Times are medians over frames of the colour sweep (colour by colour, four elements per AVX2 register; the same result on any thread count): on one thread and on all threads (rayon's pool; measured over one second from the settled state).\n\n",
         if quick { " --quick" } else { "" }
     ));
-    for scene in crate::PAPER_SCENES {
+    for scene in crate::scene::builtin::PAPER_SCENES {
         let scene_rows: Vec<&StudyRow> = rows.iter().filter(|r| r.scene == scene).collect();
         if scene_rows.is_empty() {
             continue;
