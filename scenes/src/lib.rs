@@ -1,7 +1,8 @@
 //! hox-scenes: scenes as data and what is done with them. Its rooms, lowest first (each uses
 //! only those before it; `tests/tests/rooms.rs` keeps the order and docs/ARCHITECTURE.md states
 //! it):
-//! - [`error`] — [`SceneError`];
+//! - [`error`] — [`SceneError`]; [`present`] — the colour map and colour ranges, SVG drawing
+//!   (the lab's figures and the app's views);
 //! - [`params`] — the parameter table, every parameter defined once;
 //! - [`scene`] — a scene file read, validated and built, and the built-in scenes ([`BUILTIN`],
 //!   [`by_name`]: a TOML file in `assets/scenes/` plus one line);
@@ -16,6 +17,7 @@ pub mod error;
 pub mod instance;
 pub mod lab;
 pub mod params;
+pub mod present;
 pub mod run;
 pub mod scene;
 

@@ -24,7 +24,6 @@
 mod draw;
 mod report;
 
-pub use draw::viridis;
 use draw::{draw_deformed, draw_strips};
 pub use report::{Claim, claims, paper_markdown, table_markdown};
 
