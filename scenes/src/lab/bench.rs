@@ -59,7 +59,7 @@ impl BenchCase {
 }
 
 /// The five rows of Table 1, then Q1, Q2, prism and pyramid beams of comparable node count
-/// (the meshes of the study, `scenes/src/study.rs`), then a large beam of every element type
+/// (the meshes of the study, `scenes/src/lab/study/`), then a large beam of every element type
 /// but P1 (whose largest is Table 1's 81,920): 32 cells along the beam (24 for the pyramids),
 /// large enough for the colour sweep to cut it into slabs for the threads.
 pub const CASES: [BenchCase; 15] = [
