@@ -9,7 +9,7 @@
 //!   elements ([`hox_sim::measure::field`]), mapped to viridis on one range shared by every
 //!   configuration ([`field_scale`]), so colours compare: the user's fixed top, or automatic —
 //!   growing with the largest value seen. Values beyond a fixed range take the saturation
-//!   colours ([`crate::colour::OVER`]).
+//!   colours ([`hox_scenes::present::colour::OVER`]).
 //! - **Surface frame** ([`SurfaceFrame`]): the boundary surface's vertices `x(r) = Σ N_i(r) x_i`
 //!   (curved faces follow the elements' maps, [`hox_sim::measure::surface`]), their normals,
 //!   field values and colours, in the body's own coordinates; the viewport adds the offset, the
@@ -17,8 +17,8 @@
 //! - **Held faces** ([`held_nodes`], [`Surface::edges_between`]): the nodes clamps hold and
 //!   drives move, whose face edges are drawn in their own colours.
 
-use crate::colour::{ColourRange, FieldScale};
 use hox_scenes::Instance;
+use hox_scenes::present::colour::{ColourRange, FieldScale};
 use hox_scenes::reference::ReferenceField;
 use hox_sim::Vec3;
 use hox_sim::measure::field::{Field, SurfaceGradients};

@@ -28,9 +28,9 @@
 //! Timelines: `frame` (sequence) and `sim_time` (seconds). Topology, labels and the rest shape
 //! are logged once as static data; a frame logs only what moves.
 
-use crate::colour::{ColourRange, FieldScale};
 use crate::display::{FieldSource, SurfaceFrame, f32s};
 use hox_scenes::Instance;
+use hox_scenes::present::colour::{ColourRange, FieldScale};
 use hox_scenes::reference::Reference;
 use hox_sim::Vec3;
 use hox_sim::measure::field::Field;
@@ -517,7 +517,7 @@ impl Recorder {
         if automatic {
             text += &format!(
                 "- An automatic range grows to hold {:.0} % of each frame's values (a stress peak at a clamped edge would otherwise leave the rest one colour); the few beyond are drawn pink, their share on the colour bar.\n",
-                100.0 * crate::colour::AUTOMATIC_PERCENTILE
+                100.0 * hox_scenes::present::colour::AUTOMATIC_PERCENTILE
             );
         }
         text += "- Blue thick edges: clamped faces; magenta: driven faces; red points: probes; grey lines: the rest shape.\n";
@@ -625,7 +625,7 @@ fn colour_bar_image() -> rerun::Image {
     let [w, h] = BAR_PX;
     let mut bytes = Vec::with_capacity((w * h * 3) as usize);
     for row in 0..h {
-        let c = crate::colour::viridis(1.0 - (row as f64 + 0.5) / h as f64);
+        let c = hox_scenes::present::colour::viridis(1.0 - (row as f64 + 0.5) / h as f64);
         for _ in 0..w {
             bytes.extend_from_slice(&c);
         }
@@ -666,7 +666,7 @@ fn log_ticks(rec: &RecordingStream, range: &ColourRange, values: &[f64]) -> Resu
 
 /// `0.125`, `0.3`, `1.5e-4`: a compact metre value for labels.
 pub fn format_metres(v: f64) -> String {
-    crate::colour::format_value(v, "")
+    hox_scenes::present::colour::format_value(v, "")
 }
 
 #[cfg(test)]

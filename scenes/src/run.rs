@@ -15,8 +15,9 @@
 //!   contact scene, whose contact forces the residual does not count);
 //! - or after `SETTLE_CAP_SECS` simulated seconds, reported as neither.
 
+use crate::error::SceneError;
+use crate::instance::Instance;
 use crate::scene::EffectSpec;
-use crate::{Instance, SceneError};
 use hox_sim::effect::{Damping, Effect};
 use std::time::Instant;
 

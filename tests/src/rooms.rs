@@ -1,16 +1,20 @@
 //! The room-order checker (`tests/tests/rooms.rs`): a crate's rooms — its top-level modules,
 //! `src/NAME.rs` or `src/NAME/` — use each other in one stated order of layers: a room may use
 //! the rooms of the layers before its own, never one of a later layer nor another of its own layer.
-//! A room may also state an order of its own files (hox-sim's `solver/`), checked the same way,
-//! where a file must name the file it uses, not the room's re-export.
+//! A room may also state an order of its own files (hox-sim's `solver/`, hox-scenes' `lab/` and
+//! `present/`, the app's `gui/`), checked the same way, where a file must name the file it uses,
+//! not the room's re-export; the room's front (`mod.rs`) is `mod` in that order when it holds
+//! code its files use ([`violations`] says how a front is treated).
 //!
 //! A use is a path through `crate::`, `super::` (any number) or `self::`, anywhere in the code —
 //! in `use` lines, grouped (`crate::{ROOM::…, …}`), or inline — resolved against the file's own
-//! module path. A path to an item of the crate root (`crate::Vec3`, `crate::{Instance}`) names no
-//! room: the root (`lib.rs`, `main.rs`) is the crate's front, declaring the rooms, re-exporting and
-//! holding the few items all share; its own `mod`/`pub use` lines are not uses. Comments (`//`,
-//! `//!`, `///`, `/* */`), strings, characters, test files (`tests.rs`, `*_tests.rs`,
-//! `testing.rs`) and inline `#[cfg(test)] mod … { … }` modules are not counted.
+//! module path; in a front, a bare path to one of its own modules (`scene::Scene` in `lib.rs`)
+//! too. The root (`lib.rs`, `main.rs`) is the crate's front, declaring the rooms, re-exporting and
+//! holding the few items all share; its own `mod`/`pub use` lines are not uses. A path to an item
+//! the root re-exports (`crate::Instance`, where `lib.rs` has `pub use instance::Instance`) is a
+//! use of the room that defines it; a path to an item the root defines itself (`crate::Vec3`) names
+//! no room. Comments (`//`, `//!`, `///`, `/* */`), strings, characters, test files (`tests.rs`,
+//! `*_tests.rs`, `testing.rs`) and inline `#[cfg(test)] mod … { … }` modules are not counted.
 
 use std::path::{Path, PathBuf};
 
@@ -19,8 +23,9 @@ pub struct Order<'a> {
     /// The crate's folder under the workspace (`sim`, `scenes`, `app`).
     pub crate_dir: &'a str,
     pub layers: &'a [&'a [&'a str]],
-    /// A room whose files have an order of their own: (room, files' layers).
-    pub files_of: Option<(&'a str, &'a [&'a [&'a str]])>,
+    /// The rooms whose files have an order of their own: (room, files' layers), where `mod`
+    /// ([`FRONT`]) is the room's front when it holds code its files use.
+    pub files_of: &'a [(&'a str, &'a [&'a [&'a str]])],
 }
 
 /// The order as the docs write it: "`a`, `b` → `c` → …".
@@ -211,6 +216,13 @@ pub struct Use {
 /// module `module`; each member of a group (`crate::{a::B, c}`) is one path. With `front`
 /// (the crate root or a room's `mod.rs`), `mod` and `pub use` lines are skipped.
 pub fn uses(src: &str, module: &[String], front: bool) -> Vec<Use> {
+    uses_in(src, module, front, &[])
+}
+
+/// [`uses`], and in a front also the bare paths to its own `children` (`window::Panel` in
+/// `gui/mod.rs`, `scene::EffectSpec` in `lib.rs`): a module names its children without
+/// `self::`, so a front with code reaches its files that way.
+pub fn uses_in(src: &str, module: &[String], front: bool, children: &[&str]) -> Vec<Use> {
     let mut code = code_only(src);
     if front {
         // blank `mod …;` and `pub use …;` statements: declarations and re-exports
@@ -259,6 +271,19 @@ pub fn uses(src: &str, module: &[String], front: bool) -> Vec<Use> {
         let starts = |w: &str| code[i..].iter().take(w.len()).copied().eq(w.chars());
         let boundary = i == 0 || !(is_ident(code[i - 1]) || code[i - 1] == ':' || code[i - 1] == '$');
         let prefix = ["crate::", "super::", "self::"].into_iter().find(|p| starts(p));
+        let bare = || {
+            let name: String = code[i..].iter().take_while(|&&c| is_ident(c)).collect();
+            let after = i + name.chars().count();
+            (i == 0 || code[i - 1] != '.')
+                && children.contains(&name.as_str())
+                && code.get(after) == Some(&':')
+                && code.get(after + 1) == Some(&':')
+        };
+        let prefix = match prefix {
+            Some(p) => Some(p),
+            None if front && boundary && bare() => Some(""),
+            None => None,
+        };
         let (Some(prefix), true) = (prefix, boundary) else {
             i += 1;
             continue;
@@ -266,7 +291,6 @@ pub fn uses(src: &str, module: &[String], front: bool) -> Vec<Use> {
         // the base module: the crate root, the parent for each `super`, or this module
         let mut base: Vec<String> = match prefix {
             "crate::" => Vec::new(),
-            "self::" => module.to_vec(),
             _ => module.to_vec(),
         };
         let mut j = i + prefix.len();
@@ -323,10 +347,150 @@ pub fn uses(src: &str, module: &[String], front: bool) -> Vec<Use> {
     found
 }
 
+/// The names a front (`lib.rs`, `main.rs`, a room's `mod.rs`) brings in with `use`: each item
+/// as (the name it is known by, the path it names from the front's module, a leading `crate::` or
+/// `self::` dropped), groups and `as` unfolded (`pub use run::{run as go, Settler}` → `go` ↦
+/// `run::run`, `Settler` ↦ `run::Settler`); globs name nothing. A `pub use` re-exports; a private
+/// `use` is seen by the front's own modules all the same (`super::Session` in `gui/figure.rs`).
+pub fn front_names(src: &str) -> Vec<(String, Vec<String>)> {
+    #[derive(PartialEq)]
+    enum Tok {
+        Ident(String),
+        Sep,
+        Open,
+        Close,
+        Comma,
+        Other,
+    }
+    fn tree(toks: &[Tok], i: &mut usize, prefix: &[String], out: &mut Vec<(String, Vec<String>)>) {
+        let mut path = prefix.to_vec();
+        loop {
+            match toks.get(*i) {
+                Some(Tok::Ident(name)) => {
+                    *i += 1;
+                    if toks.get(*i) == Some(&Tok::Sep) {
+                        path.push(name.clone());
+                        *i += 1;
+                        continue;
+                    }
+                    let mut known_as = name.clone();
+                    if name == "self" {
+                        known_as = path.last().cloned().unwrap_or_default();
+                    } else {
+                        path.push(name.clone());
+                    }
+                    if toks.get(*i) == Some(&Tok::Ident("as".into())) {
+                        if let Some(Tok::Ident(alias)) = toks.get(*i + 1) {
+                            known_as = alias.clone();
+                        }
+                        *i += 2;
+                    }
+                    if matches!(path.first().map(String::as_str), Some("crate" | "self")) {
+                        path.remove(0);
+                    }
+                    if !known_as.is_empty() && known_as != "_" {
+                        out.push((known_as, path));
+                    }
+                    return;
+                }
+                Some(Tok::Open) => {
+                    *i += 1;
+                    while *i < toks.len() && toks[*i] != Tok::Close {
+                        tree(toks, i, &path, out);
+                        while *i < toks.len() && !matches!(toks[*i], Tok::Comma | Tok::Close) {
+                            *i += 1;
+                        }
+                        if toks.get(*i) == Some(&Tok::Comma) {
+                            *i += 1;
+                        }
+                    }
+                    *i += 1;
+                    return;
+                }
+                _ => return,
+            }
+        }
+    }
+    let code = code_only(src);
+    let mut out = Vec::new();
+    let word_at = |k: usize, w: &str| {
+        code[k..].iter().take(w.len()).copied().eq(w.chars())
+            && (k == 0 || !is_ident(code[k - 1]))
+            && !code.get(k + w.len()).is_some_and(|&c| is_ident(c))
+    };
+    for k in 0..code.len() {
+        if !word_at(k, "use") {
+            continue;
+        }
+        let mut toks = Vec::new();
+        let mut j = k + 3;
+        while j < code.len() && code[j] != ';' {
+            let c = code[j];
+            if is_ident(c) {
+                let name: String = code[j..].iter().take_while(|&&c| is_ident(c)).collect();
+                j += name.chars().count();
+                toks.push(Tok::Ident(name));
+                continue;
+            }
+            match c {
+                ':' if code.get(j + 1) == Some(&':') => {
+                    toks.push(Tok::Sep);
+                    j += 1;
+                }
+                '{' => toks.push(Tok::Open),
+                '}' => toks.push(Tok::Close),
+                ',' => toks.push(Tok::Comma),
+                c if c.is_whitespace() => {}
+                _ => toks.push(Tok::Other),
+            }
+            j += 1;
+        }
+        tree(&toks, &mut 0, &[], &mut out);
+    }
+    out
+}
+
+/// The name the files' order of a room gives its front (`ROOM/mod.rs` or `ROOM.rs`).
+pub const FRONT: &str = "mod";
+
 /// The uses against `order` in `files` (path relative to `src/`, text), one message each.
+///
+/// A path is first resolved through what the crate root brings in (its re-exports):
+/// `crate::Instance`, where `lib.rs` has `pub use instance::Instance`, is a use of the room
+/// `instance`, checked as `crate::instance::Instance`; an item the root defines itself names no
+/// room. In a room with an order of its own files ([`Order::files_of`]) a file names the file it
+/// uses, and a path to an item of the room's front is a use of the front, [`FRONT`] (`mod`):
+/// - a pure front (`mod` lines and re-exports) is no file's dependency: a path through a name it
+///   brings in (`pub use` or `use`) fails, naming the file to use instead;
+/// - a front with code that files import from must be placed in the files' order as `mod`, and is
+///   checked like any file there: low if the files build on it, last if it builds on them (then a
+///   file using it is a back-arrow); unplaced, it is the room's top, and a use of its code fails.
+///
+/// The front's own uses of its files (`window::X`, no `self::` needed) count too.
 pub fn violations(order: &Order<'_>, files: &[(String, String)]) -> Vec<String> {
     let dir = order.crate_dir;
     let room_names: Vec<&str> = order.layers.iter().flat_map(|l| l.iter().copied()).collect();
+    let is_front_of = |rel: &str, room: &str| rel == format!("{room}/mod.rs") || rel == format!("{room}.rs");
+    let root_items: Vec<(String, Vec<String>)> =
+        files.iter().filter(|(rel, _)| rel == "lib.rs" || rel == "main.rs").flat_map(|(_, t)| front_names(t)).collect();
+    // each ordered room: its files on disk and its front's re-exports
+    let ordered: Vec<(&str, &[&[&str]], Vec<String>, Vec<(String, Vec<String>)>)> = order
+        .files_of
+        .iter()
+        .map(|&(room, layers)| {
+            let mut on_disk: Vec<String> = files
+                .iter()
+                .filter(|(rel, _)| !is_test_file(rel))
+                .map(|(rel, _)| module_path(rel))
+                .filter(|m| m.len() >= 2 && m[0] == room)
+                .map(|m| m[1].clone())
+                .collect();
+            on_disk.sort();
+            on_disk.dedup();
+            let front = files.iter().filter(|(rel, _)| is_front_of(rel, room)).flat_map(|(_, t)| front_names(t));
+            (room, layers, on_disk, front.collect())
+        })
+        .collect();
     let mut found = Vec::new();
     for (rel, text) in files {
         if is_test_file(rel) {
@@ -340,57 +504,95 @@ pub fn violations(order: &Order<'_>, files: &[(String, String)]) -> Vec<String> 
             continue;
         };
         let front = module.len() <= 1 && (rel.ends_with("mod.rs") || !rel.contains('/'));
+        let own_order = ordered.iter().find(|o| o.0 == room);
+        let children: Vec<&str> = match (module.is_empty(), own_order) {
+            (true, _) => room_names.clone(),
+            (false, Some(o)) if front => o.2.iter().map(String::as_str).collect(),
+            _ => Vec::new(),
+        };
         let lines: Vec<&str> = text.lines().collect();
         let show = |line: usize| lines.get(line - 1).map_or("", |l| l.trim());
-        for u in uses(text, &module, front) {
-            // a path of one segment names an item of the root, not a room
-            let Some(used_room) = u.path.first().filter(|_| u.path.len() > 1) else { continue };
-            if !room_names.contains(&used_room.as_str()) {
-                continue;
+        for u in uses_in(text, &module, front, &children) {
+            // through the root's re-exports: `crate::Item` is `crate::ROOM::…::Item`
+            let mut path = u.path.clone();
+            if let Some(first) = path.first().filter(|f| !room_names.contains(&f.as_str()))
+                && let Some((_, target)) = root_items.iter().find(|(name, _)| name == first)
+            {
+                path.splice(0..1, target.iter().cloned());
             }
+            let shown =
+                if path == u.path { path.join("::") } else { format!("{} = {}", u.path.join("::"), path.join("::")) };
+            let Some(used_room) = path.first().filter(|r| room_names.contains(&r.as_str())) else { continue };
             if used_room != room {
                 let used = layer_of(order.layers, used_room).expect("a listed room");
                 if used >= own {
                     let why =
                         if used == own { "is in the same layer of the order" } else { "comes later in the order" };
                     found.push(format!(
-                        "{dir}/src/{rel}:{}: the room `{room}` uses `{used_room}` ({}), which {why}\n    {}",
+                        "{dir}/src/{rel}:{}: the room `{room}` uses `{used_room}` ({shown}), which {why}\n    {}",
                         u.line,
-                        u.path.join("::"),
                         show(u.line)
                     ));
                 }
                 continue;
             }
-            let Some((sub_room, file_layers)) = order.files_of else { continue };
-            if room != sub_room || module.len() < 2 {
-                continue;
-            }
-            let here = module[1].as_str();
-            let Some(there) = u.path.get(1).map(String::as_str) else { continue };
+            let Some((_, file_layers, on_disk, front_items)) = own_order else { continue };
+            let here = module.get(1).map_or(FRONT, String::as_str);
+            let Some(there) = path.get(1).map(String::as_str) else { continue };
             if there == here {
                 continue;
             }
-            let Some(used) = layer_of(file_layers, there) else {
+            let target = if on_disk.iter().any(|f| f == there) || layer_of(file_layers, there).is_some() {
+                there
+            } else if let Some((_, via)) = front_items.iter().find(|(name, _)| name == there) {
                 found.push(format!(
-                    "{dir}/src/{rel}:{}: `{}` reaches `{room}` through its front (`{room}/mod.rs`); name the file\n    {}",
+                    "{dir}/src/{rel}:{}: `{shown}` reaches `{room}` through its front (`{room}/mod.rs` brings in `{}`); name the file\n    {}",
                     u.line,
-                    u.path.join("::"),
+                    via.join("::"),
                     show(u.line)
                 ));
                 continue;
+            } else if layer_of(file_layers, FRONT).is_none() {
+                found.push(format!(
+                    "{dir}/src/{rel}:{}: `{shown}` reaches `{room}` through its front (`{room}/mod.rs`); name the file\n    {}",
+                    u.line,
+                    show(u.line)
+                ));
+                continue;
+            } else {
+                FRONT
             };
+            if here == FRONT && layer_of(file_layers, FRONT).is_none() {
+                continue; // an unplaced front is the room's top
+            }
             let Some(own_file) = layer_of(file_layers, here) else {
                 found.push(format!(
                     "{dir}/src/{rel}: the file `{here}` of `{room}` is in no layer of its order — place it"
                 ));
                 break;
             };
-            if used >= own_file {
+            let Some(used) = layer_of(file_layers, target) else {
                 found.push(format!(
-                    "{dir}/src/{rel}:{}: `{room}/{here}` uses `{there}` ({}), which comes later in the files' order\n    {}",
+                    "{dir}/src/{rel}:{}: `{room}/{here}` uses `{target}` ({shown}), which is in no layer of the files' order — place it\n    {}",
                     u.line,
-                    u.path.join("::"),
+                    show(u.line)
+                ));
+                continue;
+            };
+            if used >= own_file {
+                let what = if target == FRONT {
+                    format!("`{FRONT}` (the front, `{room}/mod.rs`)")
+                } else {
+                    format!("`{target}`")
+                };
+                let why = if used == own_file {
+                    "is in the same layer of the files' order"
+                } else {
+                    "comes later in the files' order"
+                };
+                found.push(format!(
+                    "{dir}/src/{rel}:{}: `{room}/{here}` uses {what} ({shown}), which {why}\n    {}",
+                    u.line,
                     show(u.line)
                 ));
             }

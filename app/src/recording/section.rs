@@ -7,7 +7,8 @@
 
 use crate::display::f32s;
 use hox_scenes::Instance;
-use hox_scenes::paper::{FigureKind, ring, viridis};
+use hox_scenes::paper::{FigureKind, ring};
+use hox_scenes::present::colour::viridis;
 use hox_sim::Vec3;
 use hox_sim::measure::probe::Probe;
 use rerun::RecordingStream;

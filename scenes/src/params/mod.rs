@@ -82,7 +82,7 @@ macro_rules! params {
         }
 
         /// Changes to a scene's parameters (command line, `--compare`, the app, studies),
-        /// applied by [`crate::Scene::with_overrides`]: a field per parameter, `None` = keep.
+        /// applied by [`crate::scene::Scene::with_overrides`]: a field per parameter, `None` = keep.
         #[derive(Clone, Debug, Default, PartialEq)]
         pub struct SceneOverrides {
             $( pub $field: Option<$ty>, )*
@@ -397,7 +397,7 @@ impl Params {
         by_key(key).map(|p| (p.get)(self))
     }
 
-    /// `self` with `overrides` applied (unchecked; [`crate::Scene::with_overrides`] checks).
+    /// `self` with `overrides` applied (unchecked; [`crate::scene::Scene::with_overrides`] checks).
     pub fn overridden(&self, overrides: &SceneOverrides) -> Params {
         let mut p = self.clone();
         for (param, v) in overrides.iter() {

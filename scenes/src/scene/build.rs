@@ -6,7 +6,7 @@ use hox_sim::effect::{Clamp, ContactPlane, Damping, Effect, Gravity};
 use hox_sim::mesh::Mesh;
 
 use super::{EffectSpec, NodeSelector, Scene, SceneMesh};
-use crate::SceneError;
+use crate::error::SceneError;
 
 impl Scene {
     /// Mean displacement of the nodes of every non-empty physical group of the mesh file, for

@@ -1,6 +1,46 @@
-//! The mesh files of the built-in scenes (the curved parts of `assets/parts/`, made by
-//! `scripts/gmsh_parts.py`), embedded in the binary like the scenes' TOML, so that `hox` runs
-//! from anywhere, and read once per process.
+//! The built-in scenes: the one list of scenes the CLI, the app, tests and benchmarks read
+//! ([`BUILTIN`], each a TOML file in `assets/scenes/` plus one line), found by name
+//! ([`by_name`]); and the mesh files they name (the curved parts of `assets/parts/`, made by
+//! `scripts/gmsh_parts.py`). Both are embedded in the binary, so that `hox` runs from anywhere;
+//! a mesh file is read once per process.
+
+use super::Scene;
+use crate::error::SceneError;
+
+/// The built-in scenes: (name, TOML text). Adding a scene: its file plus one line here.
+pub const BUILTIN: &[(&str, &str)] = &[
+    ("bending", include_str!("../../../assets/scenes/bending.toml")),
+    ("tension", include_str!("../../../assets/scenes/tension.toml")),
+    ("torsion", include_str!("../../../assets/scenes/torsion.toml")),
+    ("drop", include_str!("../../../assets/scenes/drop.toml")),
+    ("twist", include_str!("../../../assets/scenes/twist.toml")),
+    ("squash", include_str!("../../../assets/scenes/squash.toml")),
+    ("tube", include_str!("../../../assets/scenes/tube.toml")),
+    ("elbow", include_str!("../../../assets/scenes/elbow.toml")),
+    ("hook", include_str!("../../../assets/scenes/hook.toml")),
+];
+
+/// The paper's three scenes.
+pub const PAPER_SCENES: [&str; 3] = ["bending", "tension", "torsion"];
+
+/// Names of the built-in scenes, comma-separated.
+pub fn names() -> String {
+    BUILTIN.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+}
+
+/// Every built-in scene, parsed and validated.
+pub fn registry() -> Result<Vec<Scene>, SceneError> {
+    BUILTIN.iter().map(|(n, text)| Scene::from_toml(text, &format!("builtin:{n}"))).collect()
+}
+
+/// A built-in scene by name.
+pub fn by_name(name: &str) -> Result<Scene, SceneError> {
+    let (n, text) = BUILTIN
+        .iter()
+        .find(|(n, _)| *n == name)
+        .ok_or_else(|| SceneError::Unknown { name: name.to_string(), available: names() })?;
+    Scene::from_toml(text, &format!("builtin:{n}"))
+}
 
 /// The mesh files the built-in scenes name (the curved parts, `scripts/gmsh_parts.py`), embedded
 /// so that `hox` runs from anywhere: (the name a scene gives, relative to `assets/scenes/`; the

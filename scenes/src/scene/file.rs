@@ -73,7 +73,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use crate::SceneError;
+use crate::error::SceneError;
 use crate::params::{Group, MeshKind, PARAMS, Params};
 use hox_sim::Vec3;
 use hox_sim::effect::{AxisRotation, Prescribed};
@@ -247,7 +247,8 @@ impl SceneFile {
     /// solver settings, and gravity unless `gravity` is false. Callers add clamps and drives
     /// (`NodeSelector::group`).
     pub fn for_mesh_file(path: &Path, gravity: bool) -> SceneFile {
-        let bending = crate::BUILTIN.iter().find(|(n, _)| *n == "bending").map(|(_, t)| *t).unwrap_or_default();
+        let bending =
+            super::builtin::BUILTIN.iter().find(|(n, _)| *n == "bending").map(|(_, t)| *t).unwrap_or_default();
         let mut params = Params::default();
         let mut given = BTreeSet::new();
         if let Ok(b) = SceneFile::parse(bending, "builtin:bending") {

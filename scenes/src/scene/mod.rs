@@ -21,7 +21,7 @@ use hox_sim::solver::{NewtonSettings, SolverSettings, VbdSettings};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::SceneError;
+use crate::error::SceneError;
 use crate::params::{Params, SceneOverrides};
 
 /// Prescribed motion of a mesh file's physical group (see [`Scene::from_mesh_file`]): a

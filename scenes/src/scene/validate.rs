@@ -12,7 +12,7 @@ use std::sync::Arc;
 
 use super::build::axis_index;
 use super::{EffectSpec, NodeSelector, Scene, SceneFile, SceneMesh};
-use crate::SceneError;
+use crate::error::SceneError;
 use crate::params::{MeshKind, PARAMS};
 
 pub(crate) type Invalid<'a> = dyn Fn(&str, String, &str) -> SceneError + 'a;

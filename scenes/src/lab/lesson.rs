@@ -28,21 +28,24 @@
 //! accept are errors naming the file, the step and the key. [`run_step`] runs a step headlessly
 //! and measures it: the CLI's recordings, the app and the tests share it.
 
+use crate::error::SceneError;
+use crate::instance::Instance;
+use crate::params::SceneOverrides;
 use crate::params::{PARAMS, Param, Value};
-use crate::{Instance, Scene, SceneError, SceneOverrides};
+use crate::scene::Scene;
 use serde::Deserialize;
 
 /// The built-in lessons, in teaching order: (name, TOML text).
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("why-high-order", include_str!("../../assets/lessons/why-high-order.toml")),
-    ("locking", include_str!("../../assets/lessons/locking.toml")),
-    ("mesh-bias", include_str!("../../assets/lessons/mesh-bias.toml")),
-    ("quadrature", include_str!("../../assets/lessons/quadrature.toml")),
-    ("shape-functions", include_str!("../../assets/lessons/shape-functions.toml")),
-    ("accuracy-cost", include_str!("../../assets/lessons/accuracy-cost.toml")),
-    ("stability", include_str!("../../assets/lessons/stability.toml")),
-    ("materials", include_str!("../../assets/lessons/materials.toml")),
-    ("curved-boundaries", include_str!("../../assets/lessons/curved-boundaries.toml")),
+    ("why-high-order", include_str!("../../../assets/lessons/why-high-order.toml")),
+    ("locking", include_str!("../../../assets/lessons/locking.toml")),
+    ("mesh-bias", include_str!("../../../assets/lessons/mesh-bias.toml")),
+    ("quadrature", include_str!("../../../assets/lessons/quadrature.toml")),
+    ("shape-functions", include_str!("../../../assets/lessons/shape-functions.toml")),
+    ("accuracy-cost", include_str!("../../../assets/lessons/accuracy-cost.toml")),
+    ("stability", include_str!("../../../assets/lessons/stability.toml")),
+    ("materials", include_str!("../../../assets/lessons/materials.toml")),
+    ("curved-boundaries", include_str!("../../../assets/lessons/curved-boundaries.toml")),
 ];
 
 /// The camera presets a step may name (the app's).
@@ -262,7 +265,7 @@ impl Lesson {
         let mut steps = Vec::new();
         for (k, s) in file.steps.into_iter().enumerate() {
             let at = |key: &str, message: String| bad(format!("step {} ('{}'): {key}: {message}", k + 1, s.title));
-            let base = crate::by_name(&s.scene).map_err(|e| at("scene", e.to_string()))?;
+            let base = crate::scene::builtin::by_name(&s.scene).map_err(|e| at("scene", e.to_string()))?;
             let mut configurations = Vec::new();
             for (label, table) in std::iter::once(("a", &s.a)).chain(s.b.as_ref().map(|b| ("b", b))) {
                 let overrides = overrides_from(table).map_err(|(key, m)| at(&format!("{label}.{key}"), m))?;
@@ -377,12 +380,12 @@ pub struct StepRunner {
     pub instances: Vec<Instance>,
     run: Run,
     measure: Measure,
-    settlers: Vec<Option<crate::Settler>>,
+    settlers: Vec<Option<crate::run::Settler>>,
     done: Vec<bool>,
     failures: Vec<Option<String>>,
     min_det_f: Vec<f64>,
     frame_ms: Vec<Vec<f64>>,
-    references: Vec<Option<crate::reference::Reference>>,
+    references: Vec<Option<crate::lab::reference::Reference>>,
 }
 
 impl StepRunner {
@@ -398,11 +401,11 @@ impl StepRunner {
             if step.run == Run::Static {
                 let mesh = instance.sim.mesh().clone();
                 let solution =
-                    crate::solve_static(&instance.scene, &mesh, 1e-9, 10, &mut |f, _, _| progress(&what, f))?;
+                    crate::instance::solve_static(&instance.scene, &mesh, 1e-9, 10, &mut |f, _, _| progress(&what, f))?;
                 instance.sim.warm_start(&solution.positions, 0.0);
             }
             settlers.push(match step.run {
-                Run::Settle => Some(crate::Settler::start(&mut instance, crate::SETTLE_CAP_SECS)?),
+                Run::Settle => Some(crate::run::Settler::start(&mut instance, crate::run::SETTLE_CAP_SECS)?),
                 _ => None,
             });
             references
@@ -459,7 +462,7 @@ impl StepRunner {
             let instance = &mut self.instances[k];
             self.done[k] = match (self.run, &mut self.settlers[k]) {
                 (Run::Seconds(secs), _) => instance.sim.time_secs() >= secs - 1e-9,
-                (_, Some(settler)) => settler.check(instance) != crate::SettleState::Running,
+                (_, Some(settler)) => settler.check(instance) != crate::run::SettleState::Running,
                 _ => true,
             };
             if self.done[k]
@@ -477,7 +480,7 @@ impl StepRunner {
             let t = self.instances[0].sim.time_secs();
             let fraction = match self.run {
                 Run::Seconds(secs) => t / secs,
-                _ => t / crate::SETTLE_CAP_SECS,
+                _ => t / crate::run::SETTLE_CAP_SECS,
             };
             progress("running", fraction.min(1.0));
         }
@@ -490,7 +493,7 @@ impl StepRunner {
                 Some(e) => Measured { value: f64::INFINITY, text: format!("failed: {e}") },
                 None => {
                     let mut ms = self.frame_ms[k].clone();
-                    let ms = if ms.is_empty() { f64::NAN } else { crate::median(&mut ms) };
+                    let ms = if ms.is_empty() { f64::NAN } else { crate::run::median(&mut ms) };
                     measure(self.measure, &self.instances[k], self.references[k].as_ref(), ms, self.min_det_f[k])
                 }
             })
@@ -508,11 +511,11 @@ impl StepRunner {
 pub fn reference_for(
     measure: Measure,
     scene: &Scene,
-    progress: crate::reference::Progress<'_>,
-) -> Result<Option<crate::reference::Reference>, SceneError> {
+    progress: crate::lab::reference::Progress<'_>,
+) -> Result<Option<crate::lab::reference::Reference>, SceneError> {
     Ok(match measure {
-        Measure::SettledError => Some(crate::reference::Lookup::default().for_scene(scene, progress)?),
-        Measure::SolverError => Some(crate::reference::own_mesh(scene, progress)?),
+        Measure::SettledError => Some(crate::lab::reference::Lookup::default().for_scene(scene, progress)?),
+        Measure::SolverError => Some(crate::lab::reference::own_mesh(scene, progress)?),
         _ => None,
     })
 }
@@ -530,7 +533,7 @@ pub fn run_step(step: &Step, progress: &mut dyn FnMut(&str, f64)) -> Result<(Ste
 pub fn measure(
     measure: Measure,
     instance: &Instance,
-    reference: Option<&crate::reference::Reference>,
+    reference: Option<&crate::lab::reference::Reference>,
     ms_per_frame: f64,
     min_det_f: f64,
 ) -> Measured {

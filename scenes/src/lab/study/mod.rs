@@ -18,7 +18,14 @@ pub mod motion;
 pub mod pareto;
 pub mod solver_axis;
 
-use crate::{Instance, RunMode, SceneError, SceneOverrides, run};
+/// An element type's colour in the study's charts (`study.svg` and the app's).
+pub use crate::present::colour::element_colour;
+
+use crate::error::SceneError;
+use crate::instance::Instance;
+use crate::params::SceneOverrides;
+use crate::present::svg::{decades, element_hex, element_legend, plot_frame};
+use crate::run::{RunMode, run};
 use hox_sim::Vec3;
 use hox_sim::element::{ElementType, ReferenceShape};
 use hox_sim::mesh::structured::TetSplit;
@@ -136,11 +143,11 @@ pub struct StudyRow {
     pub settled: bool,
 }
 
-/// Probe displacements of a paper scene's committed reference ([`crate::reference::committed`]).
+/// Probe displacements of a paper scene's committed reference ([`crate::lab::reference::committed`]).
 pub fn reference(scene: &str) -> Result<Vec<(String, Vec3)>, SceneError> {
     let unknown = || SceneError::Unknown { name: scene.to_string(), available: "bending, tension, torsion".into() };
-    let built = crate::by_name(scene).map_err(|_| unknown())?;
-    let committed = crate::reference::committed(&built)?.ok_or_else(unknown)?;
+    let built = crate::scene::builtin::by_name(scene).map_err(|_| unknown())?;
+    let committed = crate::lab::reference::committed(&built)?.ok_or_else(unknown)?;
     Ok(committed.probes.into_iter().map(|(name, u)| (name, Vec3::from(u))).collect())
 }
 
@@ -161,7 +168,7 @@ fn probes_of(instance: &Instance, positions: &[Vec3]) -> Vec<(String, Vec3)> {
 
 /// The settled probe displacements of a run, or, when it never settled (XPBD can keep a small
 /// oscillation going), their mean over the last simulated second.
-fn settled_probes(report: &crate::RunReport) -> Vec<(String, Vec3)> {
+fn settled_probes(report: &crate::run::RunReport) -> Vec<(String, Vec3)> {
     let source = if report.settled || report.at_rest { &report.probes } else { &report.probes_last_second_mean };
     source.iter().map(|(n, u)| (n.clone(), Vec3::from(*u))).collect()
 }
@@ -180,7 +187,7 @@ pub fn study_one(
 ) -> Result<StudyRow, SceneError> {
     let reference = reference(scene_name)?;
     let reference_size = reference.iter().map(|(_, u)| u.norm()).fold(0.0, f64::max);
-    let base = crate::by_name(scene_name)?;
+    let base = crate::scene::builtin::by_name(scene_name)?;
     let scene = base.with_overrides(&config.overrides())?;
     let label = config.label();
     let fail = |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label}"), message: m };
@@ -188,7 +195,7 @@ pub fn study_one(
     // 1. the static solution on this mesh
     progress(&format!("{scene_name} {label}: static solution"));
     let mut instance = Instance::new(scene.clone())?;
-    let statics = crate::solve_static(&scene, instance.sim.mesh(), 1e-8, 1, &mut |_, _, _| {})
+    let statics = crate::instance::solve_static(&scene, instance.sim.mesh(), 1e-8, 1, &mut |_, _, _| {})
         .map_err(|e| fail(e.to_string()))?;
     let static_probes = probes_of(&instance, &statics.positions);
 
@@ -264,7 +271,7 @@ pub fn study_one(
 /// Runs the study over the paper scenes (`quick`: without the heavy configurations).
 pub fn run_study(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<StudyRow>, SceneError> {
     let mut rows = Vec::new();
-    for scene in crate::PAPER_SCENES {
+    for scene in crate::scene::builtin::PAPER_SCENES {
         for config in configurations(scene).iter().filter(|c| !(quick && c.heavy)) {
             rows.push(study_one(scene, config, progress)?);
         }
@@ -333,12 +340,13 @@ fn static_tip_z(
 ) -> Result<(f64, usize), SceneError> {
     let label = config.label();
     progress(&format!("locking: {scene_name} {label} at ν = {nu}: static solution"));
-    let scene = crate::by_name(scene_name)?
+    let scene = crate::scene::builtin::by_name(scene_name)?
         .with_overrides(&SceneOverrides { poisson_ratio: Some(nu), ..config.overrides() })?;
     let mesh = scene.build_mesh()?;
     let fail =
         |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label} at ν = {nu}"), message: m };
-    let solution = crate::solve_static(&scene, &mesh, 1e-8, 4, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
+    let solution =
+        crate::instance::solve_static(&scene, &mesh, 1e-8, 4, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
     let tip = scene
         .file
         .probes
@@ -402,7 +410,7 @@ pub fn markdown(rows: &[StudyRow], quick: bool) -> String {
         "Produced by `hox study{}`. Settings: the paper's (StVK, 50 substeps × 1 iteration, 60 fps, energy formulation), settled; errors at the probes against the fine Q2 reference (`assets/reference/`), in metres and in % of the reference displacement. *Discretisation*: static solution on the mesh vs reference. *Solver*: settled XPBD vs static solution on the same mesh. *Substeps for 1 %*: the substeps that bring the solver error under 1 %, and the ms per frame that costs. Times are medians over frames of the colour sweep (colour by colour, four elements per AVX2 register; the same result on any thread count): on one thread and on all threads (rayon's pool; measured over one second from the settled state).\n\n",
         if quick { " --quick" } else { "" }
     ));
-    for scene in crate::PAPER_SCENES {
+    for scene in crate::scene::builtin::PAPER_SCENES {
         let scene_rows: Vec<&StudyRow> = rows.iter().filter(|r| r.scene == scene).collect();
         if scene_rows.is_empty() {
             continue;
@@ -465,54 +473,6 @@ pub fn csv(rows: &[StudyRow]) -> String {
     s
 }
 
-/// The colour of an element type in the study's charts (`study.svg` and the app's), by its
-/// place in the registry: matplotlib's `tab10` colours in the order the built-in types were
-/// first drawn (p1 blue, p2 red, p3 green, q1 purple, q2 brown, prism pink, pyramid orange),
-/// then olive and cyan, repeating; grey for a name that is not registered.
-pub fn element_colour(element: &str) -> [u8; 3] {
-    const PALETTE: [[u8; 3]; 9] = [
-        [0x1f, 0x77, 0xb4],
-        [0xd6, 0x27, 0x28],
-        [0x2c, 0xa0, 0x2c],
-        [0x94, 0x67, 0xbd],
-        [0x8c, 0x56, 0x4b],
-        [0xe3, 0x77, 0xc2],
-        [0xff, 0x7f, 0x0e],
-        [0xbc, 0xbd, 0x22],
-        [0x17, 0xbe, 0xcf],
-    ];
-    ElementType::all()
-        .position(|e| e.name().eq_ignore_ascii_case(element))
-        .map_or([0x7f; 3], |i| PALETTE[i % PALETTE.len()])
-}
-
-/// An element type's chart colour as `#rrggbb`.
-pub(crate) fn element_hex(element: &str) -> String {
-    let [r, g, b] = element_colour(element);
-    format!("#{r:02x}{g:02x}{b:02x}")
-}
-
-/// The element-colour legend of a chart: a dot and the name of each of `elements` from
-/// (`lx`, `ly`) down, 18 px apart; returns the y below the last entry.
-pub(crate) fn svg_element_legend<'e>(
-    s: &mut String,
-    elements: impl IntoIterator<Item = &'e str>,
-    lx: f64,
-    mut ly: f64,
-) -> f64 {
-    for e in elements {
-        s.push_str(&format!(
-            "<circle cx=\"{lx}\" cy=\"{ly}\" r=\"5\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
-            element_hex(e),
-            lx + 10.0,
-            ly + 4.0,
-            e.to_uppercase()
-        ));
-        ly += 18.0;
-    }
-    ly
-}
-
 /// `study.svg`: bending tip error versus ms per frame, log–log, one colour per element type;
 /// filled circles at the paper's settings, rings at the 1 %-solver-error settings, and the
 /// paper's Table 1 points as crosses.
@@ -546,7 +506,7 @@ pub fn svg(rows: &[StudyRow]) -> String {
         s.push_str(&format!(r##"<line x1="{left}" y1="{y}" x2="{}" y2="{y}" stroke="#ddd"/><text x="{}" y="{}" text-anchor="end">1e{d}</text>
 "##, w - right, left - 6.0, y + 4.0));
     }
-    s.push_str(&svg_plot_frame([left, top, right, bottom], [w, h], "ms per frame", "tip error vs reference (m)"));
+    s.push_str(&plot_frame([left, top, right, bottom], [w, h], "ms per frame", "tip error vs reference (m)"));
     for r in &bending {
         let c = colour(&r.element);
         if positive(&r.error_1pct_m) && r.substeps_for_1pct != 50 {
@@ -579,7 +539,7 @@ pub fn svg(rows: &[StudyRow]) -> String {
     }
     // legend
     let lx = w - right + 15.0;
-    let mut ly = svg_element_legend(&mut s, ElementType::all().map(|e| e.name()), lx, top + 10.0);
+    let mut ly = element_legend(&mut s, ElementType::all().map(|e| e.name()), lx, top + 10.0);
     ly += 8.0;
     s.push_str(&format!(r##"<circle cx="{lx}" cy="{ly}" r="5" fill="#555"/><text x="{}" y="{}">50 substeps</text>
 <circle cx="{lx}" cy="{}" r="5" fill="white" stroke="#555" stroke-width="2"/><text x="{}" y="{}">solver error &lt; 1 %</text>
@@ -587,34 +547,4 @@ pub fn svg(rows: &[StudyRow]) -> String {
 "##, lx + 10.0, ly + 4.0, ly + 18.0, lx + 10.0, ly + 22.0, lx - 5.0, ly + 31.0, lx + 5.0, ly + 41.0, lx - 5.0, ly + 41.0, lx + 5.0, ly + 31.0, lx + 10.0, ly + 40.0));
     s.push_str("</svg>\n");
     s
-}
-
-/// The enclosing decades `(floor log10 min, ceil log10 max)`.
-fn decades<'a>(values: impl Iterator<Item = &'a f64>) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in values {
-        lo = lo.min(v.log10());
-        hi = hi.max(v.log10());
-    }
-    if !lo.is_finite() {
-        return (0.0, 1.0);
-    }
-    let (lo, hi) = (lo.floor(), hi.ceil());
-    if hi > lo { (lo, hi) } else { (lo, lo + 1.0) }
-}
-
-/// A chart's plot frame and its axis labels: `margins` `[left, top, right, bottom]` inside a
-/// `size` `[w, h]` picture.
-pub(crate) fn svg_plot_frame(margins: [f64; 4], size: [f64; 2], x_label: &str, y_label: &str) -> String {
-    let ([left, top, right, bottom], [w, h]) = (margins, size);
-    let middle_y = top + (h - top - bottom) / 2.0;
-    format!(
-        "<rect x=\"{left}\" y=\"{top}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"black\"/>\n\
-         <text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>\n\
-         <text x=\"18\" y=\"{middle_y}\" text-anchor=\"middle\" transform=\"rotate(-90 18 {middle_y})\">{y_label}</text>\n",
-        w - left - right,
-        h - top - bottom,
-        left + (w - left - right) / 2.0,
-        h - 14.0,
-    )
 }

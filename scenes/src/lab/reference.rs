@@ -8,7 +8,7 @@
 //!   `assets/reference/SCENE-fine.json`, its mesh error estimated from the committed coarse and
 //!   medium levels as below.
 //! - **computed**: any other physics on a box mesh (another ν, E, ρ or model, a scene file's own
-//!   loads). hox's static solver ([`crate::solve_static`]) on triquadratic hexahedra (Q2) at
+//!   loads). hox's static solver ([`crate::instance::solve_static`]) on triquadratic hexahedra (Q2) at
 //!   six levels ([`compute`]): the finest ([`levels`]; bending 32×8×8) and ¼, ⅜, ½, ⅝ and ¾ as
 //!   many cells per direction, with provisional estimates on the way. The final reference uses
 //!   four of them (¼, ½, ¾, 1): it is the finest level extrapolated
@@ -37,9 +37,10 @@ pub mod field;
 pub use compute::{LEVELS, OnEstimate, Progress, compute_with, grids, level_scene, own_mesh, provisional};
 pub use field::ReferenceField;
 
+use crate::error::SceneError;
 use crate::params::MeshKind;
 use crate::scene::EffectSpec;
-use crate::{Scene, SceneError};
+use crate::scene::Scene;
 use hox_sim::Vec3;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -161,12 +162,12 @@ impl Reference {
 pub fn physics_key(scene: &Scene) -> String {
     let p = scene.params();
     let geometry = match &scene.mesh {
-        crate::SceneMesh::Box(_) => format!("box {:?} {:?}", p.box_min_m, p.box_max_m),
+        crate::scene::SceneMesh::Box(_) => format!("box {:?} {:?}", p.box_min_m, p.box_max_m),
         // a part meshed per element type has one reference whichever file is on screen
-        crate::SceneMesh::File { .. } if scene.mesh_kind() == MeshKind::Files => {
+        crate::scene::SceneMesh::File { .. } if scene.mesh_kind() == MeshKind::Files => {
             format!("part {:?}", scene.file.mesh_files)
         }
-        crate::SceneMesh::File { path, imported } => {
+        crate::scene::SceneMesh::File { path, imported } => {
             format!("file {} ({} nodes)", path.display(), imported.mesh.num_nodes())
         }
     };
@@ -194,25 +195,25 @@ const COMMITTED: [(&str, [([usize; 3], &str); 3]); 3] = [
     (
         "bending",
         [
-            ([8, 2, 2], include_str!("../../assets/reference/bending-coarse.json")),
-            ([16, 4, 4], include_str!("../../assets/reference/bending-medium.json")),
-            ([32, 8, 8], include_str!("../../assets/reference/bending-fine.json")),
+            ([8, 2, 2], include_str!("../../../assets/reference/bending-coarse.json")),
+            ([16, 4, 4], include_str!("../../../assets/reference/bending-medium.json")),
+            ([32, 8, 8], include_str!("../../../assets/reference/bending-fine.json")),
         ],
     ),
     (
         "tension",
         [
-            ([4, 2, 2], include_str!("../../assets/reference/tension-coarse.json")),
-            ([12, 6, 6], include_str!("../../assets/reference/tension-medium.json")),
-            ([24, 12, 12], include_str!("../../assets/reference/tension-fine.json")),
+            ([4, 2, 2], include_str!("../../../assets/reference/tension-coarse.json")),
+            ([12, 6, 6], include_str!("../../../assets/reference/tension-medium.json")),
+            ([24, 12, 12], include_str!("../../../assets/reference/tension-fine.json")),
         ],
     ),
     (
         "torsion",
         [
-            ([4, 2, 2], include_str!("../../assets/reference/torsion-coarse.json")),
-            ([12, 6, 6], include_str!("../../assets/reference/torsion-medium.json")),
-            ([24, 12, 12], include_str!("../../assets/reference/torsion-fine.json")),
+            ([4, 2, 2], include_str!("../../../assets/reference/torsion-coarse.json")),
+            ([12, 6, 6], include_str!("../../../assets/reference/torsion-medium.json")),
+            ([24, 12, 12], include_str!("../../../assets/reference/torsion-fine.json")),
         ],
     ),
 ];
@@ -239,7 +240,7 @@ pub fn committed(scene: &Scene) -> Result<Option<Reference>, SceneError> {
     let Some((name, levels)) = COMMITTED.iter().find(|(n, _)| *n == scene.name()) else {
         return Ok(None);
     };
-    if !scene.is_box() || physics_key(scene) != physics_key(&crate::by_name(name)?) {
+    if !scene.is_box() || physics_key(scene) != physics_key(&crate::scene::builtin::by_name(name)?) {
         return Ok(None);
     }
     let mut solved = Vec::new();
@@ -536,10 +537,13 @@ impl Lookup {
         let level = level_scene(scene, grid)?;
         let mesh = level.build_mesh()?;
         let what = format!("computing reference field: static Q2 {}×{}×{}", grid[0], grid[1], grid[2]);
-        let solution =
-            crate::solve_static(&level, &mesh, compute::TOLERANCE, compute::LOAD_STEPS, &mut |fraction, _, _| {
-                progress(&what, fraction)
-            })?;
+        let solution = crate::instance::solve_static(
+            &level,
+            &mesh,
+            compute::TOLERANCE,
+            compute::LOAD_STEPS,
+            &mut |fraction, _, _| progress(&what, fraction),
+        )?;
         let field = ReferenceField::lattice(&mesh, &solution.positions, p.box_min_m, p.box_max_m, grid);
         let with = Reference { field, ..reference };
         self.store(&key, &with, true);

@@ -15,7 +15,8 @@
 //!   (a top and a bottom) whose mid-time is nearest [`AMPLITUDE_AT_SECS`], which a scheme's
 //!   numerical damping shrinks.
 
-use crate::{Instance, SceneError};
+use crate::error::SceneError;
+use crate::instance::Instance;
 
 /// When the amplitude "after 2 s" is measured, seconds.
 pub const AMPLITUDE_AT_SECS: f64 = 2.0;
@@ -24,7 +25,7 @@ pub const AMPLITUDE_AT_SECS: f64 = 2.0;
 pub const MOTION_SECS: f64 = 2.5;
 
 /// The committed reference motion of the bending beam.
-pub const REFERENCE_MOTION_JSON: &str = include_str!("../../../assets/reference/bending-motion.json");
+pub const REFERENCE_MOTION_JSON: &str = include_str!("../../../../assets/reference/bending-motion.json");
 
 /// A probe's motion sampled at a fixed interval from release.
 #[derive(Clone, Debug, PartialEq)]

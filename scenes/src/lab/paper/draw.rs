@@ -3,6 +3,8 @@
 //! displacement's levels (Fig. 3), and their colour bar.
 
 use super::{Panel, ring};
+use crate::present::colour::viridis;
+use crate::present::svg::{colour_bar, hex};
 use hox_sim::Vec3;
 use std::fmt::Write;
 
@@ -17,55 +19,6 @@ fn nice_factor(x: f64) -> f64 {
         }
     }
     best
-}
-
-fn hex(c: [u8; 3]) -> String {
-    format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2])
-}
-
-/// Viridis at `t ∈ [0, 1]` (clamped; NaN maps to 0), as RGB bytes: the colour map of the figures,
-/// the recordings and the app (perceptually uniform, readable in grey and by colour-blind
-/// viewers), from the degree-6 polynomial fit of matplotlib's table by Matt Zucker (within 5/255
-/// per channel of the table).
-pub fn viridis(t: f64) -> [u8; 3] {
-    const C: [[f64; 3]; 7] = [
-        [0.277_727_327_223_417_7, 0.005_407_344_544_966_578, 0.334_099_805_335_306_1],
-        [0.105_093_043_108_577_4, 1.404_613_529_898_575, 1.384_590_162_594_685],
-        [-0.330_861_828_725_556_3, 0.214_847_559_468_213, 0.095_095_163_028_236_59],
-        [-4.634_230_498_983_486, -5.799_100_973_351_585, -19.332_440_956_279_87],
-        [6.228_269_936_347_081, 14.179_933_366_805_09, 56.690_552_600_681_05],
-        [4.776_384_997_670_288, -13.745_145_377_746_01, -65.353_032_633_372_34],
-        [-5.435_455_855_934_631, 4.645_852_612_178_535, 26.312_435_249_583_2],
-    ];
-    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
-    std::array::from_fn(|k| {
-        let v = C.iter().rev().fold(0.0, |acc, c| acc * t + c[k]);
-        (v.clamp(0.0, 1.0) * 255.0).round() as u8
-    })
-}
-
-/// The colour bar: `label` from `lo` to `hi` at `(x, y)`, `w` wide.
-fn colour_bar(s: &mut String, x: f64, y: f64, w: f64, lo: f64, hi: f64, label: &str) {
-    let steps = 40;
-    for k in 0..steps {
-        let t = k as f64 / (steps - 1) as f64;
-        let _ = write!(
-            s,
-            r#"<rect x="{:.1}" y="{y:.1}" width="{:.2}" height="12" fill="{}"/>"#,
-            x + w * k as f64 / steps as f64,
-            w / steps as f64 + 0.5,
-            hex(viridis(t))
-        );
-    }
-    let _ = write!(
-        s,
-        r#"<text x="{x:.1}" y="{:.1}" font-size="12">{lo:.3}</text><text x="{:.1}" y="{:.1}" font-size="12" text-anchor="end">{hi:.3}</text><text x="{:.1}" y="{:.1}" font-size="12" text-anchor="middle">{label}</text>"#,
-        y + 26.0,
-        x + w,
-        y + 26.0,
-        x + w / 2.0,
-        y + 26.0
-    );
 }
 
 /// Deformed sample grids drawn as filled cells coloured by `|u|`, each panel in its own box on

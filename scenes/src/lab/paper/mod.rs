@@ -24,12 +24,14 @@
 mod draw;
 mod report;
 
-pub use draw::viridis;
 use draw::{draw_deformed, draw_strips};
 pub use report::{Claim, claims, paper_markdown, table_markdown};
 
-use crate::study::{PAPER_TABLE_1, StudyConfig};
-use crate::{Instance, RunMode, SceneError, SceneOverrides, run};
+use crate::error::SceneError;
+use crate::instance::Instance;
+use crate::lab::study::{PAPER_TABLE_1, StudyConfig};
+use crate::params::SceneOverrides;
+use crate::run::{RunMode, run};
 use hox_sim::Vec3;
 use hox_sim::measure::probe::Probe;
 use hox_sim::mesh::Mesh;
@@ -267,7 +269,8 @@ pub fn reference_panel(
     };
     let built = scene.with_overrides(&overrides)?;
     let instance = Instance::new(built)?;
-    let solution = crate::solve_static(&instance.scene, instance.sim.mesh(), 1e-9, load_steps, &mut |_, _, _| {})?;
+    let solution =
+        crate::instance::solve_static(&instance.scene, instance.sim.mesh(), 1e-9, load_steps, &mut |_, _, _| {})?;
     panel_of(reference_label(name, quick), instance.sim.mesh(), &solution.positions, points, None)
 }
 
@@ -327,8 +330,12 @@ pub fn outline_distance(outline: &[[f64; 2]], reference: &[[f64; 2]]) -> f64 {
 
 /// Runs `scene` with `overrides` settled at the paper's settings (XPBD, one thread) and returns
 /// the instance and its report.
-fn settled(scene: &str, overrides: &SceneOverrides, cap_secs: f64) -> Result<(Instance, crate::RunReport), SceneError> {
-    let built = crate::by_name(scene)?.with_overrides(overrides)?;
+fn settled(
+    scene: &str,
+    overrides: &SceneOverrides,
+    cap_secs: f64,
+) -> Result<(Instance, crate::run::RunReport), SceneError> {
+    let built = crate::scene::builtin::by_name(scene)?.with_overrides(overrides)?;
     let mut instance = Instance::new(built)?;
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().map_err(|e| SceneError::Simulation {
         source_name: scene.into(),
@@ -347,9 +354,10 @@ fn reference_solution(scene: &str, quick: bool) -> Result<(Instance, Vec<Vec3>),
         grid: Some(cells),
         ..Default::default()
     };
-    let built = crate::by_name(scene)?.with_overrides(&overrides)?;
+    let built = crate::scene::builtin::by_name(scene)?.with_overrides(&overrides)?;
     let instance = Instance::new(built)?;
-    let solution = crate::solve_static(&instance.scene, instance.sim.mesh(), 1e-9, load_steps, &mut |_, _, _| {})?;
+    let solution =
+        crate::instance::solve_static(&instance.scene, instance.sim.mesh(), 1e-9, load_steps, &mut |_, _, _| {})?;
     Ok((instance, solution.positions))
 }
 
@@ -358,7 +366,7 @@ fn panel(
     instance: &Instance,
     positions: &[Vec3],
     points: &[Vec3],
-    report: Option<&crate::RunReport>,
+    report: Option<&crate::run::RunReport>,
 ) -> Result<Panel, SceneError> {
     panel_of(label, instance.sim.mesh(), positions, points, report.map(|r| (r.ms_per_frame, r.settled || r.at_rest)))
 }
@@ -387,7 +395,7 @@ pub fn run_paper(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<PaperRes
 
     // Fig. 1 and 2: the 637-vertex beams (biased: six tetrahedra per cell; unbiased: five)
     let beam = |scene: &str| -> Result<(Vec3, Vec3), SceneError> {
-        let built = crate::by_name(scene)?;
+        let built = crate::scene::builtin::by_name(scene)?;
         let params = built.params();
         Ok((Vec3::from(params.box_min_m), Vec3::from(params.box_max_m)))
     };
@@ -416,7 +424,7 @@ pub fn run_paper(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<PaperRes
     let (reference, ref_positions) = reference_solution("bending", quick)?;
     let (lo, hi) = beam("bending")?;
     let (top, nu, nv) = FigureKind::Bending.samples(lo, hi, quick);
-    let committed = crate::study::reference("bending")?;
+    let committed = crate::lab::study::reference("bending")?;
     let tip_ref = committed.iter().find(|(n, _)| n == "tip").map(|(_, u)| *u).unwrap_or_default();
     let bending = [
         (c("p1", [16, 4, 4], TetSplit::Five, 0, false), 0),

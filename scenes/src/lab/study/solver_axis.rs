@@ -24,7 +24,10 @@
 
 use super::motion::{Motion, MotionMetrics, reference_motion};
 use super::{StudyConfig, probe_distance, probes_of, reference, settled_probes};
-use crate::{Instance, RunMode, SceneError, SceneOverrides, run_observed};
+use crate::error::SceneError;
+use crate::instance::Instance;
+use crate::params::SceneOverrides;
+use crate::run::{RunMode, run_observed};
 use hox_sim::mesh::structured::TetSplit;
 use hox_sim::solver::{Integrator, Method};
 use std::time::Instant;
@@ -165,7 +168,7 @@ pub fn run_solver_axis(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Ve
     })?;
     let motion_reference = reference_motion()?.metrics();
     let mut rows = Vec::new();
-    for scene in crate::PAPER_SCENES {
+    for scene in crate::scene::builtin::PAPER_SCENES {
         for config in solver_configurations(scene, quick) {
             config_rows(&pool, scene, &config, &motion_reference, progress, &mut rows)?;
         }
@@ -184,13 +187,13 @@ fn config_rows(
 ) -> Result<(), SceneError> {
     let reference = reference(scene_name)?;
     let reference_size = reference.iter().map(|(_, u)| u.norm()).fold(0.0, f64::max);
-    let scene = crate::by_name(scene_name)?.with_overrides(&config.overrides())?;
+    let scene = crate::scene::builtin::by_name(scene_name)?.with_overrides(&config.overrides())?;
     let label = config.label();
     progress(&format!("solvers: {scene_name} {label}: static solution"));
     let instance = Instance::new(scene.clone())?;
     let mesh = instance.sim.mesh();
     let statics = pool
-        .install(|| crate::solve_static(&scene, mesh, 1e-8, 1, &mut |_, _, _| {}))
+        .install(|| crate::instance::solve_static(&scene, mesh, 1e-8, 1, &mut |_, _, _| {}))
         .map_err(|e| SceneError::Simulation { source_name: format!("{scene_name} {label}"), message: e.to_string() })?;
     let static_probes = probes_of(&instance, &statics.positions);
     let static_size = static_probes.iter().map(|(_, u)| u.norm()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
@@ -341,7 +344,7 @@ pub fn solver_markdown(rows: &[SolverRow]) -> String {
     let mut s = String::from(
         "## The solver axis: what accuracy costs with each solver\n\nEach mesh with XPBD on a grid of substeps × iterations (equal sweep budgets) and with VBD and Newton at their defaults, from rest on **one thread** until settled (settle damping 10/s; VBD with its coarse correction, `vbd_coarse_cells` 32, as the others). *Solver*: settled probes against the static solution of the same mesh; *total*: against the reference; *mesh*: the static solution's own (discretisation) error, which no solver removes. *ms/frame*: the mean frame over the first 2.5 s of motion from rest (no damping; bending: the beam released, tension and torsion: their drives' ramps). *Sweeps/frame*: XPBD substeps × iterations; VBD sweeps; Newton iterations (factorisations or back-substitutions) per frame while settling. *To 1 %*: wall seconds until the error against the static solution stays under 1 % (— never). *Settles*: in equilibrium (residual ≤ 1e-5 of the load), at rest but not in equilibrium (XPBD's bias), or neither by the cap. Bending also: the first period and the amplitude around 2 s of the beam released from rest without damping, against the reference motion (Newmark, Q2 16×4×4; `assets/reference/bending-motion.json`).\n\n",
     );
-    for scene in crate::PAPER_SCENES {
+    for scene in crate::scene::builtin::PAPER_SCENES {
         let scene_rows: Vec<&SolverRow> = rows.iter().filter(|r| r.scene == scene).collect();
         if scene_rows.is_empty() {
             continue;

@@ -21,8 +21,9 @@
 pub mod peak;
 pub mod solver;
 
+use crate::error::SceneError;
+use crate::instance::Instance;
 use crate::params::SceneOverrides;
-use crate::{Instance, SceneError};
 use hox_sim::element::ElementType;
 use hox_sim::measure::median;
 use hox_sim::solver::{Simulation, Sweep};
@@ -58,7 +59,7 @@ impl BenchCase {
 }
 
 /// The five rows of Table 1, then Q1, Q2, prism and pyramid beams of comparable node count
-/// (the meshes of the study, `scenes/src/study.rs`), then a large beam of every element type
+/// (the meshes of the study, `scenes/src/lab/study/`), then a large beam of every element type
 /// but P1 (whose largest is Table 1's 81,920): 32 cells along the beam (24 for the pyramids),
 /// large enough for the colour sweep to cut it into slabs for the threads.
 pub const CASES: [BenchCase; 15] = [
@@ -113,7 +114,7 @@ fn beam(case: &BenchCase, sweep: Sweep, method: Option<hox_sim::solver::Method>)
         method,
         ..SceneOverrides::default()
     };
-    Ok(Instance::new(crate::by_name(case.scene)?.with_overrides(&overrides)?)?.sim)
+    Ok(Instance::new(crate::scene::builtin::by_name(case.scene)?.with_overrides(&overrides)?)?.sim)
 }
 
 /// Flops of one energy-constraint projection of an element with `nodes` nodes and `points`
@@ -405,7 +406,7 @@ mod tests {
     /// and sweep.
     #[test]
     fn the_benchmark_beam_is_the_bending_scene_file() {
-        let scene = crate::by_name("bending").unwrap();
+        let scene = crate::scene::builtin::by_name("bending").unwrap();
         let case = BenchCase { scene: "bending", element: "q1", grid: [4, 1, 1], refine: 0, paper_ms_per_frame: None };
         let sim = bending_beam(&case, Sweep::Element).unwrap();
         assert_eq!(*sim.material(), scene.material());

@@ -29,7 +29,9 @@
 
 use super::field::ReferenceField;
 use super::{Origin, Probes, Reference, Refining, distance, extrapolate, levels, mesh_error, observed_order};
-use crate::{Scene, SceneError, SceneOverrides};
+use crate::error::SceneError;
+use crate::params::SceneOverrides;
+use crate::scene::Scene;
 use hox_sim::Vec3;
 use hox_sim::element::ElementType;
 
@@ -168,7 +170,7 @@ pub fn compute_with(
         let level = level_scene(scene, *grid)?;
         let mesh = level.build_mesh()?;
         let what = format!("computing reference, level {} of {n} (static {})", k + 1, grid_name(*grid));
-        let solution = crate::solve_static(&level, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
+        let solution = crate::instance::solve_static(&level, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
             progress(&what, (done + fraction * cells[k]) / total)
         })?;
         done += cells[k];
@@ -258,8 +260,9 @@ pub fn own_mesh(scene: &Scene, progress: Progress<'_>) -> Result<Reference, Scen
     } else {
         "computing reference: static solution of this mesh".to_string()
     };
-    let solution =
-        crate::solve_static(solved, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| progress(&what, fraction))?;
+    let solution = crate::instance::solve_static(solved, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
+        progress(&what, fraction)
+    })?;
     let probes = probes_at(solved, &mesh, &solution.positions)?;
     let described = format!("{} ({} elements)", solved.mesh.element_names(), mesh.num_elements());
     Ok(match highest {
@@ -315,5 +318,5 @@ pub fn highest_order(scene: &Scene) -> Result<Option<Scene>, SceneError> {
     if element == scene.params().element {
         return Ok(Some(scene.clone()));
     }
-    scene.with_overrides(&crate::SceneOverrides { element: Some(element), ..Default::default() }).map(Some)
+    scene.with_overrides(&crate::params::SceneOverrides { element: Some(element), ..Default::default() }).map(Some)
 }

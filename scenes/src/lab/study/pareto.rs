@@ -3,6 +3,7 @@
 //! the registry, with the Pareto frontier drawn through the rows no other beats on both.
 
 use super::solver_axis::{REAL_TIME_MS, SolverRow, TARGET_ERROR_PCT, pareto_frontier};
+use crate::present::svg::{decades, element_hex, element_legend, plot_frame};
 use hox_sim::solver::Method;
 
 /// The marker of a solver in the chart, by its place in the registry ([`Method::ALL`]): XPBD
@@ -51,7 +52,7 @@ fn marker(r: &SolverRow, x: f64, y: f64, fill: &str, title: &str) -> String {
 /// log–log, every element type (colour) and solver (marker), the Pareto frontier drawn, the
 /// 1 % target and the 16.7 ms frame budget as dashed lines.
 pub fn pareto_svg(rows: &[SolverRow], scene: &str) -> String {
-    let colour = super::element_hex;
+    let colour = element_hex;
     let points: Vec<&SolverRow> = rows
         .iter()
         .filter(|r| r.scene == scene && r.failure.is_none() && r.ms_per_frame > 0.0 && r.error_pct > 0.0)
@@ -59,8 +60,8 @@ pub fn pareto_svg(rows: &[SolverRow], scene: &str) -> String {
         .collect();
     let xs: Vec<f64> = points.iter().map(|r| r.ms_per_frame).chain([REAL_TIME_MS]).collect();
     let ys: Vec<f64> = points.iter().map(|r| r.error_pct).chain([TARGET_ERROR_PCT]).collect();
-    let (x0, x1) = super::decades(xs.iter());
-    let (y0, y1) = super::decades(ys.iter());
+    let (x0, x1) = decades(xs.iter());
+    let (y0, y1) = decades(ys.iter());
     let (w, h, left, right, top, bottom) = (820.0, 540.0, 80.0, 190.0, 40.0, 60.0);
     let px = |x: f64| left + (x.log10() - x0) / (x1 - x0) * (w - left - right);
     let py = |y: f64| top + (y1 - y.log10()) / (y1 - y0) * (h - top - bottom);
@@ -88,7 +89,7 @@ pub fn pareto_svg(rows: &[SolverRow], scene: &str) -> String {
             y + 4.0
         ));
     }
-    s.push_str(&super::svg_plot_frame(
+    s.push_str(&plot_frame(
         [left, top, right, bottom],
         [w, h],
         "ms per frame, one thread",
@@ -137,7 +138,7 @@ pub fn pareto_svg(rows: &[SolverRow], scene: &str) -> String {
             seen.push(&r.element);
         }
     }
-    let mut ly = super::svg_element_legend(&mut s, seen, lx, top + 10.0) + 8.0;
+    let mut ly = element_legend(&mut s, seen, lx, top + 10.0) + 8.0;
     for method in Method::ALL {
         let name = if method.is_implicit() { method.name() } else { "xpbd (substeps × iterations)" };
         let fake = SolverRow { solver: method.name().into(), ..dummy_row() };

@@ -25,8 +25,8 @@
 //!   factorisation, an upper bound of one factorisation's cost); iterations per step.
 
 use super::{BenchCase, matching_solver_cases};
-use crate::SceneError;
-use crate::study::solver_axis::opt;
+use crate::error::SceneError;
+use crate::lab::study::solver_axis::opt;
 use hox_sim::measure::median;
 use hox_sim::solver::{Method, SimError, Simulation, SolverCounters};
 use std::time::Instant;
