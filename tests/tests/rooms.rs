@@ -1,6 +1,6 @@
 //! The rooms of every crate in one stated order (docs/ARCHITECTURE.md states the same): a room
 //! uses only the rooms of the layers before its own; within hox-sim's `solver/`, hox-scenes'
-//! `lab/` and `present/` (and, once restructured, the app's `gui/`) the same holds for its files.
+//! `lab/` and `present/` and the app's `gui/` the same holds for its files.
 //! The checker is `hox_tests::rooms`; each test names the file, the line and the path of every
 //! use against the order.
 
@@ -82,17 +82,22 @@ const PRESENT_FILES: &[&[&str]] = &[&["colour"], &["svg"]];
 const APP: &[&[&str]] =
     &[&["colour", "output", "web"], &["config"], &["display"], &["recording"], &["cli", "gui"], &["main"]];
 
-/// The files of the app's `gui/`, lowest first, as today's code layers them; `mod` (the front,
-/// `gui/mod.rs`, which holds `HoxApp`) last, so that every file importing `super::HoxApp` is a
-/// use against the order until issue 56's restructuring (see [`gui_files_use_only_those_before_them`]).
+/// The files of the app's `gui/`, lowest first (`mod.rs`, a pure front, declares them): the
+/// model's parts, the model, its services, the UI's state, the panels, the app, the window.
 const GUI_FILES: &[&[&str]] = &[
-    &["config", "gl_view", "links", "raster", "readout", "study_chart", "figure", "measure"],
-    &["session", "teach", "cost", "plots"],
-    &["viewport", "rerun_link"],
-    &["args", "lesson", "playback", "persist"],
-    &["run", "serve_web", "controls"],
+    &["config", "links", "presets", "readout", "raster", "study_chart", "measure", "playback"],
+    &["session", "args", "gl_view", "teach"],
+    &["session_view", "background", "cost"],
+    &["lesson", "viewport"],
+    &["action"],
+    &["model"],
+    &["figure", "rerun_link"],
+    &["ui_state"],
+    &["persist", "sections", "serve_web", "status", "dialogs", "lesson_panel", "plots"],
+    &["controls", "menu"],
+    &["app"],
     &["window"],
-    &[FRONT],
+    &["launch"],
 ];
 
 /// hox-sim's one room with an order of its own files.
@@ -105,7 +110,7 @@ fn orders() -> [Order<'static>; 3] {
     [
         Order { crate_dir: "sim", layers: SIM, files_of: sim_files_of() },
         Order { crate_dir: "scenes", layers: SCENES, files_of: &[("lab", LAB_FILES), ("present", PRESENT_FILES)] },
-        Order { crate_dir: "app", layers: APP, files_of: &[] },
+        Order { crate_dir: "app", layers: APP, files_of: &[("gui", GUI_FILES)] },
     ]
 }
 
@@ -182,14 +187,9 @@ fn every_room_on_disk_is_in_the_order() {
     }
 }
 
-/// The app's `gui/` with its files' order: ignored until issue 56 restructures `gui/` (today each
-/// panel file imports `super::HoxApp` from the front, `mod.rs`). To set the final order, list
-/// `gui/`'s files in [`GUI_FILES`] lowest first — `FRONT` (`mod`) only if `mod.rs` keeps code the
-/// files use, placed below them; a pure front (`mod` lines and re-exports) is left out — remove
-/// the `#[ignore]`, and state the order in docs/ARCHITECTURE.md (add `GUI_FILES` to
-/// [`the_docs_state_the_same_orders`]).
+/// The app's `gui/` with its files' order: no file uses one of a later layer or of its own,
+/// nor the front (`mod.rs` holds no code: `HoxApp` is `app.rs`'s), so no two-way ties.
 #[test]
-#[ignore = "issue 56: gui/ is being restructured"]
 fn gui_files_use_only_those_before_them() {
     let order = app_with_gui();
     for (what, on_disk, listed) in on_disk_and_listed(&order).into_iter().skip(1) {
@@ -202,7 +202,7 @@ fn gui_files_use_only_those_before_them() {
 fn the_docs_state_the_same_orders() {
     let path = workspace_dir().join("docs/ARCHITECTURE.md");
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    for layers in [SIM, SOLVER_FILES_STATED, SCENES, LAB_FILES, PRESENT_FILES, APP] {
+    for layers in [SIM, SOLVER_FILES_STATED, SCENES, LAB_FILES, PRESENT_FILES, APP, GUI_FILES] {
         let order = order_text(layers).replace(&format!("`{SOLVERS}`"), SOLVERS);
         assert!(text.contains(&order), "docs/ARCHITECTURE.md does not state the order {order}");
     }
@@ -343,7 +343,16 @@ fn a_gui_file_using_a_later_file_or_the_front_is_named() {
         ("gui/viewport.rs", "use super::Panel;\n"),
         ("gui/window.rs", "use super::session::Session;\nuse super::config::Config;\n"),
     ]);
+    // the app's own order, whose front holds no code: a use of the front's item is named too
     let found = violations(&app_with_gui(), &files);
+    assert!(
+        found.iter().any(|f| f.starts_with("app/src/gui/session.rs:1: `gui::HoxApp` reaches `gui` through its front")),
+        "{found:#?}"
+    );
+    // the front placed last
+    const HIGH_FRONT: &[&[&str]] = &[&["config", "session"], &["viewport"], &["window"], &[FRONT]];
+    let order = Order { crate_dir: "app", layers: APP, files_of: &[("gui", HIGH_FRONT)] };
+    let found = violations(&order, &files);
     assert_eq!(found.len(), 3, "{found:#?}");
     assert!(found[0].starts_with("app/src/gui/config.rs:1: `gui/config` uses `viewport`"), "{}", found[0]);
     assert!(found[0].contains("comes later in the files' order"), "{}", found[0]);
