@@ -73,11 +73,11 @@ mod node_loops;
 mod simulation;
 
 pub use error::{SimError, SolverCounters};
-pub use integrator::{INFO as INTEGRATORS, Integrator, IntegratorInfo};
+pub use integrator::{Integrator, IntegratorInfo, Prediction, Scheme, SchemeState, Update};
 pub use method::{INFO as METHODS, Method, MethodInfo, SweepsPerStep};
 pub use node_loops::NODE_LOOP_MIN_NODES_PER_THREAD;
 pub use residual::StaticResidual;
-pub use settings::{NewtonSettings, SolverSettings, Sweep, VbdInit, VbdSettings};
+pub use settings::{NewtonSettings, Range, RangeValue, Setting, SolverSettings, Sweep, VbdInit, VbdSettings};
 pub use simulation::Simulation;
 
 #[cfg(test)]
