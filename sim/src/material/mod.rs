@@ -261,30 +261,7 @@ impl MaterialModel {
     }
 }
 
-impl PartialEq for MaterialModel {
-    fn eq(&self, other: &Self) -> bool {
-        self.name() == other.name()
-    }
-}
-impl Eq for MaterialModel {}
-
-impl std::hash::Hash for MaterialModel {
-    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
-        self.name().hash(state)
-    }
-}
-
-impl std::fmt::Debug for MaterialModel {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "MaterialModel({})", self.name())
-    }
-}
-
-impl std::fmt::Display for MaterialModel {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+crate::math::by_name!(MaterialModel);
 
 /// Lamé parameters, in pascals.
 #[derive(Clone, Copy, Debug, PartialEq)]

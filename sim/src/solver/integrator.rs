@@ -245,30 +245,7 @@ impl Default for Integrator {
     }
 }
 
-impl PartialEq for Integrator {
-    fn eq(&self, other: &Self) -> bool {
-        self.name() == other.name()
-    }
-}
-impl Eq for Integrator {}
-
-impl std::hash::Hash for Integrator {
-    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
-        self.name().hash(state)
-    }
-}
-
-impl std::fmt::Debug for Integrator {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "Integrator({})", self.name())
-    }
-}
-
-impl std::fmt::Display for Integrator {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+crate::math::by_name!(Integrator);
 
 /// What the simulation keeps of the scheme between steps: the scheme's own state, and where
 /// projections mark the nodes they move.

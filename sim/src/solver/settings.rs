@@ -185,65 +185,27 @@ impl Default for SolverSettings {
 
 impl SolverSettings {
     /// The substeps per frame of XPBD.
-    pub const SUBSTEPS: Setting =
-        Setting { key: "substeps", label: "Substeps", range: Range::Whole { min: 1, max: 1_000_000, soft_max: 500 } };
+    pub const SUBSTEPS: Setting = Setting::whole("substeps", "Substeps", 1, 1_000_000, 500);
     /// XPBD's constraint sweeps per substep.
-    pub const ITERATIONS: Setting = Setting {
-        key: "iterations",
-        label: "Iterations",
-        range: Range::Whole { min: 1, max: 1_000_000, soft_max: 20 },
-    };
-    /// Simulated frames per second.
-    pub const FRAMES_PER_SECOND: Setting = Setting {
-        key: "fps",
-        label: "Frames per second",
-        range: Range::Number {
-            min: 0.0,
-            min_inclusive: false,
-            max: f64::INFINITY,
-            max_inclusive: false,
-            soft: Some((10.0, 240.0)),
-        },
-    };
+    pub const ITERATIONS: Setting = Setting::whole("iterations", "Iterations", 1, 1_000_000, 20);
+    /// Simulated frames per second, > 0 (the slider: 10 to 240).
+    pub const FRAMES_PER_SECOND: Setting =
+        Setting::number("fps", "Frames per second", (0.0, false), (f64::INFINITY, false), Some((10.0, 240.0)));
     /// The implicit solvers' steps per frame.
-    pub const STEPS_PER_FRAME: Setting =
-        Setting { key: "steps", label: "Steps per frame", range: Range::Whole { min: 1, max: 10_000, soft_max: 20 } };
+    pub const STEPS_PER_FRAME: Setting = Setting::whole("steps", "Steps per frame", 1, 10_000, 20);
     /// VBD's sweeps per step.
-    pub const VBD_ITERATIONS: Setting = Setting {
-        key: "vbd-iterations",
-        label: "VBD iterations",
-        range: Range::Whole { min: 1, max: 100_000, soft_max: 200 },
-    };
+    pub const VBD_ITERATIONS: Setting = Setting::whole("vbd-iterations", "VBD iterations", 1, 100_000, 200);
     /// VBD's coarse cells (0: off).
-    pub const VBD_COARSE_CELLS: Setting = Setting {
-        key: "vbd-coarse-cells",
-        label: "VBD coarse cells",
-        range: Range::Whole { min: 0, max: VbdSettings::MAX_COARSE_CELLS as u64, soft_max: 128 },
-    };
-    /// The Chebyshev `ρ` of VBD's sweeps.
-    pub const CHEBYSHEV_RHO: Setting = Setting {
-        key: "chebyshev-rho",
-        label: "Chebyshev ρ",
-        range: Range::Number {
-            min: 0.0,
-            min_inclusive: true,
-            max: VbdSettings::CHEBYSHEV_RHO_BELOW,
-            max_inclusive: false,
-            soft: None,
-        },
-    };
-    /// Newton's tolerance per step, relative to the load.
-    pub const NEWTON_TOLERANCE: Setting = Setting {
-        key: "newton-tolerance",
-        label: "Newton tolerance",
-        range: Range::Number { min: 0.0, min_inclusive: false, max: 1.0, max_inclusive: false, soft: None },
-    };
+    pub const VBD_COARSE_CELLS: Setting =
+        Setting::whole("vbd-coarse-cells", "VBD coarse cells", 0, VbdSettings::MAX_COARSE_CELLS as u64, 128);
+    /// The Chebyshev `ρ` of VBD's sweeps, in `[0, 1)`.
+    pub const CHEBYSHEV_RHO: Setting =
+        Setting::number("chebyshev-rho", "Chebyshev ρ", (0.0, true), (VbdSettings::CHEBYSHEV_RHO_BELOW, false), None);
+    /// Newton's tolerance per step, relative to the load, in `(0, 1)`.
+    pub const NEWTON_TOLERANCE: Setting =
+        Setting::number("newton-tolerance", "Newton tolerance", (0.0, false), (1.0, false), None);
     /// Newton's iterations per step at most.
-    pub const NEWTON_ITERATIONS: Setting = Setting {
-        key: "newton-iterations",
-        label: "Newton iterations",
-        range: Range::Whole { min: 1, max: 1000, soft_max: 50 },
-    };
+    pub const NEWTON_ITERATIONS: Setting = Setting::whole("newton-iterations", "Newton iterations", 1, 1000, 50);
     /// **Every numeric setting's declaration**, checked by [`SolverSettings::validate`] and
     /// read by the parameter table (`hox_scenes::params`: its kinds and labels), so a range's
     /// bound and its message are written here once.
@@ -369,6 +331,23 @@ pub struct Setting {
 }
 
 impl Setting {
+    /// A whole-number setting in `min..=max` (`soft_max`: the slider's top).
+    pub const fn whole(key: &'static str, label: &'static str, min: u64, max: u64, soft_max: u64) -> Setting {
+        Setting { key, label, range: Range::Whole { min, max, soft_max } }
+    }
+
+    /// A number setting between `min` and `max`, each with whether it is inclusive (`soft`: the
+    /// slider's ends; None, a text field).
+    pub const fn number(
+        key: &'static str,
+        label: &'static str,
+        (min, min_inclusive): (f64, bool),
+        (max, max_inclusive): (f64, bool),
+        soft: Option<(f64, f64)>,
+    ) -> Setting {
+        Setting { key, label, range: Range::Number { min, min_inclusive, max, max_inclusive, soft } }
+    }
+
     /// The message of a value outside the range: "{label} must be {expected}" (the parameter
     /// table's wording too), with the value.
     pub fn check(&self, v: RangeValue) -> Result<(), SimError> {
