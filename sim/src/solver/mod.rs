@@ -12,9 +12,10 @@
 //!
 //! Where things are, in the order each file reads only the ones before it (`tests/tests/rooms.rs`
 //! keeps it): `method.rs` (which solvers there are and what each is, [`Method`]) and
-//! `integrator.rs` (the implicit solvers' time integrators, [`Integrator`]); `error.rs`
-//! ([`SimError`], [`SolverCounters`]); `settings.rs` (what a run is asked to do,
-//! [`SolverSettings`]); `nan_guard.rs` (naming the element of a blow-up); `step.rs` (what a
+//! `integrator.rs` (the implicit solvers' time integrators, [`Integrator`]: registered
+//! [`Scheme`]s, one file each in `integrator/`); `error.rs` ([`SimError`], [`SolverCounters`]);
+//! `settings.rs` (what a run is asked to do, [`SolverSettings`], each numeric setting's range
+//! declared once in [`SolverSettings::RANGES`]); `nan_guard.rs` (naming the element of a blow-up); `step.rs` (what a
 //! solver's step reads and the one trait every solver implements); `residual.rs` (the static
 //! residual); `sparse.rs` (the sparse stiffness and its Cholesky factor); [`stability`] (the
 //! substep guard); `potential.rs` (implicit Euler's incremental potential); `newton_core.rs`
