@@ -103,14 +103,15 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
     for (solver, integrator) in &implicit {
         let (period, amplitude) =
             (value("P2 8x2x2 five", solver, "period_error_pct"), value("P2 8x2x2 five", solver, "amplitude_error_pct"));
-        match integrator {
-            Integrator::Euler => assert!(amplitude < -5.0, "{solver}: amplitude {amplitude} %"),
-            Integrator::Newmark => {
+        match integrator.name() {
+            "euler" => assert!(amplitude < -5.0, "{solver}: amplitude {amplitude} %"),
+            "newmark" => {
                 assert!(period.abs() < 1.0 && amplitude.abs() < 2.0, "{solver}: {period} / {amplitude} %")
             }
-            Integrator::Bdf2 => {
+            "bdf2" => {
                 assert!(period.abs() < 2.5 && amplitude.abs() < 5.0, "{solver}: {period} / {amplitude} %")
             }
+            other => unreachable!("{other}: no expected motion"),
         }
     }
     let pareto = std::fs::read_to_string(out.join("pareto-bending.svg")).unwrap();

@@ -4,6 +4,9 @@
 //! of it invalidates ([`Invalidates`]).
 
 use super::value::Value;
+#[cfg(doc)]
+use hox_sim::solver::SolverSettings;
+use hox_sim::solver::{Range, RangeValue};
 
 /// How much of a running simulation a change of a parameter invalidates (the app's rebuild
 /// levels), in increasing order.
@@ -106,6 +109,29 @@ fn toml_whole(v: &toml::Value) -> Option<i64> {
 }
 
 impl Kind {
+    /// A solver setting's kind from its declaration in sim ([`SolverSettings::RANGES`]).
+    pub const fn of_range(r: Range) -> Kind {
+        match r {
+            Range::Whole { min, max, soft_max } => Kind::Whole { min, max, soft_max },
+            Range::Number { min, min_inclusive, max, max_inclusive, soft } => {
+                Kind::Number { min, min_inclusive, max, max_inclusive, soft }
+            }
+        }
+    }
+
+    /// A number kind's range, in sim's terms: its check and its wording are sim's
+    /// ([`Range::contains`], [`Range::expected`]), written once for the table and
+    /// [`SolverSettings::validate`].
+    pub fn range(&self) -> Option<Range> {
+        match *self {
+            Kind::Whole { min, max, soft_max } => Some(Range::Whole { min, max, soft_max }),
+            Kind::Number { min, min_inclusive, max, max_inclusive, soft } => {
+                Some(Range::Number { min, min_inclusive, max, max_inclusive, soft })
+            }
+            _ => None,
+        }
+    }
+
     /// What a value of this kind looks like, for messages.
     pub fn expected(&self) -> String {
         match self {
@@ -117,21 +143,7 @@ impl Kind {
                 let names: Vec<&str> = options().into_iter().map(|(n, _)| n).collect();
                 format!("one or more of {}, comma-separated", names.join(", "))
             }
-            Kind::Whole { min, max, .. } => format!("a whole number from {min} to {max}"),
-            Kind::Number { min, min_inclusive, max, max_inclusive, .. } => {
-                let lo = if *min == f64::NEG_INFINITY {
-                    String::new()
-                } else {
-                    format!("{} {min}", if *min_inclusive { "≥" } else { ">" })
-                };
-                let hi = if *max == f64::INFINITY {
-                    String::new()
-                } else {
-                    format!("{} {max}", if *max_inclusive { "≤" } else { "<" })
-                };
-                let range = [lo, hi].into_iter().filter(|s| !s.is_empty()).collect::<Vec<_>>().join(" and ");
-                if range.is_empty() { "a finite number".into() } else { format!("a finite number {range}") }
-            }
+            Kind::Whole { .. } | Kind::Number { .. } => self.range().map(|r| r.expected()).unwrap_or_default(),
             Kind::Flag => "on or off (true or false)".into(),
             Kind::Grid { min, max } => format!("NXxNYxNZ cells, each a whole number from {min} to {max} (e.g. 16x4x4)"),
             Kind::Point => "three finite numbers".into(),
@@ -233,12 +245,8 @@ impl Kind {
                 let known = options();
                 !s.is_empty() && s.split(',').all(|part| known.iter().any(|(n, _)| *n == part))
             }
-            (Kind::Whole { min, max, .. }, Value::Whole(n)) => (min..=max).contains(&n),
-            (Kind::Number { min, min_inclusive, max, max_inclusive, .. }, Value::Number(x)) => {
-                x.is_finite()
-                    && (if *min_inclusive { x >= min } else { x > min })
-                    && (if *max_inclusive { x <= max } else { x < max })
-            }
+            (Kind::Whole { .. }, Value::Whole(n)) => self.range().is_some_and(|r| r.contains(RangeValue::Whole(*n))),
+            (Kind::Number { .. }, Value::Number(x)) => self.range().is_some_and(|r| r.contains(RangeValue::Number(*x))),
             (Kind::Flag, Value::Flag(_)) => true,
             (Kind::Grid { min, max }, Value::Grid(g)) => g.iter().all(|c| (min..=max).contains(&c)),
             (Kind::Point, Value::Point(p)) => p.iter().all(|c| c.is_finite()),

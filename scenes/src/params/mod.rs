@@ -48,7 +48,7 @@ use hox_sim::element::ElementType;
 use hox_sim::material::{DENSITY_KG_M3, MaterialModel, POISSON_RATIO, YOUNGS_MODULUS_PA};
 use hox_sim::measure::field::Field;
 use hox_sim::mesh::structured::TetSplit;
-use hox_sim::solver::{Integrator, Method, SolverSettings, Sweep, VbdInit, VbdSettings};
+use hox_sim::solver::{Integrator, Method, SolverSettings, Sweep, VbdInit};
 use hox_sim::xpbd::constraint::Formulation;
 use value::as_text;
 
@@ -187,9 +187,9 @@ params! {
     }
     /// Implicit steps per frame (the implicit solvers).
     steps_per_frame: u32 = solver().steps_per_frame => {
-        key: "steps", group: Group::Solver, file_key: "steps_per_frame", label: "Steps per frame",
+        key: "steps", group: Group::Solver, file_key: "steps_per_frame", label: SolverSettings::STEPS_PER_FRAME.label,
         help: "Steps per frame of the implicit solvers (XPBD takes --substeps); more steps, less numerical damping and phase error.",
-        kind: Kind::Whole { min: 1, max: 10_000, soft_max: 20 }, ..BASE
+        kind: Kind::of_range(SolverSettings::STEPS_PER_FRAME.range), ..BASE
     }
     /// The implicit solvers' time integrator: euler | newmark | bdf2.
     #[serde(with = "as_text")]
@@ -200,22 +200,22 @@ params! {
     }
     /// VBD sweeps per step.
     vbd_iterations: u32 = solver().vbd.iterations => {
-        key: "vbd-iterations", group: Group::Solver, file_key: "vbd_iterations", label: "VBD iterations",
+        key: "vbd-iterations", group: Group::Solver, file_key: "vbd_iterations", label: SolverSettings::VBD_ITERATIONS.label,
         help: "Vertex block descent sweeps over the node colours per step.",
-        kind: Kind::Whole { min: 1, max: 100_000, soft_max: 200 }, ..BASE
+        kind: Kind::of_range(SolverSettings::VBD_ITERATIONS.range), ..BASE
     }
     /// Chebyshev acceleration's ρ for VBD (0: off).
     chebyshev_rho: f64 = solver().vbd.chebyshev_rho => {
-        key: "chebyshev-rho", group: Group::Solver, file_key: "chebyshev_rho", label: "Chebyshev ρ",
+        key: "chebyshev-rho", group: Group::Solver, file_key: "chebyshev_rho", label: SolverSettings::CHEBYSHEV_RHO.label,
         help: "Chebyshev acceleration of the VBD sweeps, its spectral radius estimate in [0, 1) (0: off; 0.9 halves the sweeps to settle the bending beam; 0.95 can diverge at few sweeps).",
-        kind: Kind::Number { min: 0.0, min_inclusive: true, max: VbdSettings::CHEBYSHEV_RHO_BELOW, max_inclusive: false, soft: None },
+        kind: Kind::of_range(SolverSettings::CHEBYSHEV_RHO.range),
         ..BASE
     }
     /// VBD's two-level correction: about how many coarse cells (0: off).
     vbd_coarse_cells: u32 = solver().vbd.coarse_cells => {
-        key: "vbd-coarse-cells", group: Group::Solver, file_key: "vbd_coarse_cells", label: "VBD coarse cells",
+        key: "vbd-coarse-cells", group: Group::Solver, file_key: "vbd_coarse_cells", label: SolverSettings::VBD_COARSE_CELLS.label,
         help: "VBD's two-level correction: before its sweeps each step solves for the smooth part of the motion on a coarse grid of about this many trilinear cells over the body (0: off, the paper's VBD alone). The sweeps barely move smooth error such as a beam's slow bending; with the correction Gmsh's P2 beam settles in 122 frames (as Newton) instead of 707.",
-        kind: Kind::Whole { min: 0, max: VbdSettings::MAX_COARSE_CELLS as u64, soft_max: 128 }, ..BASE
+        kind: Kind::of_range(SolverSettings::VBD_COARSE_CELLS.range), ..BASE
     }
     /// Where a VBD step starts: adaptive | inertia | previous.
     #[serde(with = "as_text")]
@@ -226,15 +226,15 @@ params! {
     }
     /// Newton's tolerance per step, relative to the load.
     newton_tolerance: f64 = solver().newton.tolerance => {
-        key: "newton-tolerance", group: Group::Solver, file_key: "newton_tolerance", label: "Newton tolerance",
+        key: "newton-tolerance", group: Group::Solver, file_key: "newton_tolerance", label: SolverSettings::NEWTON_TOLERANCE.label,
         help: "A Newton step has converged when its unbalanced force is at most this fraction of the load (the body force, or the reactions if larger), as `hox static` measures it; in (0, 1).",
-        kind: Kind::Number { min: 0.0, min_inclusive: false, max: 1.0, max_inclusive: false, soft: None }, ..BASE
+        kind: Kind::of_range(SolverSettings::NEWTON_TOLERANCE.range), ..BASE
     }
     /// Newton iterations per step at most.
     newton_iterations: usize = solver().newton.max_iterations as usize => {
-        key: "newton-iterations", group: Group::Solver, file_key: "newton_iterations", label: "Newton iterations",
+        key: "newton-iterations", group: Group::Solver, file_key: "newton_iterations", label: SolverSettings::NEWTON_ITERATIONS.label,
         help: "Newton iterations per step at most (the implicit solvers of the Newton family). The default runs a step to its tolerance; a budget of 2 keeps a large part at the display's rate: a step left above the tolerance carries its unbalanced force into the next, so a swinging body lags slightly and a settled one is as exact as ever (docs/PERFORMANCE.md, session 24).",
-        kind: Kind::Whole { min: 1, max: 1000, soft_max: 50 }, ..BASE
+        kind: Kind::of_range(SolverSettings::NEWTON_ITERATIONS.range), ..BASE
     }
     /// Newton's interactive mode.
     newton_quasi: bool = solver().newton.quasi_newton => {
@@ -257,15 +257,15 @@ params! {
     }
     /// XPBD substeps per frame.
     substeps: u32 = solver().substeps => {
-        key: "substeps", group: Group::Solver, file_key: "substeps", label: "Substeps",
+        key: "substeps", group: Group::Solver, file_key: "substeps", label: SolverSettings::SUBSTEPS.label,
         help: "XPBD substeps per frame (the paper: 50); more substeps, less solver bias, more time.",
-        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 500 }, ..BASE
+        kind: Kind::of_range(SolverSettings::SUBSTEPS.range), ..BASE
     }
     /// Constraint sweeps per substep.
     iterations: u32 = solver().iterations => {
-        key: "iterations", group: Group::Solver, file_key: "iterations", label: "Iterations",
+        key: "iterations", group: Group::Solver, file_key: "iterations", label: SolverSettings::ITERATIONS.label,
         help: "Constraint sweeps per substep (the paper: 1).",
-        kind: Kind::Whole { min: 1, max: 1_000_000, soft_max: 20 }, ..BASE
+        kind: Kind::of_range(SolverSettings::ITERATIONS.range), ..BASE
     }
     /// More substeps where the stiffest element needs them (`hox_sim::solver::stability`).
     stability_guard: bool = solver().stability_guard => {
@@ -275,9 +275,9 @@ params! {
     }
     /// Simulated frames per second; each frame is one time step.
     frames_per_second: f64 = solver().frames_per_second => {
-        key: "fps", group: Group::Solver, file_key: "frames_per_second", label: "Frames per second",
+        key: "fps", group: Group::Solver, file_key: "frames_per_second", label: SolverSettings::FRAMES_PER_SECOND.label,
         help: "Simulated frames per second of simulated time (the paper: 60); each frame is one time step h = 1/fps.",
-        kind: Kind::Number { min: 0.0, min_inclusive: false, max: f64::INFINITY, max_inclusive: false, soft: Some((10.0, 240.0)) },
+        kind: Kind::of_range(SolverSettings::FRAMES_PER_SECOND.range),
         ..BASE
     }
     /// colour | element: the order of XPBD's Gauss–Seidel sweep.

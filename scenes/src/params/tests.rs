@@ -1,4 +1,5 @@
 use super::*;
+use hox_sim::solver::{RangeValue, VbdSettings};
 
 #[test]
 fn every_entry_is_complete_and_its_keys_unique() {
@@ -155,5 +156,26 @@ fn solver_parameters_apply_to_the_solvers_that_read_them() {
         assert_eq!(applies("vbd_iterations"), method == Method::Vbd, "{method}");
         assert_eq!(applies("steps_per_frame"), method.is_implicit(), "{method}");
         assert!(applies("frames_per_second") && applies("quadrature_degree"), "{method}");
+    }
+}
+
+/// A solver setting's range is declared once, in sim ([`SolverSettings::RANGES`]): the table's
+/// kind and label for it are the declaration's, so its check, its message and
+/// [`SolverSettings::validate`]'s agree (a change of the declaration changes both).
+#[test]
+fn every_solver_settings_kind_and_message_are_sims_declaration() {
+    for setting in SolverSettings::RANGES {
+        let p = by_key(setting.key).unwrap_or_else(|| panic!("{}: declared in sim, not in the table", setting.key));
+        assert_eq!(p.group, Group::Solver, "{}", setting.key);
+        assert_eq!((p.kind.range(), p.label), (Some(setting.range), setting.label), "{}", setting.key);
+        // the value just past the top (or below the bottom) of the range: the table's message is
+        // sim's, word for word
+        let (value, outside) = match setting.range {
+            hox_sim::solver::Range::Whole { max, .. } => (Value::Whole(max + 1), RangeValue::Whole(max + 1)),
+            hox_sim::solver::Range::Number { min, .. } => (Value::Number(min - 1.0), RangeValue::Number(min - 1.0)),
+        };
+        let table = p.check_value(&value).unwrap_err();
+        let sim = setting.check(outside).unwrap_err().to_string();
+        assert!(sim.contains(&format!("{table}, got")), "{}: the table says {table:?}, sim {sim:?}", setting.key);
     }
 }

@@ -26,8 +26,6 @@ pub mod pyramid;
 pub mod q1;
 pub mod q2;
 
-use std::fmt;
-
 /// **The registry**: every element type hox knows, in this order (menus, `hox elements`, tests).
 ///
 /// Adding an element type is its file `sim/src/element/NAME.rs` (a `static` implementing
@@ -247,30 +245,7 @@ impl std::ops::Deref for ElementType {
     }
 }
 
-impl PartialEq for ElementType {
-    fn eq(&self, other: &Self) -> bool {
-        self.0.name() == other.0.name()
-    }
-}
-impl Eq for ElementType {}
-
-impl std::hash::Hash for ElementType {
-    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
-        self.0.name().hash(state)
-    }
-}
-
-impl fmt::Debug for ElementType {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "ElementType({})", self.0.name())
-    }
-}
-
-impl fmt::Display for ElementType {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.0.name())
-    }
-}
+crate::math::by_name!(ElementType);
 
 impl std::str::FromStr for ElementType {
     type Err = String;

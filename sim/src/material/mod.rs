@@ -65,6 +65,19 @@ pub type Mat9 = SMatrix<f64, 9, 9>;
 /// [`MaterialModel::ALL`] (as reference elements are in [`crate::element::REGISTRY`]): adding a
 /// model is its file, its `mod` line and one entry there (see [`MaterialModel::ALL`]), and the
 /// registry tests check it (`every_registered_model_*` below).
+///
+/// **The constitutive core** is what a model must state: its names, `ψ(F)`, `P(F)` and
+/// `∂P/∂F`. Everything else is an **optional solver capability** with a default written over
+/// the core (fenris adapts its small core to each solver the same way):
+/// - the tangent's contraction ([`HyperelasticModel::stress_contraction`]) and VBD's node
+///   kernels ([`HyperelasticModel::node_block`], `node_force_and_block`, `node_visit`,
+///   `node_visit_kernel`): defaults from `dpdf` and `energy_density_and_pk1`, overridden by a
+///   model only for speed;
+/// - the fast law XPBD's sweep compiles inline ([`HyperelasticModel::fast_law`]): default none,
+///   the registered law is called;
+/// - XPBD's split constraints ([`HyperelasticModel::split`], a [`SplitModel`]): default none,
+///   and then the split formulation refuses the model by name (the energy formulation and the
+///   implicit solvers need the core only).
 pub trait HyperelasticModel: Sync + Send + 'static {
     /// Short, stable identifier (`"stvk"`), unique in the registry: scene files and the command
     /// line name the model by it, and models compare equal by it.
@@ -88,9 +101,11 @@ pub trait HyperelasticModel: Sync + Send + 'static {
     /// One node's 3×3 block of an element Hessian at one quadrature point, per unit volume:
     /// `B = C(g, g)` with `g = ∇_X N_a` ([`HyperelasticModel::stress_contraction`]), i.e. column
     /// `k` is `dP[e_k ⊗ g] g` — three directional derivatives where [`HyperelasticModel::dpdf`]
-    /// takes nine (vertex block descent's per-node Hessian). Symmetric. Default: the contraction.
+    /// takes nine (vertex block descent's per-node Hessian). Symmetric. Default: the contraction,
+    /// symmetrised (the sum leaves round-off between the two halves).
     fn node_block(&self, l: Lame, f: &Mat3, g: &Vector3<f64>) -> Mat3 {
-        self.stress_contraction(l, f, g, g)
+        let b = self.stress_contraction(l, f, g, g);
+        (b + b.transpose()) * 0.5
     }
     /// One node's share at one point, per unit volume: the force direction `P(F) g` and the
     /// block `B(F, g)` of [`HyperelasticModel::node_block`], sharing the common work (what a
@@ -117,18 +132,29 @@ pub trait HyperelasticModel: Sync + Send + 'static {
     fn fast_law(&self, _l: Lame) -> Option<FastLaw> {
         None
     }
-    /// The split constraints `[deviatoric, hydrostatic]` at F.
-    fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2];
-    /// Stiffness k_t (Pa) of each split term.
-    fn split_stiffness_pa(&self, l: Lame) -> [f64; 2];
-    /// The constant c with ψ = Σ_t k_t/2 C_t² + c.
-    fn split_energy_offset(&self, l: Lame) -> f64;
+    /// The model's split constraints for XPBD's split formulation, if it has them. Default:
+    /// none (the split formulation then refuses the model).
+    fn split(&self) -> Option<&dyn SplitModel> {
+        None
+    }
     /// The law is smooth for `det F` above this; below it the model may switch to a
     /// continuation (Neo-Hookean's ln J floor), where finite differences are meaningless.
     /// −∞: smooth everywhere.
     fn smooth_above_det_f(&self) -> f64 {
         f64::NEG_INFINITY
     }
+}
+
+/// An optional capability of a [`HyperelasticModel`]: the two constraints of XPBD's "split"
+/// formulation (Macklin & Müller 2021), with `ψ(F) = Σ_t k_t/2 · C_t(F)² + c`; offered through
+/// [`HyperelasticModel::split`].
+pub trait SplitModel: Sync + Send {
+    /// The split constraints `[deviatoric, hydrostatic]` at F.
+    fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2];
+    /// Stiffness k_t (Pa) of each split term.
+    fn split_stiffness_pa(&self, l: Lame) -> [f64; 2];
+    /// The constant c with ψ = Σ_t k_t/2 C_t² + c.
+    fn split_energy_offset(&self, l: Lame) -> f64;
 }
 
 /// One node's visit of one element (vertex block descent): the element's `F_q` at its points,
@@ -235,30 +261,7 @@ impl MaterialModel {
     }
 }
 
-impl PartialEq for MaterialModel {
-    fn eq(&self, other: &Self) -> bool {
-        self.name() == other.name()
-    }
-}
-impl Eq for MaterialModel {}
-
-impl std::hash::Hash for MaterialModel {
-    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
-        self.name().hash(state)
-    }
-}
-
-impl std::fmt::Debug for MaterialModel {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "MaterialModel({})", self.name())
-    }
-}
-
-impl std::fmt::Display for MaterialModel {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+crate::math::by_name!(MaterialModel);
 
 /// Lamé parameters, in pascals.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -474,8 +477,12 @@ impl Material {
 
     /// The two split constraints `[deviatoric, hydrostatic]` at F
     /// (see each model's module doc for their definitions).
+    ///
+    /// # Panics
+    /// If the model has no split constraints ([`Material::has_split`]; a simulation refuses the
+    /// split formulation for such a model before any step).
     pub fn split_terms(&self, f: &Mat3) -> [SplitTerm; 2] {
-        self.model.law().split_terms(self.lame(), f)
+        self.split_law().split_terms(self.lame(), f)
     }
 
     /// Stiffness k_t (Pa) of each split term, so that
@@ -486,14 +493,26 @@ impl Material {
     /// for ν < 0 (and 0 for ν = 0); `snh` uses λ̂ = λ + μ > 0; `snh-log` uses
     /// [μ̂, λ̂] = [4μ/3, λ + 5μ/6], both > 0.
     pub fn split_stiffness_pa(&self) -> [f64; 2] {
-        self.model.law().split_stiffness_pa(self.lame())
+        self.split_law().split_stiffness_pa(self.lame())
     }
 
     /// The constant c (J/m³) with ψ(F) = Σ_t k_t/2 · C_t(F)² + c:
     /// 0 for `stvk` and `nh`, −3μ/2 − μ²/(2λ̂) for `snh`,
     /// μ̂ (log 2 − 3/2) − 9μ̂²/(32λ̂) for `snh-log`.
     pub fn split_energy_offset(&self) -> f64 {
-        self.model.law().split_energy_offset(self.lame())
+        self.split_law().split_energy_offset(self.lame())
+    }
+
+    /// Whether the model offers XPBD's split constraints ([`HyperelasticModel::split`]).
+    pub fn has_split(&self) -> bool {
+        self.model.law().split().is_some()
+    }
+
+    fn split_law(&self) -> &dyn SplitModel {
+        match self.model.law().split() {
+            Some(split) => split,
+            None => panic!("{}: no split constraints (the split formulation refuses it)", self.model),
+        }
     }
 }
 

@@ -40,7 +40,7 @@
 //! (with ln J and F⁻ᵀ replaced by L and L' cof F below the floor).
 
 use super::{
-    HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
+    HyperelasticModel, Lame, Mat3, Mat9, SplitModel, SplitTerm, cofactor, cofactor_directional, det_minus_one,
     dpdf_from_directional, first_invariant_minus_three, node_block_from_directional,
 };
 
@@ -112,6 +112,13 @@ impl HyperelasticModel for NeoHookean {
         node_block_from_directional(linearisation(l, f), g)
     }
 
+    fn split(&self) -> Option<&dyn SplitModel> {
+        Some(self)
+    }
+}
+
+/// The split formulation's two constraints (XPBD's `Formulation::Split`).
+impl SplitModel for NeoHookean {
     fn split_terms(&self, _l: Lame, f: &Mat3) -> [SplitTerm; 2] {
         let log = log_j(f);
         let inv_t = cofactor(f) * log.d1;

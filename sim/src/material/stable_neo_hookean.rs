@@ -29,7 +29,7 @@
 //! * hydrostatic C = J − α, k = λ̂, ∂C/∂F = cof F
 
 use super::{
-    HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
+    HyperelasticModel, Lame, Mat3, Mat9, SplitModel, SplitTerm, cofactor, cofactor_directional, det_minus_one,
     dpdf_from_directional, first_invariant_minus_three,
 };
 use nalgebra::Vector3;
@@ -92,6 +92,13 @@ impl HyperelasticModel for StableNeoHookean {
         (force, node_block_of(l, g, &w))
     }
 
+    fn split(&self) -> Option<&dyn SplitModel> {
+        Some(self)
+    }
+}
+
+/// The split formulation's two constraints (XPBD's `Formulation::Split`).
+impl SplitModel for StableNeoHookean {
     fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2] {
         let (_, r) = lambda_hat_and_ratio(l);
         let c_dev = f.norm();

@@ -48,7 +48,7 @@
 //! * hydrostatic C = J − α, k = λ̂, ∂C/∂F = cof F
 
 use super::{
-    HyperelasticModel, Lame, Mat3, Mat9, SplitTerm, cofactor, cofactor_directional, det_minus_one,
+    HyperelasticModel, Lame, Mat3, Mat9, SplitModel, SplitTerm, cofactor, cofactor_directional, det_minus_one,
     dpdf_from_directional, first_invariant_minus_three, node_block_from_directional,
 };
 
@@ -129,6 +129,13 @@ impl HyperelasticModel for StableNeoHookeanLog {
         node_block_from_directional(linearisation(l, f), g)
     }
 
+    fn split(&self) -> Option<&dyn SplitModel> {
+        Some(self)
+    }
+}
+
+/// The split formulation's two constraints (XPBD's `Formulation::Split`).
+impl SplitModel for StableNeoHookeanLog {
     fn split_terms(&self, l: Lame, f: &Mat3) -> [SplitTerm; 2] {
         let p = params(l);
         let ic = f.norm_squared();

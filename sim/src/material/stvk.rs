@@ -26,7 +26,8 @@
 //! (shear) stress as 2μE; a NaN or infinite entry of F otherwise propagates into ψ and P.
 
 use super::{
-    FastLaw, HyperelasticModel, Lame, Mat3, Mat9, NodeVisit, NodeVisitKernel, SplitTerm, dpdf_from_directional,
+    FastLaw, HyperelasticModel, Lame, Mat3, Mat9, NodeVisit, NodeVisitKernel, SplitModel, SplitTerm,
+    dpdf_from_directional,
 };
 use crate::math::lane::{Lane, M3, Scalar, from_mat3, to_mat3, tr_mat_mul};
 use nalgebra::Vector3;
@@ -269,6 +270,13 @@ impl HyperelasticModel for StVenantKirchhoff {
         None
     }
 
+    fn split(&self) -> Option<&dyn SplitModel> {
+        Some(self)
+    }
+}
+
+/// The split formulation's two constraints (XPBD's `Formulation::Split`).
+impl SplitModel for StVenantKirchhoff {
     fn split_terms(&self, _l: Lame, f: &Mat3) -> [SplitTerm; 2] {
         let e = strain(f);
         let c_dev = e.norm();

@@ -231,3 +231,70 @@ mod psd3 {
         assert_eq!(project_psd3(&last_negative), Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 0.0)));
     }
 }
+
+/// A model stating only the constitutive core (names, ψ, P, ∂P/∂F: here Saint-Venant–Kirchhoff's,
+/// through its registered law) and no solver capability, registered nowhere.
+struct CoreOnly;
+
+impl HyperelasticModel for CoreOnly {
+    fn name(&self) -> &'static str {
+        "core-only"
+    }
+    fn long_name(&self) -> &'static str {
+        "the constitutive core alone (a test's)"
+    }
+    fn energy_density(&self, l: Lame, f: &Mat3) -> f64 {
+        MaterialModel::StVenantKirchhoff.law().energy_density(l, f)
+    }
+    fn energy_density_and_pk1(&self, l: Lame, f: &Mat3) -> (f64, Mat3) {
+        MaterialModel::StVenantKirchhoff.law().energy_density_and_pk1(l, f)
+    }
+    fn dpdf(&self, l: Lame, f: &Mat3) -> Mat9 {
+        MaterialModel::StVenantKirchhoff.law().dpdf(l, f)
+    }
+}
+
+/// A new material is its constitutive core: the optional capabilities' defaults (VBD's node
+/// kernels, no fast law, no split constraints) run it under every solver as the model it
+/// restates, and XPBD's split formulation, which needs a capability it lacks, refuses it by name.
+#[test]
+fn a_model_with_the_core_alone_runs_under_every_solver_and_the_split_formulation_refuses_it() {
+    use crate::effect::{Clamp, Effect, Gravity};
+    use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+    use crate::solver::{Method, Simulation, SolverSettings};
+    use crate::xpbd::constraint::Formulation;
+    let core = MaterialModel(&CoreOnly);
+    let (stvk, ours) = (
+        Material::new(MaterialModel::StVenantKirchhoff, 1e5, 0.3, 1000.0).unwrap(),
+        Material::new(core, 1e5, 0.3, 1000.0).unwrap(),
+    );
+    assert!(!MaterialModel::ALL.contains(&core) && !ours.has_split() && ours.fast_law().is_none());
+    testing::check_pk1_matches_energy_fd(core);
+    testing::check_node_force_and_block_match_dpdf(core);
+    let et = crate::element::ElementType::from_name("p2").unwrap();
+    let grid = BoxGrid { min_m: crate::Vec3::zeros(), max_m: crate::Vec3::new(0.5, 0.1, 0.1), cells: [2, 1, 1] };
+    let mesh = BoxMeshSpec { grid, element_type: et, split: TetSplit::Five, refine: 0 }.build().unwrap();
+    let clamped = mesh.nodes_where(|p| p.x.abs() < 1e-12);
+    let effects = || -> Vec<Box<dyn Effect>> {
+        vec![Box::new(Gravity::new(crate::Vec3::new(0.0, 0.0, -9.81))), Box::new(Clamp { nodes: clamped.clone() })]
+    };
+    for method in Method::ALL {
+        let settings = SolverSettings { method, frames_per_second: 200.0, ..SolverSettings::default() };
+        let mut a = Simulation::new(mesh.clone(), stvk, settings, effects()).unwrap();
+        let mut b = Simulation::new(mesh.clone(), ours, settings, effects()).unwrap();
+        for _ in 0..10 {
+            a.step_frame().unwrap();
+            b.step_frame().unwrap();
+        }
+        let sag = a.displacements().iter().map(|u| u.norm()).fold(0.0, f64::max);
+        assert!(sag > 1e-6, "{method}: nothing moved");
+        for (x, y) in a.positions.iter().zip(&b.positions) {
+            assert!((x - y).norm() <= 1e-6 * sag, "{method}: {y} against StVK's {x}");
+        }
+    }
+    let split = SolverSettings { formulation: Formulation::Split, ..SolverSettings::default() };
+    let err = Simulation::new(mesh.clone(), ours, split, effects()).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(err.contains("split formulation") && err.contains(core.long_name()), "{err}");
+    let mut sim = Simulation::new(mesh, stvk, split, effects()).unwrap();
+    assert!(sim.set_material(ours).is_err(), "the split formulation took a model without split constraints");
+}

@@ -18,5 +18,35 @@ pub(crate) mod f64x8;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod wide;
 
+/// Equality, hashing, `Debug` (`Type(name)`) and `Display` (`name`) of a registry handle by its
+/// entry's name, which its registry keeps unique: the element types, the material models and the
+/// integrators are each a reference to a registered entry.
+macro_rules! by_name {
+    ($t:ident) => {
+        impl PartialEq for $t {
+            fn eq(&self, other: &Self) -> bool {
+                self.name() == other.name()
+            }
+        }
+        impl Eq for $t {}
+        impl std::hash::Hash for $t {
+            fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+                self.name().hash(state)
+            }
+        }
+        impl std::fmt::Debug for $t {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, concat!(stringify!($t), "({})"), self.name())
+            }
+        }
+        impl std::fmt::Display for $t {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+    };
+}
+pub(crate) use by_name;
+
 /// A 3×3 matrix of f64 (deformation gradients, stresses).
 pub type Mat3 = nalgebra::Matrix3<f64>;

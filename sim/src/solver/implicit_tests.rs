@@ -241,10 +241,11 @@ fn implicit_free_fall_is_each_integrators_on_the_prediction() {
                 sim.step_frame().unwrap();
                 last.push(sim.positions[0] - mesh.rest_positions[0]);
             }
-            let (got, want) = match integrator {
-                Integrator::Euler => (last[29], G * (h * h * n * (n + 1.0) / 2.0)),
-                Integrator::Newmark => (last[29], G * (0.5 * (n * h) * (n * h))),
-                Integrator::Bdf2 => (last[29] - last[28] * 2.0 + last[27], G * (h * h)),
+            let (got, want) = match integrator.name() {
+                "euler" => (last[29], G * (h * h * n * (n + 1.0) / 2.0)),
+                "newmark" => (last[29], G * (0.5 * (n * h) * (n * h))),
+                "bdf2" => (last[29] - last[28] * 2.0 + last[27], G * (h * h)),
+                other => unreachable!("{other}: no expected fall"),
             };
             assert!((got - want).norm() < 1e-9 * (1.0 + want.norm()), "{method} {integrator}: {got} vs {want}");
             for (x, x0) in sim.positions.iter().zip(&mesh.rest_positions) {

@@ -41,28 +41,57 @@
 //! bounce the node back off a plane it should rest on. A change of step, of integrator, a reset or a
 //! warm start drops the history: the next step starts the scheme afresh.
 
+//!
+//! **The registry.** Each scheme is one file in `integrator/` implementing [`Scheme`] (its
+//! [`IntegratorInfo`] entry, its prediction and velocity update) and one entry of
+//! [`Integrator::ALL`]; [`super::Simulation`] and the solvers ask the entry (no per-scheme
+//! `==` anywhere), so a scheme defined elsewhere (a test's) runs through the same code.
+
 use crate::Vec3;
 
-/// The time integrator of the implicit solvers; what it is: [`Integrator::info`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
-pub enum Integrator {
-    /// Backward Euler: first order, damps every mode.
-    Euler,
-    /// Newmark's average acceleration (the trapezoidal rule): second order, conserves energy.
-    Newmark,
-    /// The two-step backward differentiation formula: second order, damps the highest modes.
-    /// The default: it keeps a swinging beam's motion (docs/STUDY.md) and, unlike Newmark, lets
-    /// the modes a step cannot resolve die out (a dragged node's stiff spring, the solver's
-    /// own error under VBD).
-    #[default]
-    Bdf2,
+pub mod bdf2;
+pub mod euler;
+pub mod newmark;
+
+/// A time integrator of the implicit solvers: its entry and its behaviour. Each lives in one
+/// file and is listed once in [`Integrator::ALL`]. The defaults are implicit Euler's.
+pub trait Scheme: Sync + Send + 'static {
+    /// What the scheme is ([`IntegratorInfo`]).
+    fn info(&self) -> &IntegratorInfo;
+    /// Whether the scheme keeps a history between steps. False: implicit Euler's step, whose
+    /// prediction `x_n + h v'` (every scheme's starting point) and update `v = (x − x_n)/h` the
+    /// simulation's node loops make (then [`Scheme::predict`] and [`Scheme::update`] are never
+    /// called).
+    fn keeps_history(&self) -> bool {
+        true
+    }
+    /// Whether the step that starts the history must be given `∇U(x_n)`
+    /// ([`Prediction::start_gradient`]; Newmark's `a_0 = g − ∇U(x_0)/m`).
+    fn needs_start_acceleration(&self) -> bool {
+        false
+    }
+    /// Whether the solver is handed the scheme's guess of `x_{n+1}` ([`SchemeState::guess`],
+    /// where VBD's adaptive start begins).
+    fn offers_guess(&self) -> bool {
+        false
+    }
+    /// Rewrites the free nodes' prediction `y` and returns the inertia step `h̄`. Default:
+    /// implicit Euler's (`y = x_n + h v'` as it entered, `h̄ = h`).
+    fn predict(&self, _state: &mut SchemeState, step: Prediction<'_>) -> f64 {
+        step.h
+    }
+    /// After the solve: the velocities from the minimiser, and the history kept. Default:
+    /// implicit Euler's `v = (x − x_n)/h` for every node.
+    fn update(&self, _state: &mut SchemeState, step: Update<'_>) {
+        step.euler_all();
+    }
 }
 
-/// What an integrator is, for everything that lists or describes integrators.
+/// What an integrator is, for everything that lists, describes or runs integrators.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IntegratorInfo {
-    pub integrator: Integrator,
-    /// The name in scene files, on the command line and in recordings (`newmark`).
+    /// The name in scene files, on the command line and in recordings (`newmark`), unique in
+    /// the registry: integrators compare equal by it.
     pub name: &'static str,
     /// The name in menus and tables.
     pub long_name: &'static str,
@@ -72,48 +101,132 @@ pub struct IntegratorInfo {
     pub motion: &'static str,
     /// Where the scheme and its behaviour are stated.
     pub source: &'static str,
+    /// Whether it damps the motion a scene is about (implicit Euler: a swinging beam loses half
+    /// its amplitude in 2 s), which the app marks; BDF2 damps only the modes a step cannot
+    /// resolve.
+    pub damps_motion: bool,
     /// Whether an iterative solver (VBD) must converge each step instead of taking its fixed
     /// sweeps: a scheme that damps nothing keeps the error the sweeps leave, and Newmark's
     /// update turns it into accelerations that feed the next step (measured: VBD's 10 sweeps
     /// on the bending beam blew up within a second).
     pub needs_converged_steps: bool,
+    /// Whether VBD may Chebyshev-accelerate a step's first round of sweeps (not under BDF2:
+    /// the extrapolation leaves an unconverged step leaning to overshoot, which BDF2, damping
+    /// little and keeping such steps, turned into a steady gain of energy; issue #36).
+    pub vbd_chebyshev: bool,
+    /// Where VBD's adaptive start puts a node with the acceleration `ã` it had along gravity:
+    /// true, the scheme's own prediction with `ã` in place of `g`, `y + (ã − |g|) ĝ h̄²`; false,
+    /// implicit Euler's explicit extrapolation `x_n + h v_n + h² ã ĝ` (the same point under
+    /// implicit Euler, in other bits).
+    pub vbd_start_from_prediction: bool,
 }
 
-/// Every integrator's entry, in [`Integrator::ALL`]'s order.
-pub const INFO: [IntegratorInfo; 3] = [
-    IntegratorInfo {
-        integrator: Integrator::Euler,
-        name: "euler",
-        long_name: "implicit Euler",
-        order: 1,
-        motion: "First order; damps every mode, the more the larger h·ω: at one step per frame a swinging beam loses about half its amplitude in 2 s.",
-        source: "Hairer & Wanner, Solving ODEs II (1996), §IV.3",
-        needs_converged_steps: false,
-    },
-    IntegratorInfo {
-        integrator: Integrator::Newmark,
-        name: "newmark",
-        long_name: "Newmark (average acceleration)",
-        order: 2,
-        motion: "Second order, no numerical damping: conserves the energy of a linear system exactly and keeps a swinging beam's amplitude.",
-        source: "Newmark 1959; Hughes, The Finite Element Method (2000), §9.1",
-        needs_converged_steps: true,
-    },
-    IntegratorInfo {
-        integrator: Integrator::Bdf2,
-        name: "bdf2",
-        long_name: "BDF2 (backward differentiation)",
-        order: 2,
-        motion: "Second order, L-stable: damps the fastest, unresolved modes almost entirely and the slow ones little (more with a larger step).",
-        source: "Hairer & Wanner, Solving ODEs II (1996), §V.1",
-        needs_converged_steps: false,
-    },
-];
+/// The step a scheme's prediction reads and rewrites ([`Scheme::predict`]).
+pub struct Prediction<'a> {
+    /// The step, seconds.
+    pub h: f64,
+    /// `x_n`.
+    pub x_n: &'a [Vec3],
+    /// The velocities after the effects' kicks, `v'` (`(v' − v_n)/h` is the body acceleration
+    /// `g`).
+    pub velocities: &'a [Vec3],
+    /// Enter holding implicit Euler's `x_n + h v'`, leave holding the scheme's `y`.
+    pub positions: &'a mut [Vec3],
+    /// 0 for held and driven nodes, which keep their place.
+    pub inv_mass: &'a [f64],
+    /// `∇U(x_n)` when the history starts under a scheme that asks for it
+    /// ([`Scheme::needs_start_acceleration`]).
+    pub start_gradient: Option<&'a [Vec3]>,
+}
 
+/// The step a scheme's velocity update reads ([`Scheme::update`]).
+pub struct Update<'a> {
+    /// The step and the inertia step `h̄` the prediction returned, seconds.
+    pub h: f64,
+    pub inertia_h: f64,
+    /// `x_n` and the minimiser `x_{n+1}`.
+    pub x_n: &'a [Vec3],
+    pub positions: &'a [Vec3],
+    /// Written: `v_{n+1}`.
+    pub velocities: &'a mut [Vec3],
+    pub inv_mass: &'a [f64],
+    /// The nodes a projection (contact) moved within the step.
+    pub projected: &'a [bool],
+}
+
+impl Update<'_> {
+    /// Implicit Euler's velocity of node `i`, `(x − x_n)/h`: every scheme's for held, driven and
+    /// projected nodes.
+    #[inline]
+    pub fn euler(&self, i: usize) -> Vec3 {
+        (self.positions[i] - self.x_n[i]) / self.h
+    }
+    /// Whether node `i` keeps implicit Euler's velocity: held, driven or moved by a projection.
+    #[inline]
+    pub fn keeps_euler(&self, i: usize) -> bool {
+        self.inv_mass[i] == 0.0 || self.projected.get(i) == Some(&true)
+    }
+    /// Implicit Euler's update of every node.
+    pub fn euler_all(self) {
+        for i in 0..self.velocities.len() {
+            self.velocities[i] = self.euler(i);
+        }
+    }
+}
+
+/// What a scheme keeps between steps, in buffers any scheme may use (their size is the node
+/// count once used).
+#[derive(Default)]
+pub struct SchemeState {
+    /// Steps taken since the history started (0: the first after a reset or a change).
+    pub steps: u64,
+    /// `v_n`, the velocities at the start of the step (before any effect).
+    pub v_n: Vec<Vec3>,
+    /// The acceleration at the end of the last step (Newmark's `a_n`).
+    pub a_n: Vec<Vec3>,
+    /// `x_{n−1}` and `v_{n−1}` (BDF2).
+    pub x_before: Vec<Vec3>,
+    pub v_before: Vec<Vec3>,
+    /// The step's base, what the update measures from (Newmark's `ỹ`, BDF2's `x̂`); sized to the
+    /// nodes before each prediction.
+    pub base: Vec<Vec3>,
+    /// The scheme's guess of `x_{n+1}` ([`Scheme::offers_guess`]): enters each prediction as a
+    /// copy of implicit Euler's prediction.
+    pub guess: Vec<Vec3>,
+}
+
+/// The time integrator of the implicit solvers, by reference to its registered scheme (compare
+/// [`crate::material::MaterialModel`]); what it is: [`Integrator::info`]. Integrators compare
+/// and hash by name.
+#[derive(Clone, Copy)]
+pub struct Integrator(pub &'static dyn Scheme);
+
+// The built-in schemes keep the names they had as enum variants.
+#[allow(non_upper_case_globals)]
 impl Integrator {
+    /// **The registry**: every integrator, in this order (menus, `hox solvers`, the study).
+    /// Adding one is its file `integrator/NAME.rs` (a unit struct implementing [`Scheme`]), its
+    /// `pub mod NAME;` line and one entry here; the scene files, the command line, the app's
+    /// menu and the study read the registry.
     pub const ALL: [Integrator; 3] = [Integrator::Euler, Integrator::Newmark, Integrator::Bdf2];
+
+    /// Backward Euler: first order, damps every mode ([`euler`]).
+    pub const Euler: Integrator = Integrator(&euler::Euler);
+    /// Newmark's average acceleration (the trapezoidal rule): second order, conserves energy
+    /// ([`newmark`]).
+    pub const Newmark: Integrator = Integrator(&newmark::Newmark);
+    /// The two-step backward differentiation formula: second order, damps the highest modes
+    /// ([`bdf2`]). The default: it keeps a swinging beam's motion (docs/STUDY.md) and, unlike
+    /// Newmark, lets the modes a step cannot resolve die out (a dragged node's stiff spring, the
+    /// solver's own error under VBD).
+    pub const Bdf2: Integrator = Integrator(&bdf2::Bdf2);
+
+    /// The scheme's behaviour.
+    pub fn scheme(self) -> &'static dyn Scheme {
+        self.0
+    }
     pub fn info(self) -> &'static IntegratorInfo {
-        &INFO[self as usize]
+        self.0.info()
     }
     pub fn name(self) -> &'static str {
         self.info().name
@@ -126,59 +239,40 @@ impl Integrator {
     }
 }
 
-impl std::fmt::Display for Integrator {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
+impl Default for Integrator {
+    fn default() -> Self {
+        Integrator::Bdf2
     }
 }
 
-/// What a scheme keeps between steps, and its prediction and velocity update.
+crate::math::by_name!(Integrator);
+
+/// What the simulation keeps of the scheme between steps: the scheme's own state, and where
+/// projections mark the nodes they move.
 #[derive(Default)]
 pub(crate) struct History {
     /// The scheme and step the history was made with.
     made_for: Option<(Integrator, f64)>,
-    /// Steps taken since the history started.
-    steps: u64,
-    /// `v_n` at the start of the step.
-    v_n: Vec<Vec3>,
-    /// Newmark: `a_n`, the acceleration at the end of the last step.
-    a_n: Vec<Vec3>,
-    /// BDF2: `x_{n−1}` and `v_{n−1}`.
-    x_before: Vec<Vec3>,
-    v_before: Vec<Vec3>,
-    /// The step's `ỹ` (Newmark) or `x̂` (BDF2): what the update measures from.
-    base: Vec<Vec3>,
+    state: SchemeState,
     /// The step's inertia step `h̄`.
     inertia_h: f64,
     /// The nodes a projection (contact) moved within the step, and a scratch copy of the
     /// positions to find them ([`super::step::Hooks::projected`]).
     projected: Vec<bool>,
     before_projection: Vec<Vec3>,
-    /// The scheme's guess of `x_{n+1}` ([`History::step_views`]).
-    guess: Vec<Vec3>,
 }
 
 impl History {
     /// Drops the history (reset, warm start, a new step length or scheme).
     pub fn clear(&mut self) {
         self.made_for = None;
-        self.steps = 0;
-    }
-
-    /// The scheme this step takes: BDF2 starts with an implicit Euler step (the standard start,
-    /// and a robust one: a Newmark start from a stretched attachment overshot so far that the
-    /// next steps inverted elements).
-    fn this_step(&self, integrator: Integrator) -> Integrator {
-        match integrator {
-            Integrator::Bdf2 if self.steps == 0 => Integrator::Euler,
-            other => other,
-        }
+        self.state.steps = 0;
     }
 
     /// Whether the next step must be given the elastic gradient at `x_n` for its starting
-    /// acceleration (a Newmark step after a reset or a change).
+    /// acceleration ([`Scheme::needs_start_acceleration`], after a reset or a change).
     pub fn needs_start_acceleration(&self, integrator: Integrator, h: f64) -> bool {
-        integrator == Integrator::Newmark && self.made_for != Some((integrator, h))
+        integrator.scheme().needs_start_acceleration() && self.made_for != Some((integrator, h))
     }
 
     /// At the start of a step, before any effect: `velocities` are `v_n`. Drops the history if
@@ -188,77 +282,34 @@ impl History {
         if self.made_for != Some((integrator, h)) {
             self.clear();
         }
-        self.v_n.clear();
-        self.v_n.extend_from_slice(velocities);
+        self.state.v_n.clear();
+        self.state.v_n.extend_from_slice(velocities);
     }
 
-    /// What the solver reads and writes of the history within the step: Newmark's guess of
-    /// `x_{n+1}` ([`History::predict`]: the motion with the last acceleration kept, so a body at
-    /// rest in equilibrium stays where it is; the other schemes leave the prediction there), and where the step's projections mark the nodes
-    /// they move (all unmarked at the start) with their scratch copy of the positions.
-    pub fn step_views(&mut self, num_nodes: usize) -> (&[Vec3], (&mut [bool], &mut Vec<Vec3>)) {
-        self.projected.clear();
-        self.projected.resize(num_nodes, false);
-        (&self.guess, (&mut self.projected, &mut self.before_projection))
-    }
-
-    /// Rewrites the free nodes' prediction for the scheme and returns the inertia step `h̄`.
-    /// `positions` enter holding implicit Euler's `x_n + h v'` (`v'` the velocities after the
-    /// effects' kicks, `velocities`) and leave holding the scheme's `y`. `start_gradient`
-    /// is `∇U(x_n)` when a Newmark step starts ([`History::needs_start_acceleration`]), from
-    /// which `a_0 = g − ∇U(x_n)/m`. Also makes the scheme's guess of `x_{n+1}`
-    /// ([`History::step_views`]).
-    #[allow(clippy::too_many_arguments)]
-    pub fn predict(
+    /// What the solver reads and writes of the history within the step: the scheme's guess of
+    /// `x_{n+1}` when it offers one ([`Scheme::offers_guess`]: Newmark's, the motion with the
+    /// last acceleration kept, so a body at rest in equilibrium stays where it is), and where
+    /// the step's projections mark the nodes they move (all unmarked at the start) with their
+    /// scratch copy of the positions.
+    pub fn step_views(
         &mut self,
         integrator: Integrator,
-        h: f64,
-        x_n: &[Vec3],
-        velocities: &[Vec3],
-        positions: &mut [Vec3],
-        inv_mass: &[f64],
-        start_gradient: Option<&[Vec3]>,
-    ) -> f64 {
-        let n = positions.len();
-        self.base.resize(n, Vec3::zeros());
-        self.guess.clear();
-        self.guess.extend_from_slice(positions);
-        let kick = |i: usize| (velocities[i] - self.v_n[i]) / h;
-        self.inertia_h = match self.this_step(integrator) {
-            Integrator::Euler => h,
-            Integrator::Newmark => {
-                if let Some(grad) = start_gradient {
-                    self.a_n = (0..n)
-                        .map(|i| if inv_mass[i] > 0.0 { kick(i) - grad[i] * inv_mass[i] } else { Vec3::zeros() })
-                        .collect();
-                }
-                let q = 0.25 * h * h;
-                for i in 0..n {
-                    if inv_mass[i] == 0.0 {
-                        continue;
-                    }
-                    let tilde = x_n[i] + self.v_n[i] * h + self.a_n[i] * q;
-                    self.base[i] = tilde;
-                    positions[i] = tilde + kick(i) * q;
-                    // the acceleration goes on as it was
-                    self.guess[i] = tilde + self.a_n[i] * q;
-                }
-                0.5 * h
-            }
-            Integrator::Bdf2 => {
-                let beta = 2.0 * h / 3.0;
-                for i in 0..n {
-                    if inv_mass[i] == 0.0 {
-                        continue;
-                    }
-                    let x_hat = (x_n[i] * 4.0 - self.x_before[i]) / 3.0;
-                    let v_hat = (self.v_n[i] * 4.0 - self.v_before[i]) / 3.0;
-                    self.base[i] = x_hat;
-                    positions[i] = x_hat + v_hat * beta + kick(i) * (beta * beta);
-                }
-                beta
-            }
-        };
+        num_nodes: usize,
+    ) -> (Option<&[Vec3]>, (&mut [bool], &mut Vec<Vec3>)) {
+        self.projected.clear();
+        self.projected.resize(num_nodes, false);
+        let guess = integrator.scheme().offers_guess().then_some(self.state.guess.as_slice());
+        (guess, (&mut self.projected, &mut self.before_projection))
+    }
+
+    /// Rewrites the free nodes' prediction for the scheme and returns the inertia step `h̄`
+    /// ([`Scheme::predict`]); also makes the scheme's guess of `x_{n+1}`.
+    pub fn predict(&mut self, integrator: Integrator, step: Prediction<'_>) -> f64 {
+        let n = step.positions.len();
+        self.state.base.resize(n, Vec3::zeros());
+        self.state.guess.clear();
+        self.state.guess.extend_from_slice(step.positions);
+        self.inertia_h = integrator.scheme().predict(&mut self.state, step);
         self.inertia_h
     }
 
@@ -272,45 +323,10 @@ impl History {
         velocities: &mut [Vec3],
         inv_mass: &[f64],
     ) {
-        let n = positions.len();
-        let euler = |i: usize| (positions[i] - x_n[i]) / h;
-        let projected = |i: usize| self.projected.get(i) == Some(&true);
-        let scheme = self.this_step(integrator);
-        match scheme {
-            Integrator::Euler => {
-                for (i, v) in velocities.iter_mut().enumerate() {
-                    *v = euler(i);
-                }
-            }
-            Integrator::Newmark => {
-                let four_over_h2 = 4.0 / (h * h);
-                for i in 0..n {
-                    if inv_mass[i] == 0.0 || projected(i) {
-                        velocities[i] = euler(i);
-                        self.a_n[i] = Vec3::zeros();
-                        continue;
-                    }
-                    let a = (positions[i] - self.base[i]) * four_over_h2;
-                    velocities[i] = self.v_n[i] + (self.a_n[i] + a) * (0.5 * h);
-                    self.a_n[i] = a;
-                }
-            }
-            Integrator::Bdf2 => {
-                for i in 0..n {
-                    velocities[i] = if inv_mass[i] == 0.0 || projected(i) {
-                        euler(i)
-                    } else {
-                        (positions[i] - self.base[i]) / self.inertia_h
-                    };
-                }
-            }
-        }
-        if integrator == Integrator::Bdf2 {
-            self.x_before.clear();
-            self.x_before.extend_from_slice(x_n);
-            std::mem::swap(&mut self.v_before, &mut self.v_n);
-        }
+        let step =
+            Update { h, inertia_h: self.inertia_h, x_n, positions, velocities, inv_mass, projected: &self.projected };
+        integrator.scheme().update(&mut self.state, step);
         self.made_for = Some((integrator, h));
-        self.steps += 1;
+        self.state.steps += 1;
     }
 }

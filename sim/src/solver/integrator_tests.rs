@@ -8,6 +8,7 @@ use crate::Vec3;
 use crate::effect::{Attachment, Clamp, Effect, Gravity};
 use crate::element::ElementType;
 use crate::material::{Material, MaterialModel};
+use std::sync::atomic::Ordering::Relaxed;
 
 fn et(name: &str) -> ElementType {
     ElementType::from_name(name).unwrap()
@@ -118,25 +119,22 @@ fn the_integrators_have_their_order_on_a_linear_oscillator() {
         for (a, b) in [(p1, p2), (p2, p3)] {
             assert!(a > 0.0 && (3.4..4.6).contains(&(a / b)), "{note}");
         }
-        match integrator {
-            Integrator::Euler => {
-                for (a, b) in [(e1, e2), (e2, e3)] {
-                    assert!(a > 0.0 && (1.6..2.4).contains(&(a / b)), "first-order energy loss; {note}");
-                }
+        if integrator == Integrator::Euler {
+            for (a, b) in [(e1, e2), (e2, e3)] {
+                assert!(a > 0.0 && (1.6..2.4).contains(&(a / b)), "first-order energy loss; {note}");
             }
-            Integrator::Newmark => {
-                assert!([e1, e2, e3].iter().all(|e| e.abs() < 1e-9), "conserved energy; {note}");
-                // the trapezoidal rule's phase error is (hω)²/12
-                let h_omega = std::f64::consts::TAU / 16.0;
-                assert!((p1 / (h_omega * h_omega / 12.0) - 1.0).abs() < 0.05, "{note}");
+        } else if integrator == Integrator::Newmark {
+            assert!([e1, e2, e3].iter().all(|e| e.abs() < 1e-9), "conserved energy; {note}");
+            // the trapezoidal rule's phase error is (hω)²/12
+            let h_omega = std::f64::consts::TAU / 16.0;
+            assert!((p1 / (h_omega * h_omega / 12.0) - 1.0).abs() < 0.05, "{note}");
+        } else {
+            assert_eq!(integrator, Integrator::Bdf2);
+            for (a, b) in [(e1, e2), (e2, e3)] {
+                // third order per period once started; the implicit Euler start adds a second-order part
+                assert!(a > 0.0 && a / b > 3.5, "energy decay of at least second order; {note}");
             }
-            Integrator::Bdf2 => {
-                for (a, b) in [(e1, e2), (e2, e3)] {
-                    // third order per period once started; the implicit Euler start adds a second-order part
-                    assert!(a > 0.0 && a / b > 3.5, "energy decay of at least second order; {note}");
-                }
-                assert!(e1 < 0.1 * period_and_energy_error(Method::Newton, Integrator::Euler, 16, 4).1, "{note}");
-            }
+            assert!(e1 < 0.1 * period_and_energy_error(Method::Newton, Integrator::Euler, 16, 4).1, "{note}");
         }
     }
 }
@@ -280,4 +278,75 @@ fn bdf2_keeps_its_history_from_the_second_step_on() {
     sim.positions[node].x = f64::NAN;
     let err = sim.step_frame().unwrap_err().to_string();
     assert!(err.contains(&format!("node {node}")), "{err}");
+}
+
+/// A scheme defined here and nowhere else: implicit Euler written through the history
+/// ([`Scheme::predict`] keeps the prediction, [`Scheme::update`] sets `v = (x − x_n)/h`) under
+/// another name, counting its calls. Not in [`Integrator::ALL`]; nothing outside this file
+/// names it.
+struct CountedEuler {
+    predictions: std::sync::atomic::AtomicUsize,
+    updates: std::sync::atomic::AtomicUsize,
+}
+
+static COUNTED_EULER: CountedEuler = CountedEuler {
+    predictions: std::sync::atomic::AtomicUsize::new(0),
+    updates: std::sync::atomic::AtomicUsize::new(0),
+};
+
+const COUNTED_EULER_INFO: IntegratorInfo = IntegratorInfo {
+    name: "counted-euler",
+    long_name: "implicit Euler through the history (a test's)",
+    order: 1,
+    motion: "As implicit Euler.",
+    source: "this test",
+    damps_motion: true,
+    needs_converged_steps: false,
+    vbd_chebyshev: true,
+    vbd_start_from_prediction: false,
+};
+
+impl Scheme for CountedEuler {
+    fn info(&self) -> &IntegratorInfo {
+        &COUNTED_EULER_INFO
+    }
+    fn predict(&self, _state: &mut SchemeState, step: Prediction<'_>) -> f64 {
+        self.predictions.fetch_add(1, Relaxed);
+        step.h
+    }
+    fn update(&self, _state: &mut SchemeState, step: Update<'_>) {
+        self.updates.fetch_add(1, Relaxed);
+        for i in 0..step.velocities.len() {
+            step.velocities[i] = step.euler(i);
+        }
+    }
+}
+
+/// A new integrator needs its file and its registry line only: a scheme registered nowhere runs
+/// through [`Simulation::step_frame`] under Newton and VBD, the simulation and the solvers asking
+/// its entry, and moves as the scheme it restates (implicit Euler) up to round-off.
+#[test]
+fn a_scheme_defined_in_a_test_runs_through_the_simulation_with_every_implicit_solver() {
+    let counted = Integrator(&COUNTED_EULER);
+    assert!(!Integrator::ALL.contains(&counted) && Integrator::from_name("counted-euler").is_none());
+    assert_ne!(counted, Integrator::Euler);
+    for method in [Method::Newton, Method::Vbd] {
+        let mut ours = cantilever(et("p2"), method, counted, 200.0);
+        let mut euler = cantilever(et("p2"), method, Integrator::Euler, 200.0);
+        let (p0, u0) = (COUNTED_EULER.predictions.load(Relaxed), COUNTED_EULER.updates.load(Relaxed));
+        for _ in 0..40 {
+            ours.step_frame().unwrap();
+            euler.step_frame().unwrap();
+        }
+        assert_eq!(ours.integrator(), counted);
+        // (the tests run in parallel: other steps may count too, never fewer)
+        assert!(COUNTED_EULER.predictions.load(Relaxed) - p0 >= 40, "{method}: its prediction was not asked");
+        assert!(COUNTED_EULER.updates.load(Relaxed) - u0 >= 40, "{method}: its update was not asked");
+        let tip = ours.positions.len() - 1;
+        let sag = (euler.positions[tip] - euler.mesh().rest_positions[tip]).norm();
+        assert!(sag > 1e-3, "{method}: the beam did not move ({sag} m)");
+        for (a, b) in ours.positions.iter().zip(&euler.positions) {
+            assert!((a - b).norm() < 1e-9 * sag.max(1.0), "{method}: {a} against implicit Euler's {b}");
+        }
+    }
 }

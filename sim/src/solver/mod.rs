@@ -12,9 +12,10 @@
 //!
 //! Where things are, in the order each file reads only the ones before it (`tests/tests/rooms.rs`
 //! keeps it): `method.rs` (which solvers there are and what each is, [`Method`]) and
-//! `integrator.rs` (the implicit solvers' time integrators, [`Integrator`]); `error.rs`
-//! ([`SimError`], [`SolverCounters`]); `settings.rs` (what a run is asked to do,
-//! [`SolverSettings`]); `nan_guard.rs` (naming the element of a blow-up); `step.rs` (what a
+//! `integrator.rs` (the implicit solvers' time integrators, [`Integrator`]: registered
+//! [`Scheme`]s, one file each in `integrator/`); `error.rs` ([`SimError`], [`SolverCounters`]);
+//! `settings.rs` (what a run is asked to do, [`SolverSettings`], each numeric setting's range
+//! declared once in [`SolverSettings::RANGES`]); `nan_guard.rs` (naming the element of a blow-up); `step.rs` (what a
 //! solver's step reads and the one trait every solver implements); `residual.rs` (the static
 //! residual); `sparse.rs` (the sparse stiffness and its Cholesky factor); [`stability`] (the
 //! substep guard); `potential.rs` (implicit Euler's incremental potential); `newton_core.rs`
@@ -73,11 +74,11 @@ mod node_loops;
 mod simulation;
 
 pub use error::{SimError, SolverCounters};
-pub use integrator::{INFO as INTEGRATORS, Integrator, IntegratorInfo};
+pub use integrator::{Integrator, IntegratorInfo, Prediction, Scheme, SchemeState, Update};
 pub use method::{INFO as METHODS, Method, MethodInfo, SweepsPerStep};
 pub use node_loops::NODE_LOOP_MIN_NODES_PER_THREAD;
 pub use residual::StaticResidual;
-pub use settings::{NewtonSettings, SolverSettings, Sweep, VbdInit, VbdSettings};
+pub use settings::{NewtonSettings, Range, RangeValue, Setting, SolverSettings, Sweep, VbdInit, VbdSettings};
 pub use simulation::Simulation;
 
 #[cfg(test)]

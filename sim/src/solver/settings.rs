@@ -6,6 +6,7 @@
 use super::error::SimError;
 use super::integrator::Integrator;
 use super::method::Method;
+use crate::material::Material;
 use crate::xpbd::constraint::Formulation;
 
 /// Time stepping and constraint settings.
@@ -183,45 +184,180 @@ impl Default for SolverSettings {
 }
 
 impl SolverSettings {
+    /// The substeps per frame of XPBD.
+    pub const SUBSTEPS: Setting = Setting::whole("substeps", "Substeps", 1, 1_000_000, 500);
+    /// XPBD's constraint sweeps per substep.
+    pub const ITERATIONS: Setting = Setting::whole("iterations", "Iterations", 1, 1_000_000, 20);
+    /// Simulated frames per second, > 0 (the slider: 10 to 240).
+    pub const FRAMES_PER_SECOND: Setting =
+        Setting::number("fps", "Frames per second", (0.0, false), (f64::INFINITY, false), Some((10.0, 240.0)));
+    /// The implicit solvers' steps per frame.
+    pub const STEPS_PER_FRAME: Setting = Setting::whole("steps", "Steps per frame", 1, 10_000, 20);
+    /// VBD's sweeps per step.
+    pub const VBD_ITERATIONS: Setting = Setting::whole("vbd-iterations", "VBD iterations", 1, 100_000, 200);
+    /// VBD's coarse cells (0: off).
+    pub const VBD_COARSE_CELLS: Setting =
+        Setting::whole("vbd-coarse-cells", "VBD coarse cells", 0, VbdSettings::MAX_COARSE_CELLS as u64, 128);
+    /// The Chebyshev `ρ` of VBD's sweeps, in `[0, 1)`.
+    pub const CHEBYSHEV_RHO: Setting =
+        Setting::number("chebyshev-rho", "Chebyshev ρ", (0.0, true), (VbdSettings::CHEBYSHEV_RHO_BELOW, false), None);
+    /// Newton's tolerance per step, relative to the load, in `(0, 1)`.
+    pub const NEWTON_TOLERANCE: Setting =
+        Setting::number("newton-tolerance", "Newton tolerance", (0.0, false), (1.0, false), None);
+    /// Newton's iterations per step at most.
+    pub const NEWTON_ITERATIONS: Setting = Setting::whole("newton-iterations", "Newton iterations", 1, 1000, 50);
+    /// **Every numeric setting's declaration**, checked by [`SolverSettings::validate`] and
+    /// read by the parameter table (`hox_scenes::params`: its kinds and labels), so a range's
+    /// bound and its message are written here once.
+    pub const RANGES: [Setting; 9] = [
+        Self::SUBSTEPS,
+        Self::ITERATIONS,
+        Self::FRAMES_PER_SECOND,
+        Self::STEPS_PER_FRAME,
+        Self::VBD_ITERATIONS,
+        Self::VBD_COARSE_CELLS,
+        Self::CHEBYSHEV_RHO,
+        Self::NEWTON_TOLERANCE,
+        Self::NEWTON_ITERATIONS,
+    ];
+
+    /// These settings' value of each of [`SolverSettings::RANGES`], in its order.
+    pub fn range_values(&self) -> [RangeValue; 9] {
+        use RangeValue::{Number, Whole};
+        [
+            Whole(self.substeps.into()),
+            Whole(self.iterations.into()),
+            Number(self.frames_per_second),
+            Whole(self.steps_per_frame.into()),
+            Whole(self.vbd.iterations.into()),
+            Whole(self.vbd.coarse_cells.into()),
+            Number(self.vbd.chebyshev_rho),
+            Number(self.newton.tolerance),
+            Whole(self.newton.max_iterations.into()),
+        ]
+    }
+
+    /// Checks every numeric setting against its declaration ([`SolverSettings::RANGES`]),
+    /// naming the first out of range, its range and its value.
     pub fn validate(&self) -> Result<(), SimError> {
-        let bad = |what: String| Err(SimError::Settings(what));
-        if self.substeps == 0 {
-            return bad("substeps must be at least 1, got 0".into());
-        }
-        if self.iterations == 0 {
-            return bad("iterations must be at least 1, got 0".into());
-        }
-        if !(self.frames_per_second.is_finite() && self.frames_per_second > 0.0) {
-            return bad(format!("frames per second must be a finite positive number, got {}", self.frames_per_second));
-        }
-        if self.steps_per_frame == 0 {
-            return bad("steps per frame must be at least 1, got 0".into());
-        }
-        if self.vbd.iterations == 0 {
-            return bad("VBD iterations must be at least 1, got 0".into());
-        }
-        if self.vbd.coarse_cells > VbdSettings::MAX_COARSE_CELLS {
-            return bad(format!(
-                "VBD's coarse grid may have at most {} cells, got {}",
-                VbdSettings::MAX_COARSE_CELLS,
-                self.vbd.coarse_cells
-            ));
-        }
-        if !(0.0..VbdSettings::CHEBYSHEV_RHO_BELOW).contains(&self.vbd.chebyshev_rho) {
-            return bad(format!("the Chebyshev ρ must be in [0, 1), got {}", self.vbd.chebyshev_rho));
-        }
-        if !(self.newton.tolerance > 0.0 && self.newton.tolerance < 1.0) {
-            return bad(format!("the Newton tolerance must be in (0, 1), got {}", self.newton.tolerance));
-        }
-        if self.newton.max_iterations == 0 {
-            return bad("Newton's iterations per step must be at least 1, got 0".into());
+        for (setting, value) in Self::RANGES.iter().zip(self.range_values()) {
+            setting.check(value)?;
         }
         Ok(())
     }
+    /// Refuses a material these settings cannot run: XPBD's split formulation with a model that
+    /// offers no split constraints ([`crate::material::HyperelasticModel::split`], an optional
+    /// capability; every registered model has them).
+    pub fn check_material(&self, material: &Material) -> Result<(), SimError> {
+        if !self.method.is_implicit() && self.formulation == Formulation::Split && !material.has_split() {
+            return Err(SimError::Settings(format!(
+                "the split formulation needs the material's split constraints, which {} does not offer (the energy formulation needs none)",
+                material.model.long_name()
+            )));
+        }
+        Ok(())
+    }
+
     /// The substep length `h`, seconds.
     /// `1/(fps · substeps)`: the requested substep; the one taken may be shorter
     /// ([`Simulation::substep_dt_secs`](super::Simulation::substep_dt_secs), the stability guard).
     pub fn substep_dt_secs(&self) -> f64 {
         1.0 / (self.frames_per_second * self.substeps as f64)
+    }
+}
+
+/// A numeric setting's valid range ([`SolverSettings::RANGES`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Range {
+    /// A whole number in `min..=max`; `soft_max` bounds a slider only.
+    Whole { min: u64, max: u64, soft_max: u64 },
+    /// A finite number between `min` and `max` (each end inclusive or not); `soft` bounds a
+    /// slider only (None: a text field).
+    Number { min: f64, min_inclusive: bool, max: f64, max_inclusive: bool, soft: Option<(f64, f64)> },
+}
+
+/// A value to check against a [`Range`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RangeValue {
+    Whole(u64),
+    Number(f64),
+}
+
+impl Range {
+    /// Whether `v` lies in the range (a whole number in a whole range, a finite number in a
+    /// number range).
+    pub fn contains(&self, v: RangeValue) -> bool {
+        match (*self, v) {
+            (Range::Whole { min, max, .. }, RangeValue::Whole(n)) => (min..=max).contains(&n),
+            (Range::Number { min, min_inclusive, max, max_inclusive, .. }, RangeValue::Number(x)) => {
+                x.is_finite()
+                    && (if min_inclusive { x >= min } else { x > min })
+                    && (if max_inclusive { x <= max } else { x < max })
+            }
+            _ => false,
+        }
+    }
+
+    /// What a value in the range looks like, for messages: "a whole number from 1 to 1000",
+    /// "a finite number ≥ 0 and < 1".
+    pub fn expected(&self) -> String {
+        match *self {
+            Range::Whole { min, max, .. } => format!("a whole number from {min} to {max}"),
+            Range::Number { min, min_inclusive, max, max_inclusive, .. } => {
+                let lo = if min == f64::NEG_INFINITY {
+                    String::new()
+                } else {
+                    format!("{} {min}", if min_inclusive { "≥" } else { ">" })
+                };
+                let hi = if max == f64::INFINITY {
+                    String::new()
+                } else {
+                    format!("{} {max}", if max_inclusive { "≤" } else { "<" })
+                };
+                let range = [lo, hi].into_iter().filter(|s| !s.is_empty()).collect::<Vec<_>>().join(" and ");
+                if range.is_empty() { "a finite number".into() } else { format!("a finite number {range}") }
+            }
+        }
+    }
+}
+
+/// One numeric solver setting's declaration: its key in the parameter table (the command
+/// line's `--KEY`), its label in messages and menus, and its range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Setting {
+    pub key: &'static str,
+    pub label: &'static str,
+    pub range: Range,
+}
+
+impl Setting {
+    /// A whole-number setting in `min..=max` (`soft_max`: the slider's top).
+    pub const fn whole(key: &'static str, label: &'static str, min: u64, max: u64, soft_max: u64) -> Setting {
+        Setting { key, label, range: Range::Whole { min, max, soft_max } }
+    }
+
+    /// A number setting between `min` and `max`, each with whether it is inclusive (`soft`: the
+    /// slider's ends; None, a text field).
+    pub const fn number(
+        key: &'static str,
+        label: &'static str,
+        (min, min_inclusive): (f64, bool),
+        (max, max_inclusive): (f64, bool),
+        soft: Option<(f64, f64)>,
+    ) -> Setting {
+        Setting { key, label, range: Range::Number { min, min_inclusive, max, max_inclusive, soft } }
+    }
+
+    /// The message of a value outside the range: "{label} must be {expected}" (the parameter
+    /// table's wording too), with the value.
+    pub fn check(&self, v: RangeValue) -> Result<(), SimError> {
+        if self.range.contains(v) {
+            return Ok(());
+        }
+        let got = match v {
+            RangeValue::Whole(n) => n.to_string(),
+            RangeValue::Number(x) => x.to_string(),
+        };
+        Err(SimError::Settings(format!("{} must be {}, got {got}", self.label, self.range.expected())))
     }
 }

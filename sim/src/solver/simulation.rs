@@ -5,7 +5,7 @@
 //! [`super::registry::make`].
 
 use super::error::{SimError, SolverCounters};
-use super::integrator::{History, Integrator};
+use super::integrator::{History, Integrator, Prediction};
 use super::method::Method;
 use super::node_loops;
 use super::registry;
@@ -76,6 +76,7 @@ impl Simulation {
     ) -> Result<Self, SimError> {
         mesh.validate()?;
         settings.validate()?;
+        settings.check_material(&material)?;
         let geometry = precompute(&mesh, settings.quadrature_degree)?;
         let masses_kg = lumped_masses_kg(&mesh, material.density_kg_m3)?;
         let inv_mass: Vec<f64> = masses_kg.iter().map(|m| 1.0 / m).collect();
@@ -322,6 +323,7 @@ impl Simulation {
 
     /// Changes the material, keeping positions and velocities (masses follow the density).
     pub fn set_material(&mut self, material: Material) -> Result<(), SimError> {
+        self.settings.check_material(&material)?;
         self.model_version += 1;
         if material.density_kg_m3 != self.material.density_kg_m3 {
             let masses = lumped_masses_kg(&self.mesh, material.density_kg_m3)?;
@@ -349,6 +351,7 @@ impl Simulation {
     /// is refused (nothing changes).
     pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), SimError> {
         settings.validate()?;
+        settings.check_material(&self.material)?;
         check_effects(settings.method, self.effects.iter().map(|e| e.as_ref()))?;
         let geometry_changed = settings.quadrature_degree != self.settings.quadrature_degree;
         if geometry_changed {
@@ -508,8 +511,9 @@ impl Simulation {
     fn advance(&mut self, h: f64) -> Result<(), SimError> {
         // the implicit solvers' integrator (XPBD's substeps are its own)
         let integrator = self.integrator();
+        let scheme = integrator.scheme();
         self.solver.begin_step(&self.velocities);
-        if integrator != Integrator::Euler {
+        if scheme.keeps_history() {
             self.history.begin(integrator, h, &self.velocities);
         }
         self.time_secs += h;
@@ -536,7 +540,7 @@ impl Simulation {
         // threads would otherwise wait on them); each node on its own, so the same bits
         let chunks = node_loops::chunks(self.positions.len(), self.settings.sweep);
         node_loops::predict(&mut self.prev_positions, &mut self.positions, &self.velocities, h, chunks);
-        let inertia_h = if integrator == Integrator::Euler {
+        let inertia_h = if !scheme.keeps_history() {
             h
         } else {
             let start_gradient = self.history.needs_start_acceleration(integrator, h).then(|| {
@@ -547,26 +551,25 @@ impl Simulation {
                 }
                 grad
             });
-            self.history.predict(
-                integrator,
+            let step = Prediction {
                 h,
-                &self.prev_positions,
-                &self.velocities,
-                &mut self.positions,
-                &self.inv_mass,
-                start_gradient.as_deref(),
-            )
+                x_n: &self.prev_positions,
+                velocities: &self.velocities,
+                positions: &mut self.positions,
+                inv_mass: &self.inv_mass,
+                start_gradient: start_gradient.as_deref(),
+            };
+            self.history.predict(integrator, step)
         };
         hook!(after_prediction);
         let body_acceleration = self.body_acceleration_m_s2();
         let mut hook_calls = 0;
         let num_nodes = self.positions.len();
-        let (guess, projected) = match integrator {
-            Integrator::Euler => (None, None),
-            _ => {
-                let (guess, projected) = self.history.step_views(num_nodes);
-                (Some(guess).filter(|_| integrator == Integrator::Newmark), Some(projected))
-            }
+        let (guess, projected) = if scheme.keeps_history() {
+            let (guess, projected) = self.history.step_views(integrator, num_nodes);
+            (guess, Some(projected))
+        } else {
+            (None, None)
         };
         let input = StepInput {
             mesh: &self.mesh,
@@ -599,7 +602,7 @@ impl Simulation {
             return Err(self.fail(bad));
         }
         let inv_h = 1.0 / h;
-        if integrator != Integrator::Euler {
+        if scheme.keeps_history() {
             self.history.update(
                 integrator,
                 h,

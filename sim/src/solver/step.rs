@@ -28,8 +28,9 @@ pub(crate) struct StepInput<'a> {
     /// implicit Euler, `h/2` for Newmark, `2h/3` for BDF2 ([`super::integrator`]). The
     /// prediction `y` holds the body acceleration as `h̄² g`.
     pub inertia_h: f64,
-    /// Newmark's guess of `x_{n+1}` (the motion with its last acceleration kept), where VBD's
-    /// adaptive start begins under it ([`super::integrator`]); None under the other schemes.
+    /// The integrator's guess of `x_{n+1}` when its scheme offers one
+    /// ([`super::integrator::Scheme::offers_guess`]: Newmark's, the motion with its last
+    /// acceleration kept), where VBD's adaptive start begins; None under the other schemes.
     pub guess: Option<&'a [Vec3]>,
     pub settings: &'a SolverSettings,
     /// Changes whenever the pinned nodes, the masses or the material may have changed.

@@ -204,7 +204,7 @@ fn bad_settings_and_blow_ups_are_clear_errors() {
     let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e6, 0.35, 1000.0).unwrap();
     let bad = SolverSettings { substeps: 0, ..SolverSettings::default() };
     let err = Simulation::new(mesh.clone(), material, bad, Vec::new()).err().unwrap().to_string();
-    assert!(err.contains("substeps must be at least 1"), "{err}");
+    assert!(err.contains("Substeps must be a whole number from 1 to 1000000, got 0"), "{err}");
     let bad = SolverSettings { frames_per_second: f64::NAN, ..SolverSettings::default() };
     assert!(Simulation::new(mesh.clone(), material, bad, Vec::new()).is_err());
     let err = Simulation::new(
@@ -605,4 +605,62 @@ fn an_unregistered_p4_meshes_steps_with_the_generic_kernels_and_builds_its_surfa
     let cells = crate::io::vtk::parse_vtu(&vtu).unwrap().cells;
     assert_eq!(cells.len(), 10);
     assert!(cells.iter().all(|(ty, nodes)| *ty == 71 && nodes.len() == 35));
+}
+
+/// Every numeric setting is checked against its one declaration ([`SolverSettings::RANGES`]):
+/// the value just past each end is refused with the declaration's label and range, the ends
+/// themselves (where inclusive) are accepted.
+#[test]
+fn every_solver_setting_is_checked_against_its_declared_range() {
+    fn set(s: &mut SolverSettings, key: &str, v: RangeValue) {
+        let (whole, x) = match v {
+            RangeValue::Whole(n) => (n, n as f64),
+            RangeValue::Number(x) => (x as u64, x),
+        };
+        let w = || u32::try_from(whole).unwrap_or(u32::MAX);
+        match key {
+            "substeps" => s.substeps = w(),
+            "iterations" => s.iterations = w(),
+            "fps" => s.frames_per_second = x,
+            "steps" => s.steps_per_frame = w(),
+            "vbd-iterations" => s.vbd.iterations = w(),
+            "vbd-coarse-cells" => s.vbd.coarse_cells = w(),
+            "chebyshev-rho" => s.vbd.chebyshev_rho = x,
+            "newton-tolerance" => s.newton.tolerance = x,
+            "newton-iterations" => s.newton.max_iterations = w(),
+            other => panic!("{other}: a declared setting this test does not know"),
+        }
+    }
+    for (i, setting) in SolverSettings::RANGES.iter().enumerate() {
+        let (inside, outside) = match setting.range {
+            Range::Whole { min, max, .. } => {
+                let mut outside = vec![RangeValue::Whole(max + 1)];
+                if min > 0 {
+                    outside.push(RangeValue::Whole(min - 1));
+                }
+                (vec![RangeValue::Whole(min), RangeValue::Whole(max)], outside)
+            }
+            Range::Number { min, min_inclusive, max, max_inclusive, .. } => {
+                let mut inside = vec![RangeValue::Number(if min_inclusive { min } else { min + 1e-9 })];
+                if max.is_finite() {
+                    inside.push(RangeValue::Number(if max_inclusive { max } else { max - 1e-9 }));
+                }
+                let below = if min_inclusive { min - 1e-9 } else { min };
+                (inside, vec![RangeValue::Number(below), RangeValue::Number(f64::NAN)])
+            }
+        };
+        for v in inside {
+            let mut s = SolverSettings::default();
+            set(&mut s, setting.key, v);
+            assert_eq!(s.range_values()[i], v, "{}", setting.key);
+            assert!(s.validate().is_ok(), "{} = {v:?}: {:?}", setting.key, s.validate());
+        }
+        for v in outside {
+            let mut s = SolverSettings::default();
+            set(&mut s, setting.key, v);
+            let err = s.validate().unwrap_err().to_string();
+            let want = format!("{} must be {}, got", setting.label, setting.range.expected());
+            assert!(err.contains(&want), "{} = {v:?}: {err}", setting.key);
+        }
+    }
 }

@@ -176,5 +176,5 @@ pub(super) fn block_energy_and_gradient_fused<const GRAD: bool>(
             }
         };
     }
-    dispatch!((4, 4), (5, 8), (6, 8), (8, 8), (10, 12), (20, 20), (27, 28))
+    crate::fem::specialised_node_counts!(dispatch)
 }

@@ -54,7 +54,6 @@
 //! per node-element visit, half of them the StVK law.
 
 use super::error::SolverCounters;
-use super::integrator::Integrator;
 use super::nan_guard::BadElement;
 use super::potential::Potential;
 use super::residual::load_scale;
@@ -192,7 +191,7 @@ impl StepSolver for Vbd {
                     let dir = g / g_norm;
                     let a = ((vn - self.v_before[i]) / h).dot(&dir).clamp(0.0, g_norm);
                     let a = if a < ADAPTIVE_ACCELERATION_FLOOR_M_S2 { 0.0 } else { a };
-                    if s.settings.integrator == Integrator::Euler {
+                    if !s.settings.integrator.info().vbd_start_from_prediction {
                         xn + vn * h + dir * (a * h * h)
                     } else {
                         // the scheme's own prediction with ã in place of g (under implicit Euler
@@ -227,11 +226,11 @@ impl StepSolver for Vbd {
         let mut stale = true;
         let mut projected = false;
         for round in 0..MAX_ROUNDS {
-            // (not under BDF2: Chebyshev's extrapolation leaves an unconverged step leaning to
+            // (as the integrator's entry says, `vbd_chebyshev`; not under BDF2: Chebyshev's extrapolation leaves an unconverged step leaning to
             // overshoot, which BDF2, damping little and keeping such steps, turned into a steady
             // gain of energy on the undamped bending beam, +20 J in 50 s where Newton lost 66 J;
             // Newmark's steps converge, implicit Euler's damping outweighs it; issue #36)
-            let accelerate = round == 0 && s.settings.integrator != Integrator::Bdf2;
+            let accelerate = round == 0 && s.settings.integrator.info().vbd_chebyshev;
             let rho = if accelerate { s.settings.vbd.chebyshev_rho } else { 0.0 };
             update.line_search = round > 0;
             // the two-level correction: the smooth error the sweeps barely touch, first

@@ -24,8 +24,15 @@ pub struct NonFiniteElement {
     pub node: u32,
 }
 
-/// Node counts with a specialised sweep (P1, pyramid, prism, Q1, P2, P3, Q2).
-pub const SPECIALISED_NODE_COUNTS: [usize; 7] = [4, 5, 6, 8, 10, 20, 27];
+/// `[n, …]` of the list's `(n, p)` pairs.
+macro_rules! node_counts {
+    ($(($n:literal, $p:literal)),*) => {
+        [$($n),*]
+    };
+}
+
+/// Node counts with a specialised sweep: [`crate::fem::specialised_node_counts`]'s list.
+pub const SPECIALISED_NODE_COUNTS: &[usize] = &crate::fem::specialised_node_counts!(node_counts);
 
 /// The sweep of the energy formulation over packed elements `range` of `data`, in order.
 /// Returns the number of elements projected (those with a free node), or the first element
@@ -71,7 +78,7 @@ pub unsafe fn energy_sweep(
             }
         };
     }
-    dispatch!((4, 4), (5, 8), (6, 8), (8, 8), (10, 12), (20, 20), (27, 28))
+    crate::fem::specialised_node_counts!(dispatch)
 }
 
 /// What a sweep reads and writes, besides the material and the range of packed elements.
@@ -374,26 +381,17 @@ unsafe fn batches_of<L: lanes::BatchLaw>(
     batches: usize,
 ) -> Result<u64, NonFiniteElement> {
     macro_rules! by_node_count {
-        ($p1:path, $batch:ident) => {
-            match n {
-                4 if q == 1 => $p1(law, io, batches),
-                4 => batch::$batch::<4, L>(law, io, ref_grads, q, batches),
-                5 => batch::$batch::<5, L>(law, io, ref_grads, q, batches),
-                6 => batch::$batch::<6, L>(law, io, ref_grads, q, batches),
-                8 => batch::$batch::<8, L>(law, io, ref_grads, q, batches),
-                10 => batch::$batch::<10, L>(law, io, ref_grads, q, batches),
-                20 => batch::$batch::<20, L>(law, io, ref_grads, q, batches),
-                27 => batch::$batch::<27, L>(law, io, ref_grads, q, batches),
-                _ => unreachable!("{n} nodes: no specialised sweep"),
+        ($(($n:literal, $p:literal)),*) => {
+            match (width, n) {
+                (4, 4) if q == 1 => p1::batches_avx2(law, io, batches),
+                (8, 4) if q == 1 => p1::batches_avx512(law, io, batches),
+                $((4, $n) => batch::batches_avx2::<$n, L>(law, io, ref_grads, q, batches),
+                (8, $n) => batch::batches_avx512::<$n, L>(law, io, ref_grads, q, batches),)*
+                (4 | 8, _) => unreachable!("{n} nodes: no specialised sweep"),
+                _ => unreachable!("{width} lanes"),
             }
         };
     }
     // SAFETY: forwarded.
-    unsafe {
-        match width {
-            4 => by_node_count!(p1::batches_avx2, batches_avx2),
-            8 => by_node_count!(p1::batches_avx512, batches_avx512),
-            _ => unreachable!("{width} lanes"),
-        }
-    }
+    unsafe { crate::fem::specialised_node_counts!(by_node_count) }
 }
