@@ -307,7 +307,7 @@ pub(super) fn solver_motion_ui(
     integrator: hox_sim::solver::Integrator,
 ) {
     let info = method.info();
-    let damps = info.implicit && integrator == hox_sim::solver::Integrator::Euler;
+    let damps = info.implicit && integrator.info().damps_motion;
     let colour = if damps { egui::Color32::from_rgb(250, 200, 120) } else { ui.visuals().weak_text_color() };
     ui.label(egui::RichText::new(info.motion).small().color(colour));
     if info.implicit {
