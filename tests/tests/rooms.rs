@@ -183,11 +183,14 @@ fn every_room_on_disk_is_in_the_order() {
 }
 
 /// The app's `gui/` with its files' order: ignored until issue 56 restructures `gui/` (today each
-/// panel file imports `super::HoxApp` from the front, `mod.rs`). To set the final order, list
-/// `gui/`'s files in [`GUI_FILES`] lowest first — `FRONT` (`mod`) only if `mod.rs` keeps code the
-/// files use, placed below them; a pure front (`mod` lines and re-exports) is left out — remove
-/// the `#[ignore]`, and state the order in docs/ARCHITECTURE.md (add `GUI_FILES` to
-/// [`the_docs_state_the_same_orders`]).
+/// panel file imports `super::HoxApp` from the front, `mod.rs`). To set the final order: list
+/// every file of `gui/` in [`GUI_FILES`], lowest first (a folder such as `teach/` is one name);
+/// list `FRONT` (`mod`) only if `mod.rs` keeps code — first if the files build on it, last if it
+/// builds on them (then no file may use it) — and leave it out if `mod.rs` is a pure front (`mod`
+/// lines and re-exports), so that every file names the file it uses. Then move `("gui",
+/// GUI_FILES)` into the app's entry of [`orders`] (dropping this test and [`app_with_gui`]),
+/// state the order in docs/ARCHITECTURE.md's `gui/` entry and add `GUI_FILES` to
+/// [`the_docs_state_the_same_orders`].
 #[test]
 #[ignore = "issue 56: gui/ is being restructured"]
 fn gui_files_use_only_those_before_them() {
