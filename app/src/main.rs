@@ -29,7 +29,6 @@
 //! Errors are printed as one clear message on stderr with a non-zero exit.
 
 mod cli;
-mod colour;
 mod config;
 mod display;
 mod gui;

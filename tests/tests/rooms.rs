@@ -79,8 +79,7 @@ const LAB_FILES: &[&[&str]] = &[&["reference"], &["study"], &["paper", "bench", 
 const PRESENT_FILES: &[&[&str]] = &[&["colour"], &["svg"]];
 
 /// The app's rooms (`hox`), lowest first: `cli` and `gui` share what both need through `config`.
-const APP: &[&[&str]] =
-    &[&["colour", "output", "web"], &["config"], &["display"], &["recording"], &["cli", "gui"], &["main"]];
+const APP: &[&[&str]] = &[&["output", "web"], &["config"], &["display"], &["recording"], &["cli", "gui"], &["main"]];
 
 /// The files of the app's `gui/`, lowest first (`mod.rs`, a pure front, declares them): the
 /// model's parts, the model, its services, the UI's state, the panels, the app, the window.

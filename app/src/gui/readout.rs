@@ -303,7 +303,7 @@ impl Readout {
 
     /// The error alone, for the status line.
     pub fn error_text(&self) -> String {
-        let m = |v: f64| crate::colour::format_value(v, "m");
+        let m = |v: f64| hox_scenes::present::colour::format_value(v, "m");
         match *self {
             Readout::NoReference { ref short, .. } => short.clone(),
             Readout::Settled { error_m, error_pct, .. } => format!("settled error {} ({error_pct:.2} %)", m(error_m)),
@@ -317,7 +317,7 @@ impl Readout {
 
     /// A few words for the label above a body in the viewport.
     pub fn short_text(&self) -> String {
-        let m = |v: f64| crate::colour::format_value(v, "m");
+        let m = |v: f64| hox_scenes::present::colour::format_value(v, "m");
         match *self {
             Readout::NoReference { ref short, .. } => short.clone(),
             Readout::Settled { error_m, error_pct, .. } => format!("settled: error {} ({error_pct:.2} %)", m(error_m)),

@@ -14,10 +14,10 @@ use super::presets::{ViewOptions, ViewPreset};
 use super::raster::{BACKGROUND, Camera, Image, Overlay, TriangleLayer, shade};
 use super::session::{Drag, Session};
 use super::session_view::SessionView;
-use crate::colour::{ColourRange, FieldScale};
 use crate::display::SurfaceFrame;
 pub use crate::display::f32s;
 use eframe::egui;
+use hox_scenes::present::colour::{ColourRange, FieldScale};
 use hox_sim::Vec3;
 use hox_sim::measure::field::Field;
 use std::sync::Arc;
@@ -605,13 +605,13 @@ fn legend_ui(
         painter.text(egui::pos2(bar.max.x + 4.0, y + 5.0), egui::Align2::LEFT_CENTER, text, mono.clone(), white);
     };
     if !colours.automatic {
-        swatch(bar.min.y - 14.0, crate::colour::OVER, format!("above: {:.0} %", 100.0 * over));
+        swatch(bar.min.y - 14.0, hox_scenes::present::colour::OVER, format!("above: {:.0} %", 100.0 * over));
     }
     let steps = 40;
     for i in 0..steps {
         let f0 = i as f32 / steps as f32;
         let f1 = (i + 1) as f32 / steps as f32;
-        let c = crate::colour::viridis((f0 as f64 + 0.5 / steps as f64).clamp(0.0, 1.0));
+        let c = hox_scenes::present::colour::viridis((f0 as f64 + 0.5 / steps as f64).clamp(0.0, 1.0));
         let r = egui::Rect::from_min_max(
             egui::pos2(bar.min.x, bar.max.y - f1 * bar.height()),
             egui::pos2(bar.max.x, bar.max.y - f0 * bar.height()),
@@ -624,7 +624,7 @@ fn legend_ui(
     }
     let mut y = bar.max.y + 6.0;
     if !colours.automatic && colours.field.two_sided() {
-        swatch(y, crate::colour::UNDER, format!("below: {:.0} %", 100.0 * under));
+        swatch(y, hox_scenes::present::colour::UNDER, format!("below: {:.0} %", 100.0 * under));
         y += 14.0;
     }
     let mut line = |text: &str, colour: Option<[u8; 4]>| {
