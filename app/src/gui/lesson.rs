@@ -160,8 +160,19 @@ impl LessonState {
             .enumerate()
             .map(|(k, s)| match &s.failure {
                 Some(f) => Measured { value: f64::INFINITY, text: format!("failed: {f}") },
-                None if step.run == Run::Settle && s.settle_outcome.is_none() => {
+                None if step.run == Run::Static && s.solving_static => {
+                    Measured { value: f64::NAN, text: "solving the static equilibrium of the values shown…".into() }
+                }
+                // issue #57: the old shape kept the old numbers under the new values
+                None if step.run == Run::Static && !s.shown_static && s.changed_at_secs.is_some() => Measured {
+                    value: f64::NAN,
+                    text: "changed: not the static equilibrium of the values shown (Settle for it)".into(),
+                },
+                None if step.run == Run::Settle && s.settle_outcome.is_none() && s.settler.is_some() => {
                     Measured { value: f64::NAN, text: format!("settling… (t = {:.2} s)", s.instance.sim.time_secs()) }
+                }
+                None if step.run == Run::Settle && s.settle_outcome.is_none() => {
+                    Measured { value: f64::NAN, text: "changed: not settled for the values shown (Settle)".into() }
                 }
                 None => {
                     let reference = self.own_references.get(k).and_then(Option::as_ref).or(s.reference.reference());

@@ -10,7 +10,7 @@
 //! for the control. In compare mode the linked parameters of the other configuration follow.
 
 use super::action::Action;
-use super::background::{Background, Stepper, any_settling, step_sessions};
+use super::background::{Background, Pending, Stepper, any_settling, step_sessions};
 use super::config::{self, Config, Invalidates, SceneSource};
 use super::cost::{self, PendingChange};
 use super::lesson::LessonState;
@@ -65,8 +65,21 @@ pub struct Model {
     frames_stepped: u64,
     /// Frames the ticks deferred to the stepper ([`Action::Tick`]'s `in_background`).
     deferred_frames: usize,
+    /// Static equilibria being solved in the background for a lesson's static step after a
+    /// change ([`StaticJob`]).
+    static_jobs: Vec<StaticJob>,
     background: Background,
     stepper: Box<dyn Stepper>,
+}
+
+/// The static equilibrium of a session's configuration, solved in the background (issue #57:
+/// a value typed in a static step left the old shape labelled "static equilibrium"). Shown once
+/// ready if the session still has that configuration and mesh, else dropped.
+struct StaticJob {
+    session: usize,
+    config: Config,
+    build: u64,
+    positions: Pending<Result<Vec<Vec3>, String>>,
 }
 
 /// Whether a change from `old` to `new` changes how a configuration is drawn (a `[display]`
@@ -101,6 +114,7 @@ impl Model {
             layout: 0,
             frames_stepped: 0,
             deferred_frames: 0,
+            static_jobs: Vec::new(),
             background: start.background,
             stepper: start.stepper,
         };
@@ -342,6 +356,48 @@ impl Model {
             s.poll_reference();
         }
         self.poll_lesson(wait_for_lesson);
+        self.poll_static_jobs();
+    }
+
+    /// In a lesson's static step, solves the static equilibrium of session `k`'s configuration
+    /// (in the background); until shown, its readout and the lesson's numbers say so.
+    fn solve_static_again(&mut self, k: usize) {
+        if self.lesson.as_ref().is_none_or(|l| l.preparing() || l.current().run != Run::Static) {
+            return;
+        }
+        let s = &mut self.sessions[k];
+        let (scene, mesh) = (s.instance.scene.clone(), s.instance.sim.mesh().clone());
+        s.solving_static = true;
+        let positions = self.background.run(move || super::session::static_positions(&scene, &mesh));
+        self.static_jobs.push(StaticJob {
+            session: k,
+            config: s.config.clone(),
+            build: s.revisions().build,
+            positions,
+        });
+        self.poll_static_jobs();
+    }
+
+    /// Shows the static equilibria solved since, where the configuration is still theirs.
+    fn poll_static_jobs(&mut self) {
+        let jobs = std::mem::take(&mut self.static_jobs);
+        for job in jobs {
+            if !job.positions.is_ready() {
+                self.static_jobs.push(job);
+                continue;
+            }
+            let Some(s) = self.sessions.get_mut(job.session) else { continue };
+            if s.config != job.config || s.revisions().build != job.build {
+                continue;
+            }
+            s.solving_static = false;
+            match job.positions.take() {
+                Some(Ok(positions)) => s.show_static_solution(&positions),
+                Some(Err(e)) => self.message = Some(format!("the static equilibrium of {}: {e}", s.label())),
+                None => self.message = Some("solving the static equilibrium stopped unexpectedly".into()),
+            }
+            self.generation += 1;
+        }
     }
 
     fn load_scene(&mut self, source: SceneSource, configs: Option<(Vec<Config>, bool)>) -> Result<(), String> {
@@ -449,6 +505,9 @@ impl Model {
                 if what == Invalidates::Mesh || redraws(&old, &new) {
                     self.rebuilt();
                 }
+                if what != Invalidates::Nothing {
+                    self.solve_static_again(k);
+                }
             }
             Err(reason) => {
                 self.refusal = Some((control.to_string(), reason.clone()));
@@ -464,9 +523,18 @@ impl Model {
                 }
             }
             match self.sessions[other].apply(follow) {
-                Ok(Invalidates::Mesh) => self.rebuilt(),
-                Ok(_) if redraws(&old, &new) => self.rebuilt(),
-                Ok(_) => {}
+                Ok(Invalidates::Mesh) => {
+                    self.rebuilt();
+                    self.solve_static_again(other);
+                }
+                Ok(Invalidates::Nothing) if redraws(&old, &new) => self.rebuilt(),
+                Ok(Invalidates::Nothing) => {}
+                Ok(_) => {
+                    if redraws(&old, &new) {
+                        self.rebuilt();
+                    }
+                    self.solve_static_again(other);
+                }
                 Err(reason) => {
                     let reason = format!("the other configuration refused it: {reason}");
                     self.refusal = Some((control.to_string(), reason.clone()));

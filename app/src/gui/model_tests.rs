@@ -136,3 +136,36 @@ fn a_classroom_session_of_actions_runs_on_the_model_alone() {
     assert_eq!(time(&m), 0.0);
     assert!(!m.stepping_in_background());
 }
+
+/// Issue #57: in the locking lesson's static step, ν = 0.499 typed left the ν = 0.49 shape on
+/// screen labelled "static equilibrium" with the old numbers; and after a Settle, ν typed back
+/// showed "settled" with the other value's numbers. A static step now solves the new values'
+/// equilibrium (in the background; in place here), and every label on a state that is not the
+/// solution of the values shown says so.
+#[test]
+fn a_value_typed_in_a_static_step_never_leaves_the_old_shape_labelled_equilibrium() {
+    let mut m = model("bending");
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "locking").unwrap();
+    m.apply(Action::OpenLesson(Box::new(lesson))).unwrap();
+    m.apply(Action::GoToStep(1)).unwrap();
+    m.apply(Action::Poll { wait_for_lesson: true }).unwrap();
+    let tip = |m: &Model, k: usize| m.sessions()[k].instance.probe_displacements()[0].1[2];
+    let at_049 = tip(&m, 0);
+    assert!(m.sessions()[0].shown_static);
+
+    let mut c = m.sessions()[0].config.clone();
+    c.poisson_ratio = 0.499;
+    m.apply(Action::change("poisson", c)).unwrap();
+    m.apply(Action::Poll { wait_for_lesson: false }).unwrap();
+    // ν is linked: both configurations were solved again, at the new value
+    for k in 0..2 {
+        let s = &m.sessions()[k];
+        assert_eq!(s.config.poisson_ratio, 0.499);
+        assert!(s.shown_static && !s.solving_static, "{}", s.label());
+        let fresh = super::session::static_positions(&s.instance.scene, s.instance.sim.mesh()).unwrap();
+        assert_eq!(s.instance.sim.positions, fresh, "{}: the equilibrium of ν 0.499 on screen", s.label());
+    }
+    assert!(tip(&m, 0) > at_049 + 1e-3, "P1 locks more at 0.499: {} vs {at_049}", tip(&m, 0));
+    let text = m.lesson_text().unwrap();
+    assert!(text.contains(&format!("{:.4} m", tip(&m, 0))), "the panel shows the new numbers: {text}");
+}

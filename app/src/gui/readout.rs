@@ -278,6 +278,10 @@ pub enum Readout {
     /// Moving, but no full oscillation recorded yet; `paused` mid-swing (issue #35: a paused
     /// beam read "moving").
     Starting { paused: bool },
+    /// The physics changed (ν, E, the solver…) since the body was last at rest or solved, and no
+    /// full oscillation since: what is on screen is not the state of the parameters shown
+    /// (issue #57: it kept reading "static equilibrium" and "settled").
+    Changed { paused: bool },
     /// The static equilibrium, solved and shown (a lesson's static step): its error.
     Static { error_m: f64, error_pct: f64 },
     /// Not run yet: at t = 0, the start state (issue #35: it read "moving").
@@ -311,6 +315,7 @@ impl Readout {
             Readout::Moving { error_m, error_pct, .. } => format!("mean error {} ({error_pct:.2} %)", m(error_m)),
             Readout::Starting { paused: false } => "moving".into(),
             Readout::Starting { paused: true } => "paused mid-swing".into(),
+            Readout::Changed { .. } => "changed, not at rest".into(),
             Readout::NotStarted => "not started".into(),
         }
     }
@@ -329,6 +334,7 @@ impl Readout {
             }
             Readout::Starting { paused: false } => "moving".into(),
             Readout::Starting { paused: true } => "paused mid-swing".into(),
+            Readout::Changed { .. } => "changed: not yet at rest for these values".into(),
             Readout::NotStarted => "not started".into(),
         }
     }
@@ -357,6 +363,12 @@ impl Readout {
             }
             Readout::Starting { paused: true } => {
                 "paused mid-swing: no full oscillation yet (Play, or Settle for the equilibrium)".into()
+            }
+            Readout::Changed { paused: false } => {
+                "changed: moving to the new values' state, no full oscillation yet (Settle for the equilibrium)".into()
+            }
+            Readout::Changed { paused: true } => {
+                "changed: the shape shown is the old values' (Play, or Settle for the new equilibrium)".into()
             }
             Readout::NotStarted => "not started: t = 0 (Play, Step or Settle)".into(),
         }

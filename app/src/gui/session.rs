@@ -58,6 +58,12 @@ pub struct Drag {
 /// Compliance of the mouse attachment, m/N (stiff, but not rigid).
 const DRAG_COMPLIANCE_M_PER_N: f64 = 1e-6;
 
+/// The static equilibrium of `scene` on `mesh` (hox's static solver): the positions a lesson's
+/// static step shows. Pure, so that it runs in the background as well as here.
+pub fn static_positions(scene: &hox_scenes::scene::Scene, mesh: &hox_sim::mesh::Mesh) -> Result<Vec<Vec3>, String> {
+    hox_scenes::solve_static(scene, mesh, 1e-9, 10, &mut |_, _, _| {}).map(|s| s.positions).map_err(|e| e.to_string())
+}
+
 /// Mesh builds, numbered across every session (a view is of one build).
 static BUILDS: AtomicU64 = AtomicU64::new(1);
 
@@ -102,6 +108,14 @@ pub struct Session {
     pub watch_min_det_f: bool,
     /// The static equilibrium was solved and is shown, not stepped since.
     pub shown_static: bool,
+    /// The simulated time of the last change of the physics (material, solver settings) since
+    /// the body was last at rest, solved or reset: what is on screen then is not the state of
+    /// the parameters shown, and the readout says so until it is again (issue #57: ν typed in a
+    /// static step left the old shape labelled "static equilibrium").
+    pub changed_at_secs: Option<f64>,
+    /// The static equilibrium of the parameters shown is being solved in the background (a
+    /// lesson's static step after a change); set and cleared by the model.
+    pub solving_static: bool,
     /// The app is paused (set by the app every frame): a swing not yet complete reads "paused".
     pub paused: bool,
     /// The static residual at the last frame: the unbalanced force on the free nodes relative to
@@ -147,6 +161,8 @@ impl Session {
             min_det_f: f64::INFINITY,
             watch_min_det_f: false,
             shown_static: false,
+            changed_at_secs: None,
+            solving_static: false,
             paused: true,
             residual: f64::NAN,
             failure: None,
@@ -190,11 +206,13 @@ impl Session {
                 self.instance.sim.set_material(scene.material()).map_err(|e| e.to_string())?;
                 self.instance.sim.set_settings(scene.settings()).map_err(|e| e.to_string())?;
                 self.instance.scene = scene;
+                self.physics_changed();
             }
             Invalidates::Settings => {
                 self.instance.sim.set_settings(scene.settings()).map_err(|e| e.to_string())?;
                 self.instance.scene = scene;
                 self.revisions.settings += 1;
+                self.physics_changed();
             }
             Invalidates::Nothing => self.instance.scene = scene,
         }
@@ -207,8 +225,21 @@ impl Session {
         Ok(what)
     }
 
+    /// After a change of the physics on the same mesh: the state on screen (solved, settled or
+    /// swinging) was of the old parameters; nothing is called at rest, settled or in
+    /// equilibrium until it is again for the new ones.
+    fn physics_changed(&mut self) {
+        self.shown_static = false;
+        self.rest = RestWatch::new(&self.instance);
+        self.settle_outcome = None;
+        self.changed_at_secs = Some(self.instance.sim.time_secs());
+        self.residual = self.force_residual();
+    }
+
     /// After a (re)build: a new build for the views, the first history sample.
     fn mesh_changed(&mut self) {
+        self.changed_at_secs = None;
+        self.shown_static = false;
         self.revisions.build = BUILDS.fetch_add(1, Ordering::Relaxed);
         self.record();
     }
@@ -233,6 +264,7 @@ impl Session {
         self.frame_ms.clear();
         self.min_det_f = f64::INFINITY;
         self.shown_static = false;
+        self.changed_at_secs = None;
         self.watch();
         self.record();
         self.refresh_readout();
@@ -298,16 +330,24 @@ impl Session {
     /// Shows the static equilibrium of the configuration (hox's static solver), at rest: what
     /// settling tends to, at once (a lesson's `"static"` step).
     pub fn show_static_equilibrium(&mut self) -> Result<(), String> {
-        let mesh = self.instance.sim.mesh().clone();
-        let solution = hox_scenes::solve_static(&self.instance.scene, &mesh, 1e-9, 10, &mut |_, _, _| {})
-            .map_err(|e| e.to_string())?;
-        self.instance.sim.warm_start(&solution.positions, 0.0);
+        let positions = static_positions(&self.instance.scene, self.instance.sim.mesh())?;
+        self.show_static_solution(&positions);
+        Ok(())
+    }
+
+    /// Shows `positions`, the static equilibrium of the configuration on screen (solved by
+    /// [`static_positions`], here or in the background), at rest.
+    pub fn show_static_solution(&mut self, positions: &[Vec3]) {
+        self.instance.sim.warm_start(positions, 0.0);
         self.history = History::default();
         self.shown_static = true;
+        self.solving_static = false;
+        self.changed_at_secs = None;
+        self.settle_outcome = None;
+        self.rest = RestWatch::new(&self.instance);
         self.record();
         self.residual = self.force_residual();
         self.refresh_readout();
-        Ok(())
     }
 
     /// Starts the *Settle* action: the scene's settle damping until the body is at rest (as
@@ -331,6 +371,7 @@ impl Session {
             // taken in since the last refresh (a test waiting on the computation)
             (Readout::NoReference { .. }, Some(_)) => self.measure_readout(),
             (Readout::Starting { .. }, Some(_)) => Readout::Starting { paused: self.paused },
+            (Readout::Changed { .. }, Some(_)) => Readout::Changed { paused: self.paused },
             (r, Some(_)) => r.clone(),
         }
     }
@@ -385,12 +426,19 @@ impl Session {
         let Some(first) = self.instance.probes.first() else {
             return Readout::missing("the scene has no probes");
         };
-        if self.instance.sim.time_secs() == 0.0 {
+        if self.instance.sim.time_secs() == 0.0 && self.changed_at_secs.is_none() {
             return Readout::NotStarted;
         }
+        // only the motion since the last change of the physics is of the parameters shown
         let h = &self.history;
-        let Some((mean, amplitude_m, period_secs, before)) = last_oscillation(&h.time_secs, &h.probe_m) else {
-            return Readout::Starting { paused: self.paused };
+        let since = self.changed_at_secs.map_or(0, |t| h.time_secs.partition_point(|&s| s < t));
+        let Some((mean, amplitude_m, period_secs, before)) =
+            last_oscillation(&h.time_secs[since..], &h.probe_m[since..])
+        else {
+            return match self.changed_at_secs {
+                Some(_) => Readout::Changed { paused: self.paused },
+                None => Readout::Starting { paused: self.paused },
+            };
         };
         let one = |u: [f64; 3]| vec![(first.name.clone(), u)];
         match (r.error_m(&one(mean)), r.error_pct(&one(mean))) {
@@ -421,6 +469,10 @@ impl Session {
     }
 
     fn record(&mut self) {
+        if self.changed_at_secs.is_some() && self.rest.at_rest() {
+            // at rest again, for the parameters shown
+            self.changed_at_secs = None;
+        }
         let sim = &self.instance.sim;
         let probe = self.instance.probe_displacements().first().map(|p| p.1).unwrap_or_default();
         self.history.push(sim.time_secs(), probe, sim.kinetic_energy_j(), sim.elastic_energy_j());
@@ -502,6 +554,48 @@ mod tests {
         let mut element = element;
         element.apply(c).unwrap();
         assert!(element.reference_motion().is_some(), "another mesh of the same beam is compared with it");
+    }
+
+    /// Issue #57: a state solved or settled for one value of ν kept its "static equilibrium" or
+    /// "settled" label, with the old numbers, once another value was typed.
+    #[test]
+    fn a_changed_value_never_keeps_the_settled_or_equilibrium_label() {
+        let claims = |s: &Session| {
+            let said = [s.readout_label(), s.readout().text(), s.readout().error_text()].join(" | ");
+            said.contains("equilibrium (") || said.contains("equilibrium:") || said.contains("settled")
+        };
+        let mut s = bending();
+        s.show_static_equilibrium().unwrap();
+        assert!(claims(&s), "{}", s.readout_label());
+        let mut c = s.config.clone();
+        c.poisson_ratio = 0.45;
+        s.apply(c.clone()).unwrap();
+        s.reference.wait();
+        s.poll_reference();
+        assert!(!claims(&s), "the old shape under ν 0.45: {}", s.readout().text());
+        assert_eq!(s.readout(), Readout::Changed { paused: true });
+        // settled at 0.45, then 0.35 typed back: not settled for 0.35 until it is again
+        s.start_settle();
+        for _ in 0..3000 {
+            if s.settle_outcome.is_some() {
+                break;
+            }
+            s.step(1);
+        }
+        assert!(s.settle_outcome.is_some() && claims(&s), "{}", s.readout().text());
+        c.poisson_ratio = 0.35;
+        s.apply(c).unwrap();
+        assert!(s.reference.reference().is_some(), "the committed reference of ν 0.35");
+        assert!(!claims(&s), "{}", s.readout().text());
+        // played on, it comes to rest at the new values and says so again
+        s.start_settle();
+        for _ in 0..3000 {
+            if s.settle_outcome.is_some() {
+                break;
+            }
+            s.step(1);
+        }
+        assert!(claims(&s), "{}", s.readout().text());
     }
 
     #[test]
