@@ -139,7 +139,8 @@ fn number_ui(cx: &mut Ctx, ui: &mut egui::Ui, p: &'static Param, enabled: bool) 
 
 /// One control row: its label (with tooltip), a widget editing a copy of the value, the link
 /// toggle, and under it the reason of a refused change. A changed value goes through
-/// [`Action::Change`].
+/// [`Action::Change`]. A number typed into a slider or a cell applies on Enter or focus loss,
+/// not digit by digit (issue #57: typing "64" first rebuilt the beam at 6 cells).
 #[allow(clippy::too_many_arguments)]
 fn row_ui<T: Clone + PartialEq>(
     cx: &mut Ctx,
@@ -259,12 +260,15 @@ fn param_ui(cx: &mut Ctx, ui: &mut egui::Ui, p: &'static Param) {
         Kind::Whole { min, soft_max, .. } => row_ui(cx, ui, p.key, &text, p.help, get, set, |ui, v| {
             let Value::Whole(n) = v else { return ui.label("?") };
             let log = soft_max >= 20 * min.max(1);
-            ui.add_enabled(enabled, egui::Slider::new(n, min..=soft_max).logarithmic(log))
+            ui.add_enabled(enabled, egui::Slider::new(n, min..=soft_max).logarithmic(log).update_while_editing(false))
         }),
         Kind::Number { soft: Some((lo, hi)), .. } => row_ui(cx, ui, p.key, &text, p.help, get, set, |ui, v| {
             let Value::Number(x) = v else { return ui.label("?") };
             let suffix = if p.key == "fps" { " fps".to_string() } else { String::new() };
-            ui.add_enabled(enabled, egui::Slider::new(x, lo..=hi).logarithmic(true).suffix(suffix))
+            ui.add_enabled(
+                enabled,
+                egui::Slider::new(x, lo..=hi).logarithmic(true).suffix(suffix).update_while_editing(false),
+            )
         }),
         Kind::Flag => row_ui(cx, ui, p.key, &text, p.help, get, set, |ui, v| {
             let Value::Flag(b) = v else { return ui.label("?") };
@@ -275,7 +279,9 @@ fn param_ui(cx: &mut Ctx, ui: &mut egui::Ui, p: &'static Param) {
             let mut response: Option<egui::Response> = None;
             for (cells, axis) in g.iter_mut().zip(["x", "y", "z"]) {
                 let l = ui.label(axis);
-                let r = ui.add_enabled(enabled, egui::DragValue::new(cells).range(min..=max)).labelled_by(l.id);
+                let r = ui
+                    .add_enabled(enabled, egui::DragValue::new(cells).range(min..=max).update_while_editing(false))
+                    .labelled_by(l.id);
                 response = Some(match response {
                     Some(prev) => prev | r,
                     None => r,

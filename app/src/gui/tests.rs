@@ -930,6 +930,35 @@ fn a_change_too_slow_to_play_asks_first_and_a_slow_frame_pauses() {
     assert!(h.state().model().message().is_some_and(|m| m.starts_with("Paused: a frame takes")));
 }
 
+/// Issue #57: typing "64" into a grid cell rebuilt the beam at 6 cells first (and "32" while
+/// playing at 3, which the slowness question then kept, losing the 8 that was there). A typed
+/// number applies once, on Enter.
+#[test]
+fn typing_a_multi_digit_value_applies_it_once_not_digit_by_digit() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    let builds = |h: &Harness<'_, HoxApp>| h.state().model().generation();
+    let grid = |h: &Harness<'_, HoxApp>| h.state().model().sessions()[0].config.grid;
+    let before = builds(&h);
+    // the grid's x cell: the widget the label "x" labels (a spin button; a text field while typed in)
+    let cell =
+        || |n: &egui_kittest::kittest::AccessKitNode<'_>| n.labelled_by().any(|l| l.value().as_deref() == Some("x"));
+    h.get_by(cell()).focus();
+    h.run_steps(1);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    for digit in ["3", "2"] {
+        h.get_by(cell()).type_text(digit);
+        h.run_steps(2);
+        assert_eq!(grid(&h), [8, 2, 2], "nothing applied while typing");
+        assert_eq!(builds(&h), before, "nothing rebuilt while typing");
+    }
+    h.key_press(egui::Key::Enter);
+    h.run_steps(3);
+    assert_eq!(grid(&h), [32, 2, 2]);
+    assert_eq!(h.state().model().sessions()[0].instance.sim.mesh().num_elements(), 32 * 2 * 2 * 5);
+    assert_eq!(builds(&h), before + 1, "built once");
+}
+
 /// The drawn labels, legend and bodies of the view: every label inside the view, clear of the
 /// legend, the other label and both bodies; every body inside the view (issue #35, symptom 5).
 fn assert_layout_fits(h: &Harness<'_, HoxApp>, what: &str) {
