@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 mod bench;
 mod gmsh;
-mod inspect;
+pub(crate) mod inspect;
 mod lesson;
 mod list;
 mod mesh;

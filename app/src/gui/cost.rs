@@ -14,6 +14,15 @@
 //!   means, and keeps the current configuration until the answer.
 //! - **After**: a frame that took more than [`SLOW_FRAME_MS`] pauses the app (a slow frame then
 //!   runs only on Step), so the window stays usable and typing is not lost.
+//!
+//! Issue #57 (P1 refine 3, then 64 cells along x while paused: 655,360 elements accepted without
+//! a question, Play froze the window for minutes): a new mesh is built in the background (the
+//! window stays responsive however large it is) and estimated once built, paused or playing —
+//! from the current configuration's measured frame when there is one, else from the time per
+//! unit of work this machine last measured for the solver ([`Rates`]), else a conservative
+//! default. The estimate counts what the user gets: the simulation and the drawing, the
+//! drawing's time per frame scaled by the surface (elements^⅔). A display slower than
+//! [`SLOW_FRAME_MS`] per frame while playing pauses too ([`slow_display`]).
 
 use super::config::Config;
 use super::session::Session;
@@ -24,11 +33,91 @@ use hox_sim::solver::{Simulation, SolverSettings, SweepsPerStep};
 /// A frame slower than this (under 4 frames per second) is asked about and pauses the app.
 pub const SLOW_FRAME_MS: f64 = 250.0;
 
-/// A change held back until the user says: the control, the configuration, what it will cost.
+/// A change held back until the user says: the control, the configuration, what it will cost,
+/// and the meshes already built for it (installed as they are if the answer is yes).
 pub struct PendingChange {
     pub control: String,
     pub config: Config,
     pub estimate: String,
+    pub built: Option<Built>,
+}
+
+/// New meshes built in the background for a change: `(session, its new configuration, the
+/// instance)` for each session it rebuilds.
+pub type Built = Vec<(usize, Config, hox_scenes::Instance)>;
+
+/// What one unit of work ([`frame_work`]) costs on this machine, ms, before any frame has been
+/// measured: explicit (XPBD) and implicit solvers. On the safe side: issue #57's 655,360 P1
+/// elements at 629 substeps took 22 s per frame, 1.3e-5 ms per unit.
+const DEFAULT_MS_PER_WORK: [f64; 2] = [2e-5, 1e-4];
+
+/// What a unit of work costs on this machine, ms, by solver: the last measured, else the
+/// default ([`DEFAULT_MS_PER_WORK`]).
+#[derive(Clone, Debug, Default)]
+pub struct Rates {
+    learned: Vec<(&'static str, f64)>,
+}
+
+impl Rates {
+    /// Takes a measured frame time of `sim` (ms) in.
+    pub fn learn(&mut self, sim: &Simulation, ms_per_frame: f64) {
+        if !(ms_per_frame > 0.0 && ms_per_frame.is_finite()) {
+            return;
+        }
+        let rate = ms_per_frame / frame_work(sim).max(1.0);
+        let name = sim.settings().method.name();
+        match self.learned.iter_mut().find(|(n, _)| *n == name) {
+            Some(entry) => entry.1 = rate,
+            None => self.learned.push((name, rate)),
+        }
+    }
+
+    /// ms per unit of work of `method`.
+    fn ms_per_work(&self, method: hox_sim::solver::Method) -> f64 {
+        let learned = self.learned.iter().find(|(n, _)| *n == method.name()).map(|e| e.1);
+        learned.unwrap_or(DEFAULT_MS_PER_WORK[usize::from(method.info().implicit)])
+    }
+}
+
+/// The estimated time per frame, simulation and drawing, of `candidate` replacing `current`'s
+/// simulation; `draw_ms`: what drawing a frame costs now.
+pub fn estimated_total_ms(current: &Session, candidate: &Simulation, rates: &Rates, draw_ms: f64) -> f64 {
+    let same_solver = current.instance.sim.settings().method == candidate.settings().method;
+    let sim_ms = if current.ms_per_frame > 0.0 && same_solver {
+        estimated_ms(&current.instance.sim, current.ms_per_frame, candidate)
+    } else {
+        rates.ms_per_work(candidate.settings().method) * frame_work(candidate)
+    };
+    let surface = |n: usize| (n.max(1) as f64).powf(2.0 / 3.0);
+    let draw = draw_ms * surface(candidate.mesh().num_elements()) / surface(current.instance.sim.mesh().num_elements());
+    sim_ms + draw
+}
+
+/// The question for a built change estimated at `ms` per frame (above [`SLOW_FRAME_MS`]), or
+/// None.
+pub fn too_slow_built(current: &Session, candidate: &Simulation, rates: &Rates, draw_ms: f64) -> Option<String> {
+    let ms = estimated_total_ms(current, candidate, rates, draw_ms);
+    (ms > SLOW_FRAME_MS).then(|| {
+        let now = if current.ms_per_frame > 0.0 {
+            format!("now {:.1} ms", current.ms_per_frame + draw_ms)
+        } else {
+            "not measured yet".to_string()
+        };
+        describe(candidate.mesh().num_elements(), &candidate.work_summary(), ms, &now)
+    })
+}
+
+/// "N elements, WORK: about T per frame on this machine (NOW), about F frames per second."
+fn describe(elements: usize, work: &str, ms: f64, now: &str) -> String {
+    format!(
+        "{elements} elements, {work}: about {} per frame on this machine ({now}), {}.",
+        if ms >= 1000.0 { format!("{:.1} s", ms / 1e3) } else { format!("{ms:.0} ms") },
+        if ms >= 1000.0 {
+            "under one frame per second".to_string()
+        } else {
+            format!("about {:.0} frames per second", 1000.0 / ms)
+        }
+    )
 }
 
 /// Element–point–node visits of one sweep over `sim`'s elements.
@@ -75,42 +164,37 @@ pub fn estimated_ms_with(current: &Simulation, current_ms: f64, settings: &Solve
     current_ms * sweeps(settings, substeps) / sweeps(current.settings(), current.substeps_per_frame()).max(1e-9)
 }
 
-/// Whether `new` for `s` would be slow: the estimate in words, or None (cheap enough, not
-/// measurable yet, or not buildable: applying it says why).
-pub fn too_slow(s: &Session, new: &Config) -> Option<String> {
+/// Whether a change of solver settings `new` for `s` (the same mesh: estimated without
+/// building anything, so dragging the substeps slider stays cheap) would be slow: the question,
+/// or None. A new mesh is estimated once built ([`too_slow_built`]); a new material is not (the
+/// slow-frame pause catches a stiffer one's extra substeps).
+pub fn too_slow(s: &Session, new: &Config, rates: &Rates, draw_ms: f64) -> Option<String> {
     use super::config::Invalidates;
-    if s.ms_per_frame <= 0.0 {
+    if s.config.invalidated_by(new) != Invalidates::Settings {
         return None;
     }
-    let what = s.config.invalidated_by(new);
-    let scene = match what {
-        // a new material may raise the guard's substeps: a slow frame then pauses (below)
-        Invalidates::Nothing | Invalidates::Material => return None,
-        Invalidates::Settings | Invalidates::Mesh => super::config::resolve(new, &s.base).ok()?,
-    };
-    // the same mesh: estimated from the settings alone; a new mesh is built to be counted
-    let (ms, elements, work) = if what == Invalidates::Settings {
-        let settings = scene.settings();
-        let ms = estimated_ms_with(&s.instance.sim, s.ms_per_frame, &settings);
-        (ms, s.instance.sim.mesh().num_elements(), format!("{} solver", settings.method.name()))
+    let settings = super::config::resolve(new, &s.base).ok()?.settings();
+    let current = &s.instance.sim;
+    let sim_ms = if s.ms_per_frame > 0.0 && settings.method == current.settings().method {
+        estimated_ms_with(current, s.ms_per_frame, &settings)
     } else {
-        let candidate = hox_scenes::Instance::new(scene).ok()?;
-        let ms = estimated_ms(&s.instance.sim, s.ms_per_frame, &candidate.sim);
-        (ms, candidate.sim.mesh().num_elements(), candidate.sim.work_summary())
+        let raised = current.substeps_per_frame().max(settings.substeps);
+        rates.ms_per_work(settings.method)
+            * sweep_work(current)
+            * sweeps(&settings, if settings.stability_guard { raised } else { settings.substeps })
     };
-    (ms > SLOW_FRAME_MS).then(|| {
-        format!(
-            "{elements} elements, {work}: about {} per frame on this machine (now {:.1} ms), {}.",
-            if ms >= 1000.0 { format!("{:.1} s", ms / 1e3) } else { format!("{ms:.0} ms") },
-            s.ms_per_frame,
-            if ms >= 1000.0 {
-                "under one frame per second".to_string()
-            } else {
-                format!("about {:.0} frames per second", 1000.0 / ms)
-            }
-        )
-    })
+    let ms = sim_ms + draw_ms;
+    let now = if s.ms_per_frame > 0.0 {
+        format!("now {:.1} ms", s.ms_per_frame + draw_ms)
+    } else {
+        "not measured yet".into()
+    };
+    (ms > SLOW_FRAME_MS)
+        .then(|| describe(current.mesh().num_elements(), &format!("{} solver", settings.method.name()), ms, &now))
 }
+
+/// The start of the message a slow frame pauses the app with (cleared by the next change).
+pub const SLOW_PAUSE: &str = "Paused: a frame takes";
 
 /// After stepping while playing: the message that pauses the app when a frame took more than
 /// [`SLOW_FRAME_MS`], or None.
@@ -118,8 +202,22 @@ pub fn slow_frame(sessions: &[Session]) -> Option<String> {
     let slowest = sessions.iter().map(|s| s.ms_per_frame).fold(0.0, f64::max);
     (slowest > SLOW_FRAME_MS).then(|| {
         format!(
-            "Paused: a frame takes {:.1} s, too slow to play (Step, S, advances one frame; fewer elements or substeps play).",
+            "{SLOW_PAUSE} {:.1} s, too slow to play (Step, S, advances one frame; fewer elements or substeps play).",
             slowest / 1e3
+        )
+    })
+}
+
+/// While playing: the message that pauses the app when the window shows a frame less often than
+/// every [`SLOW_FRAME_MS`] (`display_ms`: the frames' interval, smoothed; `sim_ms`: the
+/// simulation's part of it), or None — a frame slow to draw is as unplayable as one slow to
+/// compute (issue #57: refine 3 at 95–160 ms of computing ran at 2 fps on screen, unasked).
+pub fn slow_display(display_ms: f64, sim_ms: f64) -> Option<String> {
+    (display_ms > SLOW_FRAME_MS).then(|| {
+        format!(
+            "{SLOW_PAUSE} {:.1} s on screen ({:.0} ms simulating, the rest drawing), too slow to play (Step, S, advances one frame; fewer elements, face segments or substeps play).",
+            display_ms / 1e3,
+            sim_ms
         )
     })
 }

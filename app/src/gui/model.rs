@@ -68,8 +68,33 @@ pub struct Model {
     /// Static equilibria being solved in the background for a lesson's static step after a
     /// change ([`StaticJob`]).
     static_jobs: Vec<StaticJob>,
+    /// A change's new meshes being built in the background ([`Build`]).
+    building: Option<Build>,
+    /// The interval between the window's frames while playing, smoothed, ms; and the part of
+    /// it that is not the simulation's (the drawing): what a configuration costs the user.
+    display_ms: f64,
+    draw_ms: f64,
+    /// The last tick was played (its interval is one between two frames played), and how many
+    /// intervals in a row were slower than [`cost::SLOW_FRAME_MS`].
+    display_playing: bool,
+    slow_displays: u32,
+    /// The fastest of those slow intervals, ms.
+    slow_display_ms: f64,
+    /// What a unit of a solver's work costs on this machine, as last measured.
+    rates: cost::Rates,
     background: Background,
     stepper: Box<dyn Stepper>,
+}
+
+/// A change that rebuilds meshes, built in the background so that the window stays responsive
+/// however large they are (issue #57: 655,360 elements froze it for minutes); estimated once
+/// built (`ask`: asked first when slow), then installed.
+struct Build {
+    control: String,
+    ask: bool,
+    /// `(session, its new configuration)` for each session the change rebuilds.
+    configs: Vec<(usize, Config)>,
+    instances: Pending<Result<Vec<hox_scenes::Instance>, String>>,
 }
 
 /// The static equilibrium of a session's configuration, solved in the background (issue #57:
@@ -81,6 +106,19 @@ struct StaticJob {
     build: u64,
     positions: Pending<Result<Vec<Vec3>, String>>,
 }
+
+/// Whether the new mesh of `new` is small enough to build at once, in place (well under a
+/// second): its elements estimated from `s`'s (the grid's cells, ×8 per refinement level) times
+/// the new element's nodes at most [`AT_ONCE_NODE_VISITS`].
+fn builds_at_once(s: &Session, new: &Config) -> bool {
+    let cells = |g: &[usize; 3]| g.iter().map(|&n| n.max(1) as f64).product::<f64>();
+    let ratio = cells(&new.grid) / cells(&s.config.grid) * 8f64.powi(new.refine as i32 - s.config.refine as i32);
+    let elements = s.instance.sim.mesh().num_elements() as f64 * ratio;
+    elements * new.element.reference().num_nodes() as f64 <= AT_ONCE_NODE_VISITS
+}
+
+/// [`builds_at_once`]'s bound: element–node pairs of a mesh built in place.
+const AT_ONCE_NODE_VISITS: f64 = 60_000.0;
 
 /// Whether a change from `old` to `new` changes how a configuration is drawn (a `[display]`
 /// parameter of the table).
@@ -115,6 +153,13 @@ impl Model {
             frames_stepped: 0,
             deferred_frames: 0,
             static_jobs: Vec::new(),
+            building: None,
+            display_ms: 0.0,
+            draw_ms: 0.0,
+            display_playing: false,
+            slow_displays: 0,
+            slow_display_ms: 0.0,
+            rates: cost::Rates::default(),
             background: start.background,
             stepper: start.stepper,
         };
@@ -256,20 +301,24 @@ impl Model {
             Action::SetCompare(on) => self.set_compare(on),
             Action::SetActive(k) => self.active = k.min(self.sessions.len().saturating_sub(1)),
             Action::Change { control, config } => {
-                if let Some(estimate) = cost::too_slow(&self.sessions[self.active], &config) {
-                    self.pending_change = Some(PendingChange { control, config: *config, estimate });
+                if let Some(estimate) = cost::too_slow(&self.sessions[self.active], &config, &self.rates, self.draw_ms)
+                {
+                    self.pending_change = Some(PendingChange { control, config: *config, estimate, built: None });
                     return Ok(());
                 }
-                return self.change(&control, *config);
+                return self.change_or_build(&control, *config, true);
             }
-            Action::ChangeNow { control, config } => return self.change(&control, *config),
+            Action::ChangeNow { control, config } => return self.change_or_build(&control, *config, false),
             Action::AnswerPending(apply) => {
                 // either answer ends the question; only "apply" changes anything
                 if let Some(p) = self.pending_change.take()
                     && apply
                 {
                     self.playback.playing = false;
-                    return self.change(&p.control, p.config);
+                    return match p.built {
+                        Some(built) => self.install(&p.control, built),
+                        None => self.change(&p.control, p.config),
+                    };
                 }
             }
             Action::Refuse { control, reason } => self.refusal = Some((control, reason)),
@@ -357,6 +406,111 @@ impl Model {
         }
         self.poll_lesson(wait_for_lesson);
         self.poll_static_jobs();
+        self.poll_build();
+    }
+
+    /// What is being built in the background for a change, if anything: a line for the status.
+    pub fn building(&self) -> Option<String> {
+        let b = self.building.as_ref()?;
+        let what: Vec<String> = b.configs.iter().map(|(_, c)| config::label(c, &self.sessions[0].base)).collect();
+        Some(format!("building {} for {}…", what.join(" and "), b.control))
+    }
+
+    /// Applies `new` to the active configuration (and the linked fields to the other): at once,
+    /// or, when it needs a new mesh, built in the background first ([`Build`]); `ask`: a build
+    /// estimated slower than the machine can play asks first ([`cost::too_slow_built`]).
+    fn change_or_build(&mut self, control: &str, new: Config, ask: bool) -> Result<(), String> {
+        let k = self.active;
+        let s = &self.sessions[k];
+        if s.config.invalidated_by(&new) != Invalidates::Mesh || builds_at_once(s, &new) {
+            return self.change(control, new);
+        }
+        let mut configs = vec![(k, new.clone())];
+        if self.compare {
+            let other = 1 - k;
+            let mut follow = self.sessions[other].config.clone();
+            for f in self.sessions[k].config.changed_keys(&new) {
+                if self.links.linked(f) {
+                    follow.copy_from(&new, f);
+                }
+            }
+            if follow != self.sessions[other].config {
+                configs.push((other, follow));
+            }
+        }
+        // checked against the table now (a refusal at once, for the control); built later
+        let mut scenes = Vec::new();
+        for (j, c) in &configs {
+            match config::resolve(c, &self.sessions[*j].base) {
+                Ok(scene) => scenes.push(scene),
+                Err(reason) => {
+                    let reason = if *j == k { reason } else { format!("the other configuration refused it: {reason}") };
+                    self.refusal = Some((control.to_string(), reason.clone()));
+                    return Err(reason);
+                }
+            }
+        }
+        let instances = self
+            .background
+            .run(move || scenes.into_iter().map(|s| hox_scenes::Instance::new(s).map_err(|e| e.to_string())).collect());
+        self.building = Some(Build { control: control.to_string(), ask, configs, instances });
+        self.refusal = None;
+        self.poll_build();
+        Ok(())
+    }
+
+    /// Takes a build that finished in: asks first if it would be slow, else installs it.
+    fn poll_build(&mut self) {
+        if !self.building.as_ref().is_some_and(|b| b.instances.is_ready()) {
+            return;
+        }
+        let Some(b) = self.building.take() else { return };
+        let instances = match b.instances.take() {
+            Some(Ok(instances)) => instances,
+            Some(Err(reason)) => {
+                self.refusal = Some((b.control, reason));
+                return;
+            }
+            None => {
+                self.refusal = Some((b.control, "building the mesh stopped unexpectedly".into()));
+                return;
+            }
+        };
+        let built: cost::Built = b.configs.into_iter().zip(instances).map(|((k, c), i)| (k, c, i)).collect();
+        if b.ask {
+            let question = built.iter().find_map(|(k, _, i)| {
+                self.sessions.get(*k).and_then(|s| cost::too_slow_built(s, &i.sim, &self.rates, self.draw_ms))
+            });
+            if let Some(estimate) = question {
+                let config = built[0].1.clone();
+                self.pending_change = Some(PendingChange { control: b.control, config, estimate, built: Some(built) });
+                return;
+            }
+        }
+        let _ = self.install(&b.control, built);
+    }
+
+    /// Installs meshes built for a change.
+    fn install(&mut self, control: &str, built: cost::Built) -> Result<(), String> {
+        for (k, config, instance) in built {
+            let Some(s) = self.sessions.get_mut(k) else { continue };
+            if let Err(reason) = s.apply_with(config, Some(instance)) {
+                self.refusal = Some((control.to_string(), reason.clone()));
+                return Err(reason);
+            }
+            self.rebuilt();
+            self.solve_static_again(k);
+        }
+        self.refusal = None;
+        self.clear_slow_pause();
+        Ok(())
+    }
+
+    /// A change was applied: the message of a slow frame's pause is of another configuration.
+    fn clear_slow_pause(&mut self) {
+        if self.message.as_deref().is_some_and(|m| m.starts_with(cost::SLOW_PAUSE)) {
+            self.message = None;
+        }
     }
 
     /// In a lesson's static step, solves the static equilibrium of session `k`'s configuration
@@ -501,6 +655,7 @@ impl Model {
         match self.sessions[k].apply(new.clone()) {
             Ok(what) => {
                 self.refusal = None;
+                self.clear_slow_pause();
                 // a new mesh, or a new way of drawing it: Rerun logs the static data again
                 if what == Invalidates::Mesh || redraws(&old, &new) {
                     self.rebuilt();
@@ -599,12 +754,31 @@ impl Model {
             }
         }
         self.lesson_after_advance();
-        if self.playback.playing
-            && !self.settling()
-            && let Some(message) = cost::slow_frame(&self.sessions)
-        {
-            self.playback.playing = false;
-            self.message = Some(message);
+        for s in &self.sessions {
+            self.rates.learn(&s.instance.sim, s.ms_per_frame);
+        }
+        // what the user gets: the interval between the window's frames, and its drawing part
+        let sim_ms = self.sessions.iter().map(|s| s.ms_per_frame).fold(0.0, f64::max);
+        // (an interval counts only between two frames played: the first after a pause is the
+        // pause's length)
+        if self.playback.playing && self.display_playing && dt > 0.0 {
+            let ms = dt * 1e3;
+            self.display_ms = if self.display_ms == 0.0 { ms } else { 0.7 * self.display_ms + 0.3 * ms };
+            self.draw_ms = (self.display_ms - sim_ms).max(0.0);
+            self.slow_displays = if ms > cost::SLOW_FRAME_MS { self.slow_displays + 1 } else { 0 };
+            self.slow_display_ms = if self.slow_displays == 1 { ms } else { self.slow_display_ms.min(ms) };
+        }
+        self.display_playing = self.playback.playing;
+        if self.playback.playing && !self.settling() {
+            // three slow intervals in a row: not one hiccup of the machine
+            let display_ms = if self.slow_displays >= 3 { self.slow_display_ms } else { 0.0 };
+            let slow = cost::slow_frame(&self.sessions).or_else(|| cost::slow_display(display_ms, sim_ms));
+            if let Some(message) = slow {
+                self.playback.playing = false;
+                self.display_ms = 0.0;
+                self.slow_displays = 0;
+                self.message = Some(message);
+            }
         }
         self.playback.last_clock_frame = true;
         let paused = !self.playback.playing && !self.settling();

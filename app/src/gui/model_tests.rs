@@ -169,3 +169,96 @@ fn a_value_typed_in_a_static_step_never_leaves_the_old_shape_labelled_equilibriu
     let text = m.lesson_text().unwrap();
     assert!(text.contains(&format!("{:.4} m", tip(&m, 0))), "the panel shows the new numbers: {text}");
 }
+
+fn threaded_model(scene: &str) -> Model {
+    let start = Start {
+        links: Default::default(),
+        view: ViewOptions::default(),
+        playing: false,
+        time_scale: 1.0,
+        show_reference_element: false,
+        background: Background::Threads,
+        stepper: Box::new(InlineStepper::default()),
+    };
+    Model::new(SceneSource::Builtin(scene.into()), None, start).expect("the scene loads")
+}
+
+/// Waits for the change's meshes built in the background.
+fn wait_built(m: &mut Model) {
+    while m.building().is_some() {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        m.apply(Action::Poll { wait_for_lesson: false }).unwrap();
+    }
+}
+
+/// Issue #57: while paused (no frame measured yet), P1 refine 3 then 64 cells along x
+/// (655,360 elements) was accepted without a question, and Play froze the window for minutes.
+/// A new mesh is now built in the background (the model goes on with the old one meanwhile)
+/// and estimated once built, paused or not: a huge one asks first, and "keep" keeps what was
+/// there before.
+#[test]
+fn a_huge_mesh_asked_for_while_paused_is_built_in_the_background_and_asked_about_first() {
+    let mut m = threaded_model("bending");
+    assert!(!m.playing() && m.sessions()[0].frame_ms.is_empty(), "paused, nothing measured yet");
+    let mut c = m.sessions()[0].config.clone();
+    c.element = hox_sim::element::ElementType::from_name("p1").unwrap();
+    c.refine = 2;
+    m.apply(Action::change("refine", c.clone())).unwrap();
+    assert!(m.building().is_none(), "a small mesh is built at once");
+    assert!(m.pending_change().is_none(), "10,240 elements play: {:?}", m.pending_change().map(|p| &p.estimate));
+    assert_eq!(m.sessions()[0].instance.sim.mesh().num_elements(), 10_240);
+    // 32 cells along x: 40,960 elements at the guard's substeps, estimated from the default
+    // cost of a unit of work (nothing measured on this model): asked first, paused
+    let mut big = c.clone();
+    big.grid = [32, 2, 2];
+    m.apply(Action::change("grid", big.clone())).unwrap();
+    assert!(m.building().is_some_and(|b| b.contains("P1 32×2×2")), "built in the background: {:?}", m.building());
+    m.apply(Action::Step(1)).unwrap();
+    assert_eq!(m.sessions()[0].instance.sim.mesh().num_elements(), 10_240, "the old mesh runs meanwhile");
+    wait_built(&mut m);
+    let question = m.pending_change().map(|p| p.estimate.clone()).expect("asked first");
+    assert!(question.contains("40960 elements") && question.contains("per frame"), "{question}");
+    assert_eq!(m.sessions()[0].config.grid, [8, 2, 2], "nothing changed before the answer");
+    // "keep the current configuration" keeps the 8 cells there before
+    m.apply(Action::AnswerPending(false)).unwrap();
+    assert_eq!(m.sessions()[0].config.grid, [8, 2, 2]);
+    assert_eq!(m.sessions()[0].instance.sim.mesh().num_elements(), 10_240);
+    // asked again and applied: installed as built, paused
+    m.apply(Action::change("grid", big)).unwrap();
+    wait_built(&mut m);
+    m.apply(Action::AnswerPending(true)).unwrap();
+    assert_eq!(m.sessions()[0].instance.sim.mesh().num_elements(), 40_960);
+    assert!(!m.playing());
+}
+
+/// Issue #57: the "Paused: a frame takes 18.4 s" banner stayed after going back to a small
+/// mesh; and a window that shows a frame only every half second (drawing, not computing) played
+/// on at 2 fps, unasked.
+#[test]
+fn a_slow_display_pauses_and_the_pause_message_goes_with_the_next_change() {
+    let mut m = model("bending");
+    m.apply(Action::SetPlaying(true)).unwrap();
+    for _ in 0..3 {
+        tick(&mut m, false);
+    }
+    assert!(m.playing(), "60 frames per second play");
+    for _ in 0..4 {
+        m.apply(Action::Tick { real_dt_secs: 0.5, one_frame_per_tick: false, in_background: false }).unwrap();
+    }
+    assert!(!m.playing(), "paused");
+    let message = m.message().unwrap_or_default().to_string();
+    assert!(message.starts_with("Paused: a frame takes 0.5 s on screen"), "{message}");
+    // one slow interval alone (the machine busy a moment, the first after a pause) does not pause
+    m.apply(Action::SetPlaying(true)).unwrap();
+    m.apply(Action::Tick { real_dt_secs: 30.0, one_frame_per_tick: false, in_background: false }).unwrap();
+    m.apply(Action::Tick { real_dt_secs: 0.6, one_frame_per_tick: false, in_background: false }).unwrap();
+    assert!(m.playing());
+    for _ in 0..20 {
+        tick(&mut m, false);
+    }
+    // another configuration: the message was about the one before
+    let mut c = m.sessions()[0].config.clone();
+    c.grid = [4, 2, 2];
+    m.apply(Action::change("grid", c)).unwrap();
+    assert_eq!(m.message(), None);
+}

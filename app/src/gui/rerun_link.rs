@@ -34,6 +34,12 @@ struct RerunLink {
     /// The simulation frame of the first configuration logged last, and how many were.
     last_logged_frame: Option<u64>,
     frames_logged: u64,
+    /// Added to the configurations' own frame and time (`frame`, `sim_time`): the stream's clock
+    /// never goes back when new configurations start from t = 0 (a lesson's next step, a new
+    /// mesh, a reset), so that a browser following its latest time shows only what runs now.
+    time_offset: (i64, f64),
+    /// The stream's latest frame and time logged (with the offset).
+    logged_until: Option<(i64, f64)>,
 }
 
 /// At most so many frames a second: a frame is admitted when the one admitted before it is
@@ -114,6 +120,8 @@ impl RerunLink {
                 cap,
                 last_logged_frame: None,
                 frames_logged: 0,
+                time_offset: (0, 0.0),
+                logged_until: None,
             }),
             Err(e) => Err(format!("Rerun: {e}")),
         }
@@ -164,7 +172,23 @@ impl RerunLink {
                 })
                 .collect();
             let Some(first) = sessions.first() else { return Ok(()) };
+            // issue #57: after → to the next lesson step, the page drew the last step's beams
+            // over the new ones. The new configurations start after what was logged (their clock
+            // from 0 would fall inside the old ones' time), and the old ones end there.
+            let own = (first.instance.sim.frames() as i64, first.instance.sim.time_secs());
+            if let Some(until) = self.logged_until
+                && own.0 + self.time_offset.0 <= until.0
+            {
+                let frame_secs = 1.0 / first.config.frames_per_second;
+                self.time_offset = (until.0 + 1 - own.0, until.1 + frame_secs - own.1);
+            }
+            if let Some(old) = &self.recorder {
+                self.rec.set_time_sequence("frame", own.0 + self.time_offset.0);
+                self.rec.set_duration_secs("sim_time", own.1 + self.time_offset.1);
+                old.clear(&self.rec)?;
+            }
             let mut settings = LogSettings::new(&first.config);
+            settings.time_offset = self.time_offset;
             settings.lesson_text = lesson_text.is_some();
             let fields = crate::display::fields(&first.config);
             self.recorder = Some(Recorder::new(&self.rec, &configs, &settings, &fields)?);
@@ -176,6 +200,13 @@ impl RerunLink {
             r.log_frame(&self.rec, &instances, &ms)?;
         }
         self.last_logged_frame = sessions.first().map(|s| s.instance.sim.frames());
+        if let Some(first) = sessions.first() {
+            let now = (
+                first.instance.sim.frames() as i64 + self.time_offset.0,
+                first.instance.sim.time_secs() + self.time_offset.1,
+            );
+            self.logged_until = Some(self.logged_until.map_or(now, |u| (u.0.max(now.0), u.1.max(now.1))));
+        }
         self.frames_logged += 1;
         if lesson_text != self.lesson_text {
             if let Some(text) = &lesson_text {

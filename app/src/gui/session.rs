@@ -179,6 +179,12 @@ impl Session {
     /// Applies `new`, rebuilding only what it invalidates. On refusal nothing changes and the
     /// reason is returned.
     pub fn apply(&mut self, new: Config) -> Result<Invalidates, String> {
+        self.apply_with(new, None)
+    }
+
+    /// [`Session::apply`], with the new mesh's instance already `built` (in the background) when
+    /// the change rebuilds it.
+    pub fn apply_with(&mut self, new: Config, built: Option<Instance>) -> Result<Invalidates, String> {
         if new == self.config {
             return Ok(Invalidates::Nothing);
         }
@@ -187,7 +193,10 @@ impl Session {
         let scene = config::resolve(&new, &self.base)?;
         match what {
             Invalidates::Mesh => {
-                self.instance = Instance::new(scene).map_err(|e| e.to_string())?;
+                self.instance = match built {
+                    Some(instance) => instance,
+                    None => Instance::new(scene).map_err(|e| e.to_string())?,
+                };
                 self.history = History::default();
                 self.failure = None;
                 self.drag = None;

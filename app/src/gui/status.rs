@@ -11,19 +11,21 @@ pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
             let sim = &s.instance.sim;
             let solver = sim.work_summary();
             // one short line per configuration; the details on hover
+            // a frame time only once frames were stepped (issue #57: "0.0 ms/frame" on static steps)
+            let ms = if s.frame_ms.is_empty() { "no frame yet".to_string() } else { format!("{:.1} ms/frame", s.ms_per_frame) };
             let mut text = format!(
-                "{}{}: {} nodes, {} el, {:.1} ms/frame, {}",
+                "{}{}: {} nodes, {} el, {ms}, {}",
                 if model.compare() { ["A ", "B "][k] } else { "" },
                 s.label(),
                 sim.mesh().num_nodes(),
                 sim.mesh().num_elements(),
-                s.ms_per_frame,
                 s.readout().error_text()
             );
             if s.settler.is_some() {
                 text += " (settling…)";
             }
-            let raised = sim.substeps_per_frame() > s.config.substeps;
+            // the guard's substeps matter to frames stepped, not to a solved static equilibrium
+            let raised = sim.substeps_per_frame() > s.config.substeps && !s.shown_static;
             if raised {
                 text += &format!(", {} substeps (guard)", sim.substeps_per_frame());
             }
@@ -49,6 +51,10 @@ pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
             if let Some(f) = &s.failure {
                 ui.colored_label(egui::Color32::from_rgb(255, 90, 80), f);
             }
+            ui.separator();
+        }
+        if let Some(building) = model.building() {
+            ui.label(egui::RichText::new(building).monospace().color(egui::Color32::from_rgb(250, 200, 120)));
             ui.separator();
         }
         // paused, the window repaints only on input: a frame rate then means nothing (issue

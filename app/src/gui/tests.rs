@@ -885,6 +885,18 @@ fn every_lesson_shows_the_same_numbers_in_the_app_as_headlessly() {
     }
 }
 
+/// Runs frames until a change's meshes, built in the background, are in.
+fn built(h: &mut Harness<'_, HoxApp>) {
+    for _ in 0..2_000 {
+        if h.state().model().building().is_none() {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+        h.run_steps(1);
+    }
+    panic!("still building");
+}
+
 /// Issue #35, symptom 7: refine 3 was accepted without a word and froze the window (13.6 s per
 /// frame; the next typed value was lost). A change estimated too slow to play asks first,
 /// keeping the current configuration until answered; a frame that is slow anyway pauses.
@@ -898,6 +910,8 @@ fn a_change_too_slow_to_play_asks_first_and_a_slow_frame_pauses() {
     let mut c = app.model().sessions()[0].config.clone();
     c.refine = 2;
     app.act(Action::change("refine", c.clone()));
+    built(&mut h);
+    let app = h.state_mut();
     assert!(app.model().pending_change().is_some(), "64 times the elements: asked first");
     assert_eq!(app.model().sessions()[0].instance.sim.mesh().num_elements(), 160, "nothing changed yet");
     h.run_steps(2);
@@ -908,6 +922,7 @@ fn a_change_too_slow_to_play_asks_first_and_a_slow_frame_pauses() {
     assert!(h.state().model().pending_change().is_none());
     assert_eq!(h.state().model().sessions()[0].config.refine, 0);
     h.state_mut().act(Action::change("refine", c));
+    built(&mut h);
     h.run_steps(1);
     h.get_by_label("Apply, paused").click();
     h.run_steps(2);
@@ -1248,4 +1263,67 @@ fn the_wait_for_the_next_frame_follows_the_clock_s_remainder_and_the_time_scale(
     assert!((slow.until_next_frame(frame).as_secs_f64() - 4.0 * frame).abs() < 1e-6, "a quarter of real time");
     let crawl = playback::Playback::new(true, 0.001);
     assert_eq!(crawl.until_next_frame(frame).as_secs_f64(), 0.25, "at most a quarter second between paints");
+}
+
+/// Issue #57: after → to the next lesson step, the class's browsers drew the last step's beams
+/// over the new ones (two "tip" labels), their clock going back to 0 inside the old step's time.
+/// The app's Rerun stream (here saved to a file, read back with Rerun's decoder) now runs on:
+/// each step's configurations start after the last one's frames, and the last one's bodies are
+/// cleared there, so a viewer at the stream's latest time shows only the current step's.
+#[test]
+fn a_browser_following_a_lesson_shows_only_the_current_step_s_bodies() {
+    let dir = std::env::temp_dir().join(format!("hox-lesson-stream-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("lesson.rrd");
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    h.state_mut().ui.rerun_file = path.display().to_string();
+    h.state_mut().act(super::action::Command::Rerun(Some(super::action::RerunTarget::File)));
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "why-high-order").unwrap();
+    let steps = lesson.steps.len();
+    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
+    lesson_ready(&mut h);
+    for _ in 1..steps.min(3) {
+        h.run_steps(20);
+        h.key_press(egui::Key::ArrowRight);
+        lesson_ready(&mut h);
+        h.run_steps(20);
+    }
+    h.state_mut().act(super::action::Command::Rerun(None));
+    let recording = crate::cli::inspect::read_recording(&path).expect("the stream reads back");
+    // per configuration (world/<name>): its last frame of data, and its recursive clears
+    let mut last_data: std::collections::BTreeMap<String, i64> = Default::default();
+    let mut cleared: std::collections::BTreeMap<String, i64> = Default::default();
+    for (entity, summary) in &recording.entities {
+        let Some(root) = entity.strip_prefix("world/").map(|r| r.split('/').next().unwrap_or(r).to_string()) else {
+            continue;
+        };
+        for (component, frames) in &summary.frames_per_component {
+            let Some(&last) = frames.iter().max() else { continue };
+            if component.contains("Clear") {
+                let e = cleared.entry(root.clone()).or_insert(i64::MIN);
+                *e = (*e).max(last);
+            } else {
+                let e = last_data.entry(root.clone()).or_insert(i64::MIN);
+                *e = (*e).max(last);
+            }
+        }
+    }
+    let shown: Vec<&String> =
+        last_data.iter().filter(|(root, last)| cleared.get(*root).is_none_or(|c| c < *last)).map(|(r, _)| r).collect();
+    let on_screen = h.state().model().sessions().len();
+    assert!(last_data.len() > on_screen, "several steps' configurations were streamed: {last_data:?}");
+    assert_eq!(
+        shown.len(),
+        on_screen,
+        "only the current step's bodies at the latest time: {shown:?}; cleared {cleared:?}"
+    );
+    // the step on screen was logged after every cleared one's last frame
+    let current_first = last_data.iter().filter(|(r, _)| shown.contains(r)).map(|(_, l)| *l).min().unwrap();
+    for (root, last) in &last_data {
+        if !shown.contains(&root) {
+            assert!(*last < current_first, "{root}'s frames ({last}) run into the current step's ({current_first})");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -46,8 +46,8 @@ impl HoxApp {
         if self.model.sessions().iter().any(|s| matches!(s.reference, ReferenceState::Computing { .. })) {
             ctx.request_repaint_after(std::time::Duration::from_millis(250));
         }
-        if self.model.lesson().is_some_and(|l| l.preparing()) {
-            // a lesson step being prepared: look again soon
+        if self.model.lesson().is_some_and(|l| l.preparing()) || self.model.building().is_some() {
+            // a lesson step being prepared, a mesh being built: look again soon
             ctx.request_repaint_after(std::time::Duration::from_millis(50));
         }
         let status = self.status();

@@ -562,7 +562,8 @@ pub fn measure(
         }
         Measure::Substeps => {
             let n = instance.sim.substeps_per_frame() as f64;
-            Measured { value: n, text: format!("{n} substeps per frame") }
+            let noun = if n == 1.0 { "substep" } else { "substeps" };
+            Measured { value: n, text: format!("{n} {noun} per frame") }
         }
         Measure::MaxDisplacement => metres(instance.sim.displacements().iter().map(|u| u.norm()).fold(0.0, f64::max)),
         Measure::Asymmetry => {
