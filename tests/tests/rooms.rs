@@ -87,7 +87,7 @@ const GUI_FILES: &[&[&str]] = &[
     &["config", "links", "presets", "readout", "raster", "study_chart", "measure", "playback"],
     &["session", "args", "gl_view", "teach"],
     &["session_view", "background", "cost"],
-    &["lesson", "viewport"],
+    &["lesson", "viewport", "rebuild"],
     &["action"],
     &["model"],
     &["figure", "rerun_link"],

@@ -208,11 +208,52 @@ pub fn slow_frame(sessions: &[Session]) -> Option<String> {
     })
 }
 
-/// While playing: the message that pauses the app when the window shows a frame less often than
-/// every [`SLOW_FRAME_MS`] (`display_ms`: the frames' interval, smoothed; `sim_ms`: the
-/// simulation's part of it), or None — a frame slow to draw is as unplayable as one slow to
-/// compute (issue #57: refine 3 at 95–160 ms of computing ran at 2 fps on screen, unasked).
-pub fn slow_display(display_ms: f64, sim_ms: f64) -> Option<String> {
+/// What the user gets while playing: the interval between the window's frames, smoothed, and
+/// the part of it that is not the simulation's (the drawing); a frame slow to draw is as
+/// unplayable as one slow to compute (issue #57: refine 3 at 95–160 ms of computing ran at 2 fps
+/// on screen, unasked).
+#[derive(Clone, Debug, Default)]
+pub struct Display {
+    display_ms: f64,
+    /// The drawing's part of a frame, ms.
+    pub draw_ms: f64,
+    /// The last tick was played (its interval is one between two frames played: the first
+    /// after a pause is the pause's length).
+    playing: bool,
+    /// Intervals in a row slower than [`SLOW_FRAME_MS`], and the fastest of them, ms.
+    slow_count: u32,
+    slow_ms: f64,
+}
+
+impl Display {
+    /// A tick of `dt_secs` (`playing` or not), the simulation taking `sim_ms` per frame.
+    pub fn observe(&mut self, playing: bool, dt_secs: f64, sim_ms: f64) {
+        if playing && self.playing && dt_secs > 0.0 {
+            let ms = dt_secs * 1e3;
+            self.display_ms = if self.display_ms == 0.0 { ms } else { 0.7 * self.display_ms + 0.3 * ms };
+            self.draw_ms = (self.display_ms - sim_ms).max(0.0);
+            self.slow_count = if ms > SLOW_FRAME_MS { self.slow_count + 1 } else { 0 };
+            self.slow_ms = if self.slow_count == 1 { ms } else { self.slow_ms.min(ms) };
+        }
+        self.playing = playing;
+    }
+
+    /// The message that pauses the app after three intervals in a row slower than
+    /// [`SLOW_FRAME_MS`] (not one hiccup of the machine), or None.
+    pub fn slow(&self, sim_ms: f64) -> Option<String> {
+        (self.slow_count >= 3).then(|| slow_display(self.slow_ms, sim_ms)).flatten()
+    }
+
+    /// The app paused: the intervals start again.
+    pub fn paused(&mut self) {
+        self.display_ms = 0.0;
+        self.slow_count = 0;
+    }
+}
+
+/// The message that pauses the app when the window shows a frame every `display_ms` (more than
+/// [`SLOW_FRAME_MS`]), `sim_ms` of it simulating; None when faster.
+fn slow_display(display_ms: f64, sim_ms: f64) -> Option<String> {
     (display_ms > SLOW_FRAME_MS).then(|| {
         format!(
             "{SLOW_PAUSE} {:.1} s on screen ({:.0} ms simulating, the rest drawing), too slow to play (Step, S, advances one frame; fewer elements, face segments or substeps play).",

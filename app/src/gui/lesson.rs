@@ -105,6 +105,17 @@ impl LessonState {
         self.preparing = Some(background.run(move || prepare(&step)));
     }
 
+    /// The step `delta` steps from the one on screen, within the lesson; None if it is this one.
+    pub fn step_by(&self, delta: i64) -> Option<usize> {
+        let k = (self.step as i64 + delta).clamp(0, self.lesson.steps.len() as i64 - 1) as usize;
+        (k != self.step).then_some(k)
+    }
+
+    /// Shows the answer, once the step is prepared (its numbers on screen).
+    pub fn reveal(&mut self) {
+        self.revealed |= !self.preparing();
+    }
+
     /// The step on screen.
     pub fn current(&self) -> &Step {
         &self.lesson.steps[self.step]

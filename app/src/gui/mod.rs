@@ -42,6 +42,7 @@ pub mod plots;
 pub mod presets;
 pub mod raster;
 pub mod readout;
+mod rebuild;
 mod rerun_link;
 mod sections;
 mod serve_web;

@@ -10,13 +10,14 @@
 //! for the control. In compare mode the linked parameters of the other configuration follow.
 
 use super::action::Action;
-use super::background::{Background, Pending, Stepper, any_settling, step_sessions};
-use super::config::{self, Config, Invalidates, SceneSource};
+use super::background::{Background, Stepper, any_settling, step_sessions};
+use super::config::{Config, Invalidates, SceneSource};
 use super::cost::{self, PendingChange};
 use super::lesson::LessonState;
 use super::links::Links;
 use super::playback::{Playback, SETTLE_STEP_BUDGET_MS};
 use super::presets::{ViewOptions, ViewPreset};
+use super::rebuild::{Build, StaticJobs, builds_at_once, redraws};
 use super::session::Session;
 use hox_scenes::lesson::Run;
 use hox_sim::Vec3;
@@ -66,66 +67,16 @@ pub struct Model {
     /// Frames the ticks deferred to the stepper ([`Action::Tick`]'s `in_background`).
     deferred_frames: usize,
     /// Static equilibria being solved in the background for a lesson's static step after a
-    /// change ([`StaticJob`]).
-    static_jobs: Vec<StaticJob>,
-    /// A change's new meshes being built in the background ([`Build`]).
+    /// change.
+    static_jobs: StaticJobs,
+    /// A change's new meshes being built in the background.
     building: Option<Build>,
-    /// The interval between the window's frames while playing, smoothed, ms; and the part of
-    /// it that is not the simulation's (the drawing): what a configuration costs the user.
-    display_ms: f64,
-    draw_ms: f64,
-    /// The last tick was played (its interval is one between two frames played), and how many
-    /// intervals in a row were slower than [`cost::SLOW_FRAME_MS`].
-    display_playing: bool,
-    slow_displays: u32,
-    /// The fastest of those slow intervals, ms.
-    slow_display_ms: f64,
+    /// What the user gets: the interval between the window's frames, and its drawing part.
+    display: cost::Display,
     /// What a unit of a solver's work costs on this machine, as last measured.
     rates: cost::Rates,
     background: Background,
     stepper: Box<dyn Stepper>,
-}
-
-/// A change that rebuilds meshes, built in the background so that the window stays responsive
-/// however large they are (issue #57: 655,360 elements froze it for minutes); estimated once
-/// built (`ask`: asked first when slow), then installed.
-struct Build {
-    control: String,
-    ask: bool,
-    /// `(session, its new configuration)` for each session the change rebuilds.
-    configs: Vec<(usize, Config)>,
-    instances: Pending<Result<Vec<hox_scenes::Instance>, String>>,
-}
-
-/// The static equilibrium of a session's configuration, solved in the background (issue #57:
-/// a value typed in a static step left the old shape labelled "static equilibrium"). Shown once
-/// ready if the session still has that configuration and mesh, else dropped.
-struct StaticJob {
-    session: usize,
-    config: Config,
-    build: u64,
-    positions: Pending<Result<Vec<Vec3>, String>>,
-}
-
-/// Whether the new mesh of `new` is small enough to build at once, in place (well under a
-/// second): its elements estimated from `s`'s (the grid's cells, ×8 per refinement level) times
-/// the new element's nodes at most [`AT_ONCE_NODE_VISITS`].
-fn builds_at_once(s: &Session, new: &Config) -> bool {
-    let cells = |g: &[usize; 3]| g.iter().map(|&n| n.max(1) as f64).product::<f64>();
-    let ratio = cells(&new.grid) / cells(&s.config.grid) * 8f64.powi(new.refine as i32 - s.config.refine as i32);
-    let elements = s.instance.sim.mesh().num_elements() as f64 * ratio;
-    elements * new.element.reference().num_nodes() as f64 <= AT_ONCE_NODE_VISITS
-}
-
-/// [`builds_at_once`]'s bound: element–node pairs of a mesh built in place.
-const AT_ONCE_NODE_VISITS: f64 = 60_000.0;
-
-/// Whether a change from `old` to `new` changes how a configuration is drawn (a `[display]`
-/// parameter of the table).
-fn redraws(old: &Config, new: &Config) -> bool {
-    old.changed_keys(new)
-        .iter()
-        .any(|k| hox_scenes::params::by_key(k).is_some_and(|p| p.group == hox_scenes::params::Group::Display))
 }
 
 impl Model {
@@ -152,13 +103,9 @@ impl Model {
             layout: 0,
             frames_stepped: 0,
             deferred_frames: 0,
-            static_jobs: Vec::new(),
+            static_jobs: StaticJobs::default(),
             building: None,
-            display_ms: 0.0,
-            draw_ms: 0.0,
-            display_playing: false,
-            slow_displays: 0,
-            slow_display_ms: 0.0,
+            display: cost::Display::default(),
             rates: cost::Rates::default(),
             background: start.background,
             stepper: start.stepper,
@@ -168,7 +115,6 @@ impl Model {
     }
 
     // --- reading
-
     pub fn scene(&self) -> &SceneSource {
         &self.scene
     }
@@ -268,7 +214,6 @@ impl Model {
     }
 
     // --- changing
-
     /// Applies `action`; a refusal is returned (and recorded where the panels show it).
     pub fn apply(&mut self, action: Action) -> Result<(), String> {
         self.apply_observed(action, &mut |_| {})
@@ -301,7 +246,8 @@ impl Model {
             Action::SetCompare(on) => self.set_compare(on),
             Action::SetActive(k) => self.active = k.min(self.sessions.len().saturating_sub(1)),
             Action::Change { control, config } => {
-                if let Some(estimate) = cost::too_slow(&self.sessions[self.active], &config, &self.rates, self.draw_ms)
+                if let Some(estimate) =
+                    cost::too_slow(&self.sessions[self.active], &config, &self.rates, self.display.draw_ms)
                 {
                     self.pending_change = Some(PendingChange { control, config: *config, estimate, built: None });
                     return Ok(());
@@ -346,20 +292,11 @@ impl Model {
             }
             Action::GoToStep(k) => self.go_to_step(k),
             Action::LessonStep(delta) => {
-                let Some(state) = &self.lesson else { return Ok(()) };
-                let last = state.lesson.steps.len() as i64 - 1;
-                let k = (state.step as i64 + delta).clamp(0, last) as usize;
-                if k != state.step {
+                if let Some(k) = self.lesson.as_ref().and_then(|l| l.step_by(delta)) {
                     self.go_to_step(k);
                 }
             }
-            Action::RevealAnswer => {
-                if let Some(state) = &mut self.lesson
-                    && !state.preparing()
-                {
-                    state.revealed = true;
-                }
-            }
+            Action::RevealAnswer => self.lesson.iter_mut().for_each(LessonState::reveal),
             Action::CloseLesson => self.lesson = None,
             Action::SetPresenter(on) => self.presenter = on,
             Action::Say(message) => self.message = Some(message),
@@ -370,16 +307,7 @@ impl Model {
     /// Replaces the configurations: `overrides` on the scene's own, one session each (the text
     /// that asked for each names it in a refusal). Two turn compare mode on.
     fn configure(&mut self, overrides: &[(Option<String>, hox_scenes::SceneOverrides)]) -> Result<(), String> {
-        let base = self.sessions[0].base.clone();
-        let mut sessions = Vec::new();
-        for (spec, o) in overrides {
-            let scene = base.with_overrides(o).map_err(|e| match spec {
-                Some(spec) => format!("--compare '{spec}': {e}"),
-                None => e.to_string(),
-            })?;
-            sessions.push(Session::new(base.clone(), scene.params().clone())?);
-        }
-        self.sessions = sessions;
+        self.sessions = super::rebuild::configured(&self.sessions[0].base, overrides)?;
         self.compare = self.sessions.len() > 1;
         self.active = 0;
         self.rebuilt();
@@ -409,11 +337,9 @@ impl Model {
         self.poll_build();
     }
 
-    /// What is being built in the background for a change, if anything: a line for the status.
+    /// What is being built for a change, if anything: a line for the status.
     pub fn building(&self) -> Option<String> {
-        let b = self.building.as_ref()?;
-        let what: Vec<String> = b.configs.iter().map(|(_, c)| config::label(c, &self.sessions[0].base)).collect();
-        Some(format!("building {} for {}…", what.join(" and "), b.control))
+        Some(self.building.as_ref()?.status(&self.sessions[0].base))
     }
 
     /// Applies `new` to the active configuration (and the linked fields to the other): at once,
@@ -428,32 +354,20 @@ impl Model {
         let mut configs = vec![(k, new.clone())];
         if self.compare {
             let other = 1 - k;
-            let mut follow = self.sessions[other].config.clone();
-            for f in self.sessions[k].config.changed_keys(&new) {
-                if self.links.linked(f) {
-                    follow.copy_from(&new, f);
-                }
-            }
+            let follow =
+                super::rebuild::follow(&self.links, &self.sessions[k].config, &new, &self.sessions[other].config);
             if follow != self.sessions[other].config {
                 configs.push((other, follow));
             }
         }
         // checked against the table now (a refusal at once, for the control); built later
-        let mut scenes = Vec::new();
-        for (j, c) in &configs {
-            match config::resolve(c, &self.sessions[*j].base) {
-                Ok(scene) => scenes.push(scene),
-                Err(reason) => {
-                    let reason = if *j == k { reason } else { format!("the other configuration refused it: {reason}") };
-                    self.refusal = Some((control.to_string(), reason.clone()));
-                    return Err(reason);
-                }
+        match Build::start(control, ask, configs, &self.sessions, k, self.background) {
+            Ok(build) => self.building = Some(build),
+            Err(reason) => {
+                self.refusal = Some((control.to_string(), reason.clone()));
+                return Err(reason);
             }
         }
-        let instances = self
-            .background
-            .run(move || scenes.into_iter().map(|s| hox_scenes::Instance::new(s).map_err(|e| e.to_string())).collect());
-        self.building = Some(Build { control: control.to_string(), ask, configs, instances });
         self.refusal = None;
         self.poll_build();
         Ok(())
@@ -461,33 +375,27 @@ impl Model {
 
     /// Takes a build that finished in: asks first if it would be slow, else installs it.
     fn poll_build(&mut self) {
-        if !self.building.as_ref().is_some_and(|b| b.instances.is_ready()) {
+        if !self.building.as_ref().is_some_and(|b| b.is_ready()) {
             return;
         }
         let Some(b) = self.building.take() else { return };
-        let instances = match b.instances.take() {
-            Some(Ok(instances)) => instances,
-            Some(Err(reason)) => {
-                self.refusal = Some((b.control, reason));
-                return;
-            }
-            None => {
-                self.refusal = Some((b.control, "building the mesh stopped unexpectedly".into()));
+        let control = b.control.clone();
+        let ask = b.ask;
+        let built = match b.finish() {
+            Ok(built) => built,
+            Err(reason) => {
+                self.refusal = Some((control, reason));
                 return;
             }
         };
-        let built: cost::Built = b.configs.into_iter().zip(instances).map(|((k, c), i)| (k, c, i)).collect();
-        if b.ask {
-            let question = built.iter().find_map(|(k, _, i)| {
-                self.sessions.get(*k).and_then(|s| cost::too_slow_built(s, &i.sim, &self.rates, self.draw_ms))
-            });
-            if let Some(estimate) = question {
-                let config = built[0].1.clone();
-                self.pending_change = Some(PendingChange { control: b.control, config, estimate, built: Some(built) });
-                return;
-            }
+        if ask
+            && let Some(estimate) = super::rebuild::question(&built, &self.sessions, &self.rates, self.display.draw_ms)
+        {
+            let config = built[0].1.clone();
+            self.pending_change = Some(PendingChange { control, config, estimate, built: Some(built) });
+            return;
         }
-        let _ = self.install(&b.control, built);
+        let _ = self.install(&control, built);
     }
 
     /// Installs meshes built for a change.
@@ -508,9 +416,7 @@ impl Model {
 
     /// A change was applied: the message of a slow frame's pause is of another configuration.
     fn clear_slow_pause(&mut self) {
-        if self.message.as_deref().is_some_and(|m| m.starts_with(cost::SLOW_PAUSE)) {
-            self.message = None;
-        }
+        self.message = self.message.take().filter(|m| !m.starts_with(cost::SLOW_PAUSE));
     }
 
     /// In a lesson's static step, solves the static equilibrium of session `k`'s configuration
@@ -519,51 +425,23 @@ impl Model {
         if self.lesson.as_ref().is_none_or(|l| l.preparing() || l.current().run != Run::Static) {
             return;
         }
-        let s = &mut self.sessions[k];
-        let (scene, mesh) = (s.instance.scene.clone(), s.instance.sim.mesh().clone());
-        s.solving_static = true;
-        let positions = self.background.run(move || super::session::static_positions(&scene, &mesh));
-        self.static_jobs.push(StaticJob {
-            session: k,
-            config: s.config.clone(),
-            build: s.revisions().build,
-            positions,
-        });
+        self.static_jobs.start(k, &mut self.sessions[k], self.background);
         self.poll_static_jobs();
     }
 
     /// Shows the static equilibria solved since, where the configuration is still theirs.
     fn poll_static_jobs(&mut self) {
-        let jobs = std::mem::take(&mut self.static_jobs);
-        for job in jobs {
-            if !job.positions.is_ready() {
-                self.static_jobs.push(job);
-                continue;
-            }
-            let Some(s) = self.sessions.get_mut(job.session) else { continue };
-            if s.config != job.config || s.revisions().build != job.build {
-                continue;
-            }
-            s.solving_static = false;
-            match job.positions.take() {
-                Some(Ok(positions)) => s.show_static_solution(&positions),
-                Some(Err(e)) => self.message = Some(format!("the static equilibrium of {}: {e}", s.label())),
-                None => self.message = Some("solving the static equilibrium stopped unexpectedly".into()),
-            }
+        let (shown, message) = self.static_jobs.poll(&mut self.sessions);
+        if shown {
             self.generation += 1;
+        }
+        if message.is_some() {
+            self.message = message;
         }
     }
 
     fn load_scene(&mut self, source: SceneSource, configs: Option<(Vec<Config>, bool)>) -> Result<(), String> {
-        let base = source.load()?;
-        let defaults = config::from_scene(&base);
-        let wanted = configs.clone().map(|c| c.0).filter(|c| !c.is_empty()).unwrap_or_else(|| vec![defaults.clone()]);
-        let mut sessions = Vec::new();
-        for c in wanted.into_iter().take(2) {
-            // a saved configuration the scene no longer accepts falls back to the scene's own
-            let s = Session::new(base.clone(), c).or_else(|_| Session::new(base.clone(), defaults.clone()))?;
-            sessions.push(s);
-        }
+        let mut sessions = super::rebuild::loaded(&source.load()?, configs.clone().map(|c| c.0))?;
         self.scene = source;
         self.compare = sessions.len() > 1 && configs.is_some_and(|c| c.1);
         sessions.truncate(if self.compare { 2 } else { 1 });
@@ -582,33 +460,7 @@ impl Model {
             return;
         }
         if on {
-            let first = &self.sessions[0];
-            let mut c = first.config.clone();
-            let is_box = first.base.is_box();
-            // P2 is compared with P1 refined once (the same nodes), and P1 with P2
-            let other = match c.element.name() {
-                "p2" => Some(("p1", 1)),
-                "p1" => Some(("p2", 0)),
-                _ => None,
-            };
-            if is_box
-                && let Some((name, refine)) = other
-                && let Some(element) = ElementType::from_name(name)
-            {
-                c.element = element;
-                c.refine = refine;
-            }
-            // a part meshed per element type: the same part at the other order (P1's facets
-            // against P2's curved faces)
-            if first.base.mesh_kind() == hox_scenes::params::MeshKind::Files
-                && let Some((name, _)) = other
-                && let Some(element) = ElementType::from_name(name)
-            {
-                c.element = element;
-            }
-            let second = Session::new(first.base.clone(), c.clone())
-                .or_else(|_| Session::new(first.base.clone(), first.config.clone()));
-            match second {
+            match super::rebuild::compare_partner(&self.sessions[0]) {
                 Ok(s) => {
                     // P1 first, so the pair reads "P1 vs P2" left to right
                     self.sessions.push(s);
@@ -671,12 +523,7 @@ impl Model {
         }
         if self.compare {
             let other = 1 - k;
-            let mut follow = self.sessions[other].config.clone();
-            for f in old.changed_keys(&new) {
-                if self.links.linked(f) {
-                    follow.copy_from(&new, f);
-                }
-            }
+            let follow = super::rebuild::follow(&self.links, &old, &new, &self.sessions[other].config);
             match self.sessions[other].apply(follow) {
                 Ok(Invalidates::Mesh) => {
                     self.rebuilt();
@@ -759,24 +606,12 @@ impl Model {
         }
         // what the user gets: the interval between the window's frames, and its drawing part
         let sim_ms = self.sessions.iter().map(|s| s.ms_per_frame).fold(0.0, f64::max);
-        // (an interval counts only between two frames played: the first after a pause is the
-        // pause's length)
-        if self.playback.playing && self.display_playing && dt > 0.0 {
-            let ms = dt * 1e3;
-            self.display_ms = if self.display_ms == 0.0 { ms } else { 0.7 * self.display_ms + 0.3 * ms };
-            self.draw_ms = (self.display_ms - sim_ms).max(0.0);
-            self.slow_displays = if ms > cost::SLOW_FRAME_MS { self.slow_displays + 1 } else { 0 };
-            self.slow_display_ms = if self.slow_displays == 1 { ms } else { self.slow_display_ms.min(ms) };
-        }
-        self.display_playing = self.playback.playing;
+        self.display.observe(self.playback.playing, dt, sim_ms);
         if self.playback.playing && !self.settling() {
-            // three slow intervals in a row: not one hiccup of the machine
-            let display_ms = if self.slow_displays >= 3 { self.slow_display_ms } else { 0.0 };
-            let slow = cost::slow_frame(&self.sessions).or_else(|| cost::slow_display(display_ms, sim_ms));
+            let slow = cost::slow_frame(&self.sessions).or_else(|| self.display.slow(sim_ms));
             if let Some(message) = slow {
                 self.playback.playing = false;
-                self.display_ms = 0.0;
-                self.slow_displays = 0;
+                self.display.paused();
                 self.message = Some(message);
             }
         }

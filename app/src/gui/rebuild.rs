@@ -1,0 +1,204 @@
+//! Work a configuration change hands to the background so that the window stays responsive
+//! (issue #57): new meshes built ([`Build`]; 655,360 elements built in place froze the window
+//! for minutes), and a lesson's static step's equilibrium solved again for the values typed
+//! ([`StaticJobs`]; the old shape stayed labelled "static equilibrium"). Both are polled by the
+//! model, which installs what is still wanted.
+
+use super::background::{Background, Pending};
+use super::config::{self, Config};
+use super::cost;
+use super::session::Session;
+use hox_sim::Vec3;
+
+/// [`builds_at_once`]'s bound: element–node pairs of a mesh built in place.
+const AT_ONCE_NODE_VISITS: f64 = 60_000.0;
+
+/// Whether the new mesh of `new` is small enough to build at once, in place (well under a
+/// second): its elements estimated from `s`'s (the grid's cells, ×8 per refinement level) times
+/// the new element's nodes at most [`AT_ONCE_NODE_VISITS`].
+pub fn builds_at_once(s: &Session, new: &Config) -> bool {
+    let cells = |g: &[usize; 3]| g.iter().map(|&n| n.max(1) as f64).product::<f64>();
+    let ratio = cells(&new.grid) / cells(&s.config.grid) * 8f64.powi(new.refine as i32 - s.config.refine as i32);
+    let elements = s.instance.sim.mesh().num_elements() as f64 * ratio;
+    elements * new.element.reference().num_nodes() as f64 <= AT_ONCE_NODE_VISITS
+}
+
+/// A change that rebuilds meshes, built in the background; estimated once built (`ask`: asked
+/// first when slow), then installed.
+pub struct Build {
+    pub control: String,
+    pub ask: bool,
+    /// `(session, its new configuration)` for each session the change rebuilds.
+    configs: Vec<(usize, Config)>,
+    instances: Pending<Result<Vec<hox_scenes::Instance>, String>>,
+}
+
+impl Build {
+    /// Starts building `configs` (`(session, new configuration)`) of `sessions` on
+    /// `background`, each checked against the table first: a refusal names the session's
+    /// configuration (`active`'s plainly, the other's as the other's).
+    pub fn start(
+        control: &str,
+        ask: bool,
+        configs: Vec<(usize, Config)>,
+        sessions: &[Session],
+        active: usize,
+        background: Background,
+    ) -> Result<Build, String> {
+        let mut scenes = Vec::new();
+        for (j, c) in &configs {
+            match config::resolve(c, &sessions[*j].base) {
+                Ok(scene) => scenes.push(scene),
+                Err(reason) if *j == active => return Err(reason),
+                Err(reason) => return Err(format!("the other configuration refused it: {reason}")),
+            }
+        }
+        let instances = background
+            .run(move || scenes.into_iter().map(|s| hox_scenes::Instance::new(s).map_err(|e| e.to_string())).collect());
+        Ok(Build { control: control.to_string(), ask, configs, instances })
+    }
+
+    /// "building P1 32×2×2 for grid…", for the status line.
+    pub fn status(&self, base: &hox_scenes::Scene) -> String {
+        let what: Vec<String> = self.configs.iter().map(|(_, c)| config::label(c, base)).collect();
+        format!("building {} for {}…", what.join(" and "), self.control)
+    }
+
+    pub fn is_ready(&self) -> bool {
+        self.instances.is_ready()
+    }
+
+    /// The meshes built, with their sessions and configurations; or why not.
+    pub fn finish(self) -> Result<cost::Built, String> {
+        let instances =
+            self.instances.take().unwrap_or_else(|| Err("building the mesh stopped unexpectedly".into()))?;
+        Ok(self.configs.into_iter().zip(instances).map(|((k, c), i)| (k, c, i)).collect())
+    }
+}
+
+/// The static equilibrium of a session's configuration, solved in the background; shown once
+/// ready if the session still has that configuration and mesh, else dropped.
+struct StaticJob {
+    session: usize,
+    config: Config,
+    build: u64,
+    positions: Pending<Result<Vec<Vec3>, String>>,
+}
+
+/// The static equilibria being solved ([`StaticJob`]).
+#[derive(Default)]
+pub struct StaticJobs(Vec<StaticJob>);
+
+impl StaticJobs {
+    /// Solves the static equilibrium of session `k`'s configuration on `background`; until it
+    /// is shown, its readout and the lesson's numbers say so.
+    pub fn start(&mut self, k: usize, s: &mut Session, background: Background) {
+        let (scene, mesh) = (s.instance.scene.clone(), s.instance.sim.mesh().clone());
+        s.solving_static = true;
+        let positions = background.run(move || super::session::static_positions(&scene, &mesh));
+        self.0.push(StaticJob { session: k, config: s.config.clone(), build: s.revisions().build, positions });
+    }
+
+    /// Shows the equilibria solved since where the configuration is still theirs: whether any
+    /// was shown, and a message if one failed.
+    pub fn poll(&mut self, sessions: &mut [Session]) -> (bool, Option<String>) {
+        let (mut shown, mut message) = (false, None);
+        for job in std::mem::take(&mut self.0) {
+            if !job.positions.is_ready() {
+                self.0.push(job);
+                continue;
+            }
+            let Some(s) = sessions.get_mut(job.session) else { continue };
+            if s.config != job.config || s.revisions().build != job.build {
+                continue;
+            }
+            s.solving_static = false;
+            match job.positions.take() {
+                Some(Ok(positions)) => s.show_static_solution(&positions),
+                Some(Err(e)) => message = Some(format!("the static equilibrium of {}: {e}", s.label())),
+                None => message = Some("solving the static equilibrium stopped unexpectedly".into()),
+            }
+            shown = true;
+        }
+        (shown, message)
+    }
+}
+
+/// The second configuration compare mode starts with, for `first`: P2 is compared with P1
+/// refined once (the same nodes), P1 with P2; a part meshed per element type at the other
+/// order (P1's facets against P2's curved faces); else a copy.
+pub fn compare_partner(first: &Session) -> Result<Session, String> {
+    use hox_sim::element::ElementType;
+    let mut c = first.config.clone();
+    let other = match c.element.name() {
+        "p2" => Some(("p1", 1)),
+        "p1" => Some(("p2", 0)),
+        _ => None,
+    };
+    if let Some((name, refine)) = other
+        && let Some(element) = ElementType::from_name(name)
+    {
+        if first.base.is_box() {
+            c.element = element;
+            c.refine = refine;
+        }
+        if first.base.mesh_kind() == hox_scenes::params::MeshKind::Files {
+            c.element = element;
+        }
+    }
+    Session::new(first.base.clone(), c).or_else(|_| Session::new(first.base.clone(), first.config.clone()))
+}
+
+/// One session per `overrides` on `base`'s own configuration (the text that asked for each
+/// names it in a refusal).
+pub fn configured(
+    base: &hox_scenes::Scene,
+    overrides: &[(Option<String>, hox_scenes::SceneOverrides)],
+) -> Result<Vec<Session>, String> {
+    let mut sessions = Vec::new();
+    for (spec, o) in overrides {
+        let scene = base.with_overrides(o).map_err(|e| match spec {
+            Some(spec) => format!("--compare '{spec}': {e}"),
+            None => e.to_string(),
+        })?;
+        sessions.push(Session::new(base.clone(), scene.params().clone())?);
+    }
+    Ok(sessions)
+}
+
+/// The sessions of a scene loaded with the `saved` configurations (at most two), or its own; a
+/// saved configuration the scene no longer accepts falls back to the scene's own.
+pub fn loaded(base: &hox_scenes::Scene, saved: Option<Vec<Config>>) -> Result<Vec<Session>, String> {
+    let defaults = config::from_scene(base);
+    let wanted = saved.filter(|c| !c.is_empty()).unwrap_or_else(|| vec![defaults.clone()]);
+    let mut sessions = Vec::new();
+    for c in wanted.into_iter().take(2) {
+        sessions.push(Session::new(base.clone(), c).or_else(|_| Session::new(base.clone(), defaults.clone()))?);
+    }
+    Ok(sessions)
+}
+
+/// Whether a change from `old` to `new` changes how a configuration is drawn (a `[display]`
+/// parameter of the table).
+pub fn redraws(old: &Config, new: &Config) -> bool {
+    old.changed_keys(new)
+        .iter()
+        .any(|k| hox_scenes::params::by_key(k).is_some_and(|p| p.group == hox_scenes::params::Group::Display))
+}
+
+/// The question about meshes `built` for a change, if one would be slower than the machine
+/// plays ([`cost::too_slow_built`]).
+pub fn question(built: &cost::Built, sessions: &[Session], rates: &cost::Rates, draw_ms: f64) -> Option<String> {
+    built.iter().find_map(|(k, _, i)| sessions.get(*k).and_then(|s| cost::too_slow_built(s, &i.sim, rates, draw_ms)))
+}
+
+/// The other configuration `other` after the linked fields of a change from `old` to `new`.
+pub fn follow(links: &super::links::Links, old: &Config, new: &Config, other: &Config) -> Config {
+    let mut follow = other.clone();
+    for f in old.changed_keys(new) {
+        if links.linked(f) {
+            follow.copy_from(new, f);
+        }
+    }
+    follow
+}
