@@ -67,6 +67,8 @@ impl HoxApp {
         );
         let configs = saved.filter(|_| same_scene).map(|s| (s.configs, s.compare));
         let model = Model::new(scene, configs, start)?;
+        let mut ui = ui;
+        ui.grow_to_usable = args.size.is_none();
         let mut app = HoxApp {
             model,
             ui,

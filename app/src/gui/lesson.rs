@@ -116,6 +116,21 @@ impl LessonState {
         self.revealed |= !self.preparing();
     }
 
+    /// Frames of `frame_secs` left at `t` seconds before a step that plays some seconds ends
+    /// (None: it does not end so).
+    pub fn frames_left(&self, t: f64, frame_secs: f64) -> Option<usize> {
+        self.play_until_secs.map(|until| ((until - t) / frame_secs - 1e-6).ceil().max(0.0) as usize)
+    }
+
+    /// Whether a step that plays some seconds has played them at `t` (then it plays no more).
+    pub fn played_to_its_end(&mut self, t: f64) -> bool {
+        let ended = self.play_until_secs.is_some_and(|until| t >= until - 1e-9);
+        if ended {
+            self.play_until_secs = None;
+        }
+        ended
+    }
+
     /// The step on screen.
     pub fn current(&self) -> &Step {
         &self.lesson.steps[self.step]

@@ -53,6 +53,8 @@ pub struct Model {
     /// A slow change waiting for the user's answer ([`cost`]).
     pending_change: Option<PendingChange>,
     lesson: Option<LessonState>,
+    /// The configurations and compare mode before the lesson opened: what a restart keeps.
+    before_lesson: Option<(Vec<Config>, bool)>,
     presenter: bool,
     show_reference_element: bool,
     /// The element type a lesson step shows in the reference-element view.
@@ -96,6 +98,7 @@ impl Model {
             message: None,
             pending_change: None,
             lesson: None,
+            before_lesson: None,
             presenter: false,
             show_reference_element: start.show_reference_element,
             reference_element: None,
@@ -202,6 +205,13 @@ impl Model {
     }
 
     /// The open lesson's step as the browsers show it.
+    /// The configurations and compare mode a restart keeps: a lesson's are its own (issue #57:
+    /// two "P2 8×2×2 five" beams of a lesson's step came back at the next plain start).
+    pub fn kept_configurations(&self) -> (Vec<Config>, bool) {
+        let now = || (self.sessions.iter().map(|s| s.config.clone()).collect(), self.compare);
+        self.before_lesson.clone().filter(|_| self.lesson.is_some()).unwrap_or_else(now)
+    }
+
     pub fn lesson_text(&self) -> Option<String> {
         self.lesson.as_ref().map(|l| l.step_markdown(&self.sessions))
     }
@@ -287,6 +297,9 @@ impl Model {
                 }
             }
             Action::OpenLesson(lesson) => {
+                if self.lesson.is_none() {
+                    self.before_lesson = Some(self.kept_configurations());
+                }
                 self.lesson = Some(LessonState::open(*lesson, self.background));
                 self.playback.playing = false;
             }
@@ -297,7 +310,7 @@ impl Model {
                 }
             }
             Action::RevealAnswer => self.lesson.iter_mut().for_each(LessonState::reveal),
-            Action::CloseLesson => self.lesson = None,
+            Action::CloseLesson => (self.lesson, self.before_lesson) = (None, None),
             Action::SetPresenter(on) => self.presenter = on,
             Action::Say(message) => self.message = Some(message),
         }
@@ -643,25 +656,17 @@ impl Model {
         if one_frame_per_tick {
             return 1;
         }
-        let mut frames = self.playback.frames_due(dt, frame_secs);
+        let frames = self.playback.frames_due(dt, frame_secs);
         // a lesson step that plays some seconds ends on its last frame exactly, as `hox lesson`
-        if let Some(until) = self.lesson.as_ref().and_then(|l| l.play_until_secs)
-            && let Some(first) = self.sessions.first()
-        {
-            let left = ((until - first.instance.sim.time_secs()) / frame_secs - 1e-6).ceil().max(0.0) as usize;
-            frames = frames.min(left);
-        }
-        frames
+        let t = self.sessions.first().map(|s| s.instance.sim.time_secs());
+        frames.min(self.lesson.as_ref().zip(t).and_then(|(l, t)| l.frames_left(t, frame_secs)).unwrap_or(usize::MAX))
     }
 
     /// A step that plays for some seconds pauses at its end.
     fn lesson_after_advance(&mut self) {
-        let Some(until) = self.lesson.as_ref().and_then(|s| s.play_until_secs) else { return };
-        if self.sessions.first().is_some_and(|s| s.instance.sim.time_secs() >= until - 1e-9) {
-            self.playback.playing = false;
-            if let Some(state) = &mut self.lesson {
-                state.play_until_secs = None;
-            }
+        let t = self.sessions.first().map(|s| s.instance.sim.time_secs());
+        if let (Some(state), Some(t)) = (&mut self.lesson, t) {
+            self.playback.playing &= !state.played_to_its_end(t);
         }
     }
 
@@ -685,12 +690,7 @@ impl Model {
             self.reference_element = Some(step.configurations[0].params().element);
         }
         self.rebuilt();
-        let preset = step
-            .camera
-            .as_deref()
-            .and_then(|c| ViewPreset::ALL.into_iter().find(|p| p.name() == c))
-            .unwrap_or_default();
-        self.set_preset(preset);
+        self.set_preset(step.camera.as_deref().and_then(ViewPreset::from_name).unwrap_or_default());
         self.playback.playing = step.run != Run::Static;
         self.playback.frame_budget_secs = 0.0;
         if step.run == Run::Settle {

@@ -42,10 +42,11 @@ impl Persisted {
 impl Persisted {
     /// What of `model` and the UI's `state` persists, as they are now.
     pub fn of(model: &Model, state: &UiState) -> Persisted {
+        let (configs, compare) = model.kept_configurations();
         Persisted {
             scene: model.scene().clone(),
-            configs: model.sessions().iter().map(|s| s.config.clone()).collect(),
-            compare: model.compare(),
+            configs,
+            compare,
             links: model.links().clone(),
             view: model.view().clone(),
             camera: Some(state.viewport.camera),

@@ -45,6 +45,11 @@ impl ViewPreset {
         }
     }
 
+    /// The preset named `name` ("iso", "front", "side", "top").
+    pub fn from_name(name: &str) -> Option<ViewPreset> {
+        ViewPreset::ALL.into_iter().find(|p| p.name() == name)
+    }
+
     /// The camera's (yaw, pitch), radians ([`Camera`]): the eye's direction from the target.
     pub fn yaw_pitch(self) -> (f32, f32) {
         use std::f32::consts::FRAC_PI_2;

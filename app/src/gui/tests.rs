@@ -586,9 +586,28 @@ fn presenter_scale_does_not_leak_into_the_next_start() {
     assert_eq!(h.ctx.zoom_factor(), 1.0, "an ordinary start is at the ordinary scale");
     assert!(!h.state().model().presenter());
     // 2560×1440 on a 1600×900 screen is shrunk to fit; a window that fits is left alone
-    let fitted = window::fitted_inner_size(egui::vec2(2560.0, 1440.0), egui::vec2(1600.0, 900.0)).unwrap();
+    let fitted = window::fitted_inner_size(egui::vec2(2560.0, 1440.0), egui::vec2(1600.0, 900.0), true).unwrap();
     assert!(fitted.x <= 1600.0 && fitted.y <= 900.0, "{fitted:?}");
-    assert_eq!(window::fitted_inner_size(egui::vec2(1400.0, 800.0), egui::vec2(1920.0, 1080.0)), None);
+    assert_eq!(window::fitted_inner_size(egui::vec2(1400.0, 800.0), egui::vec2(1920.0, 1080.0), true), None);
+}
+
+/// Issue #57: a presenter session once left a 784×386 window (the projector's size in presenter
+/// mode's points) that the next plain start reopened. A restored window too small to use grows to
+/// a usable size the screen has room for; a size asked for with `--size` is kept.
+#[test]
+fn a_window_left_too_small_by_presenter_mode_reopens_usable() {
+    let projector = egui::vec2(1280.0, 720.0);
+    let grown = window::fitted_inner_size(egui::vec2(784.0, 386.0), projector, true).expect("grown");
+    assert!(grown.x >= 1024.0 && grown.y >= 640.0 - 64.0, "{grown:?}");
+    assert!(grown.x <= projector.x && grown.y <= projector.y, "{grown:?}");
+    assert_eq!(window::fitted_inner_size(egui::vec2(784.0, 386.0), projector, false), None, "--size 784x386 is kept");
+    assert_eq!(window::fitted_inner_size(egui::vec2(1200.0, 700.0), egui::vec2(1920.0, 1080.0), true), None);
+    // the start that restores it asks to grow; one given --size does not
+    let restored = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap();
+    assert!(restored.ui_state().grow_to_usable);
+    let sized =
+        HoxApp::new(&AppArgs { fresh: true, size: Some("800x500".into()), ..Default::default() }, None).unwrap();
+    assert!(!sized.ui_state().grow_to_usable);
 }
 
 /// Issue #35, symptom 8: under XPBD the implicit solvers' typed fields (Chebyshev ρ, Newton
@@ -1326,4 +1345,28 @@ fn a_browser_following_a_lesson_shows_only_the_current_step_s_bodies() {
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue #57: a lesson's configurations (two "P2 8×2×2 five" beams of 50 and 100 substeps) came
+/// back at the next plain start. What persists during a lesson is what ran before it.
+#[test]
+fn a_lesson_s_configurations_do_not_leak_into_the_next_plain_start() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    let mut c = h.state().model().sessions()[0].config.clone();
+    c.youngs_modulus_pa = 2.5e6;
+    h.state_mut().act(Action::change("youngs", c.clone()));
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "accuracy-cost").unwrap();
+    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
+    lesson_ready(&mut h);
+    assert_eq!(h.state().model().sessions().len(), 2, "the lesson's pair on screen");
+    let kept = h.state().persisted();
+    assert_eq!((kept.configs, kept.compare), (vec![c.clone()], false), "what ran before the lesson");
+    // the next start on those settings runs it again
+    let again = HoxApp::new(&AppArgs::default(), Some(h.state().persisted())).unwrap();
+    assert_eq!(again.model().sessions().len(), 1);
+    assert_eq!(again.model().sessions()[0].config, c);
+    // a lesson closed: what is on screen persists again
+    h.state_mut().act(Action::CloseLesson);
+    assert_eq!(h.state().persisted().configs.len(), 2);
 }

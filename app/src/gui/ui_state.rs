@@ -62,6 +62,8 @@ pub struct UiState {
     /// screen to fit it, after so many frames (the start's scale takes a frame to reach
     /// eframe's report of the monitor and window sizes).
     pub fit_to_screen: bool,
+    /// The window's size was restored, not asked for (`--size`): one too small to use grows.
+    pub grow_to_usable: bool,
     pub fit_to_screen_in_frames: u8,
     /// The first start offers the lessons.
     pub offer_lessons: bool,
@@ -92,6 +94,7 @@ impl UiState {
             // from a presenter-mode session (issue #35: its 1.6 leaked into the next start)
             zoom_wanted: Some(1.0),
             fit_to_screen: true,
+            grow_to_usable: true,
             fit_to_screen_in_frames: 3,
             offer_lessons,
             seen: Seen::default(),

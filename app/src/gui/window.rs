@@ -11,12 +11,21 @@ use super::{controls, dialogs, lesson_panel, menu, plots, serve_web, status};
 use eframe::egui;
 use std::time::Instant;
 
+/// The smallest window a restored geometry keeps, points: below it a lesson's panels leave no
+/// room for the view (issue #57: a presenter session once left a 784×386 window, the projector's
+/// size in presenter mode's points, that the next plain start reopened).
+pub(super) const USABLE_INNER_SIZE: egui::Vec2 = egui::vec2(1024.0, 640.0);
+
 /// The inner size of a window of size `inner` that fits on a monitor of size `monitor` (both in
-/// the same points, with room for the window's decorations), or None when it already fits.
-pub(super) fn fitted_inner_size(inner: egui::Vec2, monitor: egui::Vec2) -> Option<egui::Vec2> {
+/// the same points, with room for the window's decorations) and, when `grow` (a restored size,
+/// not one asked for), is at least [`USABLE_INNER_SIZE`] where the monitor has room for it; None
+/// when it already is.
+pub(super) fn fitted_inner_size(inner: egui::Vec2, monitor: egui::Vec2, grow: bool) -> Option<egui::Vec2> {
     // title bar and borders, and a panel the desktop may keep
     let room = egui::vec2(monitor.x - 16.0, monitor.y - 64.0).max(egui::vec2(320.0, 240.0));
-    (inner.x > room.x || inner.y > room.y).then(|| inner.min(room))
+    let wanted = if grow { inner.max(USABLE_INNER_SIZE.min(room)) } else { inner };
+    let fitted = wanted.min(room);
+    (fitted != inner).then_some(fitted)
 }
 
 impl HoxApp {
@@ -31,7 +40,7 @@ impl HoxApp {
         let (monitor, inner) = ctx.input(|i| (i.viewport().monitor_size, i.viewport().inner_rect));
         let (Some(monitor), Some(inner)) = (monitor, inner) else { return };
         self.ui.fit_to_screen = false;
-        if let Some(size) = fitted_inner_size(inner.size(), monitor) {
+        if let Some(size) = fitted_inner_size(inner.size(), monitor, self.ui.grow_to_usable) {
             ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(size));
         }
     }
