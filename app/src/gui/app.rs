@@ -219,8 +219,13 @@ impl HoxApp {
                 } else {
                     Ok(SceneSource::File(path))
                 };
+                // the material and compare mode carry over to the part (issue #57: both were dropped)
+                let (material, compare) = (self.model.active_session().config.clone(), self.model.compare());
                 match source.and_then(|s| self.model.apply(Action::LoadScene(s))) {
-                    Ok(()) => self.ui.open_dialog = None,
+                    Ok(()) => {
+                        self.ui.open_dialog = None;
+                        self.carry_over(&material, compare);
+                    }
                     Err(e) => {
                         if let Some(d) = &mut self.ui.open_dialog {
                             d.error = Some(e);
@@ -230,6 +235,21 @@ impl HoxApp {
             }
         }
         self.ui.follow(&self.model);
+    }
+
+    /// After a part is opened: the material of the configuration before (`old`), where the
+    /// part's scene accepts it, and compare mode.
+    fn carry_over(&mut self, old: &super::config::Config, compare: bool) {
+        let mut c = self.model.active_session().config.clone();
+        for p in hox_scenes::params::in_group(hox_scenes::params::Group::Material) {
+            (p.set)(&mut c, (p.get)(old));
+        }
+        if self.model.apply(Action::ChangeNow { control: "material".into(), config: Box::new(c) }).is_err() {
+            self.say(Some("the part keeps its own material: the one before does not apply to it".into()));
+        }
+        if compare {
+            self.act(Action::SetCompare(true));
+        }
     }
 
     /// Carries out a frame's commands, in order.

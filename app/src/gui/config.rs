@@ -22,10 +22,21 @@ impl SceneSource {
     pub fn label(&self) -> String {
         match self {
             SceneSource::Builtin(name) => name.clone(),
-            SceneSource::File(path) => path.display().to_string(),
+            // a scene written for a mesh file is named by the mesh (issue #57: the scene box
+            // showed a temporary path)
+            SceneSource::File(path) if path.parent().is_some_and(|p| p.ends_with(MESH_SCENES)) => {
+                let name = path.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+                format!("{} (mesh file)", name.trim_end_matches(".toml"))
+            }
+            SceneSource::File(path) => {
+                path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned())
+            }
         }
     }
 }
+
+/// The folder (in the system's temporary one) of the scene files written for mesh files.
+pub const MESH_SCENES: &str = "hox-app-scenes";
 
 /// Every live control of one simulation: the parameter table's values. Persisted across runs.
 pub type Config = hox_scenes::Params;

@@ -22,36 +22,88 @@ pub fn open_dialog_ui(cx: &mut Ctx, ctx: &egui::Context) {
                 ui.add(egui::TextEdit::singleline(&mut dialog.clamp_group).desired_width(120.0)).labelled_by(l.id);
             });
         }
-        // quick picks from the project's assets
-        let folder = if dialog.mesh { "assets/meshes" } else { "assets/scenes" };
+        // the folder of the path typed, browsed: folders open, files of the kind asked for pick
         let ext = if dialog.mesh { "msh" } else { "toml" };
-        if let Ok(entries) = std::fs::read_dir(folder) {
-            let mut files: Vec<_> = entries
-                .filter_map(|e| e.ok())
-                .map(|e| e.path())
-                .filter(|p| p.extension().is_some_and(|e| e == ext))
-                .collect();
-            files.sort();
-            egui::ScrollArea::vertical().max_height(160.0).show(ui, |ui| {
-                for f in files {
-                    if ui.selectable_label(false, f.display().to_string()).clicked() {
-                        dialog.path = f.display().to_string();
-                    }
+        let (folder, entries) = browse(&dialog.path, ext);
+        ui.label(egui::RichText::new(format!("in {}", folder.display())).small());
+        egui::ScrollArea::vertical().max_height(180.0).show(ui, |ui| {
+            if let Some(parent) = folder.parent()
+                && ui.selectable_label(false, "⬆ ..").clicked()
+            {
+                dialog.path = format!("{}/", parent.display());
+            }
+            for (name, is_dir) in entries {
+                let shown = if is_dir { format!("🗀 {name}/") } else { name.clone() };
+                if ui.selectable_label(false, shown).clicked() {
+                    let picked = folder.join(&name);
+                    dialog.path = if is_dir { format!("{}/", picked.display()) } else { picked.display().to_string() };
                 }
-            });
-        }
+            }
+        });
         if let Some(e) = &dialog.error {
             ui.colored_label(egui::Color32::from_rgb(255, 110, 90), e);
         }
         if ui.button("Open").clicked() {
             // the app reads the file and closes the dialog, or puts the reason in it
-            let path = std::path::PathBuf::from(dialog.path.trim());
-            cx.out.push(Command::OpenFile { mesh: dialog.mesh, path, clamp_group: dialog.clamp_group.trim().into() });
+            match resolve(dialog.path.trim()) {
+                Ok(path) => cx.out.push(Command::OpenFile {
+                    mesh: dialog.mesh,
+                    path,
+                    clamp_group: dialog.clamp_group.trim().into(),
+                }),
+                Err(e) => dialog.error = Some(e),
+            }
         }
     });
     if open {
         cx.state.open_dialog = Some(dialog);
     }
+}
+
+/// The folder `typed` names (itself if it is one or ends in '/', else its parent; relative to
+/// the folder hox runs in) and its entries: folders, and files ending in `.ext`, sorted.
+pub fn browse(typed: &str, ext: &str) -> (std::path::PathBuf, Vec<(String, bool)>) {
+    let cwd = std::env::current_dir().unwrap_or_default();
+    let path = cwd.join(typed.trim());
+    let folder = if typed.trim().is_empty() || typed.ends_with('/') || path.is_dir() {
+        path
+    } else {
+        path.parent().map_or(cwd, std::path::Path::to_path_buf)
+    };
+    let mut entries: Vec<(String, bool)> = std::fs::read_dir(&folder)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .filter_map(|e| {
+                    let is_dir = e.file_type().ok()?.is_dir();
+                    let name = e.file_name().to_string_lossy().into_owned();
+                    (!name.starts_with('.') && (is_dir || name.ends_with(&format!(".{ext}")))).then_some((name, is_dir))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    entries.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    (folder, entries)
+}
+
+/// The file `typed` names, relative to the folder hox runs in; an error naming where it looked
+/// (issue #57: a relative path failed with a bare "os error 2").
+pub fn resolve(typed: &str) -> Result<std::path::PathBuf, String> {
+    let cwd = std::env::current_dir().map_err(|e| format!("the folder hox runs in is unreadable: {e}"))?;
+    let path = cwd.join(typed);
+    if typed.is_empty() {
+        return Err("type or pick a file".into());
+    }
+    if path.is_dir() {
+        return Err(format!("{} is a folder: pick a file in it", path.display()));
+    }
+    if !path.is_file() {
+        return Err(format!(
+            "no file at {} (a relative path is read from the folder hox runs in, {})",
+            path.display(),
+            cwd.display()
+        ));
+    }
+    Ok(path)
 }
 
 /// The question about a held-back change: apply it (paused) or keep the current one.
@@ -91,19 +143,34 @@ pub fn reference_element_ui(cx: &mut Ctx, ctx: &egui::Context) {
 }
 
 /// A scene file for a mesh file: the mesh, its `clamp_group` clamped, gravity, the paper
-/// beam's material; written next to the user's settings so it can be reopened.
+/// beam's material, a probe at the node farthest from the clamp; written where it can be
+/// reopened.
 pub fn mesh_scene_file(mesh: &std::path::Path, clamp_group: &str) -> Result<std::path::PathBuf, String> {
     let mesh = std::fs::canonicalize(mesh).map_err(|e| format!("{}: {e}", mesh.display()))?;
     let name = mesh.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().to_string());
     // the scene `hox simulate --mesh FILE --clamp GROUP` runs: the paper's material (read from
     // the bending scene), gravity, the group clamped
-    let mut file = hox_scenes::SceneFile::for_mesh_file(&mesh, true);
+    let scene =
+        hox_scenes::Scene::from_mesh_file(&mesh, &[clamp_group.to_string()], &[], true).map_err(|e| e.to_string())?;
+    let mut file = scene.file.clone();
     file.description = format!("{} with group '{clamp_group}' clamped, under gravity", mesh.display());
-    file.effects.push(hox_scenes::scene::EffectSpec::Clamp { nodes: hox_scenes::NodeSelector::group(clamp_group) });
+    // a probe at the node farthest from the clamp (issue #57: no probe, so a flat probe plot
+    // and no reference, although the part's static solution is its reference elsewhere)
+    if file.probes.is_empty()
+        && let Some(imported) = scene.mesh.imported()
+        && let Ok(held) = imported.node_set(clamp_group)
+        && !held.is_empty()
+    {
+        let rest = &imported.mesh.rest_positions;
+        let centre = held.iter().map(|&n| rest[n as usize]).sum::<hox_sim::Vec3>() / held.len() as f64;
+        if let Some(tip) = rest.iter().max_by(|a, b| (*a - centre).norm().total_cmp(&(*b - centre).norm())) {
+            file.probes.push(hox_scenes::scene::ProbeSpec { name: "tip".into(), point_m: [tip.x, tip.y, tip.z] });
+        }
+    }
     let text = file.to_toml();
-    let dir = std::env::temp_dir().join("hox-app-scenes");
+    let dir = std::env::temp_dir().join(super::config::MESH_SCENES);
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let path = dir.join(format!("{name}.toml"));
+    let path = dir.join(format!("{name}.msh.toml"));
     std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
     // validate now, so a missing group is reported in the dialog
     hox_scenes::Scene::load(&path).map_err(|e| e.to_string())?;

@@ -1370,3 +1370,46 @@ fn a_lesson_s_configurations_do_not_leak_into_the_next_plain_start() {
     h.state_mut().act(Action::CloseLesson);
     assert_eq!(h.state().persisted().configs.len(), 2);
 }
+
+/// Issue #57, opening a part: a relative path failed with a bare "os error 2"; the scene box then
+/// showed a temporary path; compare mode and ν were dropped; the probe plot stayed flat at 0
+/// while the part moved; "no reference" although the part's static solution is its reference.
+#[test]
+fn opening_a_part_keeps_compare_and_the_material_and_it_gets_a_probe_and_a_reference() {
+    let mut h = harness(AppArgs { compare: vec![String::new()], ..Default::default() });
+    h.run_steps(2);
+    let mut c = h.state().model().sessions()[0].config.clone();
+    c.poisson_ratio = 0.45;
+    h.state_mut().act(Action::change("poisson", c));
+    // a relative path is read from the folder hox runs in; a missing file says where it looked
+    let err = dialogs::resolve("no/such/part.msh").unwrap_err();
+    let cwd = std::env::current_dir().unwrap();
+    assert!(err.contains(&cwd.join("no/such/part.msh").display().to_string()) && err.contains("relative"), "{err}");
+    let beam = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/meshes/beam-tet10.msh");
+    let relative = pathdiff(&beam, &cwd);
+    let path = dialogs::resolve(&relative).expect("a relative path to the part");
+    let (folder, entries) = dialogs::browse(&relative, "msh");
+    assert!(entries.iter().any(|(n, dir)| n == "beam-tet10.msh" && !dir), "{folder:?}: {entries:?}");
+    h.state_mut().act(super::action::Command::OpenFile { mesh: true, path, clamp_group: "clamp".into() });
+    h.run_steps(2);
+    let model = h.state().model();
+    assert_eq!(model.scene().label(), "beam-tet10.msh (mesh file)");
+    assert!(model.compare(), "compare mode kept");
+    assert!(model.sessions().iter().all(|s| s.config.poisson_ratio == 0.45), "ν kept");
+    let s = &model.sessions()[0];
+    assert_eq!(s.instance.probes.len(), 1, "a probe at the tip");
+    assert!(!matches!(s.reference, readout::ReferenceState::Unavailable(_)), "{}", s.reference.status());
+    h.state_mut().step(20);
+    let moved = h.state().model().sessions()[0].history.probe_m.iter().map(|u| u[2].abs()).fold(0.0, f64::max);
+    assert!(moved > 1e-4, "the probe plot follows the part: {moved}");
+}
+
+/// `path` relative to `base` (both absolute), for a test typing a relative path.
+fn pathdiff(path: &std::path::Path, base: &std::path::Path) -> String {
+    let path = std::fs::canonicalize(path).unwrap();
+    let base = std::fs::canonicalize(base).unwrap();
+    let common = path.components().zip(base.components()).take_while(|(a, b)| a == b).count();
+    let ups = base.components().count() - common;
+    let rest: std::path::PathBuf = path.components().skip(common).collect();
+    format!("{}{}", "../".repeat(ups), rest.display())
+}
