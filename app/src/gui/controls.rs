@@ -32,7 +32,8 @@ pub fn controls_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
     if let Some(source) = chosen {
         cx.out.push(Action::LoadScene(source));
     }
-    ui.label(egui::RichText::new(&cx.model.sessions()[0].base.file.description).small());
+    // at the body's size (issue #57: at about 8 px a class could not read it)
+    ui.label(egui::RichText::new(&cx.model.sessions()[0].base.file.description).weak());
     let mut compare = cx.model.compare();
     if ui
         .checkbox(&mut compare, "Compare two configurations")
@@ -315,10 +316,10 @@ pub(super) fn solver_motion_ui(
     let info = method.info();
     let damps = info.implicit && integrator.info().damps_motion;
     let colour = if damps { egui::Color32::from_rgb(250, 200, 120) } else { ui.visuals().weak_text_color() };
-    ui.label(egui::RichText::new(info.motion).small().color(colour));
+    ui.label(egui::RichText::new(info.motion).color(colour));
     if info.implicit {
         let i = integrator.info();
-        ui.label(egui::RichText::new(format!("{}: {}", i.long_name, i.motion)).small().color(colour));
+        ui.label(egui::RichText::new(format!("{}: {}", i.long_name, i.motion)).color(colour));
     }
 }
 

@@ -78,6 +78,8 @@ pub fn caption_ui(cx: &Ctx, ui: &mut egui::Ui) {
     for line in state.parameter_lines() {
         ui.label(egui::RichText::new(line).monospace().color(egui::Color32::from_rgb(200, 200, 200)));
     }
+    // the step's explanation too (issue #57: presenter mode dropped it)
+    ui.label(egui::RichText::new(&step.text).color(egui::Color32::from_rgb(220, 220, 220)));
     ui.label(egui::RichText::new(&step.question).color(egui::Color32::WHITE));
     if state.preparing() {
         ui.label(egui::RichText::new(PREPARING).color(egui::Color32::from_rgb(250, 220, 120)));
@@ -85,7 +87,7 @@ pub fn caption_ui(cx: &Ctx, ui: &mut egui::Ui) {
     }
     for (k, m) in measured.iter().enumerate() {
         ui.label(
-            egui::RichText::new(format!("{}: {}", ["A", "B"][k.min(1)], m.text))
+            egui::RichText::new(format!("{} {}: {}", ["A", "B"][k.min(1)], step.measure.title(), m.text))
                 .monospace()
                 .color(egui::Color32::from_rgb(250, 220, 120)),
         );

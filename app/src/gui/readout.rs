@@ -233,11 +233,15 @@ impl ReferenceState {
                     Some((_, u)) => format!("{:.4} m", hox_sim::Vec3::from(*u).norm()),
                     None => String::new(),
                 };
-                Some(format!(
-                    "reference {size} ± {:.2} % (refining, {})",
-                    r.estimated_error_pct().unwrap_or(f64::NAN),
-                    level(&self.progress().unwrap_or_default().0).replace("level ", "")
-                ))
+                // issue #57: "± 0.00 % (refining, 6 of 6)" said nothing
+                let pct = match r.estimated_error_pct() {
+                    Some(p) if p < 0.01 => "< 0.01 %".to_string(),
+                    Some(p) => format!("{p:.2} %"),
+                    None => "?".into(),
+                };
+                let at = level(&self.progress().unwrap_or_default().0).replace("level ", "");
+                let last = at.split_once(" of ").is_some_and(|(a, b)| a.trim() == b.trim());
+                Some(format!("reference {size} ± {pct} ({}, {at})", if last { "last level" } else { "refining" }))
             }
             ReferenceState::Computing { .. } => {
                 Some(self.progress().map_or_else(|| "computing reference".into(), |(what, _)| level(&what)))

@@ -607,6 +607,36 @@ mod tests {
         assert!(claims(&s), "{}", s.readout().text());
     }
 
+    /// Issue #57: "± 0.00 % (refining, 6 of 6)" under a reference at its last level.
+    #[test]
+    fn a_reference_at_its_last_level_does_not_read_refining_zero_percent() {
+        let mut s = bending();
+        let mut c = s.config.clone();
+        c.poisson_ratio = 0.41;
+        s.apply(c).unwrap();
+        let mut seen: Vec<String> = Vec::new();
+        for _ in 0..40_000 {
+            if let Some(note) = s.provisional_note()
+                && !seen.contains(&note)
+            {
+                seen.push(note);
+            }
+            if !matches!(s.reference, ReferenceState::Computing { .. }) {
+                break;
+            }
+            s.poll_reference();
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
+        assert!(!seen.is_empty(), "a provisional reference was shown while refining");
+        assert!(seen.iter().all(|n| !n.contains("± 0.00 %")), "{seen:?}");
+        for n in &seen {
+            let at = n.rsplit(", ").next().unwrap_or_default().trim_end_matches(')');
+            if let Some((a, b)) = at.split_once(" of ") {
+                assert_eq!(n.contains("refining"), a != b, "{n}");
+            }
+        }
+    }
+
     #[test]
     fn refused_change_changes_nothing() {
         let mut s = bending();

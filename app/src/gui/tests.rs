@@ -1413,3 +1413,34 @@ fn pathdiff(path: &std::path::Path, base: &std::path::Path) -> String {
     let rest: std::path::PathBuf = path.components().skip(common).collect();
     format!("{}{}", "../".repeat(ups), rest.display())
 }
+
+/// Issue #57: in a lesson the labels above the bodies gave the error against the reference
+/// while the panel gave another quantity, both called "error", and a static step's label read
+/// "paused mid-swing". The labels now show the step's measurement, under its name, with the
+/// panel's text; presenter mode's caption keeps the step's explanation.
+#[test]
+fn a_lesson_s_body_labels_show_the_panel_s_numbers_under_the_same_name() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "accuracy-cost").unwrap();
+    let explanation = lesson.steps[0].text.clone();
+    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
+    lesson_ready(&mut h);
+    play_until_paused(&mut h);
+    h.run_steps(2);
+    let state = h.state().model().lesson().unwrap();
+    let title = state.current().measure.title();
+    let measured = state.measured(h.state().model().sessions());
+    let labels = h.state().ui_state().viewport.lesson_labels.clone().expect("lesson labels");
+    assert_eq!(labels.len(), 2);
+    for (k, (label, m)) in labels.iter().zip(&measured).enumerate() {
+        assert_eq!(*label, format!("{title}: {}", m.text), "body {k}");
+        // the panel shows the same text
+        h.get_by_label_contains(&m.text);
+        assert!(!label.contains("mid-swing"), "{label}");
+    }
+    h.key_press(egui::Key::P);
+    h.run_steps(3);
+    let first_line = explanation.lines().next().unwrap();
+    h.get_by_label_contains(first_line);
+}

@@ -70,6 +70,10 @@ pub struct Viewport {
     pub drawn: Drawn,
     /// Labels name the bodies only (presenter mode: its caption carries the numbers).
     pub short_labels: bool,
+    /// In a lesson, each body's label shows the step's measurement as the panel does (issue #57:
+    /// the labels' error against the reference and the panel's against the mesh's equilibrium
+    /// both said "error"); set by the window each frame.
+    pub lesson_labels: Option<Vec<String>>,
 }
 
 /// Rectangles drawn in the view at the last frame ([`Viewport::drawn`]).
@@ -109,6 +113,7 @@ impl Viewport {
             user_moved: false,
             drawn: Drawn::default(),
             short_labels: false,
+            lesson_labels: None,
         }
     }
 
@@ -411,10 +416,10 @@ impl Viewport {
                 if !body.is_positive() {
                     continue;
                 }
-                let text = if self.short_labels {
-                    format!("{}: {}", ["A", "B"][k.min(1)], s.label())
-                } else {
-                    body_label(k, &s.label(), &s.readout_label())
+                let text = match (&self.lesson_labels, self.short_labels) {
+                    (_, true) => format!("{}: {}", ["A", "B"][k.min(1)], s.label()),
+                    (Some(labels), false) if k < labels.len() => body_label(k, &s.label(), &labels[k]),
+                    _ => body_label(k, &s.label(), &s.readout_label()),
                 };
                 let galley = painter.layout_no_wrap(text, egui::FontId::proportional(14.0), egui::Color32::WHITE);
                 let size = galley.size();

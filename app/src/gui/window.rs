@@ -120,6 +120,10 @@ impl HoxApp {
         dialogs::pending_change_ui(&mut cx, &ctx);
         egui::CentralPanel::no_frame().show(ui, |ui| {
             cx.state.viewport.short_labels = presenter && cx.model.lesson().is_some();
+            cx.state.viewport.lesson_labels = cx.model.lesson().filter(|l| !l.preparing()).map(|l| {
+                let title = l.current().measure.title();
+                l.measured(cx.model.sessions()).into_iter().map(|m| format!("{title}: {}", m.text)).collect()
+            });
             let offsets = cx.model.offsets();
             let drag = cx.state.viewport.ui(ui, cx.model.sessions(), &offsets, cx.model.view(), gl);
             if let Some((session, drag)) = drag {
