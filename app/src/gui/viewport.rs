@@ -421,7 +421,10 @@ impl Viewport {
                     (Some(labels), false) if k < labels.len() => body_label(k, &s.label(), &labels[k]),
                     _ => body_label(k, &s.label(), &s.readout_label()),
                 };
-                let galley = painter.layout_no_wrap(text, egui::FontId::proportional(14.0), egui::Color32::WHITE);
+                // wrapped to the room beside the legend (issue #57: at 1280×720 with a lesson's
+                // panel the view is narrow, and a long label sat on the legend)
+                let room = (rect.width() - (rect.right() - legend.left()) - 12.0).max(140.0);
+                let galley = painter.layout(text, egui::FontId::proportional(14.0), egui::Color32::WHITE, room);
                 let size = galley.size();
                 let place = |top_left: egui::Pos2| {
                     let x = top_left.x.clamp(rect.min.x + 4.0, (rect.max.x - size.x - 4.0).max(rect.min.x + 4.0));
@@ -442,7 +445,10 @@ impl Viewport {
                     ),
                     size,
                 );
-                let at = [above, below, stacked].into_iter().find(free).unwrap_or(stacked);
+                // or in the bottom-left corner, above the labels already there
+                let low = drawn.labels.iter().map(|l| l.min.y - 4.0).fold(rect.max.y - 4.0, f32::min);
+                let bottom = egui::Rect::from_min_size(egui::pos2(rect.min.x + 4.0, low - size.y), size);
+                let at = [above, below, stacked, bottom].into_iter().find(free).unwrap_or(stacked);
                 painter.galley(at.min, galley, egui::Color32::WHITE);
                 drawn.labels.push(at);
             }
