@@ -27,3 +27,10 @@ shot classroom-1280-lesson 1280x720 5 --lesson why-high-order
 shot classroom-1280-presenter 1280x720 4 --lesson locking --presenter
 # Full HD: Newton against XPBD, the solver's effect on the motion said under it
 shot classroom-1920-newton 1920x1080 5 --compare element=p1,refine=1,solver=newton,integrator=euler --compare element=p2 --play
+# The second round (issue #57), the states `the_second_round_classroom_session_replays_at_both_sizes`
+# replays: a lesson's labels showing the step's measurement as its panel does, at both sizes;
+# presenter mode with the step's explanation; a static step solved at its own values.
+shot classroom2-1280-lesson-labels 1280x720 6 --lesson accuracy-cost
+shot classroom2-1280-presenter 1280x720 5 --lesson locking --lesson-step 2 --presenter
+shot classroom2-1920-static 1920x1080 5 --lesson locking --lesson-step 2
+shot classroom2-1920-presenter 1920x1080 6 --lesson why-high-order --lesson-step 3 --presenter
