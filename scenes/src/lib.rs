@@ -23,7 +23,7 @@ pub mod scene;
 
 pub use error::SceneError;
 pub use instance::{Instance, solve_static, static_problem};
-pub use lab::{bench, lesson, paper, reference, study};
+pub use lab::{bench, claim, lesson, paper, reference, study};
 pub use params::{Params, SceneOverrides};
 pub use run::{
     RestWatch, RunMode, RunReport, SETTLE_CAP_SECS, SETTLE_DAMPING_NAME, SETTLE_EQUILIBRIUM_FRAMES, SETTLE_FRAMES,

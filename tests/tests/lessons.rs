@@ -5,11 +5,37 @@
 
 use hox_scenes::lesson::{Measured, by_name, run_step};
 
-/// The measurements of step `k` (1-based) of `lesson`: A's and B's values.
+/// The measurements of step `k` (1-based) of `lesson`: A's and B's values. The step's claim, if
+/// it has one, holds for them (issue #57: every claim the app judges beside an answer is
+/// checked wherever its step runs, as `hox lesson` measures it).
 fn step(lesson: &str, k: usize) -> Vec<f64> {
     let l = by_name(lesson).unwrap();
     let (_, measured) = run_step(&l.steps[k - 1], &mut |_, _| {}).unwrap();
-    measured.iter().map(|m: &Measured| m.value).collect()
+    let values: Vec<f64> = measured.iter().map(|m: &Measured| m.value).collect();
+    if let Some(claim) = &l.steps[k - 1].claim {
+        let judged = claim.judge(&values).unwrap_or_else(|| panic!("{lesson} step {k}: not measured: {values:?}"));
+        assert!(judged.holds, "{lesson} step {k}: {} ({values:?})", judged.text);
+    }
+    values
+}
+
+/// Every step with a claim is run by a test of this file (through [`step`]).
+#[test]
+fn every_lesson_claim_is_checked_by_a_test_here() {
+    let source = include_str!("lessons.rs");
+    for lesson in hox_scenes::lesson::registry().unwrap() {
+        for (k, s) in lesson.steps.iter().enumerate() {
+            if s.claim.is_some() {
+                let call = format!("step(\"{}\", {})", lesson.name, k + 1);
+                assert!(
+                    source.contains(&call),
+                    "{} step {}'s claim is checked nowhere: add {call}",
+                    lesson.name,
+                    k + 1
+                );
+            }
+        }
+    }
 }
 
 #[test]

@@ -73,7 +73,7 @@ const SCENES: &[&[&str]] =
     &[&["error", "present"], &["params"], &["scene"], &["instance"], &["run"], &["lab"], &["lib"]];
 
 /// The files of hox-scenes' `lab/`, lowest first (`mod.rs`, a pure front, declares them).
-const LAB_FILES: &[&[&str]] = &[&["reference"], &["study"], &["paper", "bench", "lesson"]];
+const LAB_FILES: &[&[&str]] = &[&["claim", "reference"], &["study"], &["paper", "bench", "lesson"]];
 
 /// The files of hox-scenes' `present/`, lowest first.
 const PRESENT_FILES: &[&[&str]] = &[&["colour"], &["svg"]];

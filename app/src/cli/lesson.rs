@@ -75,8 +75,12 @@ pub fn step_markdown(lesson: &Lesson, k: usize, outcome: Option<&[Measured]>) ->
         };
         text += &format!("- **{}** {}: {}: {what}\n", ["A", "B"][j.min(1)], scene_label(scene), step.measure.title());
     }
-    if outcome.is_some() {
+    if let Some(measured) = outcome {
         text += &format!("\n**Answer:** {}\n", step.answer);
+        let values: Vec<f64> = measured.iter().map(|m| m.value).collect();
+        if let Some(j) = step.claim.as_ref().and_then(|c| c.judge(&values)) {
+            text += &format!("\n*{}*\n", j.text);
+        }
     }
     text
 }
@@ -164,10 +168,15 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
             }
         };
         bar.bar.finish_and_clear();
+        let values: Vec<f64> = measured.iter().map(|m| m.value).collect();
+        let judged = step.claim.as_ref().and_then(|c| c.judge(&values));
         if !args.json {
             println!("step {} — {}: {}", k + 1, step.title, step.measure.title());
             for (j, m) in measured.iter().enumerate() {
                 println!("  {} {}: {}", ["A", "B"][j.min(1)], scene_label(&step.configurations[j]), m.text);
+            }
+            if let Some(j) = &judged {
+                println!("  {}", j.text);
             }
         }
         report.push(serde_json::json!({
@@ -177,6 +186,7 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
             "unit": step.measure.unit(),
             "values": measured.iter().map(|m| m.value).collect::<Vec<_>>(),
             "texts": measured.iter().map(|m| m.text.clone()).collect::<Vec<_>>(),
+            "claim": judged.as_ref().map(|j| serde_json::json!({ "value": j.value, "holds": j.holds, "text": j.text })),
         }));
     }
     if let Some(rec) = &rec {

@@ -213,6 +213,12 @@ impl LessonState {
             .collect()
     }
 
+    /// The step's claim judged against the numbers on screen, once they are all measured.
+    pub fn claim_check(&self, sessions: &[Session]) -> Option<hox_scenes::claim::Judged> {
+        let values: Vec<f64> = self.measured(sessions).iter().map(|m| m.value).collect();
+        self.current().claim.as_ref()?.judge(&values)
+    }
+
     /// The step as the browsers' "Lesson" view shows it: title, question, the numbers as the
     /// app's panel shows them, the answer once revealed.
     pub fn step_markdown(&self, sessions: &[Session]) -> String {
@@ -234,6 +240,9 @@ impl LessonState {
         }
         if self.revealed {
             text += &format!("\n**Answer:** {}\n", step.answer);
+            if let Some(j) = self.claim_check(sessions) {
+                text += &format!("\n*{}*\n", j.text);
+            }
         }
         text
     }

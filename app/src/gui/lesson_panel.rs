@@ -49,6 +49,7 @@ pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
         ui.label(egui::RichText::new("(the answer once the step is ready)").weak());
     } else if revealed {
         ui.label(egui::RichText::new(format!("Answer: {answer}")).color(egui::Color32::from_rgb(250, 220, 120)));
+        claim_ui(cx, ui);
     } else if ui.button("Reveal the answer (A)").clicked() {
         cx.out.push(Action::RevealAnswer);
     }
@@ -94,7 +95,17 @@ pub fn caption_ui(cx: &Ctx, ui: &mut egui::Ui) {
     }
     if state.revealed {
         ui.label(egui::RichText::new(&step.answer).color(egui::Color32::from_rgb(180, 230, 255)));
+        claim_ui(cx, ui);
     }
+}
+
+/// Under the answer: its claim judged against the numbers on screen (issue #57: an answer of
+/// "1.15 to 2.6 times less" stood under 1.07× measured), in amber when this machine's value is
+/// outside it.
+fn claim_ui(cx: &Ctx, ui: &mut egui::Ui) {
+    let Some(j) = cx.model.lesson().and_then(|l| l.claim_check(cx.model.sessions())) else { return };
+    let colour = if j.holds { egui::Color32::from_rgb(170, 220, 170) } else { egui::Color32::from_rgb(250, 170, 80) };
+    ui.label(egui::RichText::new(j.text).color(colour));
 }
 
 /// The first start's offer: the lessons, or the free app.

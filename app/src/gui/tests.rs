@@ -1557,3 +1557,24 @@ fn the_second_round_classroom_session_replays_at_both_sizes() {
         assert_layout_fits(&h, &at("restart"));
     }
 }
+
+/// Issue #57: why-high-order's answer said "1.15 to 2.6 times less" under 1.07× measured on
+/// screen. The answer's claim is judged under it against the numbers on screen, and says when
+/// this machine's value is outside it.
+#[test]
+fn a_revealed_answer_judges_its_claim_against_the_numbers_on_screen() {
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "locking").unwrap();
+    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
+    lesson_ready(&mut h);
+    h.key_press(egui::Key::A);
+    h.run_steps(2);
+    let state = h.state().model().lesson().unwrap();
+    let values: Vec<f64> = state.measured(h.state().model().sessions()).iter().map(|m| m.value).collect();
+    let judged = state.claim_check(h.state().model().sessions()).expect("the step claims a ratio");
+    assert!((judged.value - values[0] / values[1]).abs() < 1e-12);
+    assert!(judged.holds, "{}", judged.text);
+    h.get_by_label_contains("measured here: A/B = ");
+    assert!(h.state().model().lesson_text().unwrap().contains(&judged.text), "the browsers' view too");
+}

@@ -179,6 +179,8 @@ pub struct Step {
     pub text: String,
     pub question: String,
     pub answer: String,
+    /// What the answer claims of the numbers, judged beside it as measured.
+    pub claim: Option<crate::lab::claim::Claim>,
 }
 
 /// A lesson.
@@ -222,6 +224,7 @@ struct StepFile {
     text: String,
     question: String,
     answer: String,
+    claim: Option<crate::lab::claim::Claim>,
 }
 
 /// Names of the built-in lessons, comma-separated.
@@ -291,6 +294,9 @@ impl Lesson {
             {
                 return Err(at("camera", format!("unknown '{c}' (cameras: {})", CAMERAS.join(", "))));
             }
+            if let Some(c) = &s.claim {
+                c.check(configurations.len()).map_err(|m| at("claim", m))?;
+            }
             let reference_element = match s.view.as_deref() {
                 None | Some("model") => false,
                 Some("reference-element") => true,
@@ -306,6 +312,7 @@ impl Lesson {
                 text: reflow(&s.text),
                 question: reflow(&s.question),
                 answer: reflow(&s.answer),
+                claim: s.claim.clone(),
             });
         }
         Ok(Lesson {

@@ -1,6 +1,7 @@
 //! The lab: what is done with scenes once loaded — measured, studied, reported, timed, taught.
 //! Scene loading (`params`, `scene`, `instance`, `run`) never uses it. Its files, lowest first
 //! (each uses only those before it; `tests/tests/rooms.rs` keeps the order):
+//! - [`claim`] — what a lesson step's answer claims of its numbers, judged as measured;
 //! - [`reference`] — what an error is measured against: committed, computed or own-mesh
 //!   references, Richardson's estimates, the cache;
 //! - [`study`] — the accuracy-versus-time study (`hox study`);
@@ -12,6 +13,7 @@
 //! own name (`hox_scenes::study`, …).
 
 pub mod bench;
+pub mod claim;
 pub mod lesson;
 pub mod paper;
 pub mod reference;
