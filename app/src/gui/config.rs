@@ -35,6 +35,31 @@ impl SceneSource {
     }
 }
 
+/// The labels of two configurations of `base`, told apart: when their labels are the same, each
+/// says the (first two) parameters in which they differ (issue #57: two "P2 8×2×2 five" beams
+/// of 50 and 100 substeps).
+pub fn distinct_labels(configs: &[&Config], base: &Scene) -> Vec<String> {
+    let mut labels: Vec<String> = configs.iter().map(|c| label(c, base)).collect();
+    if let [a, b] = configs
+        && labels[0] == labels[1]
+    {
+        let keys: Vec<&str> = a
+            .changed_keys(b)
+            .into_iter()
+            .filter(|k| hox_scenes::params::by_key(k).is_some_and(|p| p.group != hox_scenes::params::Group::Display))
+            .take(2)
+            .collect();
+        for (label, c) in labels.iter_mut().zip([a, b]) {
+            for k in &keys {
+                if let Some(p) = hox_scenes::params::by_key(k) {
+                    label.push_str(&format!(" · {k} {}", (p.get)(c)));
+                }
+            }
+        }
+    }
+    labels
+}
+
 /// The folder (in the system's temporary one) of the scene files written for mesh files.
 pub const MESH_SCENES: &str = "hox-app-scenes";
 

@@ -45,10 +45,11 @@ pub fn controls_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
         cx.out.push(Action::SetCompare(compare));
     }
     if cx.model.compare() {
+        let names = super::session::labels(cx.model.sessions());
         ui.horizontal(|ui| {
             ui.label("Editing:");
             for k in 0..2 {
-                let text = format!("{} {}", ["A", "B"][k], cx.model.sessions()[k].label());
+                let text = format!("{} {}", ["A", "B"][k], names[k]);
                 if ui
                     .selectable_label(cx.model.active() == k, text)
                     .on_hover_text("The configuration the controls below change.")

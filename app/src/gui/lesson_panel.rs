@@ -34,8 +34,9 @@ pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
             ui.label(PREPARING);
         });
     } else {
-        for (k, (m, s)) in measured.iter().zip(model.sessions()).enumerate() {
-            ui.label(egui::RichText::new(format!("{} {}: {}", ["A", "B"][k.min(1)], s.label(), m.text)).monospace());
+        let names = super::session::labels(model.sessions());
+        for (k, (m, name)) in measured.iter().zip(&names).enumerate() {
+            ui.label(egui::RichText::new(format!("{} {name}: {}", ["A", "B"][k.min(1)], m.text)).monospace());
         }
     }
     if let Some(p) = &state.problem {

@@ -262,3 +262,19 @@ fn a_slow_display_pauses_and_the_pause_message_goes_with_the_next_change() {
     m.apply(Action::change("grid", c)).unwrap();
     assert_eq!(m.message(), None);
 }
+
+/// Issue #57: accuracy-cost's two beams were both named "P2 8×2×2 five" though their substeps
+/// differ; each label now says what tells them apart.
+#[test]
+fn two_configurations_that_differ_only_in_settings_are_named_apart() {
+    let mut m = model("bending");
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "accuracy-cost").unwrap();
+    m.apply(Action::OpenLesson(Box::new(lesson))).unwrap();
+    m.apply(Action::Poll { wait_for_lesson: true }).unwrap();
+    let labels = super::session::labels(m.sessions());
+    assert_eq!(labels, ["P2 8×2×2 five · substeps 50", "P2 8×2×2 five · substeps 100"]);
+    // labels that differ already are left as they are
+    let mut p = model("bending");
+    p.apply(Action::SetCompare(true)).unwrap();
+    assert_eq!(super::session::labels(p.sessions()), ["P1 8×2×2 five r1", "P2 8×2×2 five"]);
+}

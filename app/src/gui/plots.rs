@@ -98,15 +98,16 @@ pub fn plots_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
         }
     });
     let names = ["A", "B"];
+    let labels = super::session::labels(model.sessions());
     match cx.state.bottom_tab {
         Tab::Probe => {
             let probe = model.sessions()[0].instance.probes.first().map_or("probe".to_string(), |p| p.name.clone());
             let axes = cx.state.probe_axes(model.compare());
             let mut entries = Vec::new();
-            for (k, s) in model.sessions().iter().enumerate() {
+            for k in 0..model.sessions().len() {
                 for (axis, label) in ["u_x", "u_y", "u_z"].iter().enumerate().filter(|(a, _)| axes[*a]) {
                     let name =
-                        if model.compare() { format!("{} {} {label}", names[k], s.label()) } else { label.to_string() };
+                        if model.compare() { format!("{} {} {label}", names[k], labels[k]) } else { label.to_string() };
                     entries.push((name, line_colour(model.compare(), k, axis), false));
                 }
             }
@@ -131,7 +132,7 @@ pub fn plots_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
                             let points =
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.probe_m[i][axis], MAX_PLOT_POINTS));
                             let name = if model.compare() {
-                                format!("{} {} {label}", names[k], s.label())
+                                format!("{} {} {label}", names[k], labels[k])
                             } else {
                                 label.to_string()
                             };

@@ -58,6 +58,15 @@ pub struct Drag {
 /// Compliance of the mouse attachment, m/N (stiff, but not rigid).
 const DRAG_COMPLIANCE_M_PER_N: f64 = 1e-6;
 
+/// The labels of `sessions`, told apart where they would read the same
+/// ([`config::distinct_labels`]).
+pub fn labels(sessions: &[Session]) -> Vec<String> {
+    match sessions.first() {
+        Some(first) => config::distinct_labels(&sessions.iter().map(|s| &s.config).collect::<Vec<_>>(), &first.base),
+        None => Vec::new(),
+    }
+}
+
 /// The static equilibrium of `scene` on `mesh` (hox's static solver): the positions a lesson's
 /// static step shows. Pure, so that it runs in the background as well as here.
 pub fn static_positions(scene: &hox_scenes::scene::Scene, mesh: &hox_sim::mesh::Mesh) -> Result<Vec<Vec3>, String> {

@@ -6,6 +6,7 @@ use eframe::egui;
 
 pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
     let model = cx.model;
+    let names = super::session::labels(model.sessions());
     ui.horizontal_wrapped(|ui| {
         for (k, s) in model.sessions().iter().enumerate() {
             let sim = &s.instance.sim;
@@ -16,7 +17,7 @@ pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
             let mut text = format!(
                 "{}{}: {} nodes, {} el, {ms}, {}",
                 if model.compare() { ["A ", "B "][k] } else { "" },
-                s.label(),
+                names[k],
                 sim.mesh().num_nodes(),
                 sim.mesh().num_elements(),
                 s.readout().error_text()

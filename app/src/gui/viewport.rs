@@ -411,15 +411,16 @@ impl Viewport {
             drawn.bodies.push(self.screen_extent(&s.instance.sim.positions, o).unwrap_or(egui::Rect::NOTHING));
         }
         if sessions.len() > 1 {
+            let names = super::session::labels(sessions);
             for (k, s) in sessions.iter().enumerate() {
                 let body = drawn.bodies[k];
                 if !body.is_positive() {
                     continue;
                 }
                 let text = match (&self.lesson_labels, self.short_labels) {
-                    (_, true) => format!("{}: {}", ["A", "B"][k.min(1)], s.label()),
-                    (Some(labels), false) if k < labels.len() => body_label(k, &s.label(), &labels[k]),
-                    _ => body_label(k, &s.label(), &s.readout_label()),
+                    (_, true) => format!("{}: {}", ["A", "B"][k.min(1)], names[k]),
+                    (Some(labels), false) if k < labels.len() => body_label(k, &names[k], &labels[k]),
+                    _ => body_label(k, &names[k], &s.readout_label()),
                 };
                 // wrapped to the room beside the legend (issue #57: at 1280×720 with a lesson's
                 // panel the view is narrow, and a long label sat on the legend)

@@ -552,7 +552,9 @@ pub fn measure(
             match reference {
                 Some(r) => {
                     let (m, pct) = (r.error_m(&now).unwrap_or(f64::NAN), r.error_pct(&now).unwrap_or(f64::NAN));
-                    Measured { value: m, text: format!("{m:.3e} m ({pct:.2} %)") }
+                    // the readout's format (issue #57: "5.521e-2 m" beside "0.05521 m")
+                    let metres = crate::present::colour::format_value(m, "m");
+                    Measured { value: m, text: format!("{metres} ({pct:.2} %)") }
                 }
                 None => Measured { value: f64::NAN, text: "no reference".into() },
             }
