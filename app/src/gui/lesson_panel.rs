@@ -17,6 +17,19 @@ pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
     let measured = state.measured(model.sessions());
     let n = state.lesson.steps.len();
     ui.heading(&state.lesson.title);
+    // the step buttons first: they never scroll out of view below a long answer (issue #57)
+    let at = state.step;
+    ui.horizontal_wrapped(|ui| {
+        if ui.add_enabled(at > 0, egui::Button::new("< Previous (left arrow)")).clicked() {
+            cx.out.push(Action::LessonStep(-1));
+        }
+        if ui.add_enabled(at + 1 < n, egui::Button::new("Next (right arrow) >")).clicked() {
+            cx.out.push(Action::LessonStep(1));
+        }
+        if ui.button("Close lesson").clicked() {
+            cx.out.push(Action::CloseLesson);
+        }
+    });
     ui.label(egui::RichText::new(&state.lesson.goal).italics());
     ui.separator();
     ui.label(egui::RichText::new(format!("Step {} of {n}: {}", state.step + 1, step.title)).strong().size(18.0));
@@ -45,7 +58,7 @@ pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
     ui.add_space(6.0);
     // no answer while the step is prepared: the numbers it speaks of are not there yet
     let (revealed, preparing) = (state.revealed, state.preparing());
-    let (at, answer) = (state.step, step.answer.clone());
+    let answer = step.answer.clone();
     if preparing {
         ui.label(egui::RichText::new("(the answer once the step is ready)").weak());
     } else if revealed {
@@ -54,18 +67,6 @@ pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
     } else if ui.button("Reveal the answer (A)").clicked() {
         cx.out.push(Action::RevealAnswer);
     }
-    ui.add_space(6.0);
-    ui.horizontal(|ui| {
-        if ui.add_enabled(at > 0, egui::Button::new("< Previous (left arrow)")).clicked() {
-            cx.out.push(Action::LessonStep(-1));
-        }
-        if ui.add_enabled(at + 1 < n, egui::Button::new("Next (right arrow) >")).clicked() {
-            cx.out.push(Action::LessonStep(1));
-        }
-        if ui.button("Close lesson").clicked() {
-            cx.out.push(Action::CloseLesson);
-        }
-    });
 }
 
 /// In presenter mode: the step's caption and numbers in a panel below the 3D view (issue #35:

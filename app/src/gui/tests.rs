@@ -1578,3 +1578,26 @@ fn a_revealed_answer_judges_its_claim_against_the_numbers_on_screen() {
     h.get_by_label_contains("measured here: A/B = ");
     assert!(h.state().model().lesson_text().unwrap().contains(&judged.text), "the browsers' view too");
 }
+
+/// Issue #57: at 1280×720 the lesson's Next and Previous scrolled out of view once the answer
+/// was revealed. They stand above the step's text now, in view whatever its length.
+#[test]
+fn the_step_buttons_stay_in_view_after_a_long_answer_at_1280x720() {
+    // a 1280×720 screen less the window's decorations (scripts/classroom-screenshots.sh)
+    let size = egui::vec2(1264.0, 680.0);
+    let mut h = harness_sized(AppArgs::default(), size);
+    h.run_steps(2);
+    // the step with the longest text, question and answer
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "curved-boundaries").unwrap();
+    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
+    lesson_ready(&mut h);
+    h.key_press(egui::Key::A);
+    h.run_steps(3);
+    h.get_by_label_contains("Answer:");
+    // the lesson panel ends where the plots begin: a button below that is scrolled out of view
+    let plots_top = h.get_by_label("Probe displacement").rect().top();
+    for button in ["< Previous (left arrow)", "Next (right arrow) >", "Close lesson"] {
+        let r = h.get_by_label(button).rect();
+        assert!(r.top() >= 0.0 && r.bottom() <= plots_top, "{button} at {r:?}, below the panel's end at {plots_top}");
+    }
+}
