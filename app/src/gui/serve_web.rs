@@ -12,7 +12,11 @@ use eframe::egui;
 pub fn address_ui(cx: &Ctx, ui: &mut egui::Ui) {
     let Some(url) = cx.status.web_url.as_deref() else { return };
     let Some((width, modules)) = crate::web::qr_modules(url) else { return };
-    let side = ui.available_width().clamp(120.0, 220.0);
+    // the code and the address under it both fit: beside a lesson's caption the panel is low
+    // (issue #57: at 1280×720 the code was cut off and the address below it lost)
+    let address_room = 4.0 * ui.text_style_height(&egui::TextStyle::Small) + 8.0;
+    let title_room = ui.text_style_height(&egui::TextStyle::Body) + 8.0;
+    let side = ui.available_width().min(ui.available_height() - address_room - title_room).clamp(90.0, 220.0);
     let module = (side / (width as f32 + 8.0)).floor().max(2.0);
     let quiet = 4.0 * module;
     let side = width as f32 * module + 2.0 * quiet;

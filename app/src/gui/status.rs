@@ -7,6 +7,10 @@ use eframe::egui;
 pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
     let model = cx.model;
     let names = super::session::labels(model.sessions());
+    // in a lesson, the step's measurement, as its panel and the labels show it (issue #57:
+    // "paused mid-swing" on steps that are not about motion)
+    let lesson =
+        model.lesson().filter(|l| !l.preparing()).map(|l| (l.current().measure.title(), l.measured(model.sessions())));
     ui.horizontal_wrapped(|ui| {
         for (k, s) in model.sessions().iter().enumerate() {
             let sim = &s.instance.sim;
@@ -20,7 +24,10 @@ pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
                 names[k],
                 sim.mesh().num_nodes(),
                 sim.mesh().num_elements(),
-                s.readout().error_text()
+                match &lesson {
+                    Some((title, measured)) => measured.get(k).map_or_else(String::new, |m| format!("{title} {}", m.text)),
+                    None => s.readout().error_text(),
+                }
             );
             if s.settler.is_some() {
                 text += " (settling…)";
