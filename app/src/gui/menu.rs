@@ -72,7 +72,9 @@ pub fn menu_bar_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
         ui.label(format!("t = {:.2} s", cx.model.sessions()[0].instance.sim.time_secs()));
         if let Some(m) = cx.model.message() {
             ui.separator();
-            ui.label(m);
+            // cut to the bar's width with "…", whole on hover (issue #57: the serving address ran
+            // off the window's edge)
+            ui.add(egui::Label::new(m).truncate()).on_hover_text(m);
         }
     });
 }
