@@ -11,6 +11,11 @@ use egui_plot::{Line, Plot, PlotPoints};
 /// renderer more than the rest of the window; min/max pairs per bucket keep the envelope.
 const MAX_PLOT_POINTS: usize = 1200;
 
+// The time plots' lines are drawn as lines, never as egui_plot's per-pixel bands
+// (`Line::allow_band(false)`): once a minute of swinging put several samples in some pixel
+// columns, the band drawing covered only those columns and the probe plot turned to dashes
+// (issue #57).
+
 /// The samples `(t[i], y(i))`, reduced to at most about `max_points` by keeping each bucket's
 /// minimum and maximum in time order (oscillations keep their full amplitude).
 pub fn decimate(t: &[f64], y: impl Fn(usize) -> f64, max_points: usize) -> Vec<egui_plot::PlotPoint> {
@@ -136,7 +141,9 @@ pub fn plots_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
                             } else {
                                 label.to_string()
                             };
-                            plot.line(Line::new(name, points).color(line_colour(model.compare(), k, axis)));
+                            plot.line(
+                                Line::new(name, points).color(line_colour(model.compare(), k, axis)).allow_band(false),
+                            );
                         }
                     }
                     let h = &first.history;
@@ -189,14 +196,16 @@ pub fn plots_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
                                 format!("{prefix}kinetic"),
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.kinetic_j[i], MAX_PLOT_POINTS)),
                             )
-                            .color(line_colour(model.compare(), k, 0)),
+                            .color(line_colour(model.compare(), k, 0))
+                            .allow_band(false),
                         );
                         plot.line(
                             Line::new(
                                 format!("{prefix}elastic"),
                                 PlotPoints::Owned(decimate(&h.time_secs, |i| h.elastic_j[i], MAX_PLOT_POINTS)),
                             )
-                            .color(line_colour(model.compare(), k, 2)),
+                            .color(line_colour(model.compare(), k, 2))
+                            .allow_band(false),
                         );
                     }
                 },

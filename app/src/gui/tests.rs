@@ -1628,3 +1628,26 @@ fn the_step_buttons_stay_in_view_after_a_long_answer_at_1280x720() {
         assert!(r.top() >= 0.0 && r.bottom() <= plots_top, "{button} at {r:?}, below the panel's end at {plots_top}");
     }
 }
+
+/// Issue #57: after about a minute of swinging the probe plot turned to dashes: egui_plot drew
+/// the line as per-pixel bands once several samples fell in some pixel columns, covering only
+/// those columns. The time plots draw lines, never bands.
+#[test]
+fn a_minute_of_swinging_is_plotted_as_a_line_not_as_dashes() {
+    let mut h = harness(AppArgs { compare: vec![String::new()], ..Default::default() });
+    h.run_steps(2);
+    // 70 s of a 0.9 s swing at 60 frames a second, as the history holds it
+    for s in h.state_mut().model_mut().sessions_mut() {
+        let history = &mut s.history;
+        for i in 0..4200 {
+            let t = i as f64 / 60.0;
+            history.time_secs.push(t);
+            history.probe_m.push([0.0, 0.0, -0.3 + 0.3 * (t * std::f64::consts::TAU / 0.9).cos()]);
+            history.kinetic_j.push(1.0);
+            history.elastic_j.push(1.0);
+        }
+    }
+    h.run_steps(2);
+    let bands = h.output().shapes.iter().filter(|c| matches!(c.shape, egui::Shape::Band(_))).count();
+    assert_eq!(bands, 0, "the probe plot drawn as bands (dashes)");
+}
