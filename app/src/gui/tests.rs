@@ -1651,3 +1651,26 @@ fn a_minute_of_swinging_is_plotted_as_a_line_not_as_dashes() {
     let bands = h.output().shapes.iter().filter(|c| matches!(c.shape, egui::Shape::Band(_))).count();
     assert_eq!(bands, 0, "the probe plot drawn as bands (dashes)");
 }
+
+/// Issue #57: the stability lesson's unguarded beam blew up out of the view. The camera backs
+/// off to keep a body that grows out of the view in it.
+#[test]
+fn a_beam_blowing_up_stays_in_view() {
+    let mut h = harness_sized(AppArgs::default(), egui::vec2(1280.0, 720.0));
+    h.run_steps(2);
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "stability").unwrap();
+    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
+    lesson_ready(&mut h);
+    // in presenter mode, as the class sees it
+    h.key_press(egui::Key::P);
+    h.run_steps(3);
+    h.key_press(egui::Key::ArrowRight);
+    lesson_ready(&mut h);
+    play_until_paused(&mut h);
+    h.run_steps(40);
+    let d = &h.state().ui_state().viewport.drawn;
+    let view = d.view.expect("drawn");
+    for (k, body) in d.bodies.iter().enumerate().filter(|(_, b)| b.is_positive()) {
+        assert!(view.expand(1.0).contains_rect(*body), "body {k} {body:?} out of the view {view:?}");
+    }
+}

@@ -410,6 +410,16 @@ impl Viewport {
         for (s, o) in sessions.iter().zip(offsets) {
             drawn.bodies.push(self.screen_extent(&s.instance.sim.positions, o).unwrap_or(egui::Rect::NOTHING));
         }
+        // a body that grows out of the view (the stability lesson's unguarded beam blowing up,
+        // issue #57) is followed: the camera backs off, a step a frame, unless the user moved it
+        if !self.user_moved
+            && drawn.bodies.iter().any(|b| b.is_positive() && !rect.contains_rect(*b))
+            && self.camera.distance.is_finite()
+            && self.camera.distance < 1e4
+        {
+            self.camera.distance *= 1.25;
+            ui.ctx().request_repaint();
+        }
         if sessions.len() > 1 {
             let names = super::session::labels(sessions);
             for (k, s) in sessions.iter().enumerate() {
