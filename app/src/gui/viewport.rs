@@ -459,7 +459,12 @@ impl Viewport {
                 // or in the bottom-left corner, above the labels already there
                 let low = drawn.labels.iter().map(|l| l.min.y - 4.0).fold(rect.max.y - 4.0, f32::min);
                 let bottom = egui::Rect::from_min_size(egui::pos2(rect.min.x + 4.0, low - size.y), size);
-                let at = [above, below, stacked, bottom].into_iter().find(free).unwrap_or(stacked);
+                // beside the body before any corner (issue #57: in presenter mode a label sat in a
+                // corner far from its body)
+                let beside_y = body.center().y - size.y / 2.0;
+                let left = egui::Rect::from_min_size(egui::pos2(body.min.x - 8.0 - size.x, beside_y), size);
+                let right = egui::Rect::from_min_size(egui::pos2(body.max.x + 8.0, beside_y), size);
+                let at = [above, below, left, right, stacked, bottom].into_iter().find(free).unwrap_or(stacked);
                 painter.galley(at.min, galley, egui::Color32::WHITE);
                 drawn.labels.push(at);
             }
