@@ -213,9 +213,10 @@ impl LessonState {
             .collect()
     }
 
-    /// The step's claim judged against the numbers on screen, once they are all measured.
-    pub fn claim_check(&self, sessions: &[Session]) -> Option<hox_scenes::claim::Judged> {
-        let values: Vec<f64> = self.measured(sessions).iter().map(|m| m.value).collect();
+    /// The step's claim judged against its `measured` numbers ([`LessonState::measured`]), once
+    /// they are all measured.
+    pub fn judge_claim(&self, measured: &[Measured]) -> Option<hox_scenes::claim::Judged> {
+        let values: Vec<f64> = measured.iter().map(|m| m.value).collect();
         self.current().claim.as_ref()?.judge(&values)
     }
 
@@ -235,12 +236,13 @@ impl LessonState {
             text += &format!("*{PREPARING}*\n");
             return text;
         }
-        for (k, m) in self.measured(sessions).iter().enumerate() {
+        let measured = self.measured(sessions);
+        for (k, m) in measured.iter().enumerate() {
             text += &format!("- **{}**: {}\n", ["A", "B"][k.min(1)], m.text);
         }
         if self.revealed {
             text += &format!("\n**Answer:** {}\n", step.answer);
-            if let Some(j) = self.claim_check(sessions) {
+            if let Some(j) = self.judge_claim(&measured) {
                 text += &format!("\n*{}*\n", j.text);
             }
         }

@@ -14,7 +14,7 @@ pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
     let model = cx.model;
     let Some(state) = model.lesson() else { return };
     let step = &state.lesson.steps[state.step];
-    let measured = state.measured(model.sessions());
+    let measured = cx.state.lesson_measured.clone().unwrap_or_default();
     let n = state.lesson.steps.len();
     ui.heading(&state.lesson.title);
     // the step buttons first: they never scroll out of view below a long answer (issue #57)
@@ -74,7 +74,7 @@ pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
 pub fn caption_ui(cx: &Ctx, ui: &mut egui::Ui) {
     let Some(state) = cx.model.lesson() else { return };
     let step = &state.lesson.steps[state.step];
-    let measured = state.measured(cx.model.sessions());
+    let measured = cx.state.lesson_measured.as_deref().unwrap_or_default();
     ui.label(
         egui::RichText::new(format!("{} — {}", state.lesson.title, step.title)).strong().color(egui::Color32::WHITE),
     );
@@ -105,7 +105,8 @@ pub fn caption_ui(cx: &Ctx, ui: &mut egui::Ui) {
 /// "1.15 to 2.6 times less" stood under 1.07× measured), in amber when this machine's value is
 /// outside it.
 fn claim_ui(cx: &Ctx, ui: &mut egui::Ui) {
-    let Some(j) = cx.model.lesson().and_then(|l| l.claim_check(cx.model.sessions())) else { return };
+    let measured = cx.state.lesson_measured.as_deref().unwrap_or_default();
+    let Some(j) = cx.model.lesson().and_then(|l| l.judge_claim(measured)) else { return };
     let colour = if j.holds { egui::Color32::from_rgb(170, 220, 170) } else { egui::Color32::from_rgb(250, 170, 80) };
     ui.label(egui::RichText::new(j.text).color(colour));
 }

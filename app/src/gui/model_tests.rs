@@ -11,13 +11,18 @@ use super::model::{Model, Start};
 use super::presets::{ViewOptions, ViewPreset};
 
 fn model(scene: &str) -> Model {
+    model_with(scene, Background::Inline)
+}
+
+/// The model on `scene` with its one-off jobs run by `background` (frames always in place).
+fn model_with(scene: &str, background: Background) -> Model {
     let start = Start {
         links: Default::default(),
         view: ViewOptions::default(),
         playing: false,
         time_scale: 1.0,
         show_reference_element: false,
-        background: Background::Inline,
+        background,
         stepper: Box::new(InlineStepper::default()),
     };
     Model::new(SceneSource::Builtin(scene.into()), None, start).expect("the scene loads")
@@ -171,16 +176,7 @@ fn a_value_typed_in_a_static_step_never_leaves_the_old_shape_labelled_equilibriu
 }
 
 fn threaded_model(scene: &str) -> Model {
-    let start = Start {
-        links: Default::default(),
-        view: ViewOptions::default(),
-        playing: false,
-        time_scale: 1.0,
-        show_reference_element: false,
-        background: Background::Threads,
-        stepper: Box::new(InlineStepper::default()),
-    };
-    Model::new(SceneSource::Builtin(scene.into()), None, start).expect("the scene loads")
+    model_with(scene, Background::Threads)
 }
 
 /// Waits for the change's meshes built in the background.

@@ -9,8 +9,7 @@ pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
     let names = super::session::labels(model.sessions());
     // in a lesson, the step's measurement, as its panel and the labels show it (issue #57:
     // "paused mid-swing" on steps that are not about motion)
-    let lesson =
-        model.lesson().filter(|l| !l.preparing()).map(|l| (l.current().measure.title(), l.measured(model.sessions())));
+    let lesson = model.lesson().zip(cx.state.lesson_measured.as_ref()).map(|(l, m)| (l.current().measure.title(), m));
     ui.horizontal_wrapped(|ui| {
         for (k, s) in model.sessions().iter().enumerate() {
             let sim = &s.instance.sim;

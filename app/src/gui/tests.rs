@@ -148,6 +148,13 @@ fn a_curved_part_compares_its_orders_and_switches_between_them() {
 }
 
 /// Waits until the lesson step asked for is prepared and installed.
+/// Opens the built-in lesson `name` and waits for its first step.
+fn open_lesson(h: &mut Harness<'_, HoxApp>, name: &str) {
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == name).unwrap();
+    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
+    lesson_ready(h);
+}
+
 fn lesson_ready(h: &mut Harness<'_, HoxApp>) {
     h.run_steps(1);
     h.state_mut().act(Action::Poll { wait_for_lesson: true });
@@ -1377,9 +1384,7 @@ fn a_lesson_s_configurations_do_not_leak_into_the_next_plain_start() {
     let mut c = h.state().model().sessions()[0].config.clone();
     c.youngs_modulus_pa = 2.5e6;
     h.state_mut().act(Action::change("youngs", c.clone()));
-    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "accuracy-cost").unwrap();
-    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
-    lesson_ready(&mut h);
+    open_lesson(&mut h, "accuracy-cost");
     assert_eq!(h.state().model().sessions().len(), 2, "the lesson's pair on screen");
     let kept = h.state().persisted();
     assert_eq!((kept.configs, kept.compare), (vec![c.clone()], false), "what ran before the lesson");
@@ -1592,14 +1597,12 @@ fn the_second_round_classroom_session_replays_at_both_sizes() {
 fn a_revealed_answer_judges_its_claim_against_the_numbers_on_screen() {
     let mut h = harness(AppArgs::default());
     h.run_steps(2);
-    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "locking").unwrap();
-    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
-    lesson_ready(&mut h);
+    open_lesson(&mut h, "locking");
     h.key_press(egui::Key::A);
     h.run_steps(2);
     let state = h.state().model().lesson().unwrap();
     let values: Vec<f64> = state.measured(h.state().model().sessions()).iter().map(|m| m.value).collect();
-    let judged = state.claim_check(h.state().model().sessions()).expect("the step claims a ratio");
+    let judged = state.judge_claim(&state.measured(h.state().model().sessions())).expect("the step claims a ratio");
     assert!((judged.value - values[0] / values[1]).abs() < 1e-12);
     assert!(judged.holds, "{}", judged.text);
     h.get_by_label_contains("measured here: A/B = ");
@@ -1615,9 +1618,7 @@ fn the_step_buttons_stay_in_view_after_a_long_answer_at_1280x720() {
     let mut h = harness_sized(AppArgs::default(), size);
     h.run_steps(2);
     // the step with the longest text, question and answer
-    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "curved-boundaries").unwrap();
-    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
-    lesson_ready(&mut h);
+    open_lesson(&mut h, "curved-boundaries");
     h.key_press(egui::Key::A);
     h.run_steps(3);
     h.get_by_label_contains("Answer:");
@@ -1658,9 +1659,7 @@ fn a_minute_of_swinging_is_plotted_as_a_line_not_as_dashes() {
 fn a_beam_blowing_up_stays_in_view() {
     let mut h = harness_sized(AppArgs::default(), egui::vec2(1280.0, 720.0));
     h.run_steps(2);
-    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "stability").unwrap();
-    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
-    lesson_ready(&mut h);
+    open_lesson(&mut h, "stability");
     // in presenter mode, as the class sees it
     h.key_press(egui::Key::P);
     h.run_steps(3);

@@ -45,6 +45,9 @@ pub struct Status {
 /// The UI's state.
 pub struct UiState {
     pub viewport: Viewport,
+    /// The lesson step's measurements this frame, taken once by the window for the panel, the
+    /// caption, the status line and the labels (None: no lesson, or a step being prepared).
+    pub lesson_measured: Option<Vec<hox_scenes::lesson::Measured>>,
     pub reference_element: ReferenceElementView,
     pub bottom_tab: Tab,
     /// The probe plot's components (None: u_z alone when comparing, else all three).
@@ -82,6 +85,7 @@ impl UiState {
     pub fn new(viewport: Viewport, rerun_url: String, rerun_file: String, offer_lessons: bool) -> UiState {
         UiState {
             viewport,
+            lesson_measured: None,
             reference_element: ReferenceElementView::default(),
             bottom_tab: Tab::default(),
             probe_axes: None,

@@ -78,6 +78,9 @@ impl HoxApp {
         let in_background = self.gl_available && !self.rerun.is_open();
         self.act(Action::Tick { real_dt_secs, one_frame_per_tick: self.measure.is_some(), in_background });
 
+        // the lesson step's numbers, measured once for every panel that shows them
+        self.ui.lesson_measured =
+            self.model.lesson().filter(|l| !l.preparing()).map(|l| l.measured(self.model.sessions()));
         let status = self.status();
         let mut out = Commands::default();
         let gl = self.gl_available;
@@ -120,9 +123,9 @@ impl HoxApp {
         dialogs::pending_change_ui(&mut cx, &ctx);
         egui::CentralPanel::no_frame().show(ui, |ui| {
             cx.state.viewport.short_labels = presenter && cx.model.lesson().is_some();
-            cx.state.viewport.lesson_labels = cx.model.lesson().filter(|l| !l.preparing()).map(|l| {
+            cx.state.viewport.lesson_labels = cx.model.lesson().zip(cx.state.lesson_measured.as_ref()).map(|(l, m)| {
                 let title = l.current().measure.title();
-                l.measured(cx.model.sessions()).into_iter().map(|m| format!("{title}: {}", m.text)).collect()
+                m.iter().map(|m| format!("{title}: {}", m.text)).collect()
             });
             let offsets = cx.model.offsets();
             let drag = cx.state.viewport.ui(ui, cx.model.sessions(), &offsets, cx.model.view(), gl);
