@@ -39,6 +39,8 @@ use rerun::RecordingStream;
 use rerun::blueprint as bp;
 
 pub mod eye;
+mod legend;
+mod retire;
 mod section;
 
 /// The bounding box of `instances`' rest shapes placed at `offsets`, metres (what a
@@ -96,15 +98,16 @@ impl LogSettings {
 struct Fixed<'a> {
     rec: &'a RecordingStream,
     statics: bool,
+    logged: &'a mut retire::Logged,
 }
 
 impl Fixed<'_> {
     fn log<A: ?Sized + rerun::AsComponents>(
-        &self,
+        &mut self,
         path: impl Into<rerun::EntityPath>,
         archetype: &A,
     ) -> Result<(), rerun::RecordingStreamError> {
-        self.rec.log_with_static(path, self.statics, archetype)
+        self.logged.log(self.rec, path, self.statics, archetype)
     }
 }
 
@@ -148,6 +151,8 @@ pub struct Recorder {
     time_offset: (i64, f64),
     /// The blueprint's legend column starts with the lesson's step text.
     lesson_text: bool,
+    /// What it logged, to retire when replaced on a stream that goes on ([`Recorder::retire`]).
+    logged: retire::Logged,
 }
 
 /// A name usable as one entity path part: lowercase letters, digits and `_`.
@@ -193,8 +198,6 @@ const SERIES: [[u8; 3]; 6] =
 /// The clamped and driven face edges (as the viewport draws them).
 const CLAMPED: [u8; 3] = [70, 120, 255];
 const DRIVEN: [u8; 3] = [230, 70, 230];
-/// Pixel size of a colour-bar image (its tick labels sit to its right, [`log_ticks`]).
-const BAR_PX: [u32; 2] = [20, 200];
 
 /// The entity of the chart of probe `probe`'s component `axis` (0–2).
 fn probe_plot(probe: &str, axis: usize) -> String {
@@ -209,6 +212,7 @@ impl SimLogger {
         config: &Configuration<'_>,
         settings: &LogSettings,
         fields: &[Field],
+        logged: &mut retire::Logged,
     ) -> Result<SimLogger, rerun::RecordingStreamError> {
         let (name, instance) = (entity_name(&config.name), config.instance);
         let mesh = instance.sim.mesh();
@@ -217,7 +221,7 @@ impl SimLogger {
             .quadrature_points
             .then(|| hox_sim::measure::surface::quadrature_points(mesh, instance.sim.geometry()));
         let root = format!("world/{name}");
-        let fixed = Fixed { rec, statics: settings.static_data };
+        let mut fixed = Fixed { rec, statics: settings.static_data, logged };
         fixed.log(root.as_str(), &rerun::Transform3D::from_translation(f32s(&config.offset_m)))?;
         for field in fields {
             fixed.log(
@@ -242,7 +246,7 @@ impl SimLogger {
             format!("{root}/probes"),
             &rerun::Points3D::update_fields()
                 .with_labels(probe_names.iter().map(String::as_str))
-                .with_colors([rerun::Color::from_rgb(230, 60, 40)])
+                .with_colors([rerun::Color::from_rgb(190, 30, 20)])
                 .with_radii([rerun::Radius::new_ui_points(6.0)]),
         )?;
         fixed.log(
@@ -342,17 +346,19 @@ impl SimLogger {
         instance: &Instance,
         ranges: &[ColourRange],
         ms_per_frame: f64,
+        logged: &mut retire::Logged,
     ) -> Result<(), rerun::RecordingStreamError> {
         let sim = &instance.sim;
         let root = format!("world/{}", self.name);
         if let Some(section) = &mut self.section {
-            section.log(rec, &root, instance)?;
+            section.log(rec, logged, &root, instance)?;
         }
         let frame = &self.frame;
         let positions: Vec<[f32; 3]> = frame.positions_m.iter().map(f32s).collect();
         let normals: Vec<[f32; 3]> = frame.normals.iter().map(f32s).collect();
         for ((source, values), range) in self.sources.iter().zip(ranges) {
-            rec.log(
+            logged.at(
+                rec,
                 format!("{root}/surface/{}", source.field.name()),
                 &rerun::Mesh3D::update_fields()
                     .with_vertex_positions(positions.iter().copied())
@@ -366,31 +372,45 @@ impl SimLogger {
         let strips = |edges: &mut dyn Iterator<Item = &Vec<u32>>| -> Vec<Vec<[f32; 3]>> {
             edges.map(|e| e.iter().map(|&i| positions[i as usize]).collect()).collect()
         };
-        rec.log(
+        logged.at(
+            rec,
             format!("{root}/edges"),
             &rerun::LineStrips3D::update_fields().with_strips(strips(&mut self.surface.edges.iter())),
         )?;
         for (part, edges) in [("clamped", &self.clamped_edges), ("driven", &self.driven_edges)] {
             if !edges.is_empty() {
                 let mut it = edges.iter().map(|&k| &self.surface.edges[k]);
-                rec.log(format!("{root}/{part}"), &rerun::LineStrips3D::update_fields().with_strips(strips(&mut it)))?;
+                logged.at(
+                    rec,
+                    format!("{root}/{part}"),
+                    &rerun::LineStrips3D::update_fields().with_strips(strips(&mut it)),
+                )?;
             }
         }
         let probe_positions: Vec<[f32; 3]> =
             instance.probes.iter().map(|p| f32s(&p.position(&sim.positions))).collect();
-        rec.log(format!("{root}/probes"), &rerun::Points3D::update_fields().with_positions(probe_positions))?;
+        logged.at(rec, format!("{root}/probes"), &rerun::Points3D::update_fields().with_positions(probe_positions))?;
         if let Some(q) = &self.quadrature {
             q.eval_into(&sim.positions, &mut self.points);
-            rec.log(
+            logged.at(
+                rec,
                 format!("{root}/quadrature_points"),
                 &rerun::Points3D::update_fields().with_positions(self.points.iter().map(f32s)),
             )?;
         }
         for (name, u) in instance.probe_displacements() {
             for (axis, value) in u.iter().enumerate() {
-                rec.log(format!("{}/{}", probe_plot(&name, axis), self.name), &rerun::Scalars::single(*value))?;
+                logged.at(
+                    rec,
+                    format!("{}/{}", probe_plot(&name, axis), self.name),
+                    &rerun::Scalars::single(*value),
+                )?;
                 if let Some(r) = self.reference.as_ref().and_then(|r| r.get(&name)) {
-                    rec.log(format!("{}/reference_static", probe_plot(&name, axis)), &rerun::Scalars::single(r[axis]))?;
+                    logged.at(
+                        rec,
+                        format!("{}/reference_static", probe_plot(&name, axis)),
+                        &rerun::Scalars::single(r[axis]),
+                    )?;
                 }
             }
         }
@@ -402,7 +422,7 @@ impl SimLogger {
             ("ms_per_frame", ms_per_frame),
             ("min_det_f", min_det_f),
         ] {
-            rec.log(format!("plots/{quantity}/{}", self.name), &rerun::Scalars::single(value))?;
+            logged.at(rec, format!("plots/{quantity}/{}", self.name), &rerun::Scalars::single(value))?;
         }
         Ok(())
     }
@@ -428,24 +448,27 @@ impl Recorder {
         };
         // z up, as the scenes are built (gravity along −z)
         rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
-        let fixed = Fixed { rec, statics: settings.static_data };
+        let mut logged = retire::Logged::default();
         let mut loggers = Vec::new();
         for (k, c) in configs.iter().enumerate() {
-            loggers.push(SimLogger::new(rec, k, c, settings, &fields)?);
+            loggers.push(SimLogger::new(rec, k, c, settings, &fields, &mut logged)?);
         }
         let probe_names = first.map(|i| i.probes.iter().map(|p| p.name.clone()).collect()).unwrap_or_default();
-        let recorder = Recorder {
+        let mut recorder = Recorder {
             loggers,
             fields,
             scales,
             probe_names,
             time_offset: settings.time_offset,
             lesson_text: settings.lesson_text,
+            logged,
         };
+        let legend = rerun::TextDocument::from_markdown(recorder.legend_markdown(configs));
+        let logged = &mut recorder.logged;
         for field in &recorder.fields {
-            rec.log_static(format!("legend/{}/bar", field.name()), &colour_bar_image())?;
+            logged.log(rec, format!("legend/{}/bar", field.name()), true, &legend::colour_bar_image())?;
         }
-        fixed.log("legend/text", &rerun::TextDocument::from_markdown(recorder.legend_markdown(configs)))?;
+        logged.log(rec, "legend/text", settings.static_data, &legend)?;
         if settings.blueprint {
             let bounds = bounds_of(configs.iter().map(|c| (c.instance, c.offset_m)));
             eye::send(rec, recorder.blueprint(), bounds)?;
@@ -459,6 +482,13 @@ impl Recorder {
             rec.log(format!("world/{}", l.name), &rerun::Clear::recursive())?;
         }
         Ok(())
+    }
+
+    /// Hides at every time what this recorder logged and `replacement` (which has logged its
+    /// first frame) does not: bodies, rest shapes, chart lines and legends of configurations
+    /// gone from a stream that goes on (`recording/retire.rs`).
+    pub fn retire(&self, rec: &RecordingStream, replacement: &Recorder) -> Result<(), rerun::RecordingStreamError> {
+        self.logged.retire(rec, &replacement.logged)
     }
 
     /// The entity names of the configurations, in order.
@@ -486,10 +516,10 @@ impl Recorder {
         let ranges: Vec<ColourRange> = self.scales.iter().map(FieldScale::range).collect();
         for (j, range) in ranges.iter().enumerate() {
             let values: Vec<f64> = self.loggers.iter().flat_map(|l| l.sources[j].1.iter().copied()).collect();
-            log_ticks(rec, range, &values)?;
+            legend::log_ticks(rec, &mut self.logged, range, &values)?;
         }
         for ((logger, instance), ms) in self.loggers.iter_mut().zip(instances).zip(ms_per_frame) {
-            logger.log(rec, instance, &ranges, *ms)?;
+            logger.log(rec, instance, &ranges, *ms, &mut self.logged)?;
         }
         Ok(())
     }
@@ -618,50 +648,6 @@ pub fn blueprint_of(root: impl Into<bp::ContainerLike>) -> bp::Blueprint {
         .with_time_panel(
             bp::TimePanel::new().with_state(bp::components::PanelState::Collapsed).with_timeline("sim_time"),
         )
-}
-
-/// A vertical viridis bar, bottom to top, as an RGB image.
-fn colour_bar_image() -> rerun::Image {
-    let [w, h] = BAR_PX;
-    let mut bytes = Vec::with_capacity((w * h * 3) as usize);
-    for row in 0..h {
-        let c = hox_scenes::present::colour::viridis(1.0 - (row as f64 + 0.5) / h as f64);
-        for _ in 0..w {
-            bytes.extend_from_slice(&c);
-        }
-    }
-    rerun::Image::from_rgb24(bytes, BAR_PX)
-}
-
-/// The tick labels of `range` beside its colour bar: five, a quarter of the bar apart, centred
-/// right of it (labels are drawn centred on their points, so a label never covers the bar or
-/// its neighbour at the view sizes of the blueprint); a fixed range's end labels say how much of
-/// the surface is saturated. An invisible corner point keeps the labels inside the view.
-fn log_ticks(rec: &RecordingStream, range: &ColourRange, values: &[f64]) -> Result<(), rerun::RecordingStreamError> {
-    let [w, h] = BAR_PX.map(|v| v as f32);
-    let (over, under) = range.saturation(values);
-    let ticks = range.ticks();
-    let label_x = w + 48.0;
-    let mut positions: Vec<[f32; 2]> =
-        ticks.iter().enumerate().map(|(i, _)| [label_x, h * (1.0 - i as f32 / 4.0)]).collect();
-    let mut labels: Vec<String> = ticks.iter().map(|&t| range.format(t)).collect();
-    if over > 0.0 || !range.automatic {
-        labels[4] = format!("{} ({:.0} % above)", labels[4], 100.0 * over);
-    }
-    if range.field.two_sided() && (under > 0.0 || !range.automatic) {
-        labels[0] = format!("{} ({:.0} % below)", labels[0], 100.0 * under);
-    }
-    let mut colours = vec![rerun::Color::from_rgb(230, 230, 230); 5];
-    positions.push([label_x + 70.0, -10.0]);
-    labels.push(String::new());
-    colours.push(rerun::Color::from_unmultiplied_rgba(0, 0, 0, 0));
-    rec.log(
-        format!("legend/{}/ticks", range.field.name()),
-        &rerun::Points2D::new(positions)
-            .with_labels(labels)
-            .with_colors(colours)
-            .with_radii([rerun::Radius::new_ui_points(1.5)]),
-    )
 }
 
 /// `0.125`, `0.3`, `1.5e-4`: a compact metre value for labels.

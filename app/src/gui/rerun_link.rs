@@ -10,6 +10,12 @@
 //! replaced by a later one; the one the app stops on (pause, the end of a settle) is always
 //! sent, as are rebuilds (a lesson's new step is one) at once. While the app is paused a change
 //! of the lesson's text (the answer revealed) is sent as it happens.
+//!
+//! The stream runs on across rebuilds: new configurations start after the frames logged, the
+//! old ones are cleared there, and what they logged that the new ones do not (their static
+//! rest shapes, chart lines, colour bars) is retired at every time (`recording/retire.rs`), so a
+//! page following the stream shows only what the app shows. An .rrd file saved from the app
+//! therefore keeps, of a configuration gone, only what is logged under a name still in use.
 
 use super::action::RerunTarget;
 use super::model::Model;
@@ -159,6 +165,7 @@ impl RerunLink {
                 return Ok(());
             }
         }
+        let mut retired = None;
         if rebuilt {
             let configs: Vec<Configuration<'_>> = sessions
                 .iter()
@@ -191,13 +198,18 @@ impl RerunLink {
             settings.time_offset = self.time_offset;
             settings.lesson_text = lesson_text.is_some();
             let fields = crate::display::fields(&first.config);
-            self.recorder = Some(Recorder::new(&self.rec, &configs, &settings, &fields)?);
+            retired = self.recorder.replace(Recorder::new(&self.rec, &configs, &settings, &fields)?);
             self.generation = generation;
         }
         let instances: Vec<&hox_scenes::Instance> = sessions.iter().map(|s| &s.instance).collect();
         let ms: Vec<f64> = sessions.iter().map(|s| s.ms_per_frame).collect();
         if let Some(r) = &mut self.recorder {
             r.log_frame(&self.rec, &instances, &ms)?;
+            // what the last configurations logged (static data, chart lines) and the new ones
+            // do not, hidden at every time: the clear above hides only the rest, after it
+            if let Some(old) = &retired {
+                old.retire(&self.rec, r)?;
+            }
         }
         self.last_logged_frame = sessions.first().map(|s| s.instance.sim.frames());
         if let Some(first) = sessions.first() {

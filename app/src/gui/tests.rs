@@ -1312,67 +1312,107 @@ fn the_wait_for_the_next_frame_follows_the_clock_s_remainder_and_the_time_scale(
     assert_eq!(crawl.until_next_frame(frame).as_secs_f64(), 0.25, "at most a quarter second between paints");
 }
 
+/// What a viewer following `path` (an .rrd file) shows at its latest `frame`, as Rerun's own
+/// store answers (latest-at queries, with its clears and static data): the configurations
+/// (`world/<name>`) with a body, rest shape, edges or probes drawn, and the chart lines
+/// (`plots/…`) with a value.
+fn shown_at_latest_frame(path: &std::path::Path) -> (std::collections::BTreeSet<String>, Vec<String>) {
+    use rerun::external::re_entity_db::{EntityDb, external::re_chunk_store::LatestAtQuery};
+    use rerun::external::re_log_encoding::DecoderApp;
+    use rerun::external::re_log_types::StoreKind;
+    let file = std::io::BufReader::new(std::fs::File::open(path).unwrap());
+    let mut db: Option<EntityDb> = None;
+    for msg in DecoderApp::decode_lazy(file) {
+        let msg = msg.unwrap();
+        if msg.store_id().kind() != StoreKind::Recording {
+            continue;
+        }
+        db.get_or_insert_with(|| EntityDb::new(msg.store_id().clone())).add_log_msg(&msg).unwrap();
+    }
+    let db = db.expect("a recording");
+    let frame = rerun::external::re_log_types::TimelineName::from_static_str("frame");
+    let latest = db.time_range_for(&frame).expect("frames").max();
+    let query = LatestAtQuery::new(frame, latest);
+    let drawn = [
+        rerun::Mesh3D::descriptor_vertex_positions().component,
+        rerun::LineStrips3D::descriptor_strips().component,
+        rerun::Points3D::descriptor_positions().component,
+        rerun::Scalars::descriptor_scalars().component,
+    ];
+    let (mut bodies, mut lines) = (std::collections::BTreeSet::new(), Vec::new());
+    for entity in db.sorted_entity_paths() {
+        let results = db.latest_at(&query, entity, drawn);
+        let shown = drawn.iter().any(|&c| results.component_batch_raw(c).is_some_and(|a| !a.is_empty()));
+        let name = entity.to_string().trim_start_matches('/').to_string();
+        if !shown {
+            continue;
+        }
+        if let Some(root) = name.strip_prefix("world/") {
+            bodies.insert(root.split('/').next().unwrap_or(root).to_string());
+        } else if name.starts_with("plots/") {
+            lines.push(name);
+        }
+    }
+    (bodies, lines)
+}
+
+/// The entity names (`world/<name>`) of the configurations on screen in the app's stream.
+fn stream_names(h: &Harness<'_, HoxApp>) -> std::collections::BTreeSet<String> {
+    let sessions = h.state().model().sessions();
+    let names = sessions.iter().enumerate().map(|(k, s)| format!("{}_{}", ["a", "b"][k.min(1)], s.label()));
+    names.map(|n| crate::recording::entity_name(&n)).collect()
+}
+
 /// Issue #57: after → to the next lesson step, the class's browsers drew the last step's beams
-/// over the new ones (two "tip" labels), their clock going back to 0 inside the old step's time.
-/// The app's Rerun stream (here saved to a file, read back with Rerun's decoder) now runs on:
-/// each step's configurations start after the last one's frames, and the last one's bodies are
-/// cleared there, so a viewer at the stream's latest time shows only the current step's.
+/// over the new ones (two "tip" labels, the rest shapes' ghosts) and the charts' legends listed
+/// four configurations, their clock going back to 0 inside the old step's time. The app's Rerun
+/// stream (here saved to a file, read back into Rerun's own store) now runs on: each step's
+/// configurations start after the last one's frames, the last one's bodies are cleared there,
+/// and what they logged as static data or as chart lines is retired (`recording/retire.rs`), so
+/// a viewer at the stream's latest time shows only the current step's bodies and lines. Every
+/// step of two lessons: one with a pair of beams on most steps, one with one beam.
 #[test]
 fn a_browser_following_a_lesson_shows_only_the_current_step_s_bodies() {
-    let dir = std::env::temp_dir().join(format!("hox-lesson-stream-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("lesson.rrd");
-    let mut h = harness(AppArgs::default());
-    h.run_steps(2);
-    h.state_mut().ui.rerun_file = path.display().to_string();
-    h.state_mut().act(super::action::Command::Rerun(Some(super::action::RerunTarget::File)));
-    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == "why-high-order").unwrap();
-    let steps = lesson.steps.len();
-    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
-    lesson_ready(&mut h);
-    for _ in 1..steps.min(3) {
-        h.run_steps(20);
-        h.key_press(egui::Key::ArrowRight);
+    for name in ["why-high-order", "locking"] {
+        let dir = std::env::temp_dir().join(format!("hox-lesson-stream-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("lesson.rrd");
+        let mut h = harness(AppArgs::default());
+        h.run_steps(2);
+        h.state_mut().ui.rerun_file = path.display().to_string();
+        h.state_mut().act(super::action::Command::Rerun(Some(super::action::RerunTarget::File)));
+        h.run_steps(2);
+        let mut streamed = stream_names(&h);
+        let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == name).unwrap();
+        let steps = lesson.steps.len();
+        h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
         lesson_ready(&mut h);
-        h.run_steps(20);
-    }
-    h.state_mut().act(super::action::Command::Rerun(None));
-    let recording = crate::cli::inspect::read_recording(&path).expect("the stream reads back");
-    // per configuration (world/<name>): its last frame of data, and its recursive clears
-    let mut last_data: std::collections::BTreeMap<String, i64> = Default::default();
-    let mut cleared: std::collections::BTreeMap<String, i64> = Default::default();
-    for (entity, summary) in &recording.entities {
-        let Some(root) = entity.strip_prefix("world/").map(|r| r.split('/').next().unwrap_or(r).to_string()) else {
-            continue;
-        };
-        for (component, frames) in &summary.frames_per_component {
-            let Some(&last) = frames.iter().max() else { continue };
-            if component.contains("Clear") {
-                let e = cleared.entry(root.clone()).or_insert(i64::MIN);
-                *e = (*e).max(last);
-            } else {
-                let e = last_data.entry(root.clone()).or_insert(i64::MIN);
-                *e = (*e).max(last);
+        for step in 0..steps {
+            h.run_steps(20);
+            // every step's configurations go into the stream (its file is read once, at the end)
+            streamed.extend(stream_names(&h));
+            if step + 1 < steps {
+                h.key_press(egui::Key::ArrowRight);
+                lesson_ready(&mut h);
             }
         }
-    }
-    let shown: Vec<&String> =
-        last_data.iter().filter(|(root, last)| cleared.get(*root).is_none_or(|c| c < *last)).map(|(r, _)| r).collect();
-    let on_screen = h.state().model().sessions().len();
-    assert!(last_data.len() > on_screen, "several steps' configurations were streamed: {last_data:?}");
-    assert_eq!(
-        shown.len(),
-        on_screen,
-        "only the current step's bodies at the latest time: {shown:?}; cleared {cleared:?}"
-    );
-    // the step on screen was logged after every cleared one's last frame
-    let current_first = last_data.iter().filter(|(r, _)| shown.contains(r)).map(|(_, l)| *l).min().unwrap();
-    for (root, last) in &last_data {
-        if !shown.contains(&root) {
-            assert!(*last < current_first, "{root}'s frames ({last}) run into the current step's ({current_first})");
+        h.run_steps(20);
+        let on_screen = stream_names(&h);
+        h.state_mut().act(super::action::Command::Rerun(None));
+        let (bodies, lines) = shown_at_latest_frame(&path);
+        println!("{name}: streamed {streamed:?}, on screen at the end {on_screen:?}");
+        assert!(streamed.len() > on_screen.len(), "{name}: several steps' configurations were streamed: {streamed:?}");
+        assert_eq!(bodies, on_screen, "{name}: only the current step's bodies at the latest frame");
+        for line in &lines {
+            let owner = line.rsplit('/').next().unwrap();
+            assert!(
+                on_screen.contains(owner) || owner == "reference_static",
+                "{name}: a chart still draws {line}, not on screen ({on_screen:?})"
+            );
         }
+        assert!(lines.iter().any(|l| l.starts_with("plots/kinetic_energy_j/")), "{name}: the charts draw: {lines:?}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Issue #57: a lesson's configurations (two "P2 8×2×2 five" beams of 50 and 100 substeps) came

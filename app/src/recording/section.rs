@@ -49,6 +49,7 @@ impl Section {
     pub fn log(
         &mut self,
         rec: &RecordingStream,
+        logged: &mut super::retire::Logged,
         root: &str,
         instance: &Instance,
     ) -> Result<(), rerun::RecordingStreamError> {
@@ -64,7 +65,8 @@ impl Section {
             })
             .collect();
         let positions: Vec<[f32; 3]> = deformed.iter().map(f32s).collect();
-        rec.log(
+        logged.at(
+            rec,
             format!("{root}/section"),
             &rerun::Mesh3D::new(positions.clone())
                 .with_triangle_indices(self.triangles.iter().map(|t| rerun::TriangleIndices::from(*t)))
@@ -72,7 +74,8 @@ impl Section {
         )?;
         let mut outline: Vec<[f32; 3]> = self.ring.iter().map(|&k| positions[k]).collect();
         outline.extend(outline.first().copied());
-        rec.log(
+        logged.at(
+            rec,
             format!("{root}/section/outline"),
             &rerun::LineStrips3D::new([outline])
                 .with_colors([rerun::Color::from_rgb(10, 10, 10)])
@@ -102,7 +105,7 @@ mod tests {
         let moved = section.probes[corner].position(&instance.sim.positions) - section.rest[corner];
         assert!(moved.norm() > 0.01, "the section's corner turned: {moved}");
         let rec = rerun::RecordingStreamBuilder::new("hox-section-test").buffered().unwrap();
-        section.log(&rec, "world/test", &instance).unwrap();
+        section.log(&rec, &mut super::super::retire::Logged::default(), "world/test", &instance).unwrap();
         assert!(section.u_max >= moved.norm());
         let tube = Instance::new(hox_scenes::by_name("tube").unwrap()).unwrap();
         assert!(Section::of(&tube).is_none());
