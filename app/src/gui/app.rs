@@ -31,6 +31,8 @@ pub struct HoxApp {
     /// software renderer (no vertical sync paces it) unless `--no-vsync` asks for the most
     /// frames (frame-rate measurements); off in the headless UI tests.
     pub(super) pace_paint: bool,
+    /// A figure export waiting for its reference's field (`figure.rs`).
+    pub(super) figure: Option<super::figure::PendingFigure>,
 }
 
 impl HoxApp {
@@ -79,6 +81,7 @@ impl HoxApp {
             gl_available: false,
             renderer: None,
             pace_paint: false,
+            figure: None,
         };
         app.start_configurations(args)?;
         if let Some(v) = args.view {
@@ -204,14 +207,14 @@ impl HoxApp {
             }
             Command::ExportFigure => {
                 let folder = std::path::PathBuf::from(&self.ui.figure_folder);
-                let message = match super::figure::export_figure(&self.model, &folder) {
-                    Ok(files) => format!(
-                        "wrote {}",
-                        files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(" and ")
-                    ),
-                    Err(e) => e,
-                };
-                self.say(Some(message));
+                match super::figure::start_export(&self.model, &folder) {
+                    Ok(super::figure::Export::Pending(pending)) => {
+                        self.say(Some(pending.status()));
+                        self.figure = Some(pending);
+                    }
+                    Ok(super::figure::Export::Written(files)) => self.say(Some(written(&files))),
+                    Err(e) => self.say(Some(e)),
+                }
             }
             Command::OpenFile { mesh, path, clamp_group } => {
                 let source = if mesh {
@@ -260,6 +263,15 @@ impl HoxApp {
     }
 
     /// Tells the model a service's message.
+    /// A figure export waiting for its reference's field: written once the field has come.
+    pub(super) fn poll_figure(&mut self) {
+        let Some(pending) = &mut self.figure else { return };
+        if let Some(done) = pending.poll(&self.model) {
+            self.figure = None;
+            self.say(Some(done.map_or_else(|e| e, |files| written(&files))));
+        }
+    }
+
     fn say(&mut self, message: Option<String>) {
         if let Some(m) = message {
             let _ = self.model.apply(Action::Say(m));
@@ -299,4 +311,9 @@ impl HoxApp {
     pub fn step(&mut self, frames: usize) {
         self.act(Action::Step(frames));
     }
+}
+
+/// "wrote a.svg and a.png".
+fn written(files: &[std::path::PathBuf]) -> String {
+    format!("wrote {}", files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(" and "))
 }

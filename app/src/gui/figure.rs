@@ -1,25 +1,81 @@
 //! The current view exported as the paper's figure (issue #39): the configurations on screen —
 //! A, and B in compare mode — as they are now, sampled inside their elements and drawn in
-//! `hox paper`'s style (`hox_scenes::paper::draw_figure`) against the reference of their physics:
-//! the reference field the app already holds (the error field's), else the static solution on
-//! the figure's coarse Q2 grid, solved on the spot (under a second).
+//! `hox paper`'s style (`hox_scenes::paper::draw_figure`) against the reference the screen
+//! measures them by (issue #57: the figure once drew its own coarse Q2 solution and said
+//! 16.33 % where the screen said 17.19 %). A reference that holds only its probes (a committed
+//! one) gets its displacement field first, solved in the background like the error field's
+//! ([`PendingFigure`]); only where the app has no reference at all is the static solution on
+//! the figure's coarse Q2 grid solved on the spot (under a second) and named so.
 
 use super::model::Model;
+use super::readout::ReferenceState;
 use super::session::Session;
 use hox_scenes::paper::{FigureKind, Panel, draw_figure, panel_of, reference_panel, sample};
-use hox_scenes::reference::ReferenceField;
+use hox_scenes::reference::{Reference, ReferenceField};
 use hox_sim::Vec3;
 use std::path::{Path, PathBuf};
 
-/// Writes the figure of the configurations on screen to `folder` (`fig2-torsion.svg` and `.png`,
-/// …) and returns the files written; the message says what went wrong (not a paper scene, an
-/// unwritable folder).
-pub fn export_figure(model: &Model, folder: &Path) -> Result<Vec<PathBuf>, String> {
+/// A figure export waiting for its reference's displacement field.
+pub struct PendingFigure {
+    folder: PathBuf,
+    reference: ReferenceState,
+}
+
+/// What *Export figure* did: wrote the files, or waits for the reference's field.
+pub enum Export {
+    Written(Vec<PathBuf>),
+    Pending(PendingFigure),
+}
+
+/// Starts the export of the configurations on screen to `folder`: at once when the screen's
+/// reference has its field (or there is none), else once the field is solved.
+pub fn start_export(model: &Model, folder: &Path) -> Result<Export, String> {
+    figure_kind(model)?;
     let first = model.active_session();
-    let name = first.base.name().to_string();
-    let kind = FigureKind::of_scene(&name).ok_or_else(|| {
+    match first.reference.reference() {
+        Some(r) if r.field.is_none() && first.instance.scene.is_box() => {
+            let reference = ReferenceState::for_scene(&first.instance.scene, true);
+            let mut pending = PendingFigure { folder: folder.to_path_buf(), reference };
+            match pending.poll(model) {
+                Some(done) => done.map(Export::Written),
+                None => Ok(Export::Pending(pending)),
+            }
+        }
+        r => export_figure(model, folder, r).map(Export::Written),
+    }
+}
+
+impl PendingFigure {
+    /// The files written once the field has come (or the message why not); None while waiting.
+    pub fn poll(&mut self, model: &Model) -> Option<Result<Vec<PathBuf>, String>> {
+        self.reference.poll();
+        match &self.reference {
+            ReferenceState::Ready { reference, .. } => Some(export_figure(model, &self.folder, Some(reference))),
+            ReferenceState::Failed { message, .. } => Some(Err(format!("figure: the reference's field: {message}"))),
+            ReferenceState::Unavailable(why) => Some(Err(format!("figure: no reference: {why}"))),
+            ReferenceState::Computing { .. } => None,
+        }
+    }
+
+    /// What it waits for, for the status line: "figure: computing reference field … (40 %)".
+    pub fn status(&self) -> String {
+        format!("figure waits for its reference: {}", self.reference.short_status().unwrap_or_default())
+    }
+}
+
+fn figure_kind(model: &Model) -> Result<FigureKind, String> {
+    let name = model.active_session().base.name().to_string();
+    FigureKind::of_scene(&name).ok_or_else(|| {
         format!("the figure export draws the paper's scenes (tension, torsion, bending); this is {name}")
-    })?;
+    })
+}
+
+/// Writes the figure of the configurations on screen to `folder` (`fig2-torsion.svg` and `.png`,
+/// …) against `reference` and returns the files written; the message says what went wrong (not
+/// a paper scene, an unwritable folder).
+fn export_figure(model: &Model, folder: &Path, reference: Option<&Reference>) -> Result<Vec<PathBuf>, String> {
+    let first = model.active_session();
+    let kind = figure_kind(model)?;
     std::fs::create_dir_all(folder).map_err(|e| format!("cannot create the folder {}: {e}", folder.display()))?;
     let stem = folder.join(kind.file_name());
     let (svg_path, png_path) = (stem.with_extension("svg"), stem.with_extension("png"));
@@ -42,7 +98,7 @@ pub fn export_figure(model: &Model, folder: &Path) -> Result<Vec<PathBuf>, Strin
                 .map_err(|e| e.to_string())?,
         );
     }
-    panels.push(reference_of(first, kind, &points)?);
+    panels.push(reference_of(first, reference, kind, &points)?);
     let figure = draw_figure(kind, panels, &points, nu, nv);
     let png = crate::output::svg_to_png(&figure.svg).map_err(|e| format!("{e:#}"))?;
     std::fs::write(&svg_path, &figure.svg).map_err(|e| format!("cannot write {}: {e}", svg_path.display()))?;
@@ -50,9 +106,14 @@ pub fn export_figure(model: &Model, folder: &Path) -> Result<Vec<PathBuf>, Strin
     Ok(vec![svg_path, png_path])
 }
 
-/// The reference panel: the session's reference field when it has one, else solved.
-fn reference_of(s: &Session, kind: FigureKind, points: &[Vec3]) -> Result<Panel, String> {
-    let field = s.reference.reference().and_then(|r| r.field.as_ref());
+/// The reference panel: `reference`'s field when it has one, else solved.
+fn reference_of(
+    s: &Session,
+    reference: Option<&Reference>,
+    kind: FigureKind,
+    points: &[Vec3],
+) -> Result<Panel, String> {
+    let field = reference.and_then(|r| r.field.as_ref());
     let mesh = s.instance.sim.mesh();
     let deformed: Option<Vec<Vec3>> = match field {
         Some(f @ ReferenceField::Lattice { .. }) => Some(points.iter().map(|p| p + f.lattice_at(p)).collect()),
@@ -65,7 +126,8 @@ fn reference_of(s: &Session, kind: FigureKind, points: &[Vec3]) -> Result<Panel,
     };
     match deformed {
         Some(deformed) => Ok(Panel {
-            label: "reference (the app's)".into(),
+            // the screen's name of it, to the mesh ("static (committed), Q2 24×12×12")
+            label: format!("reference: {}", reference.map(short_label).unwrap_or_default()),
             nodes: 0,
             elements: 0,
             ms_per_frame: None,
@@ -75,4 +137,10 @@ fn reference_of(s: &Session, kind: FigureKind, points: &[Vec3]) -> Result<Panel,
         }),
         None => reference_panel(&s.instance.scene, kind, points, true).map_err(|e| e.to_string()),
     }
+}
+
+/// The reference's label ([`Reference::label`]) up to its mesh: what fits under a panel.
+pub fn short_label(reference: &Reference) -> String {
+    let label = reference.label();
+    label.split(", ν =").next().unwrap_or(&label).to_string()
 }

@@ -52,7 +52,10 @@ impl HoxApp {
         self.times.frame_started(now);
         self.act(Action::Poll { wait_for_lesson: false });
         // a reference computed in the background arrives; until then its progress is shown
-        if self.model.sessions().iter().any(|s| matches!(s.reference, ReferenceState::Computing { .. })) {
+        self.poll_figure();
+        if self.figure.is_some()
+            || self.model.sessions().iter().any(|s| matches!(s.reference, ReferenceState::Computing { .. }))
+        {
             ctx.request_repaint_after(std::time::Duration::from_millis(250));
         }
         if self.model.lesson().is_some_and(|l| l.preparing()) || self.model.building().is_some() {
