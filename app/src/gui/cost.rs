@@ -42,9 +42,9 @@ pub struct PendingChange {
     pub built: Option<Built>,
 }
 
-/// New meshes built in the background for a change: `(session, its new configuration, the
-/// instance)` for each session it rebuilds.
-pub type Built = Vec<(usize, Config, hox_scenes::Instance)>;
+/// What was prepared in the background for a change: `(session, its new configuration, what
+/// it needs)` for each session it changes ([`super::rebuild::Prepared`]).
+pub type Built = Vec<(usize, Config, super::rebuild::Prepared)>;
 
 /// What one unit of work ([`frame_work`]) costs on this machine, ms, before any frame has been
 /// measured: explicit (XPBD) and implicit solvers. On the safe side: issue #57's 655,360 P1

@@ -361,7 +361,7 @@ impl Model {
     fn change_or_build(&mut self, control: &str, new: Config, ask: bool) -> Result<(), String> {
         let k = self.active;
         let s = &self.sessions[k];
-        if s.config.invalidated_by(&new) != Invalidates::Mesh || builds_at_once(s, &new) {
+        if builds_at_once(s, &new) {
             return self.change(control, new);
         }
         let mut configs = vec![(k, new.clone())];
@@ -413,9 +413,9 @@ impl Model {
 
     /// Installs meshes built for a change.
     fn install(&mut self, control: &str, built: cost::Built) -> Result<(), String> {
-        for (k, config, instance) in built {
+        for (k, config, prepared) in built {
             let Some(s) = self.sessions.get_mut(k) else { continue };
-            if let Err(reason) = s.apply_with(config, Some(instance)) {
+            if let Err(reason) = prepared.install(s, config) {
                 self.refusal = Some((control.to_string(), reason.clone()));
                 return Err(reason);
             }

@@ -274,3 +274,41 @@ fn two_configurations_that_differ_only_in_settings_are_named_apart() {
     p.apply(Action::SetCompare(true)).unwrap();
     assert_eq!(super::session::labels(p.sessions()), ["P1 8×2×2 five r1", "P2 8×2×2 five"]);
 }
+
+/// Issue #57: a new ν on a large mesh held the window for seconds (4 s on 655,360 P1 elements,
+/// 2.2 s on 81,920 P2): the stability guard visits every element again for another ν or model.
+/// On a mesh above the in-place bound its guard is now computed in the background, the old
+/// material running meanwhile, and installed with exactly the substeps a computation in place
+/// gives; E alone (which only scales the guard) still applies at once.
+#[test]
+fn a_new_poisson_ratio_on_a_large_mesh_computes_its_stability_guard_in_the_background() {
+    let mut m = threaded_model("bending");
+    let mut c = m.sessions()[0].config.clone();
+    c.element = hox_sim::element::ElementType::from_name("p1").unwrap();
+    c.refine = 2;
+    c.grid = [16, 2, 2];
+    m.apply(Action::ChangeNow { control: "grid".into(), config: Box::new(c.clone()) }).unwrap();
+    wait_built(&mut m);
+    assert_eq!(m.sessions()[0].instance.sim.mesh().num_elements(), 20_480);
+    let before = m.sessions()[0].instance.sim.substeps_per_frame();
+    let mut stiff = c.clone();
+    stiff.poisson_ratio = 0.49;
+    m.apply(Action::change("poisson", stiff.clone())).unwrap();
+    let status = m.building().expect("prepared in the background");
+    assert!(status.starts_with("preparing ") && status.contains("poisson"), "{status}");
+    assert_eq!(m.sessions()[0].config.poisson_ratio, c.poisson_ratio, "the old material runs meanwhile");
+    m.apply(Action::Step(1)).unwrap();
+    wait_built(&mut m);
+    let s = &m.sessions()[0];
+    assert_eq!(s.config.poisson_ratio, 0.49);
+    // the same substeps as the guard computed in place on a simulation of its own
+    let mut own = hox_scenes::Instance::new(s.instance.scene.clone()).unwrap();
+    let substeps = own.sim.stability().substeps;
+    assert_eq!(s.instance.sim.substeps_per_frame(), substeps);
+    assert!(substeps > before, "ν 0.49 is stiffer: {substeps} substeps against {before}");
+    // E only scales the guard: at once
+    let mut stiffer = stiff.clone();
+    stiffer.youngs_modulus_pa *= 2.0;
+    m.apply(Action::change("youngs", stiffer)).unwrap();
+    assert!(m.building().is_none() && m.sessions()[0].config.youngs_modulus_pa == 2.0 * stiff.youngs_modulus_pa);
+}

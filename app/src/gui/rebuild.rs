@@ -5,36 +5,90 @@
 //! model, which installs what is still wanted.
 
 use super::background::{Background, Pending};
-use super::config::{self, Config};
+use super::config::{self, Config, Invalidates};
 use super::cost;
 use super::session::Session;
 use hox_sim::Vec3;
+use hox_sim::element::ElementType;
 
-/// [`builds_at_once`]'s bound: element–node pairs of a mesh built in place.
+/// [`builds_at_once`]'s bound: element–node pairs of a mesh built in place, or of a mesh whose
+/// stability guard is computed again in place for a new material.
 const AT_ONCE_NODE_VISITS: f64 = 60_000.0;
 
-/// Whether the new mesh of `new` is small enough to build at once, in place (well under a
-/// second): its elements estimated from `s`'s (the grid's cells, ×8 per refinement level) times
-/// the new element's nodes at most [`AT_ONCE_NODE_VISITS`].
+/// Whether `new` applies to `s` at once, in place (well under a second): a change of settings;
+/// a new material on a mesh of at most [`AT_ONCE_NODE_VISITS`] element–node pairs (another ν
+/// or model has the guard visit every element again: 4 s on 655,360 P1 elements, issue #57);
+/// a new mesh estimated at most as large (its elements from `s`'s: the grid's cells, ×8 per
+/// refinement level). The others are prepared in the background ([`Build`]).
 pub fn builds_at_once(s: &Session, new: &Config) -> bool {
-    let cells = |g: &[usize; 3]| g.iter().map(|&n| n.max(1) as f64).product::<f64>();
-    let ratio = cells(&new.grid) / cells(&s.config.grid) * 8f64.powi(new.refine as i32 - s.config.refine as i32);
-    let elements = s.instance.sim.mesh().num_elements() as f64 * ratio;
-    elements * new.element.reference().num_nodes() as f64 <= AT_ONCE_NODE_VISITS
+    let visits = |elements: f64, element: ElementType| elements * element.reference().num_nodes() as f64;
+    let mesh = s.instance.sim.mesh();
+    match s.config.invalidated_by(new) {
+        Invalidates::Mesh => {
+            let cells = |g: &[usize; 3]| g.iter().map(|&n| n.max(1) as f64).product::<f64>();
+            let ratio =
+                cells(&new.grid) / cells(&s.config.grid) * 8f64.powi(new.refine as i32 - s.config.refine as i32);
+            visits(mesh.num_elements() as f64 * ratio, new.element) <= AT_ONCE_NODE_VISITS
+        }
+        Invalidates::Material => {
+            let pairs: usize = mesh.blocks.iter().map(|b| b.len() * b.nodes_per_element()).sum();
+            pairs as f64 <= AT_ONCE_NODE_VISITS || !needs_guard_again(&s.config, new)
+        }
+        Invalidates::Settings | Invalidates::Nothing => true,
+    }
 }
 
-/// A change that rebuilds meshes, built in the background; estimated once built (`ask`: asked
-/// first when slow), then installed.
+/// Whether a new material has the stability guard visit every element again (another model
+/// or Poisson ratio; E and ρ only scale it).
+fn needs_guard_again(old: &Config, new: &Config) -> bool {
+    (old.material, old.poisson_ratio) != (new.material, new.poisson_ratio)
+}
+
+/// What a change needs, prepared in the background for one session.
+pub enum Prepared {
+    /// Its new mesh, built.
+    Built(Box<hox_scenes::Instance>),
+    /// The rest ω² of its new material on its mesh (the stability guard's).
+    Guard(hox_sim::solver::stability::RestOmega2),
+    /// Nothing (a change the session takes at once: the other configuration's linked field).
+    Nothing,
+}
+
+impl Prepared {
+    /// Applies `config` to `s` with what was prepared for it.
+    pub fn install(self, s: &mut Session, config: Config) -> Result<Invalidates, String> {
+        match self {
+            Prepared::Built(instance) => s.apply_with(config, Some(*instance)),
+            Prepared::Guard(omega2) => {
+                s.instance.sim.seed_rest_omega2(omega2);
+                s.apply(config)
+            }
+            Prepared::Nothing => s.apply(config),
+        }
+    }
+}
+
+/// A job of [`Build`]'s for one session.
+enum Work {
+    Build(Box<hox_scenes::Scene>),
+    Guard(Box<dyn FnOnce() -> Result<hox_sim::solver::stability::RestOmega2, hox_sim::solver::SimError> + Send>),
+    Nothing,
+}
+
+/// A change whose meshes or stability guards take long, prepared in the background; estimated
+/// once built (`ask`: asked first when slow), then installed.
 pub struct Build {
     pub control: String,
     pub ask: bool,
-    /// `(session, its new configuration)` for each session the change rebuilds.
+    /// `(session, its new configuration)` for each session the change changes.
     configs: Vec<(usize, Config)>,
-    instances: Pending<Result<Vec<hox_scenes::Instance>, String>>,
+    /// Whether a new mesh is built (else only stability guards are computed).
+    meshes: bool,
+    prepared: Pending<Result<Vec<Prepared>, String>>,
 }
 
 impl Build {
-    /// Starts building `configs` (`(session, new configuration)`) of `sessions` on
+    /// Starts preparing `configs` (`(session, new configuration)`) of `sessions` on
     /// `background`, each checked against the table first: a refusal names the session's
     /// configuration (`active`'s plainly, the other's as the other's).
     pub fn start(
@@ -45,34 +99,54 @@ impl Build {
         active: usize,
         background: Background,
     ) -> Result<Build, String> {
-        let mut scenes = Vec::new();
+        let mut work = Vec::new();
         for (j, c) in &configs {
-            match config::resolve(c, &sessions[*j].base) {
-                Ok(scene) => scenes.push(scene),
+            let s = &sessions[*j];
+            let scene = match config::resolve(c, &s.base) {
+                Ok(scene) => scene,
                 Err(reason) if *j == active => return Err(reason),
                 Err(reason) => return Err(format!("the other configuration refused it: {reason}")),
-            }
+            };
+            work.push(match s.config.invalidated_by(c) {
+                Invalidates::Mesh => Work::Build(Box::new(scene)),
+                Invalidates::Material if needs_guard_again(&s.config, c) => {
+                    Work::Guard(Box::new(s.instance.sim.rest_omega2_job(&scene.material())))
+                }
+                _ => Work::Nothing,
+            });
         }
-        let instances = background
-            .run(move || scenes.into_iter().map(|s| hox_scenes::Instance::new(s).map_err(|e| e.to_string())).collect());
-        Ok(Build { control: control.to_string(), ask, configs, instances })
+        let meshes = work.iter().any(|w| matches!(w, Work::Build(_)));
+        let prepared = background.run(move || {
+            work.into_iter()
+                .map(|w| match w {
+                    Work::Build(scene) => hox_scenes::Instance::new(*scene)
+                        .map(|i| Prepared::Built(Box::new(i)))
+                        .map_err(|e| e.to_string()),
+                    Work::Guard(job) => job().map(Prepared::Guard).map_err(|e| e.to_string()),
+                    Work::Nothing => Ok(Prepared::Nothing),
+                })
+                .collect()
+        });
+        Ok(Build { control: control.to_string(), ask, configs, meshes, prepared })
     }
 
-    /// "building P1 32×2×2 for grid…", for the status line.
+    /// "building P1 32×2×2 for grid…" ("preparing … for poisson…" when no mesh is built: the
+    /// stability guard's element loop), for the status line.
     pub fn status(&self, base: &hox_scenes::Scene) -> String {
         let what: Vec<String> = self.configs.iter().map(|(_, c)| config::label(c, base)).collect();
-        format!("building {} for {}…", what.join(" and "), self.control)
+        let verb = if self.meshes { "building" } else { "preparing" };
+        format!("{verb} {} for {}…", what.join(" and "), self.control)
     }
 
     pub fn is_ready(&self) -> bool {
-        self.instances.is_ready()
+        self.prepared.is_ready()
     }
 
-    /// The meshes built, with their sessions and configurations; or why not.
+    /// What was prepared, with its sessions and configurations; or why not.
     pub fn finish(self) -> Result<cost::Built, String> {
-        let instances =
-            self.instances.take().unwrap_or_else(|| Err("building the mesh stopped unexpectedly".into()))?;
-        Ok(self.configs.into_iter().zip(instances).map(|((k, c), i)| (k, c, i)).collect())
+        let prepared =
+            self.prepared.take().unwrap_or_else(|| Err("preparing the change stopped unexpectedly".into()))?;
+        Ok(self.configs.into_iter().zip(prepared).map(|((k, c), p)| (k, c, p)).collect())
     }
 }
 
@@ -189,7 +263,10 @@ pub fn redraws(old: &Config, new: &Config) -> bool {
 /// The question about meshes `built` for a change, if one would be slower than the machine
 /// plays ([`cost::too_slow_built`]).
 pub fn question(built: &cost::Built, sessions: &[Session], rates: &cost::Rates, draw_ms: f64) -> Option<String> {
-    built.iter().find_map(|(k, _, i)| sessions.get(*k).and_then(|s| cost::too_slow_built(s, &i.sim, rates, draw_ms)))
+    built.iter().find_map(|(k, _, p)| match p {
+        Prepared::Built(i) => sessions.get(*k).and_then(|s| cost::too_slow_built(s, &i.sim, rates, draw_ms)),
+        Prepared::Guard(_) | Prepared::Nothing => None,
+    })
 }
 
 /// The other configuration `other` after the linked fields of a change from `old` to `new`.

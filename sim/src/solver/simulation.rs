@@ -11,7 +11,9 @@ use super::node_loops;
 use super::registry;
 use super::residual::{StaticResidual, static_residual};
 use super::settings::SolverSettings;
-use super::stability::{GUARD_H_OMEGA, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max};
+use super::stability::{
+    GUARD_H_OMEGA, RestOmega2, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max,
+};
 use super::step::{Hooks, StepInput, StepSolver};
 use super::xpbd::Xpbd;
 
@@ -54,6 +56,8 @@ pub struct Simulation {
     omega2_per_e_over_rho: Option<(f64, usize, usize)>,
     /// A node's mass was set by hand since the masses were last computed from the density.
     masses_overridden: bool,
+    /// The rest ω² of the next material, computed apart ([`Simulation::seed_rest_omega2`]).
+    omega2_seed: Option<RestOmega2>,
     /// Substeps per frame being taken (the requested ones or the guard's).
     substeps_per_frame: u32,
     /// The implicit solvers' integrator history ([`super::integrator`]).
@@ -103,6 +107,7 @@ impl Simulation {
             counters: SolverCounters::default(),
             omega2_per_e_over_rho: None,
             masses_overridden: false,
+            omega2_seed: None,
             substeps_per_frame: settings.substeps,
             history: History::default(),
             body_size_m: 0.0,
@@ -339,11 +344,38 @@ impl Simulation {
             }
         }
         if (material.model, material.poisson_ratio) != (self.material.model, self.material.poisson_ratio) {
-            self.omega2_per_e_over_rho = None;
+            // computed apart for this material ([`Simulation::rest_omega2_job`]), or again here
+            let seed = self
+                .omega2_seed
+                .take()
+                .filter(|s| (s.model, s.poisson_ratio) == (material.model, material.poisson_ratio));
+            self.omega2_per_e_over_rho = seed.map(|s| s.per_e_over_rho);
         }
+        self.omega2_seed = None;
         self.material = material;
         self.update_guard();
         Ok(())
+    }
+
+    /// A job computing on another thread the rest ω² the guard needs after [`Simulation::set_material`]
+    /// to `material` (seconds on a large mesh), with these masses or a new density's lumped ones.
+    pub fn rest_omega2_job(
+        &self,
+        material: &Material,
+    ) -> impl FnOnce() -> Result<RestOmega2, SimError> + Send + 'static {
+        let (mesh, geometry, material) = (self.mesh.clone(), self.geometry.clone(), *material);
+        let masses = (material.density_kg_m3 == self.material.density_kg_m3).then(|| self.masses_kg.clone());
+        move || {
+            let masses = masses.map_or_else(|| lumped_masses_kg(&mesh, material.density_kg_m3), Ok)?;
+            let (omega2, block, element) = mesh_omega2_max(&mesh, &geometry, &material, &masses);
+            let per_e_over_rho = (omega2 * material.density_kg_m3 / material.youngs_modulus_pa, block, element);
+            Ok(RestOmega2 { model: material.model, poisson_ratio: material.poisson_ratio, per_e_over_rho })
+        }
+    }
+
+    /// Hands in a [`Simulation::rest_omega2_job`]'s result for the next [`Simulation::set_material`].
+    pub fn seed_rest_omega2(&mut self, omega2: RestOmega2) {
+        self.omega2_seed = Some(omega2);
     }
 
     /// Changes the solver, time stepping and formulation, keeping the state. A new quadrature

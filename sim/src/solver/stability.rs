@@ -148,6 +148,19 @@ pub fn mesh_omega2_max(
     best
 }
 
+/// The largest rest frequency² of a mesh for one material, per `E/ρ` (what the stability guard
+/// scales), computed apart from the simulation by [`crate::Simulation::rest_omega2_job`] (a
+/// large mesh's takes seconds: an app computes it off its window's thread) and handed back with
+/// [`crate::Simulation::seed_rest_omega2`] before the material changes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RestOmega2 {
+    /// The material model and Poisson ratio it holds for.
+    pub model: crate::material::MaterialModel,
+    pub poisson_ratio: f64,
+    /// `(ω²·ρ/E, block, element)` of the stiffest element.
+    pub per_e_over_rho: (f64, usize, usize),
+}
+
 /// Substeps per frame the guard uses for a mesh whose fastest mode is `omega_max_rad_s`: the
 /// requested ones while their `h ω_max ≤ trigger`, else enough for `h ω_max ≤ target`; and
 /// whether [`GUARD_MAX_SUBSTEPS`] capped it.
