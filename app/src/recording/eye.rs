@@ -3,7 +3,8 @@
 //! (`EyeControls3D` is a view property it does not expose), so the blueprint is made into
 //! messages in memory, every 3D view is found in them by its class, and an `EyeControls3D`
 //! (position and look target) is added at `view/<id>/EyeControls3D` of the same blueprint
-//! before it is sent.
+//! before it is sent; each chart (`TimeSeries` view) gets a `PlotLegend` in a corner its curves
+//! leave free at the end, not over their start.
 //!
 //! The eye looks at the centre of the bodies' bounding box from the front, above and to the
 //! right (the direction of the app's three-quarter view), far enough that a sphere around the
@@ -12,6 +13,7 @@
 use hox_sim::Vec3;
 use rerun::RecordingStream;
 use rerun::blueprint as bp;
+use rerun::external::re_sdk_types::blueprint::{archetypes::PlotLegend, components::Corner2D};
 use rerun::log::LogMsg;
 
 /// Direction from the target to the eye (normalised below): front (−y), right (+x), above (+z).
@@ -72,16 +74,28 @@ pub fn send(
         let path = chunk.entity_path().to_string();
         let path = path.trim_start_matches('/');
         let Some(id) = path.strip_prefix("view/").filter(|id| !id.contains('/')) else { continue };
-        let is_3d = chunk.component_descriptors().any(|d| {
-            d.component.to_string().ends_with("class_identifier")
-                && chunk.iter_slices::<String>(d.component).flat_map(|v| v.into_iter()).any(|s| s.to_string() == "3D")
-        });
-        if is_3d {
-            let chunk = rerun::log::Chunk::builder(format!("view/{id}/EyeControls3D"))
-                .with_archetype(rerun::log::RowId::new(), rerun::TimePoint::default(), &eye)
-                .build()?;
-            let arrow = chunk.to_arrow_msg()?;
-            extra.push(LogMsg::ArrowMsg(store.clone(), arrow));
+        let text = |name: &str| -> Option<String> {
+            let d = chunk.component_descriptors().find(|d| d.component.to_string().ends_with(name))?;
+            chunk.iter_slices::<String>(d.component).flat_map(|v| v.into_iter()).map(|s| s.to_string()).next()
+        };
+        let property =
+            |name: &str, archetype: &dyn rerun::AsComponents| -> Result<LogMsg, rerun::RecordingStreamError> {
+                let chunk = rerun::log::Chunk::builder(format!("view/{id}/{name}"))
+                    .with_archetype(rerun::log::RowId::new(), rerun::TimePoint::default(), archetype)
+                    .build()?;
+                Ok(LogMsg::ArrowMsg(store.clone(), chunk.to_arrow_msg()?))
+            };
+        match text("class_identifier").as_deref() {
+            Some("3D") => extra.push(property("EyeControls3D", &eye)?),
+            Some("TimeSeries") => {
+                // issue #57: the legend's default corner (bottom left) covered each chart's first
+                // second; the curves start there and settle low (a sag, a decaying kinetic energy)
+                // or high (the elastic energy)
+                let settles_high = text("display_name").is_some_and(|n| n.starts_with("elastic energy"));
+                let corner = if settles_high { Corner2D::RightBottom } else { Corner2D::RightTop };
+                extra.push(property("PlotLegend", &PlotLegend::new().with_corner(corner))?);
+            }
+            _ => {}
         }
     }
     messages.extend(extra);
