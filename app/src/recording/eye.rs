@@ -116,6 +116,30 @@ fn blueprint_of_messages(rec: &RecordingStream, messages: Vec<LogMsg>) -> Result
 mod tests {
     use super::*;
 
+    /// Issue #57: each chart's legend sat in its default corner (bottom left), over the first
+    /// second of its curves; the blueprint sent now puts it top right (bottom right for the
+    /// elastic energy, which settles high).
+    #[test]
+    fn a_chart_s_legend_does_not_cover_its_first_second() {
+        let (rec, storage) = rerun::RecordingStreamBuilder::new("hox").memory().unwrap();
+        let charts = ["kinetic energy (J)", "elastic energy (J)", "probe tip: u_z (m)"];
+        let views: Vec<bp::ContainerLike> = charts.iter().map(|c| bp::TimeSeriesView::new(*c).into()).collect();
+        let blueprint = bp::Blueprint::new(bp::Vertical::new(views));
+        send(&rec, blueprint, Some((Vec3::zeros(), Vec3::new(1.0, 0.1, 0.1)))).unwrap();
+        rec.flush_blocking().unwrap();
+        let mut corners = Vec::new();
+        for m in storage.take() {
+            let LogMsg::ArrowMsg(_, arrow) = m else { continue };
+            let chunk = rerun::log::Chunk::from_arrow_msg(&arrow).unwrap();
+            if chunk.entity_path().to_string().ends_with("/PlotLegend") {
+                let component = PlotLegend::descriptor_corner().component;
+                corners.extend(chunk.iter_component::<Corner2D>(component).flat_map(|c| c.to_vec()));
+            }
+        }
+        corners.sort_by_key(|c| *c as u8);
+        assert_eq!(corners, [Corner2D::RightTop, Corner2D::RightTop, Corner2D::RightBottom]);
+    }
+
     #[test]
     fn the_eye_sees_the_whole_box_from_the_front_above() {
         let (eye, target) = eye_for(Vec3::new(0.0, -0.05, -0.05), Vec3::new(1.0, 0.05, 0.05));
