@@ -184,7 +184,7 @@ impl RerunLink {
             // from 0 would fall inside the old ones' time), and the old ones end there.
             let own = (first.instance.sim.frames() as i64, first.instance.sim.time_secs());
             if let Some(until) = self.logged_until
-                && own.0 + self.time_offset.0 <= until.0
+                && own.0 + self.time_offset.0 < until.0
             {
                 let frame_secs = 1.0 / first.config.frames_per_second;
                 self.time_offset = (until.0 + 1 - own.0, until.1 + frame_secs - own.1);

@@ -49,6 +49,8 @@ pub struct UiState {
     /// caption, the status line and the labels (None: no lesson, or a step being prepared).
     pub lesson_measured: Option<Vec<hox_scenes::lesson::Measured>>,
     pub reference_element: ReferenceElementView,
+    /// The controls panel shown or folded as asked (None: folded in a lesson on a narrow window).
+    pub controls_shown: Option<bool>,
     pub bottom_tab: Tab,
     /// The probe plot's components (None: u_z alone when comparing, else all three).
     pub probe_axes: Option<[bool; 3]>,
@@ -87,6 +89,7 @@ impl UiState {
             viewport,
             lesson_measured: None,
             reference_element: ReferenceElementView::default(),
+            controls_shown: None,
             bottom_tab: Tab::default(),
             probe_axes: None,
             rerun_url,

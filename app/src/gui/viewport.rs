@@ -117,6 +117,12 @@ impl Viewport {
         }
     }
 
+    /// Where the view was drawn last, points.
+    #[cfg(test)]
+    pub fn rect(&self) -> egui::Rect {
+        self.last_rect
+    }
+
     /// Frames the sessions' bodies again from the preset's direction.
     pub fn reset_camera(&mut self, sessions: &[Session], offsets: &[Vec3]) {
         let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));

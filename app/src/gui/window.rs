@@ -16,6 +16,9 @@ use std::time::Instant;
 /// size in presenter mode's points, that the next plain start reopened).
 pub(super) const USABLE_INNER_SIZE: egui::Vec2 = egui::vec2(1024.0, 640.0);
 
+/// Below this width (points) a lesson folds the controls away unless asked for.
+const NARROW_PT: f32 = 1500.0;
+
 /// The inner size of a window of size `inner` that fits on a monitor of size `monitor` (both in
 /// the same points, with room for the window's decorations) and, when `grow` (a restored size,
 /// not one asked for), is at least [`USABLE_INNER_SIZE`] where the monitor has room for it; None
@@ -116,9 +119,25 @@ impl HoxApp {
                     egui::ScrollArea::vertical().show(ui, |ui| lesson_panel::lesson_panel_ui(&mut cx, ui));
                 });
             }
-            egui::Panel::left("controls").frame(frame).resizable(true).default_size(330.0).show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| controls::controls_ui(&mut cx, ui));
-            });
+            // issue #57: at 1280×720 a lesson's panel and the controls left the 3D view 300 px
+            // wide; in a lesson on a narrow window the controls fold to a strip (the lesson sets
+            // the configuration), a click away
+            let lesson = cx.model.lesson().is_some();
+            let folded = !cx.state.controls_shown.unwrap_or(!(lesson && ctx.content_rect().width() < NARROW_PT));
+            if folded {
+                egui::Panel::left("controls_folded").frame(frame).resizable(false).show(ui, |ui| {
+                    if ui.button("▸ Controls").on_hover_text("Show the scene, mesh and material controls").clicked() {
+                        cx.state.controls_shown = Some(true);
+                    }
+                });
+            } else {
+                egui::Panel::left("controls").frame(frame).resizable(true).default_size(330.0).show(ui, |ui| {
+                    if lesson && ui.button("◂ Hide controls").on_hover_text("More room for the 3D view").clicked() {
+                        cx.state.controls_shown = Some(false);
+                    }
+                    egui::ScrollArea::vertical().show(ui, |ui| controls::controls_ui(&mut cx, ui));
+                });
+            }
         }
         lesson_panel::welcome_ui(&mut cx, &ctx);
         dialogs::reference_element_ui(&mut cx, &ctx);
