@@ -33,19 +33,6 @@ use hox_sim::solver::{Simulation, SolverSettings, SweepsPerStep};
 /// A frame slower than this (under 4 frames per second) is asked about and pauses the app.
 pub const SLOW_FRAME_MS: f64 = 250.0;
 
-/// A change held back until the user says: the control, the configuration, what it will cost,
-/// and the meshes already built for it (installed as they are if the answer is yes).
-pub struct PendingChange {
-    pub control: String,
-    pub config: Config,
-    pub estimate: String,
-    pub built: Option<Built>,
-}
-
-/// What was prepared in the background for a change: `(session, its new configuration, what
-/// it needs)` for each session it changes ([`super::rebuild::Prepared`]).
-pub type Built = Vec<(usize, Config, super::rebuild::Prepared)>;
-
 /// What one unit of work ([`frame_work`]) costs on this machine, ms, before any frame has been
 /// measured: explicit (XPBD) and implicit solvers. On the safe side: issue #57's 655,360 P1
 /// elements at 629 substeps took 22 s per frame, 1.3e-5 ms per unit.

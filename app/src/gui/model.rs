@@ -12,12 +12,12 @@
 use super::action::Action;
 use super::background::{Background, Stepper, any_settling, step_sessions};
 use super::config::{Config, Invalidates, SceneSource};
-use super::cost::{self, PendingChange};
+use super::cost;
 use super::lesson::LessonState;
 use super::links::Links;
 use super::playback::{Playback, SETTLE_STEP_BUDGET_MS};
 use super::presets::{ViewOptions, ViewPreset};
-use super::rebuild::{Build, StaticJobs, builds_at_once, redraws};
+use super::rebuild::{Build, PendingChange, StaticJobs, builds_at_once, redraws};
 use super::session::Session;
 use hox_scenes::lesson::Run;
 use hox_sim::Vec3;
@@ -412,7 +412,7 @@ impl Model {
     }
 
     /// Installs meshes built for a change.
-    fn install(&mut self, control: &str, built: cost::Built) -> Result<(), String> {
+    fn install(&mut self, control: &str, built: super::rebuild::Built) -> Result<(), String> {
         for (k, config, prepared) in built {
             let Some(s) = self.sessions.get_mut(k) else { continue };
             if let Err(reason) = prepared.install(s, config) {

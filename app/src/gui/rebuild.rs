@@ -44,6 +44,19 @@ fn needs_guard_again(old: &Config, new: &Config) -> bool {
     (old.material, old.poisson_ratio) != (new.material, new.poisson_ratio)
 }
 
+/// A change held back until the user says: the control, the configuration, what it will cost,
+/// and the meshes already built for it (installed as they are if the answer is yes).
+pub struct PendingChange {
+    pub control: String,
+    pub config: Config,
+    pub estimate: String,
+    pub built: Option<Built>,
+}
+
+/// What was prepared in the background for a change: `(session, its new configuration, what
+/// it needs)` for each session it changes ([`Prepared`]).
+pub type Built = Vec<(usize, Config, Prepared)>;
+
 /// What a change needs, prepared in the background for one session.
 pub enum Prepared {
     /// Its new mesh, built.
@@ -143,7 +156,7 @@ impl Build {
     }
 
     /// What was prepared, with its sessions and configurations; or why not.
-    pub fn finish(self) -> Result<cost::Built, String> {
+    pub fn finish(self) -> Result<Built, String> {
         let prepared =
             self.prepared.take().unwrap_or_else(|| Err("preparing the change stopped unexpectedly".into()))?;
         Ok(self.configs.into_iter().zip(prepared).map(|((k, c), p)| (k, c, p)).collect())
@@ -262,7 +275,7 @@ pub fn redraws(old: &Config, new: &Config) -> bool {
 
 /// The question about meshes `built` for a change, if one would be slower than the machine
 /// plays ([`cost::too_slow_built`]).
-pub fn question(built: &cost::Built, sessions: &[Session], rates: &cost::Rates, draw_ms: f64) -> Option<String> {
+pub fn question(built: &Built, sessions: &[Session], rates: &cost::Rates, draw_ms: f64) -> Option<String> {
     built.iter().find_map(|(k, _, p)| match p {
         Prepared::Built(i) => sessions.get(*k).and_then(|s| cost::too_slow_built(s, &i.sim, rates, draw_ms)),
         Prepared::Guard(_) | Prepared::Nothing => None,
