@@ -1738,7 +1738,7 @@ fn a_beam_blowing_up_stays_in_view() {
 
 /// Issue #57: at 1280×720 without presenter mode a lesson left about 300 px for the 3D view
 /// (the controls on the left, the lesson on the right). In a lesson on a narrow window the
-/// controls fold to a strip, a click away; the view gets the room.
+/// controls fold to a strip (a » button), a click away; the view gets the room.
 #[test]
 fn a_lesson_at_1280_by_720_leaves_the_3d_view_room() {
     let mut h = harness_sized(AppArgs::default(), egui::vec2(1280.0, 720.0));
@@ -1750,10 +1750,10 @@ fn a_lesson_at_1280_by_720_leaves_the_3d_view_room() {
     let in_lesson = h.state().ui.viewport.rect().width();
     assert!(in_lesson >= 0.55 * 1280.0, "the 3D view is {in_lesson} points wide in a lesson (out of one: {plain})");
     assert!(h.query_by_label("Poisson ratio ν").is_none(), "the controls folded");
-    h.get_by_label("▸ Controls").click();
+    h.get_by_label("»").click();
     h.run_steps(2);
     assert!(h.query_by_label("Poisson ratio ν").is_some(), "the controls a click away");
-    h.get_by_label("◂ Hide controls").click();
+    h.get_by_label("« Hide controls").click();
     h.run_steps(2);
     assert!(h.query_by_label("Poisson ratio ν").is_none());
     // a wide window keeps them

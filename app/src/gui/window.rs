@@ -125,14 +125,14 @@ impl HoxApp {
             let lesson = cx.model.lesson().is_some();
             let folded = !cx.state.controls_shown.unwrap_or(!(lesson && ctx.content_rect().width() < NARROW_PT));
             if folded {
-                egui::Panel::left("controls_folded").frame(frame).resizable(false).show(ui, |ui| {
-                    if ui.button("▸ Controls").on_hover_text("Show the scene, mesh and material controls").clicked() {
+                egui::Panel::left("controls_folded").frame(frame).resizable(false).exact_size(34.0).show(ui, |ui| {
+                    if ui.button("»").on_hover_text("Show the controls (scene, mesh, material, solver)").clicked() {
                         cx.state.controls_shown = Some(true);
                     }
                 });
             } else {
                 egui::Panel::left("controls").frame(frame).resizable(true).default_size(330.0).show(ui, |ui| {
-                    if lesson && ui.button("◂ Hide controls").on_hover_text("More room for the 3D view").clicked() {
+                    if lesson && ui.button("« Hide controls").on_hover_text("More room for the 3D view").clicked() {
                         cx.state.controls_shown = Some(false);
                     }
                     egui::ScrollArea::vertical().show(ui, |ui| controls::controls_ui(&mut cx, ui));
