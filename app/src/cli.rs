@@ -107,7 +107,8 @@ pub enum Command {
         /// speed-up over one thread, frame by frame.
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
         threads: Vec<usize>,
-        /// Only the configurations whose label contains this (e.g. "p1", "r2").
+        /// Only the configurations whose label contains this (e.g. "p1", "r2"; "table1": the
+        /// paper's Table 1 beams).
         #[arg(long, default_value = "")]
         only: String,
         /// The sweep orders timed, comma-separated: colour (the default everywhere: a register

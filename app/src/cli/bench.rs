@@ -47,6 +47,8 @@ pub fn bench(
     if matching.is_empty() {
         bail!("no configuration matches '{only}'");
     }
+    // the machine first: every figure table in docs/ names its machine (issue #58)
+    println!("Machine: {}.\n", super::paper::machine());
     if !method.is_implicit() {
         let rows =
             hox_scenes::bench::run(only, threads, &sweeps, lanes, frames, &mut |r| eprintln!("{}", r.progress_line()))?;

@@ -324,6 +324,9 @@ pub fn matching_solver_cases(filter: &str) -> Vec<&'static BenchCase> {
 
 fn matching(cases: &'static [BenchCase], filter: &str) -> Vec<&'static BenchCase> {
     let filter = filter.to_uppercase();
+    if filter == TABLE1 {
+        return cases.iter().filter(|c| c.paper_ms_per_frame.is_some()).collect();
+    }
     let exact = cases.iter().any(|c| c.label().to_uppercase() == filter);
     cases
         .iter()
@@ -331,8 +334,11 @@ fn matching(cases: &'static [BenchCase], filter: &str) -> Vec<&'static BenchCase
         .collect()
 }
 
-/// Measures the case labelled `filter`, or else every case whose label contains it (ignoring
-/// case), on each of `threads` with each of `sweeps` (the element-order sweep runs on one
+/// The filter that names the paper's Table 1 beams (every case with a paper figure).
+const TABLE1: &str = "TABLE1";
+
+/// Measures the case labelled `filter` (`table1`: the paper's Table 1 beams), or else every
+/// case whose label contains it (ignoring case), on each of `threads` with each of `sweeps` (the element-order sweep runs on one
 /// thread whatever the pool, so it is measured on one thread only; the colour sweep on each of
 /// `lanes`, or the CPU's widest when empty), every configuration of a case side by side
 /// ([`measure_side_by_side`]), reporting each row to `progress` (what `hox bench` runs).
