@@ -2,7 +2,7 @@
 //! their sizes, and how far apart in memory the four elements of a batch reach (the node-index
 //! span a batch's gathers touch); then the colour sweep timed on the beam as built (its nodes
 //! numbered along x, the slab axis, since session 29) and with its nodes renumbered along z
-//! (z slowest, as the generator numbered them before: docs/PERFORMANCE.md, sessions 22 and 28),
+//! (z slowest, as the generator numbered them before: docs/journal/performance.md, sessions 22 and 28),
 //! on one and two threads, alternately: `cargo run --release -p hox-scenes --example colour_stats`.
 
 use hox_sim::effect::{Clamp, Effect, Gravity};

@@ -120,7 +120,7 @@ fn switching_a_part_between_orders_mid_session_runs_each() {
 /// (`assets/parts/tube-fine-p3.msh`, 33,748 nodes) clamped and under gravity solves with one
 /// symbolic analysis and a few factorisations, and its factor stays within the size that keeps
 /// `hox static` under 600 MB (52.2 million entries with AMD on the node graph: 418 MB of the
-/// 577 MB peak; docs/PERFORMANCE.md, session 22). Wall time is not tested (machines differ);
+/// 577 MB peak; docs/journal/performance.md, session 22). Wall time is not tested (machines differ);
 /// the sizes and the counts are. It sags as the coarser P3 tube does, to 0.3 %.
 #[test]
 #[ignore = "release: CI runs it with --release --ignored (about 10 s)"]

@@ -107,7 +107,7 @@ fn on_the_gmsh_p2_beam_newton_settles_within_0_2_percent_ten_times_faster_than_x
 }
 
 /// VBD with its coarse correction settles in the frames Newton takes (122), at about 1/30 of
-/// XPBD's time (docs/PERFORMANCE.md, session 17); without it, 707 frames and 1/7–1/16.
+/// XPBD's time (docs/journal/performance.md, session 17); without it, 707 frames and 1/7–1/16.
 #[test]
 #[ignore = "heavy: release, .ci/run"]
 fn on_the_gmsh_p2_beam_vbd_settles_within_0_2_percent_ten_times_faster_than_xpbd() {

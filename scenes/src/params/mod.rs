@@ -233,13 +233,13 @@ params! {
     /// Newton iterations per step at most.
     newton_iterations: usize = solver().newton.max_iterations as usize => {
         key: "newton-iterations", group: Group::Solver, file_key: "newton_iterations", label: SolverSettings::NEWTON_ITERATIONS.label,
-        help: "Newton iterations per step at most (the implicit solvers of the Newton family). The default runs a step to its tolerance; a budget of 2 keeps a large part at the display's rate: a step left above the tolerance carries its unbalanced force into the next, so a swinging body lags slightly and a settled one is as exact as ever (docs/PERFORMANCE.md, session 24).",
+        help: "Newton iterations per step at most (the implicit solvers of the Newton family). The default runs a step to its tolerance; a budget of 2 keeps a large part at the display's rate: a step left above the tolerance carries its unbalanced force into the next, so a swinging body lags slightly and a settled one is as exact as ever (docs/journal/performance.md, session 24).",
         kind: Kind::of_range(SolverSettings::NEWTON_ITERATIONS.range), ..BASE
     }
     /// Newton's interactive mode.
     newton_quasi: bool = solver().newton.quasi_newton => {
         key: "newton-quasi", group: Group::Solver, file_key: "newton_quasi", label: "Newton keeps its factor",
-        help: "Newton's interactive mode: the factor kept across steps in single precision, corrected by secant pairs (L-BFGS) and refreshed only when keeping it costs more than a factorisation (the curved parts: 3–4 factorisations to settle instead of 13–18). Off: refreshed whenever an iteration reduces the residual less than 4×, in double precision, as the robustness suite measures (docs/PERFORMANCE.md session 24).",
+        help: "Newton's interactive mode: the factor kept across steps in single precision, corrected by secant pairs (L-BFGS) and refreshed only when keeping it costs more than a factorisation (the curved parts: 3–4 factorisations to settle instead of 13–18). Off: refreshed whenever an iteration reduces the residual less than 4×, in double precision, as the robustness suite measures (docs/journal/performance.md session 24).",
         kind: Kind::Flag, switch: Some(("newton-quasi", true)), ..BASE
     }
     /// energy | split.

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 /// below, one pass on the calling thread costs less than waking the others. A pass costs ≈ 2 ns
 /// per node here; during a substep the sweep's threads are usually still awake (they have just
 /// finished a phase), so a few thousand nodes per thread pay (on the 16,225-node beam, 8,192 had
-/// left the passes serial: docs/PERFORMANCE.md, session 26).
+/// left the passes serial: docs/journal/performance.md, session 26).
 pub const NODE_LOOP_MIN_NODES_PER_THREAD: usize = 4096;
 
 /// How many chunks a pass over `len` items is cut into: one per thread of the current pool, at
@@ -51,7 +51,7 @@ pub fn fill(v: &mut [f64], value: f64) {
 /// Why: a rayon worker with nothing to do sleeps after a few dozen rounds of looking, and waking
 /// it costs a system call and, in a virtual machine, an interrupt between processors; a substep of
 /// the colour sweep has about seven parallel loops, and on a shared 2-core machine the wake-ups
-/// cost more than the second thread gained (docs/PERFORMANCE.md, session 28). The waiting worker
+/// cost more than the second thread gained (docs/journal/performance.md, session 28). The waiting worker
 /// keeps looking (yielding its core to any other thread ready on it between two looks, as rayon
 /// does before it sleeps) for as long as `f` runs, so call it around a stretch of many short
 /// parallel loops (a frame), not around long serial work.

@@ -31,7 +31,7 @@
 //! the bending beam P2 8×2×2 8.2 ms per frame against 1.5 (4.5 iterations per frame, every one
 //! computing the element Hessians, which Newton's reused factor spares it), on the Gmsh P2 beam
 //! 5.2–7.1 s to settle against 1.7 s, to the same equilibrium and the same motion (the study's
-//! rows): docs/PERFORMANCE.md, session 19.
+//! rows): docs/journal/performance.md, session 19.
 
 use super::error::SolverCounters;
 use super::newton_core::{HessianModel, LinearSolver};

@@ -36,7 +36,7 @@
 //!   Liu, Bouaziz & Kavan 2017, "Quasi-Newton methods for real-time simulation of hyperelastic
 //!   materials", ACM TOG 36(3), prefactor one matrix and correct it so). The pairs stay valid
 //!   across time steps, whose potentials differ by a linear term only. On the P2 tube settling,
-//!   the factorisations fell from 18 to 5 (docs/PERFORMANCE.md session 24).
+//!   the factorisations fell from 18 to 5 (docs/journal/performance.md session 24).
 //! - **Precision** (interactive mode): a time step's factor (an inertia diagonal `D`) is single
 //!   precision
 //!   (`sparse.rs`: half the solves' memory traffic), its error corrected by the iteration; a
@@ -219,7 +219,7 @@ impl LinearSolver for SparsePattern {
     /// length, a solve's memory traffic as its entries: their ratio is the mean column length
     /// over a rate measured on the P2 tube (4,911 nodes, 260 entries per column: in single
     /// precision a factorisation 60–75 ms, an iteration with the kept factor 3.5–4.5 ms,
-    /// docs/PERFORMANCE.md session 24).
+    /// docs/journal/performance.md session 24).
     fn refresh_cost_in_iterations(&self) -> f64 {
         const ENTRIES_PER_COLUMN_PER_ITERATION: f64 = 15.0;
         let per_column = self.cost.factor_nonzeros as f64 / self.free_dofs.max(1) as f64;

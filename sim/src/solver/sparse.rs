@@ -5,7 +5,7 @@
 //! (`faer`'s supernodal `L Lᵀ`, the symbolic analysis done once per pattern and the numeric one
 //! kept for reuse).
 //!
-//! Made for 100k degrees of freedom (issue #37, docs/PERFORMANCE.md session 22): the pattern
+//! Made for 100k degrees of freedom (issue #37, docs/journal/performance.md session 22): the pattern
 //! comes from the node graph (AMD on it, a ninth of the scalar graph: the same fill, since AMD
 //! merges a node's three indistinguishable degrees of freedom anyway), `K` is assembled straight
 //! into its compressed columns in elimination order (no triplets, no sort, no permuted copy inside

@@ -43,7 +43,7 @@ pub const PARTITION_MIN_ELEMENTS_PER_SLAB: usize = 1024;
 /// slabs took 25 ms per frame and the other's 34 ms, and every phase waited for the slower; with
 /// eight per phase both threads finished each phase within a slab's time of each other).
 /// 4,096 cuts that beam into 16 slabs of 5,120 tetrahedra, ≈ 100 µs each per sweep, far above a
-/// steal's cost (docs/PERFORMANCE.md, session 26).
+/// steal's cost (docs/journal/performance.md, session 26).
 pub const ELEMENTS_PER_EXTRA_SLAB: usize = 4_096;
 
 /// The fewest slabs a cut block has: two phases of two slabs each.
