@@ -78,6 +78,9 @@ pub struct LogSettings {
     /// The blueprint shows a lesson's step text (`lesson/step`) above the legend (the app's
     /// stream while a lesson is open).
     pub lesson_text: bool,
+    /// A live stream: the viewer follows its newest frame (issue #57: a page opened late
+    /// replayed from t = 0 and ran 48 s behind the app).
+    pub follow_latest: bool,
 }
 
 impl LogSettings {
@@ -90,6 +93,7 @@ impl LogSettings {
             blueprint: true,
             time_offset: (0, 0.0),
             lesson_text: false,
+            follow_latest: false,
         }
     }
 }
@@ -151,6 +155,8 @@ pub struct Recorder {
     time_offset: (i64, f64),
     /// The blueprint's legend column starts with the lesson's step text.
     lesson_text: bool,
+    /// The viewer follows the newest frame ([`LogSettings::follow_latest`]).
+    follow_latest: bool,
     /// What it logged, to retire when replaced on a stream that goes on ([`Recorder::retire`]).
     logged: retire::Logged,
 }
@@ -461,6 +467,7 @@ impl Recorder {
             probe_names,
             time_offset: settings.time_offset,
             lesson_text: settings.lesson_text,
+            follow_latest: settings.follow_latest,
             logged,
         };
         let legend = rerun::TextDocument::from_markdown(recorder.legend_markdown(configs));
@@ -633,8 +640,16 @@ impl Recorder {
             bp::Vertical::new(charts).with_row_shares(probe_rows).into(),
         ])
         .with_column_shares([0.54, 0.18, 0.28]);
-        blueprint_of(root)
+        let panel = time_panel();
+        let panel =
+            if self.follow_latest { panel.with_play_state(bp::components::PlayState::Following) } else { panel };
+        blueprint_of(root).with_time_panel(panel)
     }
+}
+
+/// The time panel collapsed to its play bar on `sim_time`.
+fn time_panel() -> bp::TimePanel {
+    bp::TimePanel::new().with_state(bp::components::PanelState::Collapsed).with_timeline("sim_time")
 }
 
 /// A blueprint of exactly the views under `root`, the side panels folded away (the views get
@@ -645,9 +660,7 @@ pub fn blueprint_of(root: impl Into<bp::ContainerLike>) -> bp::Blueprint {
         .with_auto_layout(false)
         .with_blueprint_panel(bp::BlueprintPanel::from_state(bp::components::PanelState::Collapsed))
         .with_selection_panel(bp::SelectionPanel::from_state(bp::components::PanelState::Collapsed))
-        .with_time_panel(
-            bp::TimePanel::new().with_state(bp::components::PanelState::Collapsed).with_timeline("sim_time"),
-        )
+        .with_time_panel(time_panel())
 }
 
 /// `0.125`, `0.3`, `1.5e-4`: a compact metre value for labels.

@@ -394,7 +394,9 @@ fn bench_times_an_implicit_solver_and_refuses_an_unknown_one() {
     let table = String::from_utf8_lossy(&out.stdout);
     let cells =
         |line: &str| line.split('|').map(str::trim).filter(|c| !c.is_empty()).map(String::from).collect::<Vec<_>>();
-    let mut lines = table.lines();
+    // the machine first (issue #58), then the table
+    assert!(table.starts_with("Machine: "), "{table}");
+    let mut lines = table.lines().skip_while(|l| !l.starts_with('|'));
     let header = cells(lines.next().expect("a header"));
     let row = cells(lines.find(|l| l.starts_with("| P2 8x2x2")).unwrap_or_else(|| panic!("no P2 row in:\n{table}")));
     let column =

@@ -8,8 +8,9 @@
 //!   Newton-type solver's usual iterations); the new configuration's
 //!   time per frame is the current one's measured time scaled by the ratio of the two works. A
 //!   change of solver settings is estimated on the current mesh (nothing is built: dragging the
-//!   substeps slider stays cheap); a new mesh is built to be counted; a new material is not
-//!   estimated (the slow-frame pause below catches a stiffer one's extra substeps).
+//!   substeps slider stays cheap); a new mesh is built to be counted; a new material by the
+//!   substeps the stability guard will take with it (its rest ω², computed apart on a large
+//!   mesh, [`too_slow_material`]).
 //!   Above [`SLOW_FRAME_MS`] the app asks first, saying the estimate and the frame rate it
 //!   means, and keeps the current configuration until the answer.
 //! - **After**: a frame that took more than [`SLOW_FRAME_MS`] pauses the app (a slow frame then
@@ -32,6 +33,15 @@ use hox_sim::solver::{Simulation, SolverSettings, SweepsPerStep};
 
 /// A frame slower than this (under 4 frames per second) is asked about and pauses the app.
 pub const SLOW_FRAME_MS: f64 = 250.0;
+
+/// The most element–node pairs a mesh is built on, or its stability guard computed again on,
+/// in place (well under a second); larger ones are prepared in the background (`rebuild.rs`).
+pub const IN_PLACE_NODE_VISITS: f64 = 60_000.0;
+
+/// `sim`'s element–node pairs.
+pub fn element_node_pairs(sim: &Simulation) -> f64 {
+    sim.mesh().blocks.iter().map(|b| (b.len() * b.nodes_per_element()) as f64).sum()
+}
 
 /// What one unit of work ([`frame_work`]) costs on this machine, ms, before any frame has been
 /// measured: explicit (XPBD) and implicit solvers. On the safe side: issue #57's 655,360 P1
@@ -157,8 +167,10 @@ pub fn estimated_ms_with(current: &Simulation, current_ms: f64, settings: &Solve
 /// slow-frame pause catches a stiffer one's extra substeps).
 pub fn too_slow(s: &Session, new: &Config, rates: &Rates, draw_ms: f64) -> Option<String> {
     use super::config::Invalidates;
-    if s.config.invalidated_by(new) != Invalidates::Settings {
-        return None;
+    match s.config.invalidated_by(new) {
+        Invalidates::Settings => {}
+        Invalidates::Material => return too_slow_material(s, new, None, rates, draw_ms),
+        Invalidates::Mesh | Invalidates::Nothing => return None,
     }
     let settings = super::config::resolve(new, &s.base).ok()?.settings();
     let current = &s.instance.sim;
@@ -171,13 +183,50 @@ pub fn too_slow(s: &Session, new: &Config, rates: &Rates, draw_ms: f64) -> Optio
             * sweeps(&settings, if settings.stability_guard { raised } else { settings.substeps })
     };
     let ms = sim_ms + draw_ms;
-    let now = if s.ms_per_frame > 0.0 {
-        format!("now {:.1} ms", s.ms_per_frame + draw_ms)
-    } else {
-        "not measured yet".into()
+    (ms > SLOW_FRAME_MS).then(|| {
+        describe(current.mesh().num_elements(), &format!("{} solver", settings.method.name()), ms, &now(s, draw_ms))
+    })
+}
+
+/// Whether a new material `new` for `s` would be slow: the frame of the substeps the stability
+/// guard will take with it (a stiffer material, ν near 0.5, takes many more), from its rest ω²
+/// per E/ρ: `omega2` when computed apart (a large mesh, in the background), else the current one
+/// for a new E or ρ (which only scale it), else computed here on a mesh small enough
+/// ([`IN_PLACE_NODE_VISITS`]); a large mesh's is estimated once prepared (None here).
+pub fn too_slow_material(
+    s: &Session,
+    new: &Config,
+    omega2: Option<f64>,
+    rates: &Rates,
+    draw_ms: f64,
+) -> Option<String> {
+    let scene = super::config::resolve(new, &s.base).ok()?;
+    let (settings, material) = (scene.settings(), scene.material());
+    let current = &s.instance.sim;
+    let same_stiffness = (s.config.material, s.config.poisson_ratio) == (new.material, new.poisson_ratio);
+    let omega2 = match omega2 {
+        Some(w) => w,
+        None if same_stiffness => current.rest_omega2_per_e_over_rho()?,
+        None if element_node_pairs(current) <= IN_PLACE_NODE_VISITS => {
+            current.rest_omega2_job(&material)().ok()?.per_e_over_rho.0
+        }
+        None => return None,
     };
-    (ms > SLOW_FRAME_MS)
-        .then(|| describe(current.mesh().num_elements(), &format!("{} solver", settings.method.name()), ms, &now))
+    let (substeps, _) = hox_sim::solver::stability::substeps_for(&settings, &material, omega2);
+    let new_sweeps = sweeps(&settings, substeps);
+    let sim_ms = if s.ms_per_frame > 0.0 {
+        s.ms_per_frame * new_sweeps / sweeps(current.settings(), current.substeps_per_frame()).max(1e-9)
+    } else {
+        rates.ms_per_work(settings.method) * sweep_work(current) * new_sweeps
+    };
+    let ms = sim_ms + draw_ms;
+    let work = format!("{substeps} substeps per frame (the stability guard's, for this material)");
+    (ms > SLOW_FRAME_MS).then(|| describe(current.mesh().num_elements(), &work, ms, &now(s, draw_ms)))
+}
+
+/// "now 12.3 ms" (the frame as measured, drawing included), or "not measured yet".
+fn now(s: &Session, draw_ms: f64) -> String {
+    if s.ms_per_frame > 0.0 { format!("now {:.1} ms", s.ms_per_frame + draw_ms) } else { "not measured yet".into() }
 }
 
 /// The start of the message a slow frame pauses the app with (cleared by the next change).

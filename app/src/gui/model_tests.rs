@@ -299,6 +299,10 @@ fn a_new_poisson_ratio_on_a_large_mesh_computes_its_stability_guard_in_the_backg
     assert_eq!(m.sessions()[0].config.poisson_ratio, c.poisson_ratio, "the old material runs meanwhile");
     m.apply(Action::Step(1)).unwrap();
     wait_built(&mut m);
+    // estimated from the guard's substeps once its ω² is known: a slow one asks first
+    if m.pending_change().is_some() {
+        m.apply(Action::AnswerPending(true)).unwrap();
+    }
     let s = &m.sessions()[0];
     assert_eq!(s.config.poisson_ratio, 0.49);
     // the same substeps as the guard computed in place on a simulation of its own
@@ -310,5 +314,45 @@ fn a_new_poisson_ratio_on_a_large_mesh_computes_its_stability_guard_in_the_backg
     let mut stiffer = stiff.clone();
     stiffer.youngs_modulus_pa *= 2.0;
     m.apply(Action::change("youngs", stiffer)).unwrap();
-    assert!(m.building().is_none() && m.sessions()[0].config.youngs_modulus_pa == 2.0 * stiff.youngs_modulus_pa);
+    assert!(m.building().is_none(), "nothing to prepare in the background");
+    // twice the stiffness, √2 the substeps: estimated from the guard at once, asked if slow
+    if m.pending_change().is_some() {
+        m.apply(Action::AnswerPending(true)).unwrap();
+    }
+    assert_eq!(m.sessions()[0].config.youngs_modulus_pa, 2.0 * stiff.youngs_modulus_pa);
+}
+
+/// Issue #57, "a change estimated slower than the machine can play asks first": a new material
+/// was never estimated, and ν → 0.4999 has the stability guard take many times the substeps. It
+/// is now estimated by the substeps the guard will take with it, asked about first when slow
+/// ("keep" keeps the material), on a mesh small enough to compute its guard in place as on one
+/// whose guard is computed in the background; E alone at the same ν is estimated from the
+/// current guard and plays.
+#[test]
+fn a_much_stiffer_material_is_estimated_by_its_guard_s_substeps_and_asked_about_first() {
+    for (refine, grid) in [(2, [8, 2, 2]), (2, [16, 2, 2])] {
+        let mut m = threaded_model("bending");
+        let mut c = m.sessions()[0].config.clone();
+        c.element = hox_sim::element::ElementType::from_name("p1").unwrap();
+        c.refine = refine;
+        c.grid = grid;
+        m.apply(Action::ChangeNow { control: "grid".into(), config: Box::new(c.clone()) }).unwrap();
+        wait_built(&mut m);
+        let elements = m.sessions()[0].instance.sim.mesh().num_elements();
+        let mut soft = c.clone();
+        soft.youngs_modulus_pa *= 0.5;
+        m.apply(Action::change("youngs", soft.clone())).unwrap();
+        wait_built(&mut m);
+        assert!(m.pending_change().is_none(), "{elements}: a softer E plays");
+        assert_eq!(m.sessions()[0].config.youngs_modulus_pa, soft.youngs_modulus_pa);
+        let mut stiff = soft.clone();
+        stiff.poisson_ratio = 0.4999;
+        m.apply(Action::change("poisson", stiff.clone())).unwrap();
+        wait_built(&mut m);
+        let question = m.pending_change().map(|p| p.estimate.clone()).expect("asked first");
+        assert!(question.contains("substeps per frame (the stability guard's"), "{elements}: {question}");
+        assert_eq!(m.sessions()[0].config.poisson_ratio, soft.poisson_ratio, "{elements}: nothing changed yet");
+        m.apply(Action::AnswerPending(false)).unwrap();
+        assert_eq!(m.sessions()[0].config.poisson_ratio, soft.poisson_ratio, "{elements}: kept");
+    }
 }

@@ -11,12 +11,8 @@ use super::session::Session;
 use hox_sim::Vec3;
 use hox_sim::element::ElementType;
 
-/// [`builds_at_once`]'s bound: element–node pairs of a mesh built in place, or of a mesh whose
-/// stability guard is computed again in place for a new material.
-const AT_ONCE_NODE_VISITS: f64 = 60_000.0;
-
 /// Whether `new` applies to `s` at once, in place (well under a second): a change of settings;
-/// a new material on a mesh of at most [`AT_ONCE_NODE_VISITS`] element–node pairs (another ν
+/// a new material on a mesh of at most [`cost::IN_PLACE_NODE_VISITS`] element–node pairs (another ν
 /// or model has the guard visit every element again: 4 s on 655,360 P1 elements, issue #57);
 /// a new mesh estimated at most as large (its elements from `s`'s: the grid's cells, ×8 per
 /// refinement level). The others are prepared in the background ([`Build`]).
@@ -28,11 +24,11 @@ pub fn builds_at_once(s: &Session, new: &Config) -> bool {
             let cells = |g: &[usize; 3]| g.iter().map(|&n| n.max(1) as f64).product::<f64>();
             let ratio =
                 cells(&new.grid) / cells(&s.config.grid) * 8f64.powi(new.refine as i32 - s.config.refine as i32);
-            visits(mesh.num_elements() as f64 * ratio, new.element) <= AT_ONCE_NODE_VISITS
+            visits(mesh.num_elements() as f64 * ratio, new.element) <= cost::IN_PLACE_NODE_VISITS
         }
         Invalidates::Material => {
-            let pairs: usize = mesh.blocks.iter().map(|b| b.len() * b.nodes_per_element()).sum();
-            pairs as f64 <= AT_ONCE_NODE_VISITS || !needs_guard_again(&s.config, new)
+            cost::element_node_pairs(&s.instance.sim) <= cost::IN_PLACE_NODE_VISITS
+                || !needs_guard_again(&s.config, new)
         }
         Invalidates::Settings | Invalidates::Nothing => true,
     }
@@ -276,9 +272,13 @@ pub fn redraws(old: &Config, new: &Config) -> bool {
 /// The question about meshes `built` for a change, if one would be slower than the machine
 /// plays ([`cost::too_slow_built`]).
 pub fn question(built: &Built, sessions: &[Session], rates: &cost::Rates, draw_ms: f64) -> Option<String> {
-    built.iter().find_map(|(k, _, p)| match p {
-        Prepared::Built(i) => sessions.get(*k).and_then(|s| cost::too_slow_built(s, &i.sim, rates, draw_ms)),
-        Prepared::Guard(_) | Prepared::Nothing => None,
+    built.iter().find_map(|(k, c, p)| {
+        let s = sessions.get(*k)?;
+        match p {
+            Prepared::Built(i) => cost::too_slow_built(s, &i.sim, rates, draw_ms),
+            Prepared::Guard(w) => cost::too_slow_material(s, c, Some(w.per_e_over_rho.0), rates, draw_ms),
+            Prepared::Nothing => None,
+        }
     })
 }
 

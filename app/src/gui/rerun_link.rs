@@ -46,6 +46,8 @@ struct RerunLink {
     time_offset: (i64, f64),
     /// The stream's latest frame and time logged (with the offset).
     logged_until: Option<(i64, f64)>,
+    /// Streamed to a viewer or browsers (not saved to a file).
+    live: bool,
 }
 
 /// At most so many frames a second: a frame is admitted when the one admitted before it is
@@ -97,6 +99,7 @@ impl RerunLink {
         let builder = rerun::RecordingStreamBuilder::new("hox").recording_name(name.clone());
         let mut web = None;
         let cap = if target == RerunTarget::Browsers { FrameCap::new(serve_fps) } else { None };
+        let live = target != RerunTarget::File;
         let (rec, target) = match target {
             RerunTarget::File => {
                 let path = PathBuf::from(file);
@@ -128,6 +131,7 @@ impl RerunLink {
                 frames_logged: 0,
                 time_offset: (0, 0.0),
                 logged_until: None,
+                live,
             }),
             Err(e) => Err(format!("Rerun: {e}")),
         }
@@ -197,6 +201,8 @@ impl RerunLink {
             let mut settings = LogSettings::new(&first.config);
             settings.time_offset = self.time_offset;
             settings.lesson_text = lesson_text.is_some();
+            // a viewer or a browser opened late starts at the present, not at t = 0
+            settings.follow_latest = self.live;
             let fields = crate::display::fields(&first.config);
             retired = self.recorder.replace(Recorder::new(&self.rec, &configs, &settings, &fields)?);
             self.generation = generation;

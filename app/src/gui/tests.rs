@@ -1013,6 +1013,17 @@ fn assert_layout_fits(h: &Harness<'_, HoxApp>, what: &str) {
         assert!(view.expand(1.0).contains_rect(*body), "{what}: body {k} {body:?} leaves the view {view:?}");
         assert!(!body.intersects(legend), "{what}: body {k} {body:?} under the legend {legend:?}");
     }
+    // issue #57: in presenter mode a label could sit in a corner far from its body
+    let gap = |a: egui::Rect, b: egui::Rect| {
+        let dx = (a.min.x - b.max.x).max(b.min.x - a.max.x).max(0.0);
+        let dy = (a.min.y - b.max.y).max(b.min.y - a.max.y).max(0.0);
+        (dx * dx + dy * dy).sqrt()
+    };
+    let near = 0.25 * view.width().max(view.height());
+    for (k, (label, body)) in d.labels.iter().zip(&d.bodies).enumerate() {
+        let g = gap(*label, *body);
+        assert!(g <= near, "{what}: label {k} {label:?} is {g:.0} points from its body {body:?} (at most {near:.0})");
+    }
     for (k, label) in d.labels.iter().enumerate() {
         assert!(view.contains_rect(*label), "{what}: label {k} {label:?} leaves the view {view:?}");
         assert!(!label.intersects(legend), "{what}: label {k} {label:?} on the legend {legend:?}");
@@ -1396,45 +1407,63 @@ fn stream_names(h: &Harness<'_, HoxApp>) -> std::collections::BTreeSet<String> {
 #[test]
 fn a_browser_following_a_lesson_shows_only_the_current_step_s_bodies() {
     for name in ["why-high-order", "locking"] {
-        let dir = std::env::temp_dir().join(format!("hox-lesson-stream-{}-{name}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("lesson.rrd");
-        let mut h = harness(AppArgs::default());
-        h.run_steps(2);
-        h.state_mut().ui.rerun_file = path.display().to_string();
-        h.state_mut().act(super::action::Command::Rerun(Some(super::action::RerunTarget::File)));
-        h.run_steps(2);
-        let mut streamed = stream_names(&h);
-        let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == name).unwrap();
-        let steps = lesson.steps.len();
-        h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
-        lesson_ready(&mut h);
-        for step in 0..steps {
-            h.run_steps(20);
-            // every step's configurations go into the stream (its file is read once, at the end)
-            streamed.extend(stream_names(&h));
-            if step + 1 < steps {
-                h.key_press(egui::Key::ArrowRight);
-                lesson_ready(&mut h);
-            }
-        }
-        h.run_steps(20);
-        let on_screen = stream_names(&h);
-        h.state_mut().act(super::action::Command::Rerun(None));
-        let (bodies, lines) = shown_at_latest_frame(&path);
-        println!("{name}: streamed {streamed:?}, on screen at the end {on_screen:?}");
+        let (streamed, on_screen) = follow_lesson_stream(name);
         assert!(streamed.len() > on_screen.len(), "{name}: several steps' configurations were streamed: {streamed:?}");
-        assert_eq!(bodies, on_screen, "{name}: only the current step's bodies at the latest frame");
-        for line in &lines {
-            let owner = line.rsplit('/').next().unwrap();
-            assert!(
-                on_screen.contains(owner) || owner == "reference_static",
-                "{name}: a chart still draws {line}, not on screen ({on_screen:?})"
-            );
-        }
-        assert!(lines.iter().any(|l| l.starts_with("plots/kinetic_energy_j/")), "{name}: the charts draw: {lines:?}");
-        let _ = std::fs::remove_dir_all(&dir);
     }
+}
+
+/// [`a_browser_following_a_lesson_shows_only_the_current_step_s_bodies`] for every lesson (the
+/// app's ignored tests: `.ci/run`).
+#[test]
+#[ignore = "every lesson's steps, about two minutes in a debug build; .ci/run runs it"]
+fn a_browser_following_every_lesson_shows_only_the_current_step_s_bodies() {
+    for lesson in hox_scenes::lesson::registry().unwrap() {
+        follow_lesson_stream(&lesson.name);
+    }
+}
+
+/// Streams the app to a file through every step of lesson `name` and checks, in Rerun's own
+/// store, that at the latest frame only the configurations on screen are drawn (bodies and chart
+/// lines); returns the configurations streamed and those on screen at the end.
+fn follow_lesson_stream(name: &str) -> (std::collections::BTreeSet<String>, std::collections::BTreeSet<String>) {
+    let dir = std::env::temp_dir().join(format!("hox-lesson-stream-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("lesson.rrd");
+    let mut h = harness(AppArgs::default());
+    h.run_steps(2);
+    h.state_mut().ui.rerun_file = path.display().to_string();
+    h.state_mut().act(super::action::Command::Rerun(Some(super::action::RerunTarget::File)));
+    h.run_steps(2);
+    let mut streamed = stream_names(&h);
+    let lesson = hox_scenes::lesson::registry().unwrap().into_iter().find(|l| l.name == name).unwrap();
+    let steps = lesson.steps.len();
+    h.state_mut().act(Action::OpenLesson(Box::new(lesson)));
+    lesson_ready(&mut h);
+    for step in 0..steps {
+        h.run_steps(20);
+        // every step's configurations go into the stream (its file is read once, at the end)
+        streamed.extend(stream_names(&h));
+        if step + 1 < steps {
+            h.key_press(egui::Key::ArrowRight);
+            lesson_ready(&mut h);
+        }
+    }
+    h.run_steps(20);
+    let on_screen = stream_names(&h);
+    h.state_mut().act(super::action::Command::Rerun(None));
+    let (bodies, lines) = shown_at_latest_frame(&path);
+    println!("{name}: streamed {streamed:?}, on screen at the end {on_screen:?}");
+    assert_eq!(bodies, on_screen, "{name}: only the current step's bodies at the latest frame");
+    for line in &lines {
+        let owner = line.rsplit('/').next().unwrap();
+        assert!(
+            on_screen.contains(owner) || owner == "reference_static",
+            "{name}: a chart still draws {line}, not on screen ({on_screen:?})"
+        );
+    }
+    assert!(lines.iter().any(|l| l.starts_with("plots/kinetic_energy_j/")), "{name}: the charts draw: {lines:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+    (streamed, on_screen)
 }
 
 /// Issue #57: a lesson's configurations (two "P2 8×2×2 five" beams of 50 and 100 substeps) came
@@ -1762,4 +1791,38 @@ fn a_lesson_at_1280_by_720_leaves_the_3d_view_room() {
     open_lesson(&mut wide, "why-high-order");
     wide.run_steps(2);
     assert!(wide.query_by_label("Poisson ratio ν").is_some());
+}
+
+/// Issue #57: a page opened late on the app's live stream replayed it from t = 0 and ran 48 s
+/// behind the app. A live stream's blueprint (the app streaming to a viewer or to browsers) has
+/// the viewer follow the newest frame; a file (`hox record`, *Save to file*) still opens at its
+/// start.
+#[test]
+fn a_page_opened_late_on_the_live_stream_starts_at_the_present() {
+    use rerun::external::re_sdk_types::blueprint::components::PlayState;
+    let instance = hox_scenes::Instance::new(hox_scenes::by_name("bending").unwrap()).unwrap();
+    let configs = [crate::recording::Configuration {
+        name: "a".into(),
+        instance: &instance,
+        offset_m: hox_sim::Vec3::zeros(),
+        reference: None,
+    }];
+    let mut play_states = Vec::new();
+    for live in [false, true] {
+        let (rec, storage) = rerun::RecordingStreamBuilder::new("hox").memory().unwrap();
+        let mut settings = crate::recording::LogSettings::new(instance.scene.params());
+        settings.follow_latest = live;
+        crate::recording::Recorder::new(&rec, &configs, &settings, &[]).unwrap();
+        rec.flush_blocking().unwrap();
+        let mut states = Vec::new();
+        for m in storage.take() {
+            let rerun::log::LogMsg::ArrowMsg(_, arrow) = m else { continue };
+            let chunk = rerun::log::Chunk::from_arrow_msg(&arrow).unwrap();
+            for d in chunk.component_descriptors().filter(|d| d.component.to_string().ends_with("play_state")) {
+                states.extend(chunk.iter_component::<PlayState>(d.component).flat_map(|s| s.to_vec()));
+            }
+        }
+        play_states.push(states);
+    }
+    assert_eq!(play_states, [vec![], vec![PlayState::Following]], "a file opens at its start; a live stream follows");
 }

@@ -11,9 +11,7 @@ use super::node_loops;
 use super::registry;
 use super::residual::{StaticResidual, static_residual};
 use super::settings::SolverSettings;
-use super::stability::{
-    GUARD_H_OMEGA, RestOmega2, StabilityReport, guard_trigger_h_omega, guarded_substeps, mesh_omega2_max,
-};
+use super::stability::{RestOmega2, StabilityReport, guard_trigger_h_omega, mesh_omega2_max, substeps_for};
 use super::step::{Hooks, StepInput, StepSolver};
 use super::xpbd::Xpbd;
 
@@ -438,11 +436,7 @@ impl Simulation {
         let implicit = s.method.is_implicit();
         let requested = if implicit { s.steps_per_frame } else { s.substeps };
         let guard = s.stability_guard && !implicit;
-        let (substeps, capped) = if guard {
-            guarded_substeps(requested, s.frames_per_second, omega_max_rad_s, trigger_h_omega, GUARD_H_OMEGA)
-        } else {
-            (requested, false)
-        };
+        let (substeps, capped) = substeps_for(s, &self.material, omega2_normalised);
         StabilityReport {
             omega_max_rad_s,
             block,
@@ -455,6 +449,11 @@ impl Simulation {
             capped,
             implicit,
         }
+    }
+
+    /// The stiffest element's rest `ω²·ρ/E` the guard last used, if computed.
+    pub fn rest_omega2_per_e_over_rho(&self) -> Option<f64> {
+        self.omega2_per_e_over_rho.map(|v| v.0)
     }
 
     /// Substeps per frame being taken: the requested ones, or more (the stability guard).

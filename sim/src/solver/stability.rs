@@ -29,6 +29,7 @@
 //! masses linear in ρ), so a change of E or ρ rescales the cached value instead of recomputing
 //! it; ν, the model, the quadrature or a node's mass recompute it (in parallel over elements).
 
+use super::settings::SolverSettings;
 use crate::Vec3;
 use crate::fem::energy::{element_grads, element_hessian, gather};
 use crate::fem::geometry::BlockGeometry;
@@ -159,6 +160,20 @@ pub struct RestOmega2 {
     pub poisson_ratio: f64,
     /// `(ω²·ρ/E, block, element)` of the stiffest element.
     pub per_e_over_rho: (f64, usize, usize),
+}
+
+/// The substeps per frame `settings` take with `material` on a mesh whose stiffest element has
+/// rest `ω²·ρ/E` = `omega2_per_e_over_rho` (more than asked where the guard raises them), and
+/// whether [`GUARD_MAX_SUBSTEPS`] capped them; an implicit solver's steps per frame.
+pub fn substeps_for(settings: &SolverSettings, material: &Material, omega2_per_e_over_rho: f64) -> (u32, bool) {
+    let implicit = settings.method.is_implicit();
+    let requested = if implicit { settings.steps_per_frame } else { settings.substeps };
+    if !settings.stability_guard || implicit {
+        return (requested, false);
+    }
+    let omega_max_rad_s = (omega2_per_e_over_rho * material.youngs_modulus_pa / material.density_kg_m3).sqrt();
+    let trigger = guard_trigger_h_omega(settings.formulation, material);
+    guarded_substeps(requested, settings.frames_per_second, omega_max_rad_s, trigger, GUARD_H_OMEGA)
 }
 
 /// Substeps per frame the guard uses for a mesh whose fastest mode is `omega_max_rad_s`: the
