@@ -163,8 +163,8 @@ pub fn estimated_ms_with(current: &Simulation, current_ms: f64, settings: &Solve
 
 /// Whether a change of solver settings `new` for `s` (the same mesh: estimated without
 /// building anything, so dragging the substeps slider stays cheap) would be slow: the question,
-/// or None. A new mesh is estimated once built ([`too_slow_built`]); a new material is not (the
-/// slow-frame pause catches a stiffer one's extra substeps).
+/// or None. A new mesh is estimated once built ([`too_slow_built`]); a new material by its
+/// stability guard's substeps ([`too_slow_material`]).
 pub fn too_slow(s: &Session, new: &Config, rates: &Rates, draw_ms: f64) -> Option<String> {
     use super::config::Invalidates;
     match s.config.invalidated_by(new) {
