@@ -1,22 +1,25 @@
 #!/usr/bin/env python3
 """Side by side with Jan Bender's PositionBasedDynamics (pypbd): its FEM tetrahedra on the same
 three P1 beams as `hox bench` (the paper's Table 1 bending beam: 2 x 0.5 x 0.5 m, clamped at
-x = 0, gravity, 50 substeps x 1 iteration per 1/60 s frame), timed, then `hox`'s own timing of
-the same beams run right after, so the ratio is measured in one run.
+x = 0, gravity, 50 substeps x 1 iteration per 1/60 s frame), timed, then `hox bench`'s timing of
+the same beam right after, so each ratio is measured in one run.
 
-    python3 bench/pbd_peer.py [--frames 20] [--method 3]
+    python3 bench/pbd_peer.py [--frames 15] [--method 3] [--hox PATH]
 
-(set HOX_CARGO="flock /tmp/hox-cargo.lock cargo" where builds must take turns).
+Prints the machine line and a markdown table (docs/PERFORMANCE.md holds it between generated
+markers: `python3 scripts/docs_tables.py` rewrites it, `cargo test -p hox --test doc_tables`
+checks its format). `hox` is --hox, else $HOX_BIN, else the release binary under
+$CARGO_TARGET_DIR (built if missing; HOX_CARGO="flock /tmp/hox-cargo.lock cargo" where builds
+must take turns).
 
 Installs pypbd into bench/.venv (a virtualenv) on first use. The meshes come from hox itself
-(`cargo run --release -p hox-scenes --example beam_mesh -- LABEL`), so both solve identical meshes.
-PBD's solid method 3 is its XPBD FEM tetrahedron (the constitutive model of Bender et al.
-2014 / PBD's `FEMTetConstraint`): one constraint per tetrahedron, like hox's energy
-formulation; stiffness is Young's modulus, 3 MPa, Poisson ratio 0.35. Times are medians of ms
-per frame on one thread (PBD's OpenMP loop is limited with OMP_NUM_THREADS=1); hox is timed
-with both of its sweeps: colour (the default: a register of same-colour tetrahedra at a time,
-`Sweep::Colour`) at each register width the CPU runs (8 lanes on AVX-512, the default there; 4
-on AVX2) and element order (`Sweep::Element`, the order before issue #22).
+(`hox bench --beam-json LABEL`), so both solve identical meshes. PBD's solid method 3 is its
+XPBD FEM tetrahedron (the constitutive model of Bender et al. 2014 / PBD's `FEMTetConstraint`):
+one constraint per tetrahedron, like hox's energy formulation; stiffness is Young's modulus,
+3 MPa, Poisson ratio 0.35. Times are medians of ms per frame on one thread (PBD's OpenMP loop is
+limited with OMP_NUM_THREADS=1); hox is timed with both of its sweeps: colour (the default: a
+register of same-colour tetrahedra at a time, at the widest register this CPU runs, 8 lanes on
+AVX-512, else 4) and element order (`Sweep::Element`, the order before issue #22).
 """
 import argparse
 import json
@@ -28,6 +31,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+from hox_binary import hox_binary  # noqa: E402
 VENV = ROOT / "bench" / ".venv"
 BEAMS = ["P1 16x4x4", "P1 16x4x4 r1", "P1 16x4x4 r2"]
 
@@ -42,16 +47,8 @@ def ensure_venv() -> Path:
     return python
 
 
-def cargo() -> list:
-    """The cargo command (HOX_CARGO, e.g. "flock /tmp/hox-cargo.lock cargo" on a shared machine)."""
-    return os.environ.get("HOX_CARGO", "cargo").split()
-
-
-def beam_mesh(label: str) -> dict:
-    out = subprocess.run(
-        cargo() + ["run", "--quiet", "--release", "-p", "hox-scenes", "--example", "beam_mesh", "--", label],
-        cwd=ROOT, check=True, capture_output=True, text=True,
-    ).stdout
+def beam_mesh(hox: str, label: str) -> dict:
+    out = subprocess.run([hox, "bench", "--beam-json", label], cwd=ROOT, check=True, capture_output=True, text=True).stdout
     return json.loads(out)
 
 
@@ -97,53 +94,56 @@ def time_pbd(mesh: dict, frames: int, method: int) -> float:
     return statistics.median(times_ms)
 
 
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--frames", type=int, default=20)
     parser.add_argument("--method", type=int, default=3, help="PBD solid method (3: XPBD FEM tetrahedra)")
-    parser.add_argument("--hox", default="run --quiet --release -p hox-scenes --example bench_table --",
-                        help="cargo arguments that print the hox bench table for FRAMES THREADS FILTER")
+    parser.add_argument("--hox", help="the hox binary (default: $HOX_BIN, else the release build)")
     parser.add_argument("--inner", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.frames < 1:
+        sys.exit("pbd_peer: --frames must be at least 1")
     if args.inner:
         mesh = json.loads(Path(args.inner).read_text())
         print(json.dumps({"ms_per_frame": time_pbd(mesh, args.frames, args.method)}))
         return
+    hox = hox_binary(args.hox)
     python = ensure_venv()
     env = dict(os.environ, OMP_NUM_THREADS="1")
     rows = []
+    machine = None
     for label in BEAMS:
-        mesh = beam_mesh(label)
+        mesh = beam_mesh(hox, label)
         path = VENV / f"mesh-{label.replace(' ', '_')}.json"
         path.write_text(json.dumps(mesh))
         out = subprocess.run([str(python), __file__, "--inner", str(path), "--frames", str(args.frames), "--method", str(args.method)],
                              env=env, check=True, capture_output=True, text=True).stdout
         pbd_ms = json.loads(out.strip().splitlines()[-1])["ms_per_frame"]
-        hox_out = subprocess.run(cargo() + args.hox.split() + [str(args.frames), "1", label], cwd=ROOT, check=True, capture_output=True, text=True,
-                                 env=dict(os.environ, HOX_BENCH_ELEMENT_ORDER="1", HOX_BENCH_LANES=lanes_here())).stdout
-        # one row per sweep and width: colour ×8 / ×4 (a register of tetrahedra) and element (mesh order)
-        hox = {}
-        for line in hox_out.splitlines():
+        bench = [hox, "bench", "--only", label, "--threads", "1", "--sweep", "colour,element", "--frames", str(args.frames)]
+        hox_out = subprocess.run(bench, cwd=ROOT, check=True, capture_output=True, text=True).stdout
+        lines = hox_out.splitlines()
+        machine = lines[0]
+        # the configuration's two rows: colour (at the default width) and element order
+        hox_ms, lanes = {}, None
+        for line in lines:
             if line.startswith("| P1"):
                 cells = [c.strip() for c in line.split("|")]
-                key = cells[4] if cells[5] in ("", "–") else f"{cells[4]} x{cells[5]}"
-                hox[key] = float(cells[7])
-        nan = float("nan")
-        rows.append((label, len(mesh["tets"]) // 4, pbd_ms, hox.get("colour x8", nan), hox.get("colour x4", nan), hox.get("element", nan)))
-        print(f"{label}: PBD {pbd_ms:.2f} ms/frame, hox {hox} ms/frame", file=sys.stderr)
-    print("| beam | tetrahedra | PBD ms/frame (1 thread) | hox colour ×8 (AVX-512, the default there) | hox / PBD | hox colour ×4 (AVX2) | hox / PBD | hox element order | hox / PBD |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for label, n, p, h8, h4, e in rows:
-        print(f"| {label} | {n} | {p:.2f} | {h8:.2f} | {h8 / p:.2f} | {h4:.2f} | {h4 / p:.2f} | {e:.2f} | {e / p:.2f} |")
-
-
-def lanes_here() -> str:
-    """The register widths this CPU runs: 4,8 with AVX-512 F, else 4."""
-    try:
-        flags = Path("/proc/cpuinfo").read_text()
-    except OSError:
-        return "4"
-    return "4,8" if " avx512f" in flags else "4"
+                hox_ms[cells[4]] = float(cells[7])
+                if cells[4] == "colour":
+                    lanes = cells[5]
+        if set(hox_ms) != {"colour", "element"}:
+            sys.exit(f"pbd_peer: `{' '.join(bench)}` printed no colour and element rows:\n{hox_out}")
+        rows.append((label, len(mesh["tets"]) // 4, pbd_ms, hox_ms["colour"], lanes, hox_ms["element"]))
+        print(f"{label}: PBD {pbd_ms:.2f} ms/frame, hox {hox_ms} ms/frame", file=sys.stderr)
+    print(machine)
+    print()
+    print("| P1 beam | tetrahedra | PBD ms/frame, 1 thread | hox ms/frame, colour sweep (the default) | lanes "
+          "| hox / PBD | hox ms/frame, element order | hox / PBD |")
+    print("|---|---|---|---|---|---|---|---|")
+    for label, n, p, colour, lanes, element in rows:
+        print(f"| {label} | {n} | {p:.2f} | {colour:.2f} | {lanes} | **{colour / p:.2f}** | {element:.2f} | {element / p:.2f} |")
 
 
 if __name__ == "__main__":

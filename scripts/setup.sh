@@ -47,3 +47,7 @@ install_missing "the app's window" xvfb xauth libgl1 libegl1 libgl1-mesa-dri mes
 # browser) use Debian's Chromium, headless with software WebGL (SwiftShader, built in), and
 # python3 (scripts/browser_shot.py: the standard library only).
 install_missing "the browser tests" chromium fonts-liberation python3
+
+# The PositionBasedDynamics table of docs/PERFORMANCE.md (bench/pbd_peer.py, checked by
+# app/tests/doc_tables.rs) installs pypbd from PyPI into bench/.venv: a virtualenv needs venv.
+install_missing "the peer benchmark" python3-venv

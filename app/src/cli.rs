@@ -92,8 +92,13 @@ pub enum Command {
         #[arg(long)]
         quick: bool,
         /// Output folder (created if missing).
-        #[arg(long)]
-        out: PathBuf,
+        #[arg(long, required_unless_present = "summary", conflicts_with = "summary")]
+        out: Option<PathBuf>,
+        /// Run nothing: print the figures of the study a `--out DIR` run wrote to DIR, as
+        /// docs/STUDY.md shows them (its machine line, the bending beam beside the paper's
+        /// Table 1, the cheapest configuration within 1 % per scene, the beam in motion).
+        #[arg(long, value_name = "DIR")]
+        summary: Option<PathBuf>,
     },
     /// Time the XPBD loop on the paper's Table 1 beams and the other element types: ms per
     /// frame against the paper's, ns per element per substep, GFLOP/s (docs/PERFORMANCE.md);
@@ -108,7 +113,7 @@ pub enum Command {
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
         threads: Vec<usize>,
         /// Only the configurations whose label contains this (e.g. "p1", "r2"; "table1": the
-        /// paper's Table 1 beams).
+        /// paper's Table 1 beams; "parts": the curved parts, with --solver).
         #[arg(long, default_value = "")]
         only: String,
         /// The sweep orders timed, comma-separated: colour (the default everywhere: a register
@@ -125,6 +130,16 @@ pub enum Command {
         /// factorisation); the thread counts run side by side, with the speed-up over one thread.
         #[arg(long, default_value = "xpbd")]
         solver: String,
+        /// Print the beam labelled LABEL (e.g. "P1 16x4x4 r1") as JSON, `positions_m`, `tets`
+        /// and `clamped`, and time nothing: the mesh a peer benchmark solves too
+        /// (bench/pbd_peer.py times PositionBasedDynamics on it).
+        #[arg(long, value_name = "LABEL")]
+        beam_json: Option<String>,
+        /// Print the stability guard's figures for every built-in scene and benchmark beam at
+        /// its own settings, timing nothing: the fastest element mode ω_max, `h·ω_max` at the
+        /// substeps asked, and the substeps the guard takes (docs/STABILITY.md).
+        #[arg(long, conflicts_with = "beam_json")]
+        stability: bool,
     },
     /// Run a scene (for --seconds, or until it --settle-s) and print the probe displacements.
     Simulate {
@@ -199,9 +214,15 @@ pub fn run(command: Command) -> Result<()> {
         Command::Simulate { scene, mesh, physics, seconds, settle, vtk, reference, json } => {
             simulate::simulate(&scene, &mesh, &physics, seconds, settle, &vtk, &reference, json)
         }
-        Command::Study { quick, out } => study::study(quick, &out),
+        Command::Study { quick, out, summary } => match (summary, out) {
+            (Some(dir), _) => study::summary(&dir),
+            (None, Some(out)) => study::study(quick, &out),
+            (None, None) => anyhow::bail!("hox study needs --out DIR (run the study) or --summary DIR (print one)"),
+        },
         Command::Paper { quick, out } => paper::paper(quick, &out),
-        Command::Bench { frames, threads, only, sweep, lanes, solver } => {
+        Command::Bench { beam_json: Some(label), .. } => bench::beam_json(&label),
+        Command::Bench { stability: true, .. } => bench::stability(),
+        Command::Bench { frames, threads, only, sweep, lanes, solver, beam_json: None, stability: false } => {
             bench::bench(frames, &threads, &only, &sweep, &lanes, &solver)
         }
         Command::Static { scene, mesh, physics, tolerance, load_steps, reference, json } => {

@@ -412,6 +412,43 @@ fn bench_times_an_implicit_solver_and_refuses_an_unknown_one() {
     fails_with(&["bench", "--solver", "foo"], "xpbd, vbd, newton");
 }
 
+/// Issue #58: the commands behind docs/' tables. `bench --beam-json` gives a peer benchmark the
+/// beam hox times (bench/pbd_peer.py), `bench --stability` the guard's table, `study --summary` a
+/// study folder's figures; each refuses what it cannot print, by name.
+#[test]
+fn the_commands_behind_the_docs_tables_print_them_and_refuse_bad_input_by_name() {
+    let beam = json(&["bench", "--beam-json", "P1 16x4x4"]);
+    let tets = beam["tets"].as_array().unwrap();
+    assert_eq!(tets.len(), 4 * 1280, "the paper's P1 1,280 beam");
+    let nodes = beam["positions_m"].as_array().unwrap().len();
+    assert!(tets.iter().all(|t| (t.as_u64().unwrap() as usize) < nodes));
+    // the clamped face at x = 0: a 17 × 5 × 5 grid of nodes has 25 there
+    assert_eq!(beam["clamped"].as_array().unwrap().len(), 25);
+    fails_with(&["bench", "--beam-json", "P2 8x2x2"], "not a P1 beam");
+    fails_with(&["bench", "--beam-json", "P9"], "no beam labelled 'P9' (one of: P1 16x4x4,");
+
+    let out = hox(&["bench", "--stability"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.starts_with("Machine: "), "{table}");
+    // the paper's bending scene runs as asked; the 10,240-element P3 beam needs the guard
+    assert!(table.contains("| scene bending | 160 | 2725 | 50 | 0.91 | 50 |"), "{table}");
+    let p3 = table.lines().find(|l| l.starts_with("| bench P3 32x8x8 |")).expect("the P3 beam's row");
+    let taken: u32 = p3.split('|').nth(6).unwrap().trim().parse().unwrap();
+    assert!(taken > 50, "{p3}");
+
+    let study = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/study");
+    let out = hox(&["study", "--summary", study.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert!(summary.contains("| P2 8x2x2 five | 160 |") && summary.contains("| bending |"), "{summary}");
+    fails_with(&["study"], "--out");
+    let empty = scratch("study-summary");
+    fails_with(&["study", "--summary", empty.to_str().unwrap()], "study.md");
+    std::fs::write(empty.join("study.md"), "# Accuracy versus time\n\nno machine here\n").unwrap();
+    fails_with(&["study", "--summary", empty.to_str().unwrap()], "no machine line");
+}
+
 /// Issue #20: `simulate --json` and `static --json` report the reference of the physics at hand
 /// and the error against it: the committed one for bending as built, one computed (and cached)
 /// for ν = 0.49; a swinging run is measured by its last-second mean, and says so.

@@ -7,6 +7,8 @@
 //! Ignored in a plain `cargo test` (each takes 30–90 s and needs Chromium, the app test Xvfb);
 //! `.ci/run` runs them where the browser is present: `cargo test -p hox --test web -- --ignored`.
 
+mod doc_blocks;
+
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -131,6 +133,20 @@ fn have_browser() {
         Command::new("sh").arg("-c").arg(format!("command -v {b}")).output().is_ok_and(|o| o.status.success())
     });
     assert!(found, "no Chromium: scripts/setup.sh installs Debian's package (root), or run without --ignored");
+}
+
+/// Issue #58: docs/WEB.md's figures are `scripts/web_figures.py`'s output; the committed table
+/// keeps the format a short run of it writes (the page coloured within its wait, every row).
+#[test]
+#[ignore = "needs headless Chromium and Xvfb; .ci/run runs it"]
+fn the_web_figures_table_in_the_docs_has_the_format_its_command_writes() {
+    have_browser();
+    let blocks = doc_blocks::blocks();
+    let web: Vec<_> = blocks.iter().filter(|(_, c, _)| doc_blocks::needs_browser(c)).collect();
+    assert!(!web.is_empty(), "docs/WEB.md holds a table written by scripts/web_figures.py");
+    for (file, command, body) in web {
+        doc_blocks::check(file, command, body);
+    }
 }
 
 #[test]

@@ -60,3 +60,53 @@ pub fn bench(
     }
     Ok(())
 }
+
+/// `hox bench --beam-json LABEL`: the beam's P1 mesh as JSON (`positions_m`, `tets` with four
+/// node indices each, `clamped`: the nodes at x = 0), for a peer benchmark to solve the same mesh.
+pub fn beam_json(label: &str) -> Result<()> {
+    let Some(case) = hox_scenes::bench::CASES.iter().find(|c| c.label().eq_ignore_ascii_case(label)) else {
+        let labels: Vec<String> = hox_scenes::bench::CASES.iter().map(|c| c.label()).collect();
+        bail!("--beam-json: no beam labelled '{label}' (one of: {})", labels.join(", "));
+    };
+    if case.element != "p1" {
+        bail!("--beam-json: '{label}' is not a P1 beam: a peer benchmark solves linear tetrahedra");
+    }
+    let sim = hox_scenes::bench::bending_beam(case, Sweep::Element)?;
+    let mesh = sim.mesh();
+    let positions: Vec<String> = mesh.rest_positions.iter().map(|p| format!("[{},{},{}]", p.x, p.y, p.z)).collect();
+    let tets: Vec<String> = mesh.blocks[0].connectivity.iter().map(u32::to_string).collect();
+    let clamped: Vec<String> = mesh.nodes_where(|p| p.x.abs() < 1e-12).iter().map(u32::to_string).collect();
+    println!(
+        "{{\"positions_m\":[{}],\"tets\":[{}],\"clamped\":[{}]}}",
+        positions.join(","),
+        tets.join(","),
+        clamped.join(",")
+    );
+    Ok(())
+}
+
+/// `hox bench --stability`: the stability guard's figures (`hox_sim::solver::stability`) for
+/// every built-in scene and every benchmark beam at their own settings. They depend on the mesh
+/// and the material, not on the machine; the machine line keeps the format of the tables in docs/.
+pub fn stability() -> Result<()> {
+    println!("Machine: {}.\n", super::paper::machine());
+    println!("| configuration | elements | ω_max (rad/s) | substeps asked | h·ω_max | substeps taken |");
+    println!("|---|---|---|---|---|---|");
+    let row = |label: String, elements: usize, r: hox_sim::solver::stability::StabilityReport| {
+        println!(
+            "| {label} | {elements} | {:.0} | {} | {:.2} | {} |",
+            r.omega_max_rad_s, r.requested_substeps, r.requested_h_omega, r.substeps
+        );
+    };
+    for (name, _) in hox_scenes::BUILTIN {
+        let mut instance = hox_scenes::Instance::new(hox_scenes::by_name(name)?)?;
+        let elements = instance.sim.mesh().num_elements();
+        row(format!("scene {name}"), elements, instance.sim.stability());
+    }
+    for case in hox_scenes::bench::CASES.iter() {
+        let mut sim = hox_scenes::bench::bending_beam(case, Sweep::Element)?;
+        let elements = sim.mesh().num_elements();
+        row(format!("bench {}", case.label()), elements, sim.stability());
+    }
+    Ok(())
+}

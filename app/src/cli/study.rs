@@ -46,8 +46,12 @@ pub fn study(quick: bool, out: &std::path::Path) -> Result<()> {
     let mut files = vec![
         (
             "study.md".to_string(),
-            hox_scenes::study::markdown(&rows, quick)
-                + "\n"
+            // the machine line under the title: `hox study --summary` and docs/STUDY.md name it
+            hox_scenes::study::markdown(&rows, quick).replacen(
+                "\n\n",
+                &format!("\n\nMachine: {}.\n\n", super::paper::machine()),
+                1,
+            ) + "\n"
                 + &solver_axis::solver_markdown(&solvers)
                 + &hox_scenes::study::locking_markdown(&locking),
         ),
@@ -66,5 +70,11 @@ pub fn study(quick: bool, out: &std::path::Path) -> Result<()> {
         std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }
+    Ok(())
+}
+
+/// `hox study --summary DIR`: the figures of the study in DIR as docs/STUDY.md shows them.
+pub fn summary(dir: &std::path::Path) -> Result<()> {
+    print!("{}", hox_scenes::study::summary::summary(dir)?);
     Ok(())
 }

@@ -317,6 +317,9 @@ pub fn matching_cases(filter: &str) -> Vec<&'static BenchCase> {
 /// [`matching_cases`] among the beams and the curved parts ([`PART_CASES`]): what the implicit
 /// solvers are timed on.
 pub fn matching_solver_cases(filter: &str) -> Vec<&'static BenchCase> {
+    if filter.eq_ignore_ascii_case(PARTS) {
+        return PART_CASES.iter().collect();
+    }
     let mut cases = matching(&CASES, filter);
     cases.extend(matching(&PART_CASES, filter));
     cases
@@ -336,6 +339,8 @@ fn matching(cases: &'static [BenchCase], filter: &str) -> Vec<&'static BenchCase
 
 /// The filter that names the paper's Table 1 beams (every case with a paper figure).
 const TABLE1: &str = "TABLE1";
+/// The `--only` word that picks every curved part ([`PART_CASES`]) for the implicit solvers.
+const PARTS: &str = "parts";
 
 /// Measures the case labelled `filter` (`table1`: the paper's Table 1 beams), or else every
 /// case whose label contains it (ignoring case), on each of `threads` with each of `sweeps` (the element-order sweep runs on one

@@ -17,6 +17,7 @@
 pub mod motion;
 pub mod pareto;
 pub mod solver_axis;
+pub mod summary;
 
 /// An element type's colour in the study's charts (`study.svg` and the app's).
 pub use crate::present::colour::element_colour;
@@ -407,7 +408,7 @@ pub fn locking_csv(rows: &[LockingRow]) -> String {
 pub fn markdown(rows: &[StudyRow], quick: bool) -> String {
     let mut s = String::from("# Accuracy versus time\n\n");
     s.push_str(&format!(
-        "Produced by `hox study{}`. Settings: the paper's (StVK, 50 substeps × 1 iteration, 60 fps, energy formulation), settled; errors at the probes against the fine Q2 reference (`assets/reference/`), in metres and in % of the reference displacement. *Discretisation*: static solution on the mesh vs reference. *Solver*: settled XPBD vs static solution on the same mesh. *Substeps for 1 %*: the substeps that bring the solver error under 1 %, and the ms per frame that costs. Times are medians over frames of the colour sweep (colour by colour, four elements per AVX2 register; the same result on any thread count): on one thread and on all threads (rayon's pool; measured over one second from the settled state).\n\n",
+        "Produced by `hox study{}`. Settings: the paper's (StVK, 50 substeps × 1 iteration, 60 fps, energy formulation), settled; errors at the probes against the fine Q2 reference (`assets/reference/`), in metres and in % of the reference displacement. *Discretisation*: static solution on the mesh vs reference. *Solver*: settled XPBD vs static solution on the same mesh. *Substeps for 1 %*: the substeps that bring the solver error under 1 %, and the ms per frame that costs. Times are medians over frames of the colour sweep (colour by colour, four elements per AVX2 register or eight per AVX-512 one; the same result on any thread count): on one thread and on all threads (rayon's pool; measured over one second from the settled state).\n\n",
         if quick { " --quick" } else { "" }
     ));
     for scene in crate::scene::builtin::PAPER_SCENES {
