@@ -6,11 +6,13 @@
 //! committed. A renamed column, a row gone, a table written by hand inside the markers fails.
 //! A script of the project (`python3 bench/pbd_peer.py`, which installs pypbd from PyPI into
 //! bench/.venv) runs with this build of hox as $HOX_BIN. The browser measurements of docs/WEB.md
-//! (`scripts/web_figures.py`) are checked by `web.rs`'s ignored tests, where Chromium is.
+//! (`scripts/web_figures.py`) are checked by `web.rs`'s ignored tests, where Chromium is; a table a
+//! test measures (`cargo test … robustness_solvers`) by that test (`hox_tests::docs::publish`).
 
 mod doc_blocks;
 
-use doc_blocks::{blocks, check, needs_browser, quick, shape};
+use doc_blocks::{blocks, check, is_test, needs_browser, quick};
+use hox_tests::docs::shape;
 
 #[test]
 fn the_shape_of_a_line_keeps_its_words_and_drops_its_numbers() {
@@ -32,7 +34,8 @@ fn the_shape_of_a_line_keeps_its_words_and_drops_its_numbers() {
 fn every_generated_table_in_the_docs_has_the_format_its_command_writes() {
     let blocks = blocks();
     assert!(blocks.len() >= 6, "docs/ has generated tables (PERFORMANCE, STUDY, STABILITY, WEB): {}", blocks.len());
-    for (file, command, body) in blocks.iter().filter(|(_, c, _)| !needs_browser(c)) {
+    // a browser's measurements are checked by web.rs, a test's table by the test itself
+    for (file, command, body) in blocks.iter().filter(|(_, c, _)| !needs_browser(c) && !is_test(c)) {
         check(file, command, body);
     }
 }

@@ -14,6 +14,7 @@
 //!   same after the best rigid alignment (Kabsch: the rotation `R` and translation `t` minimising
 //!   `Σ_i |R X_i + t − x_i|²`, from the SVD of the centred cross-covariance).
 
+pub mod docs;
 pub mod rooms;
 
 use hox_sim::Vec3;

@@ -9,8 +9,9 @@
 //! 4.7 sizes long under its weight with every solver) — or stops with a clear error
 //! naming the solver (the NaN guard, the step watch's divergence or unsolved step) or the
 //! effect it cannot honour (contact under the Newton-type solvers). Which configurations stop instead of
-//! recovering is printed (`PASS` / `STOP` lines) for docs/STABILITY.md; the families' own
-//! recovery criteria (tests/tests/robustness.rs) still run with XPBD only.
+//! recovering is printed (`PASS` / `STOP` lines), and the run's table of farthest nodes is
+//! docs/STABILITY.md's (checked against it; written there by `scripts/docs_tables.py`); the
+//! families' own recovery criteria (tests/tests/robustness.rs) still run with XPBD only.
 
 use hox_sim::Vec3;
 use hox_sim::effect::{AxisRotation, ContactPlane, Damping, Effect, Gravity, Prescribed};
@@ -204,21 +205,72 @@ fn run(case: &Case, method: Method, integrator: Integrator) -> Result<String, St
     ))
 }
 
+/// docs/STABILITY.md's cell for one run's figures: the farthest node in body sizes and the steps
+/// taken again, `refused` or `stops`.
+fn cell(figures: &str) -> String {
+    if figures.starts_with("refused") {
+        return "refused".into();
+    }
+    if figures.starts_with("STOP") {
+        return "stops".into();
+    }
+    let words: Vec<&str> = figures.split_whitespace().collect();
+    let before = |w: &str| words.iter().position(|x| *x == w).and_then(|k| k.checked_sub(1)).map_or("?", |k| words[k]);
+    let after = |w: &str| words.iter().position(|x| *x == w).and_then(|k| words.get(k + 1)).copied().unwrap_or("?");
+    match before("steps") {
+        "0" => after("node").to_string(),
+        rejected => format!("{}, {rejected} rej.", after("node")),
+    }
+}
+
+/// The command whose table docs/STABILITY.md holds.
+const COMMAND: &str = "cargo test --release -p hox-tests --test robustness_solvers -- --ignored";
+
 #[test]
 #[ignore = "heavy: release, .ci/run"]
 fn no_solver_ends_a_hard_case_finite_but_absurd() {
     let mut problems = Vec::new();
+    let labels: Vec<String> = solvers()
+        .into_iter()
+        .map(
+            |(method, integrator)| {
+                if method.is_implicit() { format!("{method} {integrator}") } else { method.to_string() }
+            },
+        )
+        .collect();
+    let mut table = format!(
+        "{}\n\n| family | {} |\n|---|{}\n",
+        docs::machine_line(),
+        labels.join(" | "),
+        "---|".repeat(labels.len())
+    );
     for case in cases() {
-        for (method, integrator) in solvers() {
-            let label = if method.is_implicit() { format!("{method} {integrator}") } else { method.to_string() };
+        let mut row = format!("| {} |", case.family);
+        for ((method, integrator), label) in solvers().into_iter().zip(&labels) {
             match run(&case, method, integrator) {
-                Ok(figures) => eprintln!("{} | {label} | {figures}", case.family),
+                Ok(figures) => {
+                    eprintln!("{} | {label} | {figures}", case.family);
+                    row.push_str(&format!(" {} |", cell(&figures)));
+                }
                 Err(why) => {
                     eprintln!("FAIL {} | {label} | {why}", case.family);
                     problems.push(format!("{}, {label}: {why}", case.family));
+                    row.push_str(" absurd |");
                 }
             }
         }
+        table.push_str(&row);
+        table.push('\n');
     }
     assert!(problems.is_empty(), "{} run(s):\n{}", problems.len(), problems.join("\n"));
+    // docs/STABILITY.md's table is this run's (issue #58)
+    docs::publish("docs/STABILITY.md", COMMAND, &table);
+}
+
+#[test]
+fn a_runs_cell_gives_its_farthest_node_and_the_steps_taken_again() {
+    assert_eq!(cell("PASS: farthest node 0.287 sizes from rest, 0 steps rejected, 0 unconverged"), "0.287");
+    assert_eq!(cell("PASS: farthest node 0.289 sizes from rest, 279 steps rejected, 3 unconverged"), "0.289, 279 rej.");
+    assert_eq!(cell("refused: contact is not supported by newton"), "refused");
+    assert_eq!(cell("STOP: newton: step unsolved at frame 3"), "stops");
 }

@@ -48,7 +48,7 @@ pub fn bench(
         bail!("no configuration matches '{only}'");
     }
     // the machine first: every figure table in docs/ names its machine (issue #58)
-    println!("Machine: {}.\n", super::paper::machine());
+    println!("Machine: {}.\n", hox_scenes::bench::machine());
     if !method.is_implicit() {
         let rows =
             hox_scenes::bench::run(only, threads, &sweeps, lanes, frames, &mut |r| eprintln!("{}", r.progress_line()))?;
@@ -89,7 +89,7 @@ pub fn beam_json(label: &str) -> Result<()> {
 /// every built-in scene and every benchmark beam at their own settings. They depend on the mesh
 /// and the material, not on the machine; the machine line keeps the format of the tables in docs/.
 pub fn stability() -> Result<()> {
-    println!("Machine: {}.\n", super::paper::machine());
+    println!("Machine: {}.\n", hox_scenes::bench::machine());
     println!("| configuration | elements | ω_max (rad/s) | substeps asked | h·ω_max | substeps taken |");
     println!("|---|---|---|---|---|---|");
     let row = |label: String, elements: usize, r: hox_sim::solver::stability::StabilityReport| {

@@ -3,28 +3,13 @@
 
 use anyhow::{Context, Result};
 
-/// The CPU's name, the machine's logical cores, for every figure's caption.
-pub fn machine() -> String {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|text| {
-            text.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|s| s.trim().to_string())
-        })
-        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    format!("\"{cpu}\", {cores} logical cores")
-}
-
 pub fn paper(quick: bool, out: &std::path::Path) -> Result<()> {
     let job = super::study::FolderJob::start(out)?;
     let (bar, started) = (&job.bar, job.started);
     let mut report = |message: &str| job.report(message);
     let result = hox_scenes::paper::run_paper(quick, &mut report)?;
     bar.finish_and_clear();
-    let machine = machine();
+    let machine = hox_scenes::bench::machine();
     let secs = started.elapsed().as_secs_f64();
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     for figure in &result.figures {

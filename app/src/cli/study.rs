@@ -49,7 +49,7 @@ pub fn study(quick: bool, out: &std::path::Path) -> Result<()> {
             // the machine line under the title: `hox study --summary` and docs/STUDY.md name it
             hox_scenes::study::markdown(&rows, quick).replacen(
                 "\n\n",
-                &format!("\n\nMachine: {}.\n\n", super::paper::machine()),
+                &format!("\n\nMachine: {}.\n\n", hox_scenes::bench::machine()),
                 1,
             ) + "\n"
                 + &solver_axis::solver_markdown(&solvers)

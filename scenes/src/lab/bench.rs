@@ -34,6 +34,22 @@ use std::time::Instant;
 /// and FMA exist, `hox bench` measures the peak instead ([`peak::measured_avx2_peak_gflops`]).
 pub const NOMINAL_PEAK_GFLOPS_PER_CORE: f64 = 2.7 * 2.0 * 4.0 * 2.0;
 
+/// The machine every figure is measured on, as the tables in docs/ name it: `"CPU", N logical
+/// cores` (the CPU's model name from /proc/cpuinfo, else the architecture).
+pub fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    format!("\"{cpu}\", {cores} logical cores")
+}
+
 /// One benchmarked configuration: a bending beam, or a curved part ([`PART_CASES`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BenchCase {
