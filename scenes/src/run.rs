@@ -19,7 +19,7 @@ use crate::error::SceneError;
 use crate::instance::Instance;
 use crate::scene::EffectSpec;
 use hox_sim::effect::{Damping, Effect};
-use std::time::Instant;
+use web_time::Instant;
 
 /// Consecutive quiet frames that count as settled.
 pub const SETTLE_FRAMES: usize = 30;

@@ -27,7 +27,7 @@ use crate::params::SceneOverrides;
 use hox_sim::element::ElementType;
 use hox_sim::measure::median;
 use hox_sim::solver::{Simulation, Sweep};
-use std::time::Instant;
+use web_time::Instant;
 
 /// The peak rate used when the CPU cannot be measured (no AVX2): 2.7 GHz × 2 FMA units ×
 /// 4 doubles × 2 flops per FMA, the nominal figure of the project's first machine. Where AVX2

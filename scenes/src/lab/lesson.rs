@@ -457,7 +457,7 @@ impl StepRunner {
             if self.done[k] {
                 continue;
             }
-            let t0 = std::time::Instant::now();
+            let t0 = web_time::Instant::now();
             let result = self.instances[k].sim.step_frame();
             self.frame_ms[k].push(t0.elapsed().as_secs_f64() * 1e3);
             if let Err(e) = result {

@@ -262,6 +262,7 @@ impl HyperelasticModel for StVenantKirchhoff {
         points.sum(|f, g| self.node_force_and_block(l, f, g))
     }
 
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
     fn node_visit_kernel(&self, width: usize) -> Option<NodeVisitKernel> {
         #[cfg(target_arch = "x86_64")]
         if width == 4 && crate::math::f64x4::available() {

@@ -229,7 +229,7 @@ impl LinearSolver for SparsePattern {
         true
     }
     fn solve(&mut self, r: &mut [f64], _relative_residual: f64, _counters: &mut SolverCounters) {
-        let started = std::time::Instant::now();
+        let started = web_time::Instant::now();
         self.solve_in_place(r, SEQ);
         self.cost.solve_secs += started.elapsed().as_secs_f64();
     }

@@ -106,7 +106,7 @@ const ASSEMBLY_CHUNK: usize = 64;
 impl SparsePattern {
     /// The pattern of `mesh` with the DOFs of nodes where `held(i)` left out.
     pub fn new(mesh: &Mesh, held: impl Fn(usize) -> bool) -> Result<Self, SparseError> {
-        let started = std::time::Instant::now();
+        let started = web_time::Instant::now();
         let pattern = |e: &dyn std::fmt::Debug| SparseError::Pattern(format!("{e:?}"));
         let n = mesh.num_nodes();
         let mut free_of = vec![u32::MAX; n];
@@ -257,7 +257,7 @@ impl SparsePattern {
     ) -> Result<(), SparseError> {
         use rayon::prelude::*;
         self.factored = false;
-        let started = std::time::Instant::now();
+        let started = web_time::Instant::now();
         self.values.iter_mut().for_each(|v| *v = 0.0);
         for (b, g) in mesh.blocks.iter().zip(geo) {
             for chunk_start in (0..b.len()).step_by(ASSEMBLY_CHUNK) {
@@ -281,7 +281,7 @@ impl SparsePattern {
             }
         }
         let k = SparseColMatRef::new(self.symbolic.as_ref(), &self.values);
-        let assembled = std::time::Instant::now();
+        let assembled = web_time::Instant::now();
         self.cost.hessian_secs += (assembled - started).as_secs_f64();
         self.cost.factorisations += 1;
         self.single = single;

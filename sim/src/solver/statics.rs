@@ -73,7 +73,7 @@ pub type Progress<'p> = &'p mut dyn FnMut(f64, usize, f64);
 
 /// Solves `problem`. `progress` is called after every Newton iteration.
 pub fn solve(problem: &StaticProblem<'_>, progress: Progress<'_>) -> Result<StaticSolution, StaticError> {
-    let started = std::time::Instant::now();
+    let started = web_time::Instant::now();
     let mesh = problem.mesh;
     let geo = precompute(mesh, problem.quadrature_degree)?;
     let masses = lumped_masses_kg(mesh, problem.material.density_kg_m3)?;

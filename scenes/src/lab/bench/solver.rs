@@ -29,7 +29,7 @@ use crate::error::SceneError;
 use crate::lab::study::solver_axis::opt;
 use hox_sim::measure::median;
 use hox_sim::solver::{Method, SimError, Simulation, SolverCounters};
-use std::time::Instant;
+use web_time::Instant;
 
 /// The solver named `name` (`xpbd`, `vbd`, `newton`), or an error naming `--solver` and the
 /// allowed values.

@@ -131,7 +131,7 @@ pub fn record_motion(instance: &mut Instance, secs: f64, probe: &str) -> Result<
     tip_z_m.push(probe_z(instance));
     let mut stepping_secs = 0.0;
     for _ in 0..frames {
-        let clock = std::time::Instant::now();
+        let clock = web_time::Instant::now();
         instance
             .sim
             .step_frame()

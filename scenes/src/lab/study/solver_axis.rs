@@ -30,7 +30,7 @@ use crate::params::SceneOverrides;
 use crate::run::{RunMode, run_observed};
 use hox_sim::mesh::structured::TetSplit;
 use hox_sim::solver::{Integrator, Method};
-use std::time::Instant;
+use web_time::Instant;
 
 /// XPBD's grid of (substeps, iterations) per frame: equal sweep budgets of 50 and 100.
 pub const XPBD_GRID: [(u32, u32); 5] = [(50, 1), (25, 2), (10, 5), (100, 1), (50, 2)];

@@ -132,6 +132,7 @@ pub(super) unsafe fn add_outer_any<const FMA: bool>(width: usize, f: &mut [f64],
 /// Whether the CPU has AVX2 and FMA: the sweep's node updates and `F_q` refreshes are then
 /// compiled for them (four-lane `F_q` moves in one fused instruction per entry).
 #[derive(Clone, Copy)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 pub(super) struct Fused(pub(super) bool);
 
 impl Fused {
@@ -241,6 +242,7 @@ impl PointLanes {
     }
 
     /// `F_q = I + Σ_a (x_a − X_a) ⊗ ∇_X N_a(r_q)` of every element from the positions.
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
     pub(super) fn refresh(&mut self, mesh: &Mesh, positions: &[Vec3], fused: Fused) {
         use rayon::prelude::*;
         for (lanes, block) in self.blocks.iter_mut().zip(&mesh.blocks) {

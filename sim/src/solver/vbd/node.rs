@@ -21,6 +21,7 @@ pub(super) struct NodeUpdate<'a> {
     pub(super) springs: &'a [NodeSpring],
     pub(super) w: f64,
     pub(super) lame: Lame,
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub(super) fused: Fused,
     /// Backtrack each node step on the node's potential (VBD's recovery rounds).
     pub(super) line_search: bool,

@@ -207,15 +207,7 @@ unsafe fn batches_wide<W: Wide, const N: usize, L: BatchLaw>(
     Ok(projected)
 }
 
-/// Whether the batches of `nodes`-node elements read reference gradients and one `J⁻¹` per point
-/// (P3, Q2) rather than stored material gradients (see the module doc).
-pub const fn from_reference_gradients(nodes: usize) -> bool {
-    nodes >= 20
-}
-
-/// Doubles per quadrature point and lane of a batch read from reference gradients: `J⁻¹` (9)
-/// and `V`.
-pub const POINT_VALUES_PER_LANE: usize = 10;
+pub use super::{POINT_VALUES_PER_LANE, from_reference_gradients};
 
 /// Lanes `WIDTH k..WIDTH (k + 1)` from `base`.
 ///

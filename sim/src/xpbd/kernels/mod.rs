@@ -44,14 +44,25 @@ pub(crate) mod lanes;
 #[cfg(target_arch = "x86_64")]
 pub mod p1;
 
+/// Whether the batches of `nodes`-node elements read reference gradients and one `J⁻¹` per point
+/// (P3, Q2) rather than stored material gradients (see `batch`'s module doc). A layout, not a
+/// kernel: the packing reads it on every target.
+pub const fn from_reference_gradients(nodes: usize) -> bool {
+    nodes >= 20
+}
+
+/// Doubles per quadrature point and lane of a batch read from reference gradients: `J⁻¹` (9)
+/// and `V`.
+pub const POINT_VALUES_PER_LANE: usize = 10;
+
 /// Doubles per batch of `lanes` elements of `nodes` nodes and `points` quadrature points in
 /// [`PackedBlock::batches`] (the layouts of [`p1`] and [`batch`]).
 pub const fn batch_values(nodes: usize, points: usize, lanes: usize) -> usize {
     lanes
         * if nodes == 4 && points == 1 {
             P1_VALUES_PER_LANE
-        } else if batch::from_reference_gradients(nodes) {
-            points * batch::POINT_VALUES_PER_LANE
+        } else if from_reference_gradients(nodes) {
+            points * POINT_VALUES_PER_LANE
         } else {
             points * (3 * nodes + 1)
         }

@@ -121,7 +121,7 @@ impl PackedBlock {
                 g
             })
             .collect();
-        if batches && super::batch::from_reference_gradients(n) {
+        if batches && super::from_reference_gradients(n) {
             for g in &ref_grads {
                 for axis in 0..3 {
                     packed.ref_grads.extend(g.iter().map(|gi| gi[axis]));
@@ -161,7 +161,7 @@ impl PackedBlock {
                         put(&mut batch.iter().map(|&e| geometry.volumes(e as usize)[0]));
                         continue;
                     }
-                    if !super::batch::from_reference_gradients(n) {
+                    if !super::from_reference_gradients(n) {
                         for p in 0..q {
                             for axis in 0..3 {
                                 for i in 0..n {

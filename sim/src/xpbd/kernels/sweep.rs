@@ -12,6 +12,7 @@ use crate::fem::energy::point_energy_and_gradient;
 use crate::material::{FastLaw, Mat3, Material};
 use crate::xpbd::constraint::xpbd_step;
 
+#[cfg(target_arch = "x86_64")]
 use super::batch_values;
 #[cfg(target_arch = "x86_64")]
 use super::{batch, lanes, p1};
@@ -274,7 +275,7 @@ pub unsafe fn colour_sweep(
     range: std::ops::Range<usize>,
     lambdas: Multipliers,
     inv_dt2: f64,
-    batched: bool,
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))] batched: bool,
 ) -> Option<Result<u64, NonFiniteElement>> {
     if !SPECIALISED_NODE_COUNTS.contains(&nodes_per_element) {
         return None;
@@ -283,7 +284,10 @@ pub unsafe fn colour_sweep(
     let colour_start = packed.colour_starts[colour];
     let width = packed.lanes;
     assert!((range.start - colour_start).is_multiple_of(width) && range.end <= packed.colour_starts[colour + 1]);
+    // the batches (x86-64 only) take the first part of the range; the rest goes one by one
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut))]
     let mut tail = range.clone();
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut))]
     let mut projected = 0;
     #[cfg(target_arch = "x86_64")]
     if batched && packed.colour_batches.len() == packed.colour_starts.len() && lanes::lanes_available(width) {
