@@ -2,7 +2,7 @@
 //! `--measure-secs` run that prints them with the frame counts as JSON and closes the window, and
 //! the `--screenshot` taken some seconds after the start.
 
-use std::time::Instant;
+use web_time::Instant;
 
 /// Running averages of the displayed frames' times, milliseconds (the status line shows them).
 #[derive(Default)]

@@ -17,7 +17,7 @@ use hox_sim::Vec3;
 use hox_sim::effect::Attachment;
 use hox_sim::measure::field::Field;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
+use web_time::Instant;
 
 /// Samples kept for the time plots (older ones are dropped).
 const HISTORY_LEN: usize = 20_000;

@@ -21,7 +21,7 @@ use hox_scenes::present::colour::{ColourRange, FieldScale};
 use hox_sim::Vec3;
 use hox_sim::measure::field::Field;
 use std::sync::Arc;
-use std::time::Instant;
+use web_time::Instant;
 
 pub const CORNER_NODE: [u8; 4] = [250, 250, 250, 255];
 pub const HIGH_ORDER_NODE: [u8; 4] = [40, 220, 240, 255];

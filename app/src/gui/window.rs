@@ -9,7 +9,7 @@ use super::readout::ReferenceState;
 use super::ui_state::Ctx;
 use super::{controls, dialogs, lesson_panel, menu, plots, serve_web, status};
 use eframe::egui;
-use std::time::Instant;
+use web_time::Instant;
 
 /// The smallest window a restored geometry keeps, points: below it a lesson's panels leave no
 /// room for the view (issue #57: a presenter session once left a 784×386 window, the projector's
