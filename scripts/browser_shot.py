@@ -4,12 +4,16 @@ package, installed by scripts/setup.sh) with software WebGL (SwiftShader), drive
 over the DevTools protocol with the standard library only (no pip package).
 
     scripts/browser_shot.py URL OUT.png [--size 1280x720] [--wait 20] [--shots 1] [--every 5]
+        [--press KEYS] [--state OUT.json] [--eval EXPRESSION]
 
 Opens URL, waits --wait seconds (the Rerun web viewer compiles 42 MB of WebAssembly first),
 then writes --shots screenshots --every seconds apart: OUT.png, or OUT-1.png, OUT-2.png, ...
 when there are several, all of the one page kept open (the first captured, the others taken
 from the page's screencast, the frames it streams as it repaints). The page's errors (console errors, uncaught exceptions) are printed to stderr. Exit 0 when every
-screenshot was written. A first capture that gets no answer within BROWSER_SHOT_CAPTURE_SECS
+screenshot was written. --press types KEYS (letters and digits) into the page after --wait,
+then waits --every before the screenshots. --state writes, once the screenshots are taken, the
+app's state as hox's page publishes it (window.hox_state), the page's errors and, with --eval,
+the value of EXPRESSION (awaited if it is a promise; the page's module is window.hox). A first capture that gets no answer within BROWSER_SHOT_CAPTURE_SECS
 (default 30) is taken from the screencast too."""
 
 import argparse
@@ -225,6 +229,9 @@ def main():
     ap.add_argument("--every", type=float, default=5.0)
     ap.add_argument("--frames", help="also keep every frame the page paints from the moment it is "
                     "opened, as DIR/frame-SECONDS.png (seconds since the page was asked for)")
+    ap.add_argument("--press", default="", help="keys typed into the page after --wait")
+    ap.add_argument("--state", help="write the page's state, errors and --eval's value here (JSON)")
+    ap.add_argument("--eval", help="a JavaScript expression evaluated at the end (with --state)")
     args = ap.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
     # how long the first picture's capture may take before the screencast stands in
@@ -281,6 +288,14 @@ def main():
             page.call("Page.startScreencast", format="png", maxWidth=width, maxHeight=height)
         page.call("Page.navigate", url=args.url)
         page.sleep(args.wait)
+        if args.press:
+            for ch in args.press:
+                key = {"type": "keyDown", "key": ch.lower(), "text": ch.lower(),
+                       "code": ("Key" + ch.upper()) if ch.isalpha() else ("Digit" + ch),
+                       "windowsVirtualKeyCode": ord(ch.upper())}
+                page.call("Input.dispatchKeyEvent", **key)
+                page.call("Input.dispatchKeyEvent", **dict(key, type="keyUp", text=""))
+            page.sleep(args.every)
         base, ext = os.path.splitext(args.out)
         for k in range(args.shots):
             if k > 0:
@@ -313,8 +328,23 @@ def main():
             if args.shots > 1 and not streaming:
                 streaming = True
                 page.call("Page.startScreencast", format="png", maxWidth=width, maxHeight=height)
-        for e in page_errors(page):
+        errors = page_errors(page)
+        for e in errors:
             print(f"browser_shot: page error: {e}", file=sys.stderr)
+        if args.state:
+            state = {"errors": errors}
+            result = page.call("Runtime.evaluate", timeout=60, expression="window.hox_state || null",
+                               returnByValue=True)
+            text = result.get("result", {}).get("value")
+            state["state"] = json.loads(text) if text else None
+            if args.eval:
+                result = page.call("Runtime.evaluate", timeout=1800, expression=args.eval,
+                                   awaitPromise=True, returnByValue=True)
+                if "exceptionDetails" in result:
+                    state["eval_error"] = json.dumps(result["exceptionDetails"])[:2000]
+                state["eval"] = result.get("result", {}).get("value")
+            with open(args.state, "w") as f:
+                json.dump(state, f, indent=1)
     finally:
         browser.terminate()
         try:

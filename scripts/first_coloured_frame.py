@@ -51,12 +51,19 @@ def read_png(path):
     return width, height, channels, rows
 
 
-def coloured_share(path):
+# The Rerun viewer's 3D view (rows 10-90 %, the left half); the app's own page (app/tests/page.rs)
+# has its view right of the control panel, above the plots.
+VIEWER_VIEW = ((0.10, 0.90), (0.0, 0.5))
+APP_VIEW = ((0.08, 0.58), (0.36, 0.97))
+
+
+def coloured_share(path, view=VIEWER_VIEW):
     width, height, channels, rows = read_png(path)
+    (y0, y1), (x0, x1) = view
     total = coloured = 0
-    for y in range(height * 10 // 100, height * 90 // 100, 2):
+    for y in range(int(height * y0), int(height * y1), 2):
         row = rows[y]
-        for x in range(0, width // 2, 2):
+        for x in range(int(width * x0), int(width * x1), 2):
             r, g, b = row[x * channels:x * channels + 3]
             hi, lo = max(r, g, b), min(r, g, b)
             total += 1

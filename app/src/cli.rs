@@ -180,6 +180,9 @@ pub enum Command {
     /// Serve a recording (.rrd, e.g. from `hox record`) to browsers: students open the URL it
     /// prints and play it in the Rerun web viewer, nothing to install.
     Serve(Box<serve::ServeFileArgs>),
+    /// Serve the app itself to browsers (the site `scripts/build-web.sh` builds): every student
+    /// runs hox in their own page, drives it and takes the lessons at their own pace.
+    ServeApp(Box<serve::ServeAppArgs>),
 }
 
 #[derive(Args)]
@@ -233,6 +236,7 @@ pub fn run(command: Command) -> Result<()> {
         Command::Lessons { json } => lesson::lessons(json),
         Command::Lesson(args) => lesson::lesson(&args),
         Command::Serve(args) => serve::serve(&args),
+        Command::ServeApp(args) => serve::serve_app(&args),
     }
 }
 

@@ -11,6 +11,13 @@ use std::path::Path;
 mod params;
 pub use params::{DisplayArgs, MeshArgs, PhysicsArgs, overrides};
 
+/// What a page's link may carry besides the parameter table's keys (`element`, `poisson`, …, as
+/// `--compare` takes them): the scene, a lesson and its step, compare mode, the camera, the
+/// start view, playing and presenter mode; `nu` is the table's `poisson` (`gui::args::from_link`
+/// reads a link, `hox serve-app --link` checks one).
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))] // `hox serve-app --link`'s, a desktop command
+pub const LINK_KEYS: &[&str] = &["scene", "lesson", "step", "compare", "camera", "view", "play", "presenter", "nu"];
+
 /// Applies one `--compare` value (`key=value,...`, the keys of the parameter table) on top of
 /// `base`; an unknown key or a bad value is an error naming it.
 pub fn parse_compare(spec: &str, base: &SceneOverrides) -> Result<SceneOverrides> {

@@ -202,6 +202,11 @@ pub fn f32s(v: &Vec3) -> [f32; 3] {
     [v.x as f32, v.y as f32, v.z as f32]
 }
 
+/// `0.125`, `0.3`, `1.5e-4`: a compact metre value for labels.
+pub fn format_metres(v: f64) -> String {
+    hox_scenes::present::colour::format_value(v, "")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -27,17 +27,25 @@
 //! use each other, so only this file knows both.
 //!
 //! Errors are printed as one clear message on stderr with a non-zero exit.
+//!
+//! In a web page (wasm32, issue #59) there is no command line: `main` starts the app on the
+//! page's canvas with the options its link carries (`gui::start_in_page`). The headless commands
+//! (`cli`) and the Rerun recordings (`recording`) are the desktop's only.
 
+#[cfg(not(target_arch = "wasm32"))]
 mod cli;
 mod config;
 mod display;
 mod gui;
 mod output;
+#[cfg(not(target_arch = "wasm32"))]
 mod recording;
 mod web;
 
+#[cfg(not(target_arch = "wasm32"))]
 use clap::{Parser, Subcommand};
 
+#[cfg(not(target_arch = "wasm32"))]
 #[derive(Parser)]
 #[command(name = "hox", version, about = "hox: see, measure and teach high-order finite elements in XPBD")]
 struct Hox {
@@ -47,6 +55,7 @@ struct Hox {
 
 // Every command: the headless ones, then the app. (A plain comment: clap's derive reads doc
 // comments as help text, and the help stays as it was.)
+#[cfg(not(target_arch = "wasm32"))]
 #[derive(Subcommand)]
 enum Command {
     #[command(flatten)]
@@ -55,6 +64,7 @@ enum Command {
     App(Box<gui::AppArgs>),
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 fn main() -> std::process::ExitCode {
     let result = match Hox::parse().command {
         Some(Command::Headless(command)) => cli::run(*command),
@@ -67,5 +77,15 @@ fn main() -> std::process::ExitCode {
             eprintln!("error: {e:#}");
             std::process::ExitCode::FAILURE
         }
+    }
+}
+
+/// The page's entry point: the generated JavaScript calls it once the module is loaded. In a Web
+/// Worker (the page's reference computations, `app/web/worker.js`) there is no window and
+/// nothing to start: the worker calls the module's functions itself.
+#[cfg(target_arch = "wasm32")]
+fn main() {
+    if web_sys::window().is_some() {
+        gui::start_in_page();
     }
 }

@@ -24,6 +24,7 @@ pub fn check_writable(path: &Path) -> Result<()> {
 
 /// The SVG `svg` rasterised to PNG bytes at twice its own size (resvg, with the Ubuntu font
 /// egui ships, so no system font is needed): `hox paper`'s figures and the app's export.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn svg_to_png(svg: &str) -> Result<Vec<u8>> {
     let mut options = resvg::usvg::Options::default();
     options.fontdb_mut().load_font_data(epaint_default_fonts::UBUNTU_LIGHT.to_vec());

@@ -663,14 +663,10 @@ pub fn blueprint_of(root: impl Into<bp::ContainerLike>) -> bp::Blueprint {
         .with_time_panel(time_panel())
 }
 
-/// `0.125`, `0.3`, `1.5e-4`: a compact metre value for labels.
-pub fn format_metres(v: f64) -> String {
-    hox_scenes::present::colour::format_value(v, "")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::display::format_metres;
 
     #[test]
     fn names_and_labels() {

@@ -526,3 +526,17 @@ fn bad_input_is_a_clear_error_under_every_solver_and_integrator() {
         }
     }
 }
+
+/// Issue #59: `hox app --link` opens what a page's link opens; a link it cannot use is refused by
+/// name before any window opens, and so is `hox serve-app`'s `--link` and a folder that holds no
+/// built site.
+#[test]
+fn a_bad_link_or_a_missing_site_is_refused_by_name() {
+    fails_with(&["app", "--link", "http://127.0.0.1:9090/?nu=abc&element=p2"], "nu=abc");
+    fails_with(&["app", "--link", "lesson=locking&step=9"], "step=9");
+    fails_with(&["serve-app", "--link", "bogus=1", "--seconds", "0"], "unknown key 'bogus'");
+    let empty = std::env::temp_dir().join(format!("hox-no-site-{}", std::process::id()));
+    std::fs::create_dir_all(&empty).unwrap();
+    fails_with(&["serve-app", "--site", empty.to_str().unwrap(), "--web-port", "0", "--seconds", "0"], "build-web.sh");
+    let _ = std::fs::remove_dir_all(empty);
+}

@@ -30,6 +30,17 @@ fn the_shape_of_a_line_keeps_its_words_and_drops_its_numbers() {
     assert_eq!(quick("python3 scripts/web_figures.py"), ["python3", "scripts/web_figures.py", "--quick"]);
 }
 
+/// Found by CI (2026-11-29): docs/WEB.md's frame-rate change was committed as −0.3 % and came out
+/// +1.1 % on the next machine, and the format check failed on the sign. A sign is the number's.
+#[test]
+fn a_measured_change_that_turns_positive_keeps_the_table_s_shape() {
+    assert_eq!(
+        shape("| 50.4 fps | no browser: 50.5 fps (**-0.3 %**) |"),
+        shape("| 50.4 fps | no browser: 50.5 fps (**+1.1 %**) |")
+    );
+    assert_eq!(shape("the x-axis of P1-2 at -3e-2"), "the x-axis of P#-# at #");
+}
+
 #[test]
 fn every_generated_table_in_the_docs_has_the_format_its_command_writes() {
     let blocks = blocks();

@@ -3,6 +3,9 @@
 //! - `cargo test --workspace` and `bash scripts/setup.sh` must be what `.ci/run` runs;
 //! - `cargo run --release` (the app) and every `hox app …` run under Xvfb with a screenshot
 //!   taken after a few seconds (`--fresh`, a home of their own; a served app on free ports);
+//! - `bash scripts/build-web.sh --open` builds the app's site into the scratch folder (the
+//!   serving it would start is `hox serve-app`'s, checked next); `hox serve-app …` serves that site
+//!   for two seconds on a free port;
 //! - every other `hox …` runs as written, in a scratch folder that sees the repository's
 //!   `assets/`, and must exit 0.
 //!
@@ -99,7 +102,20 @@ fn every_command_in_the_readme_runs() {
                 assert!(ci.lines().any(|l| l.trim() == part), "README's `{part}` is not what .ci/run runs");
                 continue;
             }
-            let Some(args) = hox_args(part) else { panic!("README's `{part}`: not a hox command this test knows") };
+            if part.starts_with("bash scripts/build-web.sh") {
+                let status = Command::new("bash")
+                    .arg(root().join("scripts/build-web.sh"))
+                    .arg(dir.join("site"))
+                    .status()
+                    .expect("bash");
+                assert!(status.success(), "README's `{part}` failed");
+                continue;
+            }
+            let Some(mut args) = hox_args(part) else { panic!("README's `{part}`: not a hox command this test knows") };
+            if args.first().is_some_and(|a| a == "serve-app") {
+                args.extend(["--web-port", "0", "--seconds", "2", "--site"].map(String::from));
+                args.push(dir.join("site").display().to_string());
+            }
             if args.first().is_some_and(|a| a == "app") {
                 run_app(&args, &dir, k);
                 continue;
@@ -116,8 +132,10 @@ fn every_command_in_the_readme_runs() {
 fn the_readme_s_commands_are_read_and_its_first_screen_has_the_four_readers() {
     let commands = readme_commands();
     assert!(commands.contains(&"cargo test --workspace".to_string()), "{commands:?}");
-    let known =
-        |part: &str| hox_args(part).is_some() || ["cargo test --workspace", "bash scripts/setup.sh"].contains(&part);
+    let known = |part: &str| {
+        hox_args(part).is_some()
+            || ["cargo test --workspace", "bash scripts/setup.sh", "bash scripts/build-web.sh --open"].contains(&part)
+    };
     assert!(commands.iter().all(|c| c.split("&&").map(str::trim).all(known)), "{commands:?}");
     assert_eq!(hox_args("bash scripts/setup.sh && cargo run --release"), None);
     assert_eq!(hox_args("cargo run --release"), Some(vec!["app".to_string()]));

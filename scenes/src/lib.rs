@@ -31,7 +31,9 @@ pub use run::{
     run_observed,
 };
 pub use scene::builtin::{BUILTIN, PAPER_SCENES, by_name, names, registry};
-pub use scene::{BUILTIN_MESHES, Drive, NodeSelector, Scene, SceneFile, SceneMesh, builtin_mesh};
+pub use scene::{
+    BUILTIN_MESHES, Drive, NodeSelector, OPENED_PREFIX, Scene, SceneFile, SceneMesh, builtin_mesh, open_mesh_bytes,
+};
 
 #[cfg(test)]
 mod tests;

@@ -45,7 +45,8 @@ pub fn blocks() -> Vec<(PathBuf, String, String)> {
     out
 }
 
-/// A line with every number replaced by `#` (digits with their `.`, `,` and exponent), and a
+/// A line with every number replaced by `#` (digits with their sign, `.`, `,` and exponent: a
+/// change measured `+0.3 %` on one run is `-0.3 %` on the next), and a
 /// cell that holds only a dash (a figure a short run has none of: no factorisation in one frame)
 /// taken as a number too, so that two runs of one command on two machines give the same shape.
 pub fn shape(line: &str) -> String {
@@ -74,7 +75,12 @@ fn numbers_masked(line: &str) -> String {
                 '-' => chars.get(k.wrapping_sub(1)) == Some(&'e') && next_digit(k + 1),
                 _ => false,
             };
-        if digit || joins {
+        // a sign before a number, not a hyphen inside a word ("P1-2", "x-axis")
+        let sign = !in_number
+            && matches!(c, '+' | '-' | '−')
+            && next_digit(k + 1)
+            && !chars.get(k.wrapping_sub(1)).is_some_and(|p| p.is_alphanumeric());
+        if digit || joins || sign {
             if !in_number {
                 out.push('#');
             }

@@ -119,6 +119,12 @@ pub enum Command {
         path: std::path::PathBuf,
         clamp_group: String,
     },
+    /// Opens a mesh file given as bytes (dropped onto the window or the page), its group
+    /// `clamp` held, gravity on.
+    OpenMeshBytes {
+        name: String,
+        bytes: std::sync::Arc<[u8]>,
+    },
 }
 
 impl From<Action> for Command {

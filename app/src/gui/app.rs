@@ -6,14 +6,20 @@
 
 use super::action::{Action, Command, Commands};
 use super::args::{self, AppArgs};
-use super::background::{Background, ThreadStepper};
+use super::background::{Background, platform_stepper};
 use super::config::SceneSource;
 use super::measure::{FrameTimes, Measure, Screenshot};
 use super::model::{Model, Start};
 use super::persist::Persisted;
+#[cfg(target_arch = "wasm32")]
+use super::platform::page::Rerun;
+#[cfg(not(target_arch = "wasm32"))]
 use super::rerun_link::Rerun;
 use super::ui_state::{Status, UiState};
 use super::viewport::Viewport;
+
+/// The group of a dropped mesh file that is held (the Open dialog's default).
+pub const MESH_CLAMP_GROUP: &str = "clamp";
 
 /// The app: the model, the UI's state and the services.
 pub struct HoxApp {
@@ -51,8 +57,8 @@ impl HoxApp {
             playing: args.play,
             time_scale: saved.as_ref().map_or(1.0, |s| s.time_scale),
             show_reference_element: saved.as_ref().is_some_and(|s| s.show_reference_element),
-            background: Background::Threads,
-            stepper: Box::new(ThreadStepper::default()),
+            background: Background::of_platform(),
+            stepper: platform_stepper(),
         };
         // the very first start (no saved settings) offers the lessons
         let offer_lessons = saved.is_none()
@@ -236,6 +242,17 @@ impl HoxApp {
                     }
                 }
             }
+            Command::OpenMeshBytes { name, bytes } => {
+                let (material, compare) = (self.model.active_session().config.clone(), self.model.compare());
+                let opened = hox_scenes::open_mesh_bytes(&name, &bytes)
+                    .map(|mesh| SceneSource::Opened { mesh, clamp_group: MESH_CLAMP_GROUP.into() })
+                    .and_then(|s| self.model.apply(Action::LoadScene(s)));
+                match opened {
+                    Ok(()) => self.carry_over(&material, compare),
+                    // the app keeps what it had, and says why the file was not taken
+                    Err(e) => self.say(Some(format!("{name} not opened: {e}"))),
+                }
+            }
         }
         self.ui.follow(&self.model);
     }
@@ -270,6 +287,95 @@ impl HoxApp {
             self.figure = None;
             self.say(Some(done.map_or_else(|e| e, |files| written(&files))));
         }
+    }
+
+    /// Plays the lesson step on screen to its end in place (no window, as the window would: a
+    /// slow frame's pause is played on, as a teacher presses Play, until the step's seconds are
+    /// up).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // the page's (and the tests')
+    pub(super) fn play_step_to_its_end(&mut self) {
+        for _ in 0..200_000 {
+            if !self.model.playing() {
+                let unfinished = self.model.lesson().is_some_and(|l| l.play_until_secs.is_some());
+                if unfinished && self.model.message().is_some_and(|m| m.starts_with(super::cost::SLOW_PAUSE)) {
+                    self.act(Action::SetPlaying(true));
+                    continue;
+                }
+                return;
+            }
+            self.act(Action::Tick { real_dt_secs: 1.0 / 60.0, one_frame_per_tick: false, in_background: false });
+        }
+    }
+
+    /// Every step of `lesson` as the app shows it, each prepared and played to its end in place:
+    /// the texts of each step's numbers, A's and B's (`after_step` looks at the app after each).
+    /// The desktop's test against `hox lesson` (issue #35) and the page's (issue #59) read it.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // the page's (and the tests')
+    pub fn lesson_answers(
+        &mut self,
+        lesson: &hox_scenes::lesson::Lesson,
+        after_step: &mut dyn FnMut(&HoxApp, usize),
+    ) -> Vec<Vec<String>> {
+        self.act(Action::OpenLesson(Box::new(lesson.clone())));
+        let mut shown = Vec::new();
+        for k in 0..lesson.steps.len() {
+            self.act(Action::GoToStep(k));
+            self.act(Action::Poll { wait_for_lesson: true });
+            self.play_step_to_its_end();
+            after_step(self, k);
+            let Some(state) = self.model.lesson() else { break };
+            shown.push(state.measured(self.model.sessions()).into_iter().map(|m| m.text).collect());
+        }
+        shown
+    }
+
+    /// What the app shows, as JSON: the scene, each configuration (its label, element, ν, the
+    /// simulated time and frames, the time per frame), the frames stepped and the sessions'
+    /// generation (a rebuild adds one), playing or not, the message, the lesson
+    /// step with its text as the panel shows it (question, numbers, answer once revealed). The
+    /// page publishes it as `window.hox_state` for its tests and scripts (issue #59).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // the page's (and the tests')
+    pub fn page_state(&self) -> serde_json::Value {
+        let m = &self.model;
+        let configurations: Vec<serde_json::Value> = m
+            .sessions()
+            .iter()
+            .map(|s| {
+                let value = |key: &str| s.config.value(key).map(|v| v.to_string());
+                serde_json::json!({
+                    "label": s.label(),
+                    "element": value("element"),
+                    "poisson": value("poisson"),
+                    "time_secs": s.instance.sim.time_secs(),
+                    "ms_per_frame": s.ms_per_frame,
+                })
+            })
+            .collect();
+        let lesson = m.lesson().map(|l| {
+            serde_json::json!({
+                "name": l.lesson.name,
+                "step": l.step + 1,
+                "steps": l.lesson.steps.len(),
+                "question": l.current().question,
+                "revealed": l.revealed,
+                "preparing": l.preparing(),
+                "text": m.lesson_text(),
+            })
+        });
+        serde_json::json!({
+            "scene": m.scene().label(),
+            "configurations": configurations,
+            "frames_stepped": m.frames_stepped(),
+            "generation": m.generation(),
+            "playing": m.playing(),
+            "message": m.message(),
+            "lesson": lesson,
+        })
+    }
+
+    /// A message to show from the start (a page link's parameters that could not be used).
+    pub(super) fn say_at_start(&mut self, message: String) {
+        self.act(Command::Model(Action::Say(message)));
     }
 
     fn say(&mut self, message: Option<String>) {

@@ -22,6 +22,11 @@ pub enum Background {
 }
 
 impl Background {
+    /// Threads where the platform has them (the desktop), in place otherwise (a page).
+    pub fn of_platform() -> Background {
+        if super::platform::HAS_THREADS { Background::Threads } else { Background::Inline }
+    }
+
     /// Runs `job` as this policy says; its result is pending until it is ready.
     pub fn run<T: Send + 'static>(self, job: impl FnOnce() -> T + Send + 'static) -> Pending<T> {
         match self {
@@ -116,6 +121,12 @@ impl Stepper for InlineStepper {
     fn busy(&self) -> bool {
         self.done.is_some()
     }
+}
+
+/// The platform's stepper: on a thread while the window paints where there are threads (the
+/// desktop), at once in a page.
+pub fn platform_stepper() -> Box<dyn Stepper> {
+    if super::platform::HAS_THREADS { Box::new(ThreadStepper::default()) } else { Box::new(InlineStepper::default()) }
 }
 
 /// Whether a *Settle* is under way in any of `sessions`.

@@ -10,6 +10,12 @@ use std::path::PathBuf;
 pub enum SceneSource {
     Builtin(String),
     File(PathBuf),
+    /// A mesh file opened from its bytes (dropped into the page, issue #59): its name in
+    /// [`hox_scenes::open_mesh_bytes`]'s list, the group held.
+    Opened {
+        mesh: String,
+        clamp_group: String,
+    },
 }
 
 impl SceneSource {
@@ -17,6 +23,10 @@ impl SceneSource {
         match self {
             SceneSource::Builtin(name) => hox_scenes::by_name(name).map_err(|e| e.to_string()),
             SceneSource::File(path) => Scene::load(path).map_err(|e| e.to_string()),
+            SceneSource::Opened { mesh, clamp_group } => {
+                let file = mesh_scene(std::path::Path::new(mesh), clamp_group)?;
+                Scene::from_file(file, mesh).map_err(|e| e.to_string())
+            }
         }
     }
     pub fn label(&self) -> String {
@@ -31,8 +41,35 @@ impl SceneSource {
             SceneSource::File(path) => {
                 path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned())
             }
+            SceneSource::Opened { mesh, .. } => {
+                format!("{} (mesh file)", mesh.trim_start_matches(hox_scenes::OPENED_PREFIX))
+            }
         }
     }
+}
+
+/// The scene of a mesh file: the mesh, its `clamp_group` clamped, gravity, the paper beam's
+/// material (`hox simulate --mesh FILE --clamp GROUP`'s), a probe at the node farthest from the
+/// clamp. A missing group is an error naming it.
+pub fn mesh_scene(mesh: &std::path::Path, clamp_group: &str) -> Result<hox_scenes::SceneFile, String> {
+    let scene =
+        hox_scenes::Scene::from_mesh_file(mesh, &[clamp_group.to_string()], &[], true).map_err(|e| e.to_string())?;
+    let mut file = scene.file.clone();
+    file.description = format!("{} with group '{clamp_group}' clamped, under gravity", mesh.display());
+    // a probe at the node farthest from the clamp (issue #57: no probe, so a flat probe plot
+    // and no reference, although the part's static solution is its reference elsewhere)
+    if file.probes.is_empty()
+        && let Some(imported) = scene.mesh.imported()
+        && let Ok(held) = imported.node_set(clamp_group)
+        && !held.is_empty()
+    {
+        let rest = &imported.mesh.rest_positions;
+        let centre = held.iter().map(|&n| rest[n as usize]).sum::<hox_sim::Vec3>() / held.len() as f64;
+        if let Some(tip) = rest.iter().max_by(|a, b| (*a - centre).norm().total_cmp(&(*b - centre).norm())) {
+            file.probes.push(hox_scenes::scene::ProbeSpec { name: "tip".into(), point_m: [tip.x, tip.y, tip.z] });
+        }
+    }
+    Ok(file)
 }
 
 /// The labels of two configurations of `base`, told apart: when their labels are the same, each

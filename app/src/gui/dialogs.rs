@@ -148,25 +148,7 @@ pub fn reference_element_ui(cx: &mut Ctx, ctx: &egui::Context) {
 pub fn mesh_scene_file(mesh: &std::path::Path, clamp_group: &str) -> Result<std::path::PathBuf, String> {
     let mesh = std::fs::canonicalize(mesh).map_err(|e| format!("{}: {e}", mesh.display()))?;
     let name = mesh.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().to_string());
-    // the scene `hox simulate --mesh FILE --clamp GROUP` runs: the paper's material (read from
-    // the bending scene), gravity, the group clamped
-    let scene =
-        hox_scenes::Scene::from_mesh_file(&mesh, &[clamp_group.to_string()], &[], true).map_err(|e| e.to_string())?;
-    let mut file = scene.file.clone();
-    file.description = format!("{} with group '{clamp_group}' clamped, under gravity", mesh.display());
-    // a probe at the node farthest from the clamp (issue #57: no probe, so a flat probe plot
-    // and no reference, although the part's static solution is its reference elsewhere)
-    if file.probes.is_empty()
-        && let Some(imported) = scene.mesh.imported()
-        && let Ok(held) = imported.node_set(clamp_group)
-        && !held.is_empty()
-    {
-        let rest = &imported.mesh.rest_positions;
-        let centre = held.iter().map(|&n| rest[n as usize]).sum::<hox_sim::Vec3>() / held.len() as f64;
-        if let Some(tip) = rest.iter().max_by(|a, b| (*a - centre).norm().total_cmp(&(*b - centre).norm())) {
-            file.probes.push(hox_scenes::scene::ProbeSpec { name: "tip".into(), point_m: [tip.x, tip.y, tip.z] });
-        }
-    }
+    let file = super::config::mesh_scene(&mesh, clamp_group)?;
     let text = file.to_toml();
     let dir = std::env::temp_dir().join(super::config::MESH_SCENES);
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;

@@ -100,10 +100,22 @@ fn export_figure(model: &Model, folder: &Path, reference: Option<&Reference>) ->
     }
     panels.push(reference_of(first, reference, kind, &points)?);
     let figure = draw_figure(kind, panels, &points, nu, nv);
+    write_figure(&figure, &svg_path, &png_path)
+}
+
+/// The figure as SVG and PNG files.
+#[cfg(not(target_arch = "wasm32"))]
+fn write_figure(figure: &hox_scenes::paper::Figure, svg_path: &Path, png_path: &Path) -> Result<Vec<PathBuf>, String> {
     let png = crate::output::svg_to_png(&figure.svg).map_err(|e| format!("{e:#}"))?;
-    std::fs::write(&svg_path, &figure.svg).map_err(|e| format!("cannot write {}: {e}", svg_path.display()))?;
-    std::fs::write(&png_path, png).map_err(|e| format!("cannot write {}: {e}", png_path.display()))?;
-    Ok(vec![svg_path, png_path])
+    std::fs::write(svg_path, &figure.svg).map_err(|e| format!("cannot write {}: {e}", svg_path.display()))?;
+    std::fs::write(png_path, png).map_err(|e| format!("cannot write {}: {e}", png_path.display()))?;
+    Ok(vec![svg_path.to_path_buf(), png_path.to_path_buf()])
+}
+
+/// In a page: no folder to write to.
+#[cfg(target_arch = "wasm32")]
+fn write_figure(figure: &hox_scenes::paper::Figure, _svg: &Path, _png: &Path) -> Result<Vec<PathBuf>, String> {
+    Err(format!("{} figure drawn; saving it needs the desktop app (a page has no folder to write to)", figure.name))
 }
 
 /// The reference panel: `reference`'s field when it has one, else solved.

@@ -6,35 +6,17 @@
 use super::action::Action;
 use super::presets::ViewPreset;
 use super::sections::play_buttons_ui;
-use super::ui_state::{Ctx, OpenDialog};
+use super::ui_state::Ctx;
+#[cfg(not(target_arch = "wasm32"))]
+use super::ui_state::OpenDialog;
 use eframe::egui;
 
 pub fn menu_bar_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
     egui::MenuBar::new().ui(ui, |ui| {
-        ui.menu_button("File", |ui| {
-            if ui
-                .button("Open scene file…")
-                .on_hover_text("Load a scene from a TOML file (see assets/scenes/).")
-                .clicked()
-            {
-                cx.state.open_dialog =
-                    Some(OpenDialog { mesh: false, path: "assets/scenes/".into(), ..Default::default() });
-                ui.close();
-            }
-            if ui
-                .button("Open mesh file…")
-                .on_hover_text("Simulate a Gmsh .msh mesh: clamp one of its physical groups, gravity on.")
-                .clicked()
-            {
-                cx.state.open_dialog = Some(OpenDialog {
-                    mesh: true,
-                    path: "assets/meshes/".into(),
-                    clamp_group: "clamp".into(),
-                    ..Default::default()
-                });
-                ui.close();
-            }
-        });
+        #[cfg(not(target_arch = "wasm32"))]
+        file_menu_ui(cx, ui);
+        #[cfg(target_arch = "wasm32")]
+        page_menu_ui(cx, ui);
         lessons_menu_ui(cx, ui);
         ui.menu_button("View", |ui| {
             let mut shown = cx.model.show_reference_element();
@@ -76,6 +58,73 @@ pub fn menu_bar_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
             // off the window's edge)
             ui.add(egui::Label::new(m).truncate()).on_hover_text(m);
         }
+    });
+}
+
+/// The desktop's File menu: a scene file or a mesh file opened by its path.
+#[cfg(not(target_arch = "wasm32"))]
+fn file_menu_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
+    ui.menu_button("File", |ui| {
+        if ui
+            .button("Open scene file…")
+            .on_hover_text("Load a scene from a TOML file (see assets/scenes/).")
+            .clicked()
+        {
+            cx.state.open_dialog =
+                Some(OpenDialog { mesh: false, path: "assets/scenes/".into(), ..Default::default() });
+            ui.close();
+        }
+        if ui
+            .button("Open mesh file…")
+            .on_hover_text("Simulate a Gmsh .msh mesh: clamp one of its physical groups, gravity on.")
+            .clicked()
+        {
+            cx.state.open_dialog = Some(OpenDialog {
+                mesh: true,
+                path: "assets/meshes/".into(),
+                clamp_group: "clamp".into(),
+                ..Default::default()
+            });
+            ui.close();
+        }
+        ui.separator();
+        if ui
+            .button("Copy page link")
+            .on_hover_text("The link query that opens this configuration (or lesson step) in hox's web page: `hox serve-app --link` takes it, and so does the page's address.")
+            .clicked()
+        {
+            let query = link_query_of(cx);
+            ui.ctx().copy_text(query.clone());
+            cx.out.push(Action::Say(format!("Copied: {query} (hox serve-app --link takes it)")));
+            ui.close();
+        }
+    });
+}
+
+/// The link query that opens what is on screen ([`super::args::link_query`]).
+fn link_query_of(cx: &Ctx) -> String {
+    let configs: Vec<_> = cx.model.sessions().iter().map(|s| (&s.config, s.base.params())).collect();
+    let lesson = cx.model.lesson().map(|l| (l.lesson.name.as_str(), l.step + 1));
+    super::args::link_query(cx.model.scene(), &configs, lesson)
+}
+
+/// The page's menu (no files to open by path): copy the link that opens what is on screen, and
+/// how to bring a mesh of one's own (dropped onto the page).
+#[cfg(target_arch = "wasm32")]
+fn page_menu_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
+    ui.menu_button("Page", |ui| {
+        if ui
+            .button("Copy link")
+            .on_hover_text("A link that opens this configuration (or this lesson step): hand it to the class.")
+            .clicked()
+        {
+            let link = format!("{}{}", super::platform::page::page_address().unwrap_or_default(), link_query_of(cx));
+            ui.ctx().copy_text(link.clone());
+            cx.out.push(Action::Say(format!("Link copied: {link}")));
+            ui.close();
+        }
+        ui.separator();
+        ui.label("Your own mesh: drop a Gmsh .msh file onto the page\n(its group 'clamp' is held, gravity on).");
     });
 }
 

@@ -12,6 +12,9 @@
 //!   lesson's panel and caption, the dialogs, the status line, the 3D view): they read the model
 //!   and the UI's state ([`ui_state::Ctx`]) and return [`action::Command`]s.
 //!
+//! What differs between the desktop and a web page (clock, threads, storage, files, Rerun, the
+//! start) is [`platform`]'s.
+//!
 //! [`HoxApp`] (`app.rs`) holds the three and the services (the live Rerun link, the frame clock
 //! and measurements) and carries out the commands; `window.rs` is a frame of the window.
 //!
@@ -37,14 +40,18 @@ mod measure;
 mod menu;
 pub mod model;
 mod persist;
+pub mod platform;
 mod playback;
 pub mod plots;
 pub mod presets;
 pub mod raster;
 pub mod readout;
 mod rebuild;
+// the desktop's only (platform.rs says what the page has instead)
+#[cfg(not(target_arch = "wasm32"))]
 mod rerun_link;
 mod sections;
+#[cfg(not(target_arch = "wasm32"))]
 mod serve_web;
 pub mod session;
 pub mod session_view;
@@ -55,8 +62,12 @@ mod ui_state;
 pub mod viewport;
 mod window;
 
+#[cfg(not(target_arch = "wasm32"))]
 pub use args::AppArgs;
+#[cfg(not(target_arch = "wasm32"))]
 pub use launch::run;
+#[cfg(target_arch = "wasm32")]
+pub use launch::start_in_page;
 
 #[cfg(test)]
 mod model_tests;

@@ -44,7 +44,12 @@ impl Persisted {
     pub fn of(model: &Model, state: &UiState) -> Persisted {
         let (configs, compare) = model.kept_configurations();
         Persisted {
-            scene: model.scene().clone(),
+            // a mesh opened from its bytes lives as long as the page: the next start opens the
+            // default scene instead
+            scene: match model.scene() {
+                SceneSource::Opened { .. } => SceneSource::Builtin("bending".into()),
+                s => s.clone(),
+            },
             configs,
             compare,
             links: model.links().clone(),

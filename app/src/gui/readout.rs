@@ -58,6 +58,9 @@ pub struct Job {
     pub(super) estimate: Mutex<Option<Arc<Reference>>>,
     /// The outcome, once finished.
     pub(super) result: Mutex<Option<Result<Arc<Reference>, String>>>,
+    /// In a page: the Web Worker computing it (terminated with the job).
+    #[cfg(target_arch = "wasm32")]
+    worker: Mutex<Option<super::platform::page::WorkerJob>>,
 }
 
 impl Job {
@@ -67,6 +70,7 @@ impl Job {
 }
 
 /// Why a computation stopped: no session wanted it any more.
+#[cfg(not(target_arch = "wasm32"))]
 struct Cancelled;
 
 /// The computations under way, by key.
@@ -85,10 +89,20 @@ fn job(lookup: Lookup, key: &str, scene: &Scene, with_field: bool) -> Arc<Job> {
     }
     let job = Arc::new(Job { progress: Mutex::new(("computing reference".into(), 0.0)), ..Default::default() });
     jobs.insert(key.to_string(), Arc::downgrade(&job));
+    #[cfg(target_arch = "wasm32")]
+    in_worker(&job, &lookup, scene, with_field);
+    #[cfg(not(target_arch = "wasm32"))]
+    in_thread(&job, lookup, scene, with_field);
+    job
+}
+
+/// On the desktop: the computation on a thread of its own.
+#[cfg(not(target_arch = "wasm32"))]
+fn in_thread(job: &Arc<Job>, lookup: Lookup, scene: &Scene, with_field: bool) {
     // the thread holds the job weakly: once no session wants it, the next progress report
     // stops the computation (issue #35: a class typing ν after ν had each computation slow
     // the next); `resume_unwind` stops it without the panic hook's message
-    let (scene, weak) = (scene.clone(), Arc::downgrade(&job));
+    let (scene, weak) = (scene.clone(), Arc::downgrade(job));
     std::thread::spawn(move || {
         let wanted = || weak.upgrade().unwrap_or_else(|| std::panic::resume_unwind(Box::new(Cancelled)));
         let run = || {
@@ -115,7 +129,45 @@ fn job(lookup: Lookup, key: &str, scene: &Scene, with_field: bool) -> Arc<Job> {
             *r = Some(result);
         }
     });
-    job
+}
+
+/// In a page: the computation on a Web Worker of its own (`platform::page`), its reports taken
+/// in as they come between frames; the job holds the worker, which stops with it.
+#[cfg(target_arch = "wasm32")]
+fn in_worker(job: &Arc<Job>, lookup: &Lookup, scene: &Scene, with_field: bool) {
+    use super::platform::page::{WorkerEvent, reference_in_worker};
+    let request = serde_json::json!({
+        "scene": scene.file.to_toml(),
+        "source": scene.source,
+        "with_field": with_field,
+        "finest_cells": lookup.finest_cells,
+    });
+    let weak = Arc::downgrade(job);
+    let started = reference_in_worker(&request, move |event| {
+        let Some(job) = weak.upgrade() else { return };
+        let parse = |text: &str| serde_json::from_str::<Reference>(text).map(Arc::new).map_err(|e| e.to_string());
+        match event {
+            WorkerEvent::Progress(what, fraction) => {
+                if let Ok(mut p) = job.progress.lock() {
+                    *p = (what, fraction);
+                }
+            }
+            WorkerEvent::Estimate(text) => {
+                if let (Ok(r), Ok(mut e)) = (parse(&text), job.estimate.lock()) {
+                    *e = Some(r);
+                }
+            }
+            WorkerEvent::Done(result) => {
+                if let Ok(mut r) = job.result.lock() {
+                    *r = Some(result.and_then(|text| parse(&text)));
+                }
+            }
+        }
+    });
+    match started {
+        Ok(worker) => *job.worker.lock().unwrap_or_else(|e| e.into_inner()) = Some(worker),
+        Err(e) => *job.result.lock().unwrap_or_else(|e| e.into_inner()) = Some(Err(e)),
+    }
 }
 
 /// The key of what is wanted: the reference, or (`with_field`, for the error field) the
@@ -345,7 +397,7 @@ impl Readout {
 
     /// Short text for the status line and the viewport.
     pub fn text(&self) -> String {
-        let m = crate::recording::format_metres;
+        let m = crate::display::format_metres;
         match *self {
             Readout::NoReference { ref why, .. } => why.clone(),
             Readout::Settled { error_m, error_pct, in_equilibrium } => format!(

@@ -841,25 +841,6 @@ fn a_reference_no_longer_wanted_stops_computing() {
     assert_eq!((r.poisson_ratio, r.refining), (0.46, None));
 }
 
-/// Plays the open lesson's step as the window would, frame by frame of egui's clock, until it
-/// pauses (its seconds played, or settled).
-fn play_step_to_its_end(app: &mut HoxApp) {
-    for _ in 0..200_000 {
-        if !app.model().playing() {
-            // a slow frame (a debug build) pauses the app, as the window does: played on, as a
-            // teacher presses Play, until the step's seconds are up
-            let unfinished = app.model().lesson().is_some_and(|l| l.play_until_secs.is_some());
-            if unfinished && app.model().message().is_some_and(|m| m.starts_with("Paused: a frame takes")) {
-                app.act(Action::SetPlaying(true));
-                continue;
-            }
-            return;
-        }
-        app.act(Action::Tick { real_dt_secs: 1.0 / 60.0, one_frame_per_tick: false, in_background: false });
-    }
-    panic!("the step never ended");
-}
-
 /// Issue #35, symptom 4: lessons showed other numbers than `hox lesson` (why-high-order step 1
 /// stopped at 0.47–0.48 s instead of 0.45 s), and different ones each run. Every lesson, run
 /// twice in the app and once headlessly, shows the same numbers to the digits shown; a time per
@@ -880,20 +861,12 @@ fn every_lesson_shows_the_same_numbers_in_the_app_as_headlessly() {
         let mut runs = Vec::new();
         for _ in 0..2 {
             let mut app = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None).unwrap();
-            app.act(Action::OpenLesson(Box::new(lesson.clone())));
-            let mut shown = Vec::new();
-            for (k, step) in lesson.steps.iter().enumerate() {
-                app.act(Action::GoToStep(k));
-                assert!(app.model().lesson().unwrap().preparing());
-                app.act(Action::Poll { wait_for_lesson: true });
-                play_step_to_its_end(&mut app);
-                if let Run::Seconds(secs) = step.run {
+            let shown = app.lesson_answers(&lesson, &mut |app, k| {
+                if let Run::Seconds(secs) = lesson.steps[k].run {
                     let t = app.model().sessions()[0].instance.sim.time_secs();
                     assert!((t - secs).abs() < 1e-9, "{} step {}: ended at {t} s, not {secs} s", lesson.name, k + 1);
                 }
-                let state = app.model().lesson().unwrap();
-                shown.push(state.measured(app.model().sessions()).into_iter().map(|m| m.text).collect::<Vec<_>>());
-            }
+            });
             runs.push(shown);
         }
         for (k, step) in lesson.steps.iter().enumerate() {

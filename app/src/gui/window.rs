@@ -6,8 +6,10 @@
 use super::action::{Action, Commands};
 use super::app::HoxApp;
 use super::readout::ReferenceState;
+#[cfg(not(target_arch = "wasm32"))]
+use super::serve_web;
 use super::ui_state::Ctx;
-use super::{controls, dialogs, lesson_panel, menu, plots, serve_web, status};
+use super::{controls, dialogs, lesson_panel, menu, plots, status};
 use eframe::egui;
 use web_time::Instant;
 
@@ -68,6 +70,13 @@ impl HoxApp {
         let status = self.status();
         let mut keys = Commands::default();
         menu::shortcuts(&mut Ctx { model: &self.model, state: &mut self.ui, status: &status, out: &mut keys }, &ctx);
+        // a mesh file dropped onto the window (in a page the only way to bring one's own part)
+        for (name, bytes) in super::platform::dropped_files(&ctx) {
+            match bytes {
+                Ok(bytes) => keys.push(super::action::Command::OpenMeshBytes { name, bytes }),
+                Err(e) => keys.push(Action::Say(format!("{name} could not be read: {e}"))),
+            }
+        }
         self.act_all(keys);
         if let Some(z) = self.ui.zoom_wanted.take() {
             ctx.set_zoom_factor(z);
@@ -102,7 +111,8 @@ impl HoxApp {
             egui::Panel::bottom("caption").frame(frame).show(ui, |ui| lesson_panel::caption_ui(&cx, ui));
         }
         // presenter mode while serving the class's browsers: the address and its QR code beside
-        // the view
+        // the view (the desktop's: a page serves no one)
+        #[cfg(not(target_arch = "wasm32"))]
         if presenter && cx.status.web_url.is_some() {
             egui::Panel::right("serve_web").frame(frame).resizable(false).default_size(230.0).show(ui, |ui| {
                 serve_web::address_ui(&cx, ui);
@@ -174,6 +184,8 @@ impl HoxApp {
         self.times.app_part(ms);
         self.after_frame(&ctx, now);
         self.act(Action::StepDeferred);
+        #[cfg(target_arch = "wasm32")]
+        super::platform::page::publish_state(&self.page_state());
     }
 
     /// Screenshot and measurement bookkeeping: once `--measure-secs` have passed, prints the

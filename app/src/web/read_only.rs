@@ -40,13 +40,20 @@ const HOP_BY_HOP: [&str; 7] = [
     "proxy-authorization",
 ];
 
-/// The proxy; it stops when dropped.
-pub struct ReadOnlyDoor {
+/// A server on a thread of its own, told to stop and joined when dropped (the door, the app's
+/// page of `site.rs`).
+pub struct ServerThread {
     stop: Option<tokio::sync::oneshot::Sender<()>>,
     thread: Option<std::thread::JoinHandle<()>>,
 }
 
-impl Drop for ReadOnlyDoor {
+impl ServerThread {
+    pub fn new(stop: tokio::sync::oneshot::Sender<()>, thread: std::thread::JoinHandle<()>) -> ServerThread {
+        ServerThread { stop: Some(stop), thread: Some(thread) }
+    }
+}
+
+impl Drop for ServerThread {
     fn drop(&mut self) {
         if let Some(stop) = self.stop.take() {
             let _ = stop.send(());
@@ -56,6 +63,9 @@ impl Drop for ReadOnlyDoor {
         }
     }
 }
+
+/// The proxy; it stops when dropped (the thread is held for its `Drop`).
+pub struct ReadOnlyDoor(#[allow(dead_code)] ServerThread);
 
 /// Whether a request path names a gRPC method that writes (`/package.Service/WriteSomething`).
 pub fn is_write(path: &str) -> bool {
@@ -107,7 +117,7 @@ pub fn start(listener: TcpListener, upstream: SocketAddr) -> Result<ReadOnlyDoor
             // the connections still open are dropped with the runtime
         })
         .context("cannot start the data stream's proxy thread")?;
-    Ok(ReadOnlyDoor { stop: Some(stop), thread: Some(thread) })
+    Ok(ReadOnlyDoor(ServerThread::new(stop, thread)))
 }
 
 /// How long a request waits for Rerun's server to listen when the door opened first (the

@@ -57,11 +57,39 @@ pub const BUILTIN_MESHES: &[(&str, &[u8])] = &[
     ("../parts/hook-p3.msh", include_bytes!("../../../assets/parts/hook-p3.msh")),
 ];
 
+/// What a mesh opened from its bytes is named by ([`open_mesh_bytes`]): `opened:NAME`.
+pub const OPENED_PREFIX: &str = "opened:";
+
+type OpenedMeshes =
+    std::sync::Mutex<std::collections::HashMap<String, std::sync::Arc<hox_sim::io::gmsh::ImportedMesh>>>;
+
+/// The meshes opened from their bytes in this process, by name.
+fn opened() -> &'static OpenedMeshes {
+    static OPENED: std::sync::OnceLock<OpenedMeshes> = std::sync::OnceLock::new();
+    OPENED.get_or_init(Default::default)
+}
+
+/// A mesh file given as bytes rather than a path (a file dropped into the app's web page, which
+/// has no file system; issue #59): read and checked now (a broken file is the reader's message,
+/// naming `file_name`), kept for this process, and named `opened:FILE_NAME`, the name a scene's
+/// `mesh_file` then gives to find it as it finds the built-in ones ([`builtin_mesh`]).
+pub fn open_mesh_bytes(file_name: &str, bytes: &[u8]) -> Result<String, String> {
+    let mesh = hox_sim::io::gmsh::read_msh_bytes(bytes, file_name).map_err(|e| e.to_string())?;
+    let name = format!("{OPENED_PREFIX}{file_name}");
+    opened().lock().unwrap_or_else(|e| e.into_inner()).insert(name.clone(), std::sync::Arc::new(mesh));
+    Ok(name)
+}
+
 /// The embedded mesh file `name` ([`BUILTIN_MESHES`]), read once per process (switching a part's
-/// element type back and forth in the app reads nothing again); None if no built-in scene names it.
+/// element type back and forth in the app reads nothing again), or a mesh opened from its bytes
+/// ([`open_mesh_bytes`]); None if neither has that name.
 pub fn builtin_mesh(name: &str) -> Option<Result<std::sync::Arc<hox_sim::io::gmsh::ImportedMesh>, String>> {
     use std::collections::HashMap;
     use std::sync::{Arc, Mutex, OnceLock};
+    if name.starts_with(OPENED_PREFIX) {
+        let mesh = opened().lock().ok().and_then(|m| m.get(name).cloned());
+        return Some(mesh.ok_or_else(|| format!("{name}: no such mesh was opened in this session")));
+    }
     type Cache = Mutex<HashMap<&'static str, Arc<hox_sim::io::gmsh::ImportedMesh>>>;
     static READ: OnceLock<Cache> = OnceLock::new();
     let (key, bytes) = BUILTIN_MESHES.iter().find(|(n, _)| *n == name)?;

@@ -9,7 +9,7 @@ pub mod file;
 pub mod validate;
 
 pub use build::select_nodes;
-pub use builtin::{BUILTIN_MESHES, builtin_mesh};
+pub use builtin::{BUILTIN_MESHES, OPENED_PREFIX, builtin_mesh, open_mesh_bytes};
 pub use file::{EffectSpec, NodeSelector, ProbeSpec, SceneFile};
 pub(crate) use validate::invalid_in;
 

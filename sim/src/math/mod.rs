@@ -1,6 +1,7 @@
 //! The number types below every other room: the lane a point law is written over ([`lane`]: one
 //! `f64` or a SIMD register), the SIMD register types behind one trait ([`wide`]) — four lanes
-//! on AVX2 ([`f64x4`]) and eight on AVX-512 ([`f64x8`]), each with the runtime check that the
+//! on AVX2 ([`f64x4`]), eight on AVX-512 ([`f64x8`]) and two in a web page (`f64x2`, wasm
+//! `simd128`), each with the runtime check that the
 //! CPU can run it — the raw shared pointer parallel sweeps write through ([`shared`]), and how a
 //! pass over the nodes is cut between threads ([`par`]).
 //! It reads no other room (as Rapier keeps its SIMD number type in a `math` module below
@@ -11,11 +12,13 @@ pub mod par;
 pub mod shared;
 pub mod soa;
 
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+pub(crate) mod f64x2;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod f64x4;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod f64x8;
-#[cfg(target_arch = "x86_64")]
+#[cfg(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128")))]
 pub(crate) mod wide;
 
 /// Equality, hashing, `Debug` (`Type(name)`) and `Display` (`name`) of a registry handle by its

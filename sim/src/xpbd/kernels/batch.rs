@@ -31,7 +31,7 @@
 //! then the volumes; or, from reference gradients, `(J⁻¹)_{bc}` for `b, c < 3` (index `3b + c`)
 //! then the volumes: [`super::batch_values`]`(N, Q, WIDTH)` doubles per batch.
 
-use super::lanes::{BatchLaw, F64x4, F64x8, V3, finish_batch, gather, scaled};
+use super::lanes::{BatchLaw, V3, finish_batch, gather, scaled};
 use super::p1::BatchIo;
 use super::{NonFiniteElement, batch_values};
 use crate::math::wide::Wide;
@@ -44,6 +44,7 @@ use crate::math::wide::Wide;
 /// # Safety
 /// As [`super::p1::batches_avx2`], with `4 N` node indices and [`batch_values`]`(N, points, 4)`
 /// values per batch.
+#[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 pub unsafe fn batches_avx2<const N: usize, L: BatchLaw>(
     law: &L,
@@ -53,7 +54,7 @@ pub unsafe fn batches_avx2<const N: usize, L: BatchLaw>(
     batches: usize,
 ) -> Result<u64, NonFiniteElement> {
     // SAFETY: forwarded; compiled with AVX2 and FMA.
-    unsafe { batches_wide::<F64x4, N, L>(law, io, ref_grads, points, batches) }
+    unsafe { batches_wide::<super::lanes::F64x4, N, L>(law, io, ref_grads, points, batches) }
 }
 
 /// [`batches_avx2`] eight elements at a time.
@@ -61,6 +62,7 @@ pub unsafe fn batches_avx2<const N: usize, L: BatchLaw>(
 /// # Safety
 /// As [`batches_avx2`] with `8 N` node indices and [`batch_values`]`(N, points, 8)` values per
 /// batch; the CPU must support AVX-512 F too.
+#[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx2,fma")]
 pub unsafe fn batches_avx512<const N: usize, L: BatchLaw>(
     law: &L,
@@ -70,7 +72,24 @@ pub unsafe fn batches_avx512<const N: usize, L: BatchLaw>(
     batches: usize,
 ) -> Result<u64, NonFiniteElement> {
     // SAFETY: forwarded; compiled with AVX-512 F, AVX2 and FMA.
-    unsafe { batches_wide::<F64x8, N, L>(law, io, ref_grads, points, batches) }
+    unsafe { batches_wide::<super::lanes::F64x8, N, L>(law, io, ref_grads, points, batches) }
+}
+
+/// [`batches_avx2`] two elements at a time, in a web page (WebAssembly `simd128`).
+///
+/// # Safety
+/// As [`batches_avx2`] with `2 N` node indices and [`batch_values`]`(N, points, 2)` values per
+/// batch; the module was compiled with `simd128`.
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+pub unsafe fn batches_simd128<const N: usize, L: BatchLaw>(
+    law: &L,
+    io: BatchIo<'_>,
+    ref_grads: &[f64],
+    points: usize,
+    batches: usize,
+) -> Result<u64, NonFiniteElement> {
+    // SAFETY: forwarded; the whole module is compiled with simd128.
+    unsafe { batches_wide::<super::lanes::F64x2, N, L>(law, io, ref_grads, points, batches) }
 }
 
 /// The batches on `W`'s lanes.

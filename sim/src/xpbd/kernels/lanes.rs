@@ -14,7 +14,11 @@ use crate::material::{Mat3, stvk};
 use crate::math::lane::M3;
 use crate::math::wide::{Wide, from_lanes, to_lanes};
 
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+pub use crate::math::f64x2::F64x2;
+#[cfg(target_arch = "x86_64")]
 pub use crate::math::f64x4::F64x4;
+#[cfg(target_arch = "x86_64")]
 pub use crate::math::f64x8::F64x8;
 
 /// A 3-vector of lanes.
@@ -22,6 +26,7 @@ pub type V3<W> = [W; 3];
 
 /// The register width the colour sweep runs on: the widest this CPU has (eight lanes with
 /// AVX-512 F, four with AVX2 and FMA), None without either (the scalar sweep only).
+#[cfg(target_arch = "x86_64")]
 pub fn widest_available() -> Option<usize> {
     if <F64x8 as Wide>::available() {
         Some(8)
@@ -33,12 +38,26 @@ pub fn widest_available() -> Option<usize> {
 }
 
 /// Whether the CPU runs batches of `lanes` elements (4: AVX2 and FMA; 8: AVX-512 F too).
+#[cfg(target_arch = "x86_64")]
 pub fn lanes_available(lanes: usize) -> bool {
     match lanes {
         4 => <F64x4 as Wide>::available(),
         8 => <F64x8 as Wide>::available(),
         _ => false,
     }
+}
+
+/// In a web page: two lanes (`simd128`, a feature the module was compiled with).
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+#[allow(dead_code)] // kernels/mod.rs re-exports it for the solvers and the benchmarks
+pub fn widest_available() -> Option<usize> {
+    Some(2)
+}
+
+/// In a web page: batches of two.
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+pub fn lanes_available(lanes: usize) -> bool {
+    lanes == 2
 }
 
 /// `m v`: every entry of a 3×3 matrix of lanes scaled by the lanes `v` (the quadrature volume

@@ -16,7 +16,7 @@
 //! [`super::PackedBlock::batches`]: [`super::P1_VALUES_PER_LANE`] doubles per lane, `G[r][c]`
 //! (`∂N_{r+1}/∂X_c`) for `r, c < 3` as `WIDTH` lanes each, then the volumes.
 
-use super::lanes::{BatchLaw, F64x4, F64x8, finish_batch, gather, scaled};
+use super::lanes::{BatchLaw, finish_batch, gather, scaled};
 use super::{Multipliers, NonFiniteElement, P1_VALUES_PER_LANE, Positions};
 use crate::Vec3;
 use crate::math::wide::Wide;
@@ -60,20 +60,32 @@ impl BatchIo<'_> {
 /// `batches` batches; node indices below `io.positions.len()` and `io.rest.len()` and
 /// `io.inv_mass.len()`, element ids below `io.lambdas.len()`; the elements of a batch
 /// share no node, and no other thread touches these nodes and multipliers meanwhile.
+#[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 pub unsafe fn batches_avx2<L: BatchLaw>(law: &L, io: BatchIo<'_>, batches: usize) -> Result<u64, NonFiniteElement> {
     // SAFETY: forwarded; compiled with AVX2 and FMA.
-    unsafe { batches_wide::<F64x4, L>(law, io, batches) }
+    unsafe { batches_wide::<super::lanes::F64x4, L>(law, io, batches) }
 }
 
 /// [`batches_avx2`] eight elements at a time.
 ///
 /// # Safety
 /// As [`batches_avx2`]; the CPU must support AVX-512 F too.
+#[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx2,fma")]
 pub unsafe fn batches_avx512<L: BatchLaw>(law: &L, io: BatchIo<'_>, batches: usize) -> Result<u64, NonFiniteElement> {
     // SAFETY: forwarded; compiled with AVX-512 F, AVX2 and FMA.
-    unsafe { batches_wide::<F64x8, L>(law, io, batches) }
+    unsafe { batches_wide::<super::lanes::F64x8, L>(law, io, batches) }
+}
+
+/// [`batches_avx2`] two elements at a time, in a web page (WebAssembly `simd128`).
+///
+/// # Safety
+/// As [`batches_avx2`] but for the CPU features: the module was compiled with `simd128`.
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+pub unsafe fn batches_simd128<L: BatchLaw>(law: &L, io: BatchIo<'_>, batches: usize) -> Result<u64, NonFiniteElement> {
+    // SAFETY: forwarded; the whole module is compiled with simd128.
+    unsafe { batches_wide::<super::lanes::F64x2, L>(law, io, batches) }
 }
 
 /// The batches on `W`'s lanes.

@@ -87,7 +87,7 @@ impl PackedBlock {
         colours: &[Vec<u32>],
         lanes: usize,
     ) -> Self {
-        assert!(lanes == 4 || lanes == 8, "{lanes} lanes: 4 or 8");
+        assert!(lanes == 2 || lanes == 4 || lanes == 8, "{lanes} lanes: 2 (a web page), 4 or 8");
         Self::new(block, geometry, colours, true, lanes)
     }
 
@@ -264,12 +264,15 @@ pub const EIGHT_LANE_BATCH_COST: f64 = 1.25;
 /// The register width for a block swept in `colours`: 8 where the CPU has AVX-512 F and the
 /// block's batches of eight (`Σ ⌈len/8⌉`, a colour's last batch padded) cost less than its
 /// batches of four (`Σ ⌈len/4⌉`), a batch of eight counting [`EIGHT_LANE_BATCH_COST`]; else 4
-/// (also where the CPU has no SIMD batches at all: they are then not run). Small blocks with
+/// (also where the CPU has no SIMD batches at all: they are then not run); 2 in a web page. Small blocks with
 /// short colours (the paper's P3 beam: 80 elements) keep four lanes, where half-empty batches
 /// of eight were slower. A function of the colours and the CPU alone, never of the thread count.
 pub fn auto_lanes(colours: &[Vec<u32>]) -> usize {
-    if super::widest_available() != Some(8) {
-        return 4;
+    match super::widest_available() {
+        // a web page's register: two lanes (wasm simd128)
+        Some(2) => return 2,
+        Some(8) => {}
+        _ => return 4,
     }
     let batches = |w: usize| colours.iter().map(|c| c.len().div_ceil(w)).sum::<usize>() as f64;
     if EIGHT_LANE_BATCH_COST * batches(8) < batches(4) { 8 } else { 4 }

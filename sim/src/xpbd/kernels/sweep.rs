@@ -12,9 +12,9 @@ use crate::fem::energy::point_energy_and_gradient;
 use crate::material::{FastLaw, Mat3, Material};
 use crate::xpbd::constraint::xpbd_step;
 
-#[cfg(target_arch = "x86_64")]
+#[cfg(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128")))]
 use super::batch_values;
-#[cfg(target_arch = "x86_64")]
+#[cfg(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128")))]
 use super::{batch, lanes, p1};
 
 /// What the sweep hands back when an element's corrections come out non-finite: its element
@@ -275,7 +275,11 @@ pub unsafe fn colour_sweep(
     range: std::ops::Range<usize>,
     lambdas: Multipliers,
     inv_dt2: f64,
-    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))] batched: bool,
+    #[cfg_attr(
+        not(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128"))),
+        allow(unused_variables)
+    )]
+    batched: bool,
 ) -> Option<Result<u64, NonFiniteElement>> {
     if !SPECIALISED_NODE_COUNTS.contains(&nodes_per_element) {
         return None;
@@ -284,12 +288,19 @@ pub unsafe fn colour_sweep(
     let colour_start = packed.colour_starts[colour];
     let width = packed.lanes;
     assert!((range.start - colour_start).is_multiple_of(width) && range.end <= packed.colour_starts[colour + 1]);
-    // the batches (x86-64 only) take the first part of the range; the rest goes one by one
-    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut))]
+    // the batches (x86-64, a web page with simd128) take the first part of the range; the rest
+    // goes one by one
+    #[cfg_attr(
+        not(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128"))),
+        allow(unused_mut)
+    )]
     let mut tail = range.clone();
-    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut))]
+    #[cfg_attr(
+        not(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128"))),
+        allow(unused_mut)
+    )]
     let mut projected = 0;
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128")))]
     if batched && packed.colour_batches.len() == packed.colour_starts.len() && lanes::lanes_available(width) {
         let (n, q) = (nodes_per_element, packed.points);
         let per_batch = batch_values(n, q, width);
@@ -372,9 +383,9 @@ pub unsafe fn colour_sweep(
 /// node count and width.
 ///
 /// # Safety
-/// As [`p1::batches_avx2`] (`width` 4) or [`p1::batches_avx512`] (8); `n` one of
-/// [`SPECIALISED_NODE_COUNTS`].
-#[cfg(target_arch = "x86_64")]
+/// As [`p1::batches_avx2`] (`width` 4) or `p1::batches_avx512` (8), `p1::batches_simd128` (2,
+/// in a web page); `n` one of [`SPECIALISED_NODE_COUNTS`].
+#[cfg(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128")))]
 unsafe fn batches_of<L: lanes::BatchLaw>(
     width: usize,
     n: usize,
@@ -387,11 +398,19 @@ unsafe fn batches_of<L: lanes::BatchLaw>(
     macro_rules! by_node_count {
         ($(($n:literal, $p:literal)),*) => {
             match (width, n) {
+                #[cfg(target_arch = "x86_64")]
                 (4, 4) if q == 1 => p1::batches_avx2(law, io, batches),
+                #[cfg(target_arch = "x86_64")]
                 (8, 4) if q == 1 => p1::batches_avx512(law, io, batches),
-                $((4, $n) => batch::batches_avx2::<$n, L>(law, io, ref_grads, q, batches),
-                (8, $n) => batch::batches_avx512::<$n, L>(law, io, ref_grads, q, batches),)*
-                (4 | 8, _) => unreachable!("{n} nodes: no specialised sweep"),
+                #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+                (2, 4) if q == 1 => p1::batches_simd128(law, io, batches),
+                $(#[cfg(target_arch = "x86_64")]
+                (4, $n) => batch::batches_avx2::<$n, L>(law, io, ref_grads, q, batches),
+                #[cfg(target_arch = "x86_64")]
+                (8, $n) => batch::batches_avx512::<$n, L>(law, io, ref_grads, q, batches),
+                #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+                (2, $n) => batch::batches_simd128::<$n, L>(law, io, ref_grads, q, batches),)*
+                (2 | 4 | 8, _) => unreachable!("{n} nodes: no specialised sweep"),
                 _ => unreachable!("{width} lanes"),
             }
         };

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Builds hox for the browser (issue #59): the app compiled to WebAssembly with the toolchain
+# scripts/setup-web.sh installs, its JavaScript glue (wasm-bindgen) and the page (app/web/
+# index.html), into one folder any static web server serves. `hox serve-app` serves it to a
+# classroom; the sizes printed are the ones docs/WEB.md quotes.
+#
+#   bash scripts/build-web.sh [SITE_DIR]     # default: site/ in the repository
+#   bash scripts/build-web.sh --open         # and open it in this machine's browser
+set -euo pipefail
+cd "$(dirname "$0")/.."
+open=0
+site=site
+for a in "$@"; do
+    case "$a" in
+        --open) open=1 ;;
+        -h|--help) sed -n 2,8p "$0"; exit 0 ;;
+        *) site="$a" ;;
+    esac
+done
+bash scripts/setup-web.sh >/dev/null
+lld=$(find "$(rustc --print sysroot)/lib/rustlib" -name rust-lld -type f | head -n1)
+target="${HOX_WEB_TARGET_DIR:-$HOME/.cache/hox-web-target}"
+start=$(date +%s)
+# wasm's 128-bit SIMD (every browser of the last years runs it); no debug information in the page
+RUSTFLAGS="-C target-feature=+simd128" RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 \
+    CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_LINKER="$lld" \
+    CARGO_PROFILE_RELEASE_DEBUG=false CARGO_PROFILE_RELEASE_STRIP=debuginfo \
+    /usr/bin/cargo build --release -p hox --bin hox --target wasm32-unknown-unknown \
+    -Zbuild-std=std,panic_abort --target-dir "$target"
+mkdir -p "$site"
+"$HOME/.cargo/bin/wasm-bindgen" --target web --no-typescript --out-dir "$site" --out-name hox \
+    "$target/wasm32-unknown-unknown/release/hox.wasm"
+cp app/web/index.html app/web/worker.js "$site/"
+wasm="$site/hox_bg.wasm"
+bytes=$(stat -c %s "$wasm")
+# the gzipped copy `hox serve-app` sends to browsers that accept it
+gzip -9 -k -f "$wasm"
+gz=$(stat -c %s "$wasm.gz")
+echo "build-web: $site: hox_bg.wasm $(( bytes / 1024 )) KiB ($(( gz / 1024 )) KiB gzipped), built in $(( $(date +%s) - start )) s"
+if [ "$open" = 1 ]; then
+    echo "build-web: serving $site (Ctrl-C stops)"
+    exec cargo run --release -p hox -- serve-app --site "$site" --open
+fi
