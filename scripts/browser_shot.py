@@ -338,7 +338,7 @@ def main():
             text = result.get("result", {}).get("value")
             state["state"] = json.loads(text) if text else None
             if args.eval:
-                result = page.call("Runtime.evaluate", timeout=1800, expression=args.eval,
+                result = page.call("Runtime.evaluate", timeout=1200, expression=args.eval,
                                    awaitPromise=True, returnByValue=True)
                 if "exceptionDetails" in result:
                     state["eval_error"] = json.dumps(result["exceptionDetails"])[:2000]

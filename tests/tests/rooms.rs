@@ -84,7 +84,8 @@ const APP: &[&[&str]] = &[&["output", "web"], &["config"], &["display"], &["reco
 /// The files of the app's `gui/`, lowest first (`mod.rs`, a pure front, declares them): the
 /// model's parts, the model, its services, the UI's state, the panels, the app, the window.
 const GUI_FILES: &[&[&str]] = &[
-    &["platform", "config", "links", "presets", "readout", "raster", "study_chart", "measure", "playback"],
+    &["platform"],
+    &["config", "links", "presets", "readout", "raster", "study_chart", "measure", "playback"],
     &["session", "args", "gl_view", "teach"],
     &["session_view", "background", "cost"],
     &["lesson", "viewport", "rebuild"],

@@ -309,8 +309,9 @@ impl HoxApp {
 
     /// Every step of `lesson` as the app shows it, each prepared and played to its end in place:
     /// the texts of each step's numbers, A's and B's (`after_step` looks at the app after each).
-    /// The desktop's test against `hox lesson` (issue #35) and the page's (issue #59) read it.
-    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // the page's (and the tests')
+    /// The desktop's test against `hox lesson` (issue #35) reads it; the page's check (issue #59)
+    /// runs the same steps, awaiting its Web Workers' references between them (`launch.rs`).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // the tests'
     pub fn lesson_answers(
         &mut self,
         lesson: &hox_scenes::lesson::Lesson,
@@ -319,14 +320,33 @@ impl HoxApp {
         self.act(Action::OpenLesson(Box::new(lesson.clone())));
         let mut shown = Vec::new();
         for k in 0..lesson.steps.len() {
-            self.act(Action::GoToStep(k));
-            self.act(Action::Poll { wait_for_lesson: true });
-            self.play_step_to_its_end();
+            self.play_lesson_step(k);
             after_step(self, k);
-            let Some(state) = self.model.lesson() else { break };
-            shown.push(state.measured(self.model.sessions()).into_iter().map(|m| m.text).collect());
+            shown.push(self.lesson_step_answers());
         }
         shown
+    }
+
+    /// Opens step `k` of the lesson open, prepares it and plays it to its end in place.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // the page's (and the tests')
+    pub(super) fn play_lesson_step(&mut self, k: usize) {
+        self.act(Action::GoToStep(k));
+        self.act(Action::Poll { wait_for_lesson: true });
+        self.play_step_to_its_end();
+    }
+
+    /// The numbers of the lesson step on screen as its panel shows them (A's, B's).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // the page's (and the tests')
+    pub(super) fn lesson_step_answers(&self) -> Vec<String> {
+        self.model
+            .lesson()
+            .map_or_else(Vec::new, |l| l.measured(self.model.sessions()).into_iter().map(|m| m.text).collect())
+    }
+
+    /// Whether a configuration's reference is still being computed (in the background).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // the page's
+    pub(super) fn references_computing(&self) -> bool {
+        self.model.sessions().iter().any(|s| matches!(s.reference, super::readout::ReferenceState::Computing { .. }))
     }
 
     /// What the app shows, as JSON: the scene, each configuration (its label, element, ν, the
@@ -342,7 +362,17 @@ impl HoxApp {
             .iter()
             .map(|s| {
                 let value = |key: &str| s.config.value(key).map(|v| v.to_string());
+                let reference = match &s.reference {
+                    super::readout::ReferenceState::Unavailable(why) => format!("unavailable: {why}"),
+                    super::readout::ReferenceState::Computing { job, .. } => {
+                        let (what, fraction) = job.progress.lock().map(|p| p.clone()).unwrap_or_default();
+                        format!("computing: {what} {:.0} %", 100.0 * fraction)
+                    }
+                    super::readout::ReferenceState::Ready { .. } => "ready".into(),
+                    super::readout::ReferenceState::Failed { message, .. } => format!("failed: {message}"),
+                };
                 serde_json::json!({
+                    "reference": reference,
                     "label": s.label(),
                     "element": value("element"),
                     "poisson": value("poisson"),

@@ -183,9 +183,10 @@ impl HoxApp {
         let ms = now.elapsed().as_secs_f64() * 1e3;
         self.times.app_part(ms);
         self.after_frame(&ctx, now);
-        self.act(Action::StepDeferred);
+        // before the sessions go out to be stepped (in a page, at once, in place)
         #[cfg(target_arch = "wasm32")]
         super::platform::page::publish_state(&self.page_state());
+        self.act(Action::StepDeferred);
     }
 
     /// Screenshot and measurement bookkeeping: once `--measure-secs` have passed, prints the

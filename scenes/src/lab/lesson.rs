@@ -545,7 +545,7 @@ pub fn measure(
     min_det_f: f64,
 ) -> Measured {
     let probe = instance.probe_displacements().first().map(|p| p.1);
-    let metres = |v: f64| Measured { value: v, text: format!("{v:.4} m") };
+    let metres = |v: f64| Measured { value: v, text: metres_text(v) };
     match measure {
         Measure::SettledError | Measure::SolverError => {
             let now = instance.probe_displacements();
@@ -595,6 +595,14 @@ pub fn measure(
             Measured { value: v, text: format!("min N_i = {shown:.4}") }
         }
     }
+}
+
+/// `v` in metres to the tenth of a millimetre, as a lesson shows it; a value that rounds to zero
+/// is "0.0000 m" whatever its sign (issue #59: mesh-bias's sideways tip, ±1e-17 m, read
+/// "-0.0000 m" in the page and "0.0000 m" on the desktop).
+pub fn metres_text(v: f64) -> String {
+    let shown = if v.abs() < 5e-5 { 0.0 } else { v };
+    format!("{shown:.4} m")
 }
 
 /// The most negative value any shape function of `element` takes on a fine lattice of its

@@ -204,3 +204,14 @@ pub fn bench_beam(label: &str, frames: u32) -> Result<String, String> {
     })
     .to_string())
 }
+
+/// Waits `ms` milliseconds, the page's event loop running meanwhile (a worker's messages, the
+/// next frame).
+pub async fn sleep_ms(ms: i32) {
+    let promise = js_sys::Promise::new(&mut |resolve, _| {
+        if let Some(w) = web_sys::window() {
+            let _ = w.set_timeout_with_callback_and_timeout_and_arguments_0(&resolve, ms);
+        }
+    });
+    let _ = wasm_bindgen_futures::JsFuture::from(promise).await;
+}

@@ -84,3 +84,14 @@ fn a_lesson_names_the_parameters_its_steps_change() {
     assert!(lines[0].contains("Poisson ratio ν 0.49") && lines[0].contains("p1"), "{lines:?}");
     assert!(lines[1].contains("Poisson ratio ν 0.49") && lines[1].contains("p2"), "{lines:?}");
 }
+
+/// Issue #59: mesh-bias's sideways tip (±1e-17 m) read "-0.0000 m" in the page and "0.0000 m" on
+/// the desktop: a value that rounds to zero is shown without a sign.
+#[test]
+fn a_sideways_tip_that_rounds_to_zero_shows_no_minus_sign() {
+    assert_eq!(metres_text(-1e-17), "0.0000 m");
+    assert_eq!(metres_text(1e-17), "0.0000 m");
+    assert_eq!(metres_text(-0.0), "0.0000 m");
+    assert_eq!(metres_text(-0.00012), "-0.0001 m");
+    assert_eq!(metres_text(-0.2884), "-0.2884 m");
+}
