@@ -5,7 +5,8 @@
 # classroom; the sizes printed are the ones docs/WEB.md quotes.
 #
 #   bash scripts/build-web.sh [SITE_DIR]     # default: site/ in the repository
-#   bash scripts/build-web.sh --open         # and open it in this machine's browser
+#   bash scripts/build-web.sh --open         # and serve it here (`hox serve-app`; a browser opened
+#                                            # on its address where xdg-open finds one)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 open=0
@@ -39,5 +40,8 @@ gz=$(stat -c %s "$wasm.gz")
 echo "build-web: $site: hox_bg.wasm $(( bytes / 1024 )) KiB ($(( gz / 1024 )) KiB gzipped), built in $(( $(date +%s) - start )) s"
 if [ "$open" = 1 ]; then
     echo "build-web: serving $site (Ctrl-C stops)"
-    exec cargo run --release -p hox -- serve-app --site "$site" --open
+    if command -v xdg-open >/dev/null 2>&1 && [ -n "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
+        (sleep 3 && xdg-open "http://127.0.0.1:9090/" >/dev/null 2>&1) &
+    fi
+    exec cargo run --release -p hox -- serve-app --site "$site"
 fi
