@@ -5,7 +5,9 @@ WebAssembly, one thread, the colour sweep on two-lane simd128 batches) against t
 binary on one thread (`hox bench --threads 1 --sweep colour`), measured side by side: the page
 and the desktop take turns, round after round, and each row's figure is the median over rounds;
 then how soon the page shows the beam coloured (browser_shot.py --frames, the first frame with
-the beam in the field's colours) and the size of its module.
+the beam in the field's colours), how many simulated frames per real second the page steps
+while it plays P2 bending (its published state read twice, ten seconds apart) and the size of
+its module.
 
     python3 scripts/web_speed.py [--site DIR] [--frames 60] [--rounds 3] [--hox BIN]
 
@@ -61,6 +63,38 @@ def first_coloured(url, scratch, wait=30):
     return None
 
 
+PLAYED_SECS = 10
+
+# Two readings of the page's published state PLAYED_SECS apart: simulated frames stepped and
+# simulated seconds advanced per real second while the page plays.
+PLAY_RATE = """new Promise(done => {
+  const read = () => JSON.parse(window.hox_state);
+  const a = read(), t0 = performance.now();
+  setTimeout(() => {
+    const b = read(), secs = (performance.now() - t0) / 1000;
+    done(JSON.stringify({
+      frames_per_sec: (b.frames_stepped - a.frames_stepped) / secs,
+      sim_secs_per_sec: (b.configurations[0].time_secs - a.configurations[0].time_secs) / secs,
+      element: b.configurations[0].element,
+      ms_per_frame: b.configurations[0].ms_per_frame,
+    }));
+  }, %d);
+})""" % (PLAYED_SECS * 1000)
+
+
+def play_rate(url, scratch):
+    """Simulated frames per real second while the page plays P2 bending (its frames are 1/60 s)."""
+    state = scratch / "play.json"
+    subprocess.run(
+        [sys.executable, str(ROOT / "scripts/browser_shot.py"), url + "?scene=bending&element=p2&play",
+         str(scratch / "play.png"), "--wait", "5", "--state", str(state), "--eval", PLAY_RATE],
+        check=True, stdout=subprocess.DEVNULL)
+    result = json.loads(state.read_text())
+    if result.get("eval_error") or not result.get("eval"):
+        sys.exit(f"web_speed: the page's play rate could not be read: {result.get('eval_error')}")
+    return json.loads(result["eval"])
+
+
 def native_ms(hox, label, frames):
     """The native binary's median ms per frame of `label`, one thread, the colour sweep."""
     out = subprocess.run([hox, "bench", "--only", label, "--threads", "1", "--sweep", "colour",
@@ -93,6 +127,7 @@ def main():
         lanes = {}
         with tempfile.TemporaryDirectory(prefix="hox-web-speed-") as tmp:
             first = first_coloured(url, Path(tmp))
+            played = play_rate(url, Path(tmp))
             for r in range(args.rounds):
                 for label, _ in BEAMS:
                     # the order alternates, so that neither always goes first
@@ -119,6 +154,9 @@ def main():
         print("| the page | now | asked |")
         print("|---|---|---|")
         print(f"| first coloured frame after the page was asked for (P2 bending, playing) | {coloured} | 10 s |")
+        print(f"| P2 bending playing in the page ({played['element']}, frames of 1/60 s) | "
+              f"**{played['frames_per_sec']:.0f} simulated frames/s** "
+              f"({played['sim_secs_per_sec']:.2f} simulated s per s) | 60 |")
         print(f"| hox_bg.wasm | {wasm:.1f} MB, {gz:.1f} MB gzipped (as `hox serve-app` sends it) | 20 MB, 6 MB compressed |")
     finally:
         server.terminate()

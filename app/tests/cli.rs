@@ -538,5 +538,11 @@ fn a_bad_link_or_a_missing_site_is_refused_by_name() {
     let empty = std::env::temp_dir().join(format!("hox-no-site-{}", std::process::id()));
     std::fs::create_dir_all(&empty).unwrap();
     fails_with(&["serve-app", "--site", empty.to_str().unwrap(), "--web-port", "0", "--seconds", "0"], "build-web.sh");
+    // a site's references written where no folder can be made: refused before the lesson runs
+    let file = empty.join("a-file");
+    std::fs::write(&file, "kept").unwrap();
+    let under_a_file = file.join("references");
+    fails_with(&["lesson", "locking", "--references-to", under_a_file.to_str().unwrap()], "--references-to");
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "kept", "nothing already written is lost");
     let _ = std::fs::remove_dir_all(empty);
 }

@@ -27,6 +27,12 @@ pub struct LessonArgs {
     /// Print the measurements as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Also write every configuration's computed reference (what its error is measured against,
+    /// in a step's answer or the app's readout) into this folder, as the cache files the page
+    /// reads (`scripts/build-web.sh` puts them in the site's references/); each is computed
+    /// once per machine, then read from the cache (~/.cache/hox).
+    #[arg(long, value_name = "DIR")]
+    pub references_to: Option<PathBuf>,
     /// Serve the lesson to the class's browsers as it runs (the Rerun web viewer): students open
     /// the address printed first and follow the steps live; it stays served until Ctrl-C.
     #[arg(long, conflicts_with = "record")]
@@ -108,6 +114,9 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
     if let Some(out) = &args.record {
         check_writable(out)?;
     }
+    if let Some(dir) = &args.references_to {
+        std::fs::create_dir_all(dir).with_context(|| format!("--references-to: cannot create {}", dir.display()))?;
+    }
     if let Some(s) = args.serve_secs
         && !(s.is_finite() && s >= 0.0)
     {
@@ -167,6 +176,25 @@ pub fn lesson(args: &LessonArgs) -> Result<()> {
                 runner.measured()
             }
         };
+        if let Some(dir) = &args.references_to {
+            // every configuration's reference as the app's readout shows it, whether or not the
+            // step's measure needs it (computed here once per machine, then cached)
+            let lookup = hox_scenes::reference::Lookup::default();
+            for instance in &runner.instances {
+                // a mesh file's own solution is not cached (the page solves it itself)
+                let cached = instance.scene.mesh_kind() != hox_scenes::params::MeshKind::File;
+                if cached
+                    && hox_scenes::reference::unavailable(&instance.scene).is_none()
+                    && let Err(e) = lookup.for_scene(&instance.scene, &mut progress)
+                {
+                    // the app's readout says the same; the lesson's own measures are unaffected
+                    eprintln!("--references-to: {} step {}: no reference to write: {e}", lesson.name, k + 1);
+                }
+                lookup
+                    .export(&instance.scene, dir)
+                    .with_context(|| format!("--references-to: cannot write into {}", dir.display()))?;
+            }
+        }
         bar.bar.finish_and_clear();
         let values: Vec<f64> = measured.iter().map(|m| m.value).collect();
         let judged = step.claim.as_ref().and_then(|c| c.judge(&values));

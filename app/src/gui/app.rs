@@ -311,7 +311,7 @@ impl HoxApp {
     /// the texts of each step's numbers, A's and B's (`after_step` looks at the app after each).
     /// The desktop's test against `hox lesson` (issue #35) reads it; the page's check (issue #59)
     /// runs the same steps, awaiting its Web Workers' references between them (`launch.rs`).
-    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // the tests'
+    #[cfg(test)]
     pub fn lesson_answers(
         &mut self,
         lesson: &hox_scenes::lesson::Lesson,

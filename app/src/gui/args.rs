@@ -88,6 +88,7 @@ pub struct AppArgs {
 
 impl AppArgs {
     /// These options with `--link`'s on top (`--link`'s own problems refused by name).
+    #[cfg(not(target_arch = "wasm32"))] // the page reads its own address instead
     pub fn with_link(mut self) -> Result<AppArgs, String> {
         let Some(link) = self.link.take() else { return Ok(self) };
         let query = link.split_once('?').map_or(link.as_str(), |(_, q)| q);

@@ -186,22 +186,26 @@ pub const REFERENCE_PENDING: &str = "reference still computing";
 #[cfg(target_arch = "wasm32")]
 #[wasm_bindgen::prelude::wasm_bindgen]
 pub async fn lesson_answers(name: String) -> Result<String, String> {
+    use hox_scenes::lesson::Measure;
     let lesson = hox_scenes::lesson::by_name(&name).map_err(|e| e.to_string())?;
     let mut app = HoxApp::new(&AppArgs { fresh: true, ..Default::default() }, None)?;
     app.act(super::action::Action::OpenLesson(Box::new(lesson.clone())));
     let mut shown = Vec::new();
     for k in 0..lesson.steps.len() {
         app.play_lesson_step(k);
-        // a worker's reports come between the page's turns: give it those turns, a minute at
-        // most (a reference on the finest level takes minutes on one thread of a page)
+        // an error's reference comes from a worker, whose reports come between the page's
+        // turns: give it those turns, a minute at most (the site carries every lesson's
+        // references; one it lacks takes minutes on one thread of a page). The other measures
+        // need no reference (the readouts' references may still be coming).
+        let needs_reference = matches!(lesson.steps[k].measure, Measure::SettledError | Measure::SolverError);
         for _ in 0..3_000 {
-            if !app.references_computing() {
+            if !needs_reference || !app.references_computing() {
                 break;
             }
             super::platform::page::sleep_ms(20).await;
             app.act(super::action::Action::Poll { wait_for_lesson: false });
         }
-        shown.push(if app.references_computing() {
+        shown.push(if needs_reference && app.references_computing() {
             vec![REFERENCE_PENDING.to_string()]
         } else {
             app.lesson_step_answers()

@@ -592,8 +592,8 @@ impl Model {
         }
     }
 
-    /// Real time passed: steps as much simulated time as passed × the time scale (at most 4
-    /// frames per tick, so a slow configuration slows down instead of freezing the window);
+    /// Real time passed: steps as much simulated time as passed × the time scale (at most
+    /// about 50 ms of stepping per tick, at least 4 frames: `Playback::frames_due`);
     /// while settling as many frames as about 50 ms of stepping allows; then a step that plays
     /// some seconds pauses at its end, and a slow frame pauses.
     fn tick(
@@ -656,7 +656,7 @@ impl Model {
         if one_frame_per_tick {
             return 1;
         }
-        let frames = self.playback.frames_due(dt, frame_secs);
+        let frames = self.playback.frames_due(dt, frame_secs, self.sessions.iter().map(|s| s.ms_per_frame).sum());
         // a lesson step that plays some seconds ends on its last frame exactly, as `hox lesson`
         let t = self.sessions.first().map(|s| s.instance.sim.time_secs());
         frames.min(self.lesson.as_ref().zip(t).and_then(|(l, t)| l.frames_left(t, frame_secs)).unwrap_or(usize::MAX))

@@ -17,6 +17,8 @@ pub struct Playback {
 
 /// Wall time of stepping per displayed frame while settling, ms.
 pub const SETTLE_STEP_BUDGET_MS: f64 = 50.0;
+/// Wall time of stepping per displayed frame while playing, ms (at least 4 frames are stepped).
+pub const PLAY_STEP_BUDGET_MS: f64 = 50.0;
 
 impl Playback {
     pub fn new(playing: bool, time_scale: f64) -> Playback {
@@ -29,11 +31,15 @@ impl Playback {
         std::time::Duration::from_secs_f64(secs.min(frame_secs / self.time_scale.max(1e-6)).min(0.25))
     }
 
-    /// The frames of `frame_secs` due after `real_dt_secs` of real time (at most 4); the
-    /// remainder, less than a frame, is kept for the next call.
-    pub(super) fn frames_due(&mut self, real_dt_secs: f64, frame_secs: f64) -> usize {
+    /// The frames of `frame_secs` due after `real_dt_secs` of real time, each costing `step_ms`
+    /// of stepping: as many as [`PLAY_STEP_BUDGET_MS`] of stepping allows, at least 4 (so a
+    /// slow configuration slows down instead of freezing the window, and a cheap one keeps real
+    /// time when the window draws slowly, as a page without a GPU does); the remainder, less
+    /// than a frame, is kept for the next call.
+    pub(super) fn frames_due(&mut self, real_dt_secs: f64, frame_secs: f64, step_ms: f64) -> usize {
         self.frame_budget_secs += real_dt_secs.min(0.25) * self.time_scale;
-        let frames = ((self.frame_budget_secs / frame_secs).floor() as usize).min(4);
+        let most = ((PLAY_STEP_BUDGET_MS / step_ms.max(1e-3)) as usize).max(4);
+        let frames = ((self.frame_budget_secs / frame_secs).floor() as usize).min(most);
         self.frame_budget_secs = (self.frame_budget_secs - frames as f64 * frame_secs).min(frame_secs);
         frames
     }

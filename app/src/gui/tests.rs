@@ -1318,6 +1318,19 @@ fn the_wait_for_the_next_frame_follows_the_clock_s_remainder_and_the_time_scale(
     assert_eq!(crawl.until_next_frame(frame).as_secs_f64(), 0.25, "at most a quarter second between paints");
 }
 
+#[test]
+fn a_cheap_frame_keeps_real_time_when_the_window_draws_slowly() {
+    // the page without a GPU shows a frame every 100 ms: P2 bending's 3 ms frames keep up
+    let frame = 1.0 / 60.0;
+    let mut p = playback::Playback::new(true, 1.0);
+    let stepped: usize = (0..10).map(|_| p.frames_due(0.1, frame, 3.0)).sum();
+    assert!((59..=61).contains(&stepped), "{stepped} frames in a second of 100 ms paints");
+    // a 30 ms frame slows down: four frames a paint, not the six real time owes
+    let mut slow = playback::Playback::new(true, 1.0);
+    assert_eq!(slow.frames_due(0.1, frame, 30.0), 4);
+    assert_eq!(slow.frames_due(0.1, frame, 30.0), 4, "what it could not step is dropped, not owed");
+}
+
 /// What a viewer following `path` (an .rrd file) shows at its latest `frame`, as Rerun's own
 /// store answers (latest-at queries, with its clears and static data): the configurations
 /// (`world/<name>`) with a body, rest shape, edges or probes drawn, and the chart lines

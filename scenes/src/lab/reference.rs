@@ -29,7 +29,8 @@
 //!
 //! Computed references are cached by their physics key, in memory and on disk (`HOX_CACHE_DIR`,
 //! else `$XDG_CACHE_HOME/hox` or `~/.cache/hox`, folder `references/`), so a configuration is
-//! solved once per machine.
+//! solved once per machine; the page reads the references its site was built with as well
+//! ([`read_only_cache`]).
 
 pub mod compute;
 pub mod field;
@@ -235,14 +236,20 @@ pub(crate) fn parse_probes(text: &str, source_name: &str) -> Result<Probes, Scen
         .collect()
 }
 
-/// The committed reference of `scene`, if its physics are a paper scene's as built.
+/// The committed reference of `scene`, if its physics are a paper scene's as built, whatever
+/// the scene is called (a lesson's beam with the paper's physics has the paper's reference).
 pub fn committed(scene: &Scene) -> Result<Option<Reference>, SceneError> {
-    let Some((name, levels)) = COMMITTED.iter().find(|(n, _)| *n == scene.name()) else {
-        return Ok(None);
-    };
-    if !scene.is_box() || physics_key(scene) != physics_key(&crate::scene::builtin::by_name(name)?) {
+    if !scene.is_box() {
         return Ok(None);
     }
+    static KEYS: std::sync::OnceLock<Vec<Option<String>>> = std::sync::OnceLock::new();
+    let keys = KEYS.get_or_init(|| {
+        COMMITTED.iter().map(|(n, _)| crate::scene::builtin::by_name(n).ok().map(|s| physics_key(&s))).collect()
+    });
+    let key = physics_key(scene);
+    let Some(((name, levels), _)) = COMMITTED.iter().zip(keys).find(|(_, k)| k.as_deref() == Some(key.as_str())) else {
+        return Ok(None);
+    };
     let mut solved = Vec::new();
     for (k, (grid, text)) in levels.iter().enumerate() {
         let level = ["coarse", "medium", "fine"][k];
@@ -373,6 +380,21 @@ fn fnv1a(text: &str) -> u64 {
     text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
 }
 
+/// The name of the cache file of `key` (in the cache folder, or the page's site).
+pub fn cache_file_name(key: &str) -> String {
+    format!("{:016x}.json", fnv1a(key))
+}
+
+/// A read-only cache besides the cache folder: a cache file's text by its name. The page (issue
+/// #59) reads the references its site was built with (`references/NAME` on the site, written
+/// by `scripts/build-web.sh`), set by [`read_only_cache`]; unset elsewhere.
+static READ_ONLY_CACHE: std::sync::OnceLock<fn(&str) -> Option<String>> = std::sync::OnceLock::new();
+
+/// Adds a read-only cache of references ([`READ_ONLY_CACHE`]); a second call changes nothing.
+pub fn read_only_cache(read: fn(&str) -> Option<String>) {
+    let _ = READ_ONLY_CACHE.set(read);
+}
+
 #[derive(serde::Serialize, serde::Deserialize)]
 struct Cached {
     key: String,
@@ -418,7 +440,7 @@ impl Lookup {
     }
 
     fn cache_file(&self, key: &str) -> Option<PathBuf> {
-        self.cache_dir.as_ref().map(|d| d.join(format!("{:016x}.json", fnv1a(key))))
+        self.cache_dir.as_ref().map(|d| d.join(cache_file_name(key)))
     }
 
     /// The reference of `scene` if it is known without solving: committed, or computed before
@@ -436,9 +458,13 @@ impl Lookup {
         if let Some(r) = memory().lock().ok().and_then(|m| m.get(key).cloned()) {
             return Some(r);
         }
-        let path = self.cache_file(key).filter(|_| disk)?;
+        if !disk {
+            return None;
+        }
+        let text = self.cache_file(key).and_then(|path| std::fs::read_to_string(path).ok());
+        let text = text.or_else(|| READ_ONLY_CACHE.get().and_then(|read| read(&cache_file_name(key))))?;
         // an unreadable or foreign cache file is recomputed, never trusted
-        let cached = std::fs::read_to_string(&path).ok().and_then(|t| serde_json::from_str::<Cached>(&t).ok())?;
+        let cached = serde_json::from_str::<Cached>(&text).ok()?;
         (cached.key == key).then(|| {
             if let Ok(mut m) = memory().lock() {
                 m.insert(key.to_string(), cached.reference.clone());
@@ -461,6 +487,28 @@ impl Lookup {
                 .and_then(|_| std::fs::write(&tmp, text))
                 .and_then(|_| std::fs::rename(&tmp, &path));
         }
+    }
+
+    /// Writes the cache files of `scene`'s computed reference (and of its field, when solved)
+    /// into `dir`, as the cache folder holds them, when they are known without solving: the
+    /// references a site carries for the page (issue #59, `hox lesson --references-to`). A
+    /// committed reference (in the page's module already) or a mesh file's is not written.
+    /// Ok(files written).
+    pub fn export(&self, scene: &Scene, dir: &std::path::Path) -> std::io::Result<usize> {
+        if !on_disk(scene) || unavailable(scene).is_some() || committed(scene).ok().flatten().is_some() {
+            return Ok(0);
+        }
+        let mut written = 0;
+        for key in [self.key(scene), self.field_key(scene)] {
+            if let Some(reference) = self.load(&key, true) {
+                let text =
+                    serde_json::to_string(&Cached { key: key.clone(), reference }).map_err(std::io::Error::other)?;
+                std::fs::create_dir_all(dir)?;
+                std::fs::write(dir.join(cache_file_name(&key)), text)?;
+                written += 1;
+            }
+        }
+        Ok(written)
     }
 
     /// The reference of `scene`: committed, cached, or computed now (and cached). Err when the

@@ -153,6 +153,7 @@ pub fn compute_reference(request: &str, post: &js_sys::Function) {
         let text = r["scene"].as_str().ok_or("no scene in the request")?;
         let scene =
             hox_scenes::Scene::from_toml(text, r["source"].as_str().unwrap_or("page")).map_err(|e| e.to_string())?;
+        hox_scenes::reference::read_only_cache(site_reference);
         let lookup = hox_scenes::reference::Lookup {
             finest_cells: r["finest_cells"].as_u64().unwrap_or(hox_scenes::reference::FINEST_CELLS as u64) as usize,
             cache_dir: None,
@@ -172,6 +173,16 @@ pub fn compute_reference(request: &str, post: &js_sys::Function) {
         Ok(r) => json!({ "result": r }),
         Err(e) => json!({ "error": e }),
     });
+}
+
+/// A reference cache file the site was built with (`references/NAME`, written by
+/// `scripts/build-web.sh` from the desktop's computation of every lesson's references), read
+/// synchronously, which a worker may do; None when the site has none.
+fn site_reference(name: &str) -> Option<String> {
+    let request = web_sys::XmlHttpRequest::new().ok()?;
+    request.open_with_async("GET", &format!("references/{name}"), false).ok()?;
+    request.send().ok()?;
+    (request.status().ok()? == 200).then(|| request.response_text().ok().flatten()).flatten()
 }
 
 /// Milliseconds per simulated frame of the benchmark beam `label` (`hox bench`'s labels, e.g.

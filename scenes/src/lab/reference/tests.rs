@@ -239,3 +239,59 @@ fn the_cache_file_names_its_key() {
     assert_ne!(a, fnv1a("box [0,0,0]; nu=0.35"));
     assert_eq!(a, fnv1a("box [0,0,0]; nu=0.49"));
 }
+
+/// Issue #59: a computed reference written out for a site (`hox lesson --references-to`) is the
+/// cache file the page reads back through its read-only cache, under the same key, whole; a
+/// committed reference is not written (the page's module has it).
+#[test]
+fn a_reference_exported_for_a_site_is_read_back_through_the_read_only_cache() {
+    let b = by_name("bending").unwrap();
+    let nu = with(&b, SceneOverrides { poisson_ratio: Some(0.42), ..Default::default() });
+    let computed = Lookup { finest_cells: 64, cache_dir: None };
+    let r = computed.for_scene(&nu, &mut |_, _| {}).unwrap();
+    let site = std::env::temp_dir().join(format!("hox-site-references-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&site);
+    assert_eq!(computed.export(&nu, &site).unwrap(), 1, "the probes' reference, no field solved");
+    assert_eq!(computed.export(&b, &site).unwrap(), 0, "a committed reference stays in the module");
+    // the page's lookup: the same levels' key, nothing in memory, no cache folder
+    let page = Lookup { finest_cells: 64, cache_dir: None };
+    let name = cache_file_name(&page.key(&nu));
+    assert!(site.join(&name).is_file(), "{name}");
+    memory().lock().unwrap().remove(&page.key(&nu));
+    assert_eq!(page.known(&nu).unwrap(), None, "nothing read yet");
+    read_only_cache(|name| {
+        std::fs::read_to_string(
+            std::env::temp_dir().join(format!("hox-site-references-{}", std::process::id())).join(name),
+        )
+        .ok()
+    });
+    assert_eq!(page.known(&nu).unwrap(), Some(r));
+    let _ = std::fs::remove_dir_all(&site);
+}
+
+/// Issue #59: the page's Web Worker rebuilds the scene it computes a reference for from its TOML
+/// (`scene.file.to_toml()`); a paper scene as built keeps its committed reference through the
+/// trip, as on the desktop.
+#[test]
+fn a_scene_rebuilt_from_its_toml_keeps_its_committed_reference() {
+    for name in ["bending", "tension", "torsion"] {
+        let scene = by_name(name).unwrap();
+        let rebuilt = crate::Scene::from_toml(&scene.file.to_toml(), &scene.source).unwrap();
+        assert_eq!(physics_key(&rebuilt), physics_key(&scene), "{name}");
+        let r = committed(&rebuilt).unwrap().unwrap_or_else(|| panic!("{name}: no committed reference after the trip"));
+        assert_eq!(r.origin, Origin::Committed);
+    }
+}
+
+/// A reference follows the physics, not the name: the paper's bending beam renamed (a lesson's
+/// or a user's scene file with the paper's physics) has the committed reference; with another
+/// ν it has none.
+#[test]
+fn a_beam_with_the_paper_s_physics_under_another_name_has_the_committed_reference() {
+    let mut renamed = by_name("bending").unwrap();
+    renamed.file.name = "my beam".into();
+    let r = committed(&renamed).unwrap().expect("the paper's bending physics");
+    assert_eq!((r.origin, r.poisson_ratio), (Origin::Committed, 0.35));
+    let other = with(&renamed, SceneOverrides { poisson_ratio: Some(0.3), ..Default::default() });
+    assert_eq!(committed(&other).unwrap(), None, "ν = 0.3 is not the paper's");
+}

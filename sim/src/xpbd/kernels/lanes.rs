@@ -49,7 +49,6 @@ pub fn lanes_available(lanes: usize) -> bool {
 
 /// In a web page: two lanes (`simd128`, a feature the module was compiled with).
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
-#[allow(dead_code)] // kernels/mod.rs re-exports it for the solvers and the benchmarks
 pub fn widest_available() -> Option<usize> {
     Some(2)
 }

@@ -69,16 +69,17 @@ pub const fn batch_values(nodes: usize, points: usize, lanes: usize) -> usize {
 }
 
 /// The register widths the colour sweep can batch with: the widest this CPU runs (8 with
-/// AVX-512 F, 4 with AVX2 and FMA), None without either; and whether a given width runs here.
-#[cfg(target_arch = "x86_64")]
+/// AVX-512 F, 4 with AVX2 and FMA, 2 in a web page compiled with `simd128`), None without
+/// any; and whether a given width runs here.
+#[cfg(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128")))]
 pub use lanes::{lanes_available, widest_available};
-/// No batches off x86-64: the scalar sweep only.
-#[cfg(not(target_arch = "x86_64"))]
+/// No batches without x86-64's or the page's registers: the scalar sweep only.
+#[cfg(not(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128"))))]
 pub fn widest_available() -> Option<usize> {
     None
 }
-/// No batches off x86-64.
-#[cfg(not(target_arch = "x86_64"))]
+/// No batches without x86-64's or the page's registers.
+#[cfg(not(any(target_arch = "x86_64", all(target_arch = "wasm32", target_feature = "simd128"))))]
 pub fn lanes_available(_lanes: usize) -> bool {
     false
 }
