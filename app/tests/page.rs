@@ -110,6 +110,39 @@ fn the_app_runs_in_the_page_driven_by_its_link_and_its_keys_without_an_error() {
     let message = s["message"].as_str().unwrap_or_default();
     assert!(message.contains("nu=abc") && message.contains("bogus"), "{s}");
     assert!(s["configurations"][0]["element"].as_str().is_some_and(|e| e.eq_ignore_ascii_case("q1")), "{s}");
+
+    // meshes dropped onto the page (a browser's drop events, as a file manager sends them): a
+    // broken one is a message naming it and the app plays on; a Gmsh beam opens
+    let good = std::fs::read_to_string(root().join("assets/meshes/beam-tet4.msh")).unwrap();
+    let eval = format!(
+        "(async () => {{
+            const drop = async (name, text) => {{
+                const files = new DataTransfer();
+                files.items.add(new File([text], name));
+                const canvas = document.getElementById('hox');
+                for (const type of ['dragenter', 'dragover', 'drop'])
+                    canvas.dispatchEvent(new DragEvent(type, {{ dataTransfer: files, bubbles: true, cancelable: true }}));
+                await new Promise(done => setTimeout(done, 5000));
+                return JSON.parse(window.hox_state);
+            }};
+            const broken = await drop('broken.msh', {});
+            const good = await drop('beam-tet4.msh', {});
+            return JSON.stringify({{ broken, good }});
+        }})()",
+        serde_json::to_string("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\nnot a number\n").unwrap(),
+        serde_json::to_string(&good).unwrap()
+    );
+    let (_, state) =
+        page_run(&format!("{url}?scene=bending&play"), &dir.join("drop.png"), 15.0, 1, 0.0, "", Some(&eval));
+    assert!(state.get("eval_error").is_none(), "{}", state["eval_error"]);
+    assert!(errors(&state).is_empty(), "the page's console: {:?}", errors(&state));
+    let dropped: serde_json::Value = serde_json::from_str(state["eval"].as_str().expect("the page's states")).unwrap();
+    let (broken, good) = (&dropped["broken"], &dropped["good"]);
+    let message = broken["message"].as_str().unwrap_or_default();
+    assert!(message.contains("broken.msh") && message.contains("not opened"), "{broken}");
+    assert_eq!(broken["scene"].as_str(), Some("bending"), "the scene kept: {broken}");
+    assert!(broken["playing"] == true, "it plays on: {broken}");
+    assert!(good["scene"].as_str().is_some_and(|s| s.contains("beam-tet4.msh")), "the dropped beam: {good}");
     assert!(errors(&state).is_empty(), "the page's console: {:?}", errors(&state));
 }
 

@@ -338,3 +338,29 @@ fn a_settling_run_cut_short_by_its_cap_says_it_did_not_settle_and_how_far_it_is(
     assert!(summary.starts_with("NOT settled after 0.1 s (residual "), "{summary}");
     assert!(summary.ends_with(" of the load)"), "{summary}");
 }
+
+/// Found building the page's site (issue #59): the stability lesson's beam (P2 bending, E = 1 GPa)
+/// had no reference — "Newton's method did not converge (load fraction 0.0008, relative residual
+/// 8.3e-8)": a stiff beam's residual stops at a round-off floor above the tolerance, and halving
+/// the load only raised the floor relative to it. Stalling at round-off is the solution.
+#[test]
+fn a_stiff_beam_s_static_solve_stops_at_its_round_off_floor_instead_of_failing() {
+    let stiff = by_name("bending")
+        .unwrap()
+        .with_overrides(&SceneOverrides { youngs_modulus_pa: Some(1e9), ..Default::default() })
+        .unwrap();
+    let mesh = stiff.build_mesh().unwrap();
+    let solution =
+        crate::instance::solve_static(&stiff, &mesh, 1e-9, 10, &mut |_, _, _| {}).expect("a static solution");
+    let tip = stiff.file.probes[0].point_m;
+    let moved = mesh
+        .rest_positions
+        .iter()
+        .zip(&solution.positions)
+        .filter(|(x, _)| (x.x - tip[0]).abs() < 1e-9)
+        .map(|(x, y)| (y - x).z)
+        .fold(0.0f64, f64::min);
+    // a cantilever 3e6/1e9 as soft: the paper's tip sag (about 0.3 m) shrunk about 333 times
+    assert!(moved < -2e-4 && moved > -3e-3, "tip sag {moved} m");
+    assert!(solution.relative_residual < 1e-6, "{}", solution.relative_residual);
+}

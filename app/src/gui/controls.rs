@@ -79,7 +79,7 @@ fn refusal_ui(cx: &Ctx, ui: &mut egui::Ui, control: &str) {
     if let Some((c, reason)) = cx.model.refusal()
         && c == control
     {
-        ui.colored_label(egui::Color32::from_rgb(255, 110, 90), format!("refused: {reason}"));
+        ui.colored_label(ui.visuals().error_fg_color, format!("refused: {reason}"));
     }
 }
 
@@ -316,7 +316,7 @@ pub(super) fn solver_motion_ui(
 ) {
     let info = method.info();
     let damps = info.implicit && integrator.info().damps_motion;
-    let colour = if damps { egui::Color32::from_rgb(250, 200, 120) } else { ui.visuals().weak_text_color() };
+    let colour = if damps { ui.visuals().warn_fg_color } else { ui.visuals().weak_text_color() };
     ui.label(egui::RichText::new(info.motion).color(colour));
     if info.implicit {
         let i = integrator.info();

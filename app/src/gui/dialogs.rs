@@ -41,7 +41,7 @@ pub fn open_dialog_ui(cx: &mut Ctx, ctx: &egui::Context) {
             }
         });
         if let Some(e) = &dialog.error {
-            ui.colored_label(egui::Color32::from_rgb(255, 110, 90), e);
+            ui.colored_label(ui.visuals().error_fg_color, e);
         }
         if ui.button("Open").clicked() {
             // the app reads the file and closes the dialog, or puts the reason in it

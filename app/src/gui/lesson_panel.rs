@@ -53,7 +53,7 @@ pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
         }
     }
     if let Some(p) = &state.problem {
-        ui.colored_label(egui::Color32::from_rgb(255, 120, 90), p);
+        ui.colored_label(Palette::of(ui.visuals()).warning, p);
     }
     ui.add_space(6.0);
     // no answer while the step is prepared: the numbers it speaks of are not there yet
@@ -62,10 +62,51 @@ pub fn lesson_panel_ui(cx: &mut Ctx, ui: &mut egui::Ui) {
     if preparing {
         ui.label(egui::RichText::new("(the answer once the step is ready)").weak());
     } else if revealed {
-        ui.label(egui::RichText::new(format!("Answer: {answer}")).color(egui::Color32::from_rgb(250, 220, 120)));
+        ui.label(egui::RichText::new(format!("Answer: {answer}")).color(Palette::of(ui.visuals()).numbers));
         claim_ui(cx, ui);
     } else if ui.button("Reveal the answer (A)").clicked() {
         cx.out.push(Action::RevealAnswer);
+    }
+}
+
+/// The lesson's colours on the theme's panels: light on the dark theme, dark on the light one
+/// (found in the page, issue #59: a browser that prefers light showed the presenter caption's
+/// white title and question on light grey).
+pub struct Palette {
+    pub title: egui::Color32,
+    pub text: egui::Color32,
+    /// The measured numbers (amber).
+    pub numbers: egui::Color32,
+    /// The answer (blue).
+    pub answer: egui::Color32,
+    /// A claim that holds (green).
+    pub holds: egui::Color32,
+    /// A claim that does not, a problem (orange).
+    pub warning: egui::Color32,
+}
+
+impl Palette {
+    pub fn of(visuals: &egui::Visuals) -> Palette {
+        use egui::Color32 as C;
+        if visuals.dark_mode {
+            Palette {
+                title: C::WHITE,
+                text: C::from_gray(220),
+                numbers: C::from_rgb(250, 220, 120),
+                answer: C::from_rgb(180, 230, 255),
+                holds: C::from_rgb(170, 220, 170),
+                warning: C::from_rgb(250, 170, 80),
+            }
+        } else {
+            Palette {
+                title: C::BLACK,
+                text: C::from_gray(40),
+                numbers: C::from_rgb(130, 80, 0),
+                answer: C::from_rgb(20, 70, 150),
+                holds: C::from_rgb(20, 110, 40),
+                warning: C::from_rgb(170, 60, 0),
+            }
+        }
     }
 }
 
@@ -75,28 +116,27 @@ pub fn caption_ui(cx: &Ctx, ui: &mut egui::Ui) {
     let Some(state) = cx.model.lesson() else { return };
     let step = &state.lesson.steps[state.step];
     let measured = cx.state.lesson_measured.as_deref().unwrap_or_default();
-    ui.label(
-        egui::RichText::new(format!("{} — {}", state.lesson.title, step.title)).strong().color(egui::Color32::WHITE),
-    );
+    let colours = Palette::of(ui.visuals());
+    ui.label(egui::RichText::new(format!("{} — {}", state.lesson.title, step.title)).strong().color(colours.title));
     for line in state.parameter_lines() {
-        ui.label(egui::RichText::new(line).monospace().color(egui::Color32::from_rgb(200, 200, 200)));
+        ui.label(egui::RichText::new(line).monospace().color(colours.text));
     }
     // the step's explanation too (issue #57: presenter mode dropped it)
-    ui.label(egui::RichText::new(&step.text).color(egui::Color32::from_rgb(220, 220, 220)));
-    ui.label(egui::RichText::new(&step.question).color(egui::Color32::WHITE));
+    ui.label(egui::RichText::new(&step.text).color(colours.text));
+    ui.label(egui::RichText::new(&step.question).color(colours.title));
     if state.preparing() {
-        ui.label(egui::RichText::new(PREPARING).color(egui::Color32::from_rgb(250, 220, 120)));
+        ui.label(egui::RichText::new(PREPARING).color(colours.numbers));
         return;
     }
     for (k, m) in measured.iter().enumerate() {
         ui.label(
             egui::RichText::new(format!("{} {}: {}", ["A", "B"][k.min(1)], step.measure.title(), m.text))
                 .monospace()
-                .color(egui::Color32::from_rgb(250, 220, 120)),
+                .color(colours.numbers),
         );
     }
     if state.revealed {
-        ui.label(egui::RichText::new(&step.answer).color(egui::Color32::from_rgb(180, 230, 255)));
+        ui.label(egui::RichText::new(&step.answer).color(colours.answer));
         claim_ui(cx, ui);
     }
 }
@@ -107,7 +147,8 @@ pub fn caption_ui(cx: &Ctx, ui: &mut egui::Ui) {
 fn claim_ui(cx: &Ctx, ui: &mut egui::Ui) {
     let measured = cx.state.lesson_measured.as_deref().unwrap_or_default();
     let Some(j) = cx.model.lesson().and_then(|l| l.judge_claim(measured)) else { return };
-    let colour = if j.holds { egui::Color32::from_rgb(170, 220, 170) } else { egui::Color32::from_rgb(250, 170, 80) };
+    let colours = Palette::of(ui.visuals());
+    let colour = if j.holds { colours.holds } else { colours.warning };
     ui.label(egui::RichText::new(j.text).color(colour));
 }
 

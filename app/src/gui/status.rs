@@ -56,12 +56,12 @@ pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
                 ));
             }
             if let Some(f) = &s.failure {
-                ui.colored_label(egui::Color32::from_rgb(255, 90, 80), f);
+                ui.colored_label(ui.visuals().error_fg_color, f);
             }
             ui.separator();
         }
         if let Some(building) = model.building() {
-            ui.label(egui::RichText::new(building).monospace().color(egui::Color32::from_rgb(250, 200, 120)));
+            ui.label(egui::RichText::new(building).monospace().color(ui.visuals().warn_fg_color));
             ui.separator();
         }
         // paused, the window repaints only on input: a frame rate then means nothing (issue
@@ -74,7 +74,7 @@ pub fn status_line_ui(cx: &Ctx, ui: &mut egui::Ui) {
         ui.label(egui::RichText::new(rate).monospace())
             .on_hover_text(format!("Displayed frames per second; view {:.1} ms and app {:.1} ms of CPU per frame (the 3D view's preparation and the app's whole frame). Renderer: {}.", cx.state.viewport.render_ms, cx.status.app_ms, cx.status.renderer.as_deref().unwrap_or("none (no OpenGL: CPU rasteriser)")));
         if let Some(e) = cx.state.viewport.gl_error() {
-            ui.colored_label(egui::Color32::from_rgb(255, 170, 60), format!("OpenGL view unavailable, drawn on the CPU: {e}"));
+            ui.colored_label(ui.visuals().warn_fg_color, format!("OpenGL view unavailable, drawn on the CPU: {e}"));
         }
     });
 }

@@ -1812,3 +1812,65 @@ fn a_page_opened_late_on_the_live_stream_starts_at_the_present() {
     }
     assert_eq!(play_states, [vec![], vec![PlayState::Following]], "a file opens at its start; a live stream follows");
 }
+
+/// Found in the page (issue #59): a browser that prefers a light theme showed presenter mode's
+/// caption — white title and question, light grey text — on the light panel, unreadable. Every
+/// colour of the lesson's panels reads on both themes' panels (WCAG contrast at least 4.5:1).
+#[test]
+fn the_lesson_s_colours_read_on_a_light_theme_as_on_a_dark_one() {
+    fn luminance(c: egui::Color32) -> f64 {
+        let lin = |v: u8| {
+            let v = v as f64 / 255.0;
+            if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+        };
+        0.2126 * lin(c.r()) + 0.7152 * lin(c.g()) + 0.0722 * lin(c.b())
+    }
+    for visuals in [egui::Visuals::dark(), egui::Visuals::light()] {
+        let p = lesson_panel::Palette::of(&visuals);
+        let background = luminance(visuals.panel_fill);
+        for (name, c) in [
+            ("title", p.title),
+            ("text", p.text),
+            ("numbers", p.numbers),
+            ("answer", p.answer),
+            ("holds", p.holds),
+            ("warning", p.warning),
+        ] {
+            let (a, b) = (luminance(c), background);
+            let ratio = (a.max(b) + 0.05) / (a.min(b) + 0.05);
+            assert!(
+                ratio >= 4.5,
+                "{name} on the {} theme: contrast {ratio:.1}",
+                if visuals.dark_mode { "dark" } else { "light" }
+            );
+        }
+    }
+}
+
+/// Issue #59, a mesh dropped onto the window (the page's only way to open one): a broken file is
+/// a message naming it, and the app keeps its scene and plays on; a good one opens with its
+/// group `clamp` held, the material kept.
+#[test]
+fn a_broken_mesh_dropped_in_is_a_message_and_a_good_one_opens() {
+    let mut h = harness(AppArgs { fresh: true, ..Default::default() });
+    h.run_steps(2);
+    let before = h.state().model().scene().label();
+    h.state_mut().act(super::action::Command::OpenMeshBytes {
+        name: "broken.msh".into(),
+        bytes: b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\nnot a number\n".to_vec().into(),
+    });
+    h.run_steps(2);
+    let model = h.state().model();
+    let message = model.message().unwrap_or_default().to_string();
+    assert!(message.contains("broken.msh") && message.contains("not opened"), "{message}");
+    assert_eq!(model.scene().label(), before, "the scene kept");
+    h.state_mut().step(3);
+    assert!(h.state().model().sessions()[0].instance.sim.time_secs() > 0.0, "it plays on");
+    let beam = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/meshes/beam-tet4.msh");
+    let bytes = std::fs::read(beam).unwrap();
+    h.state_mut().act(super::action::Command::OpenMeshBytes { name: "beam-tet4.msh".into(), bytes: bytes.into() });
+    h.run_steps(2);
+    let model = h.state().model();
+    assert!(model.scene().label().contains("beam-tet4.msh"), "{}", model.scene().label());
+    assert_eq!(model.sessions()[0].instance.probes.len(), 1, "a probe at the tip");
+}
