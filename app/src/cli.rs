@@ -86,11 +86,23 @@ pub enum Command {
         out: PathBuf,
     },
     /// The accuracy-versus-time study over the paper scenes: writes study.md, study.csv,
-    /// locking.csv (P1/P2/P3 near incompressibility) and study.svg to --out.
+    /// locking.csv (P1/P2/P3 near incompressibility) and study.svg to --out. For a job array:
+    /// `--shard K/N` runs the K-th of N parts into study-part-K-of-N.toml, `hox study merge`
+    /// joins the parts into the same files as one run.
+    #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
     Study {
+        #[command(subcommand)]
+        merge: Option<StudyMerge>,
         /// Only the coarse configurations (minutes instead of an hour).
         #[arg(long)]
         quick: bool,
+        /// Only these tables, comma-separated: accuracy, locking, solvers (default: all).
+        #[arg(long, value_name = "TABLES")]
+        only: Option<String>,
+        /// Run part K of N of the study's cells (K from 1; cell i goes to part i mod N + 1) and
+        /// write it to --out as study-part-K-of-N.toml, for `hox study merge`.
+        #[arg(long, value_name = "K/N", conflicts_with = "summary")]
+        shard: Option<String>,
         /// Output folder (created if missing).
         #[arg(long, required_unless_present = "summary", conflicts_with = "summary")]
         out: Option<PathBuf>,
@@ -207,6 +219,21 @@ pub fn note_stability(instance: &mut Instance) -> hox_sim::solver::stability::St
     stability
 }
 
+/// `hox study merge`.
+#[derive(Subcommand)]
+pub enum StudyMerge {
+    /// Join the parts of a sharded study (`hox study --shard K/N`) into the files one run
+    /// writes; refuses a part missing, given twice or of another study, writing nothing.
+    Merge {
+        /// Part files, or folders holding study-part-*.toml files.
+        #[arg(required = true, value_name = "PART")]
+        parts: Vec<PathBuf>,
+        /// Output folder (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
 /// Runs a headless command.
 pub fn run(command: Command) -> Result<()> {
     match command {
@@ -217,9 +244,10 @@ pub fn run(command: Command) -> Result<()> {
         Command::Simulate { scene, mesh, physics, seconds, settle, vtk, reference, json } => {
             simulate::simulate(&scene, &mesh, &physics, seconds, settle, &vtk, &reference, json)
         }
-        Command::Study { quick, out, summary } => match (summary, out) {
+        Command::Study { merge: Some(StudyMerge::Merge { parts, out }), .. } => study::merge(&parts, &out),
+        Command::Study { quick, only, shard, out, summary, merge: None } => match (summary, out) {
             (Some(dir), _) => study::summary(&dir),
-            (None, Some(out)) => study::study(quick, &out),
+            (None, Some(out)) => study::study(quick, only.as_deref(), shard.as_deref(), &out),
             (None, None) => anyhow::bail!("hox study needs --out DIR (run the study) or --summary DIR (print one)"),
         },
         Command::Paper { quick, out } => paper::paper(quick, &out),

@@ -3,17 +3,37 @@
     >>> import hox
     >>> sim = hox.Simulation(hox.Scene.builtin("bending").with_params(element="p2", poisson=0.45))
     >>> sim.step(60)                      # one simulated second, the interpreter released
-    >>> sim.positions.shape               # numpy arrays: positions, velocities, displacements
+    >>> sim.positions.shape               # a read-only numpy view: positions, velocities, …
     >>> report = sim.settle()             # until equilibrium: `hox simulate --settle --json`'s fields
+    >>> sim.element_field("von-mises")    # Pa per element; also strain, det-f, energy-density
+    >>> sim.error()                       # the probes against the reference
 
-Scenes come from the registry (`hox.scenes()`), a scene file (`Scene.load`, `Scene.from_toml`)
-or a Gmsh file (`Scene.from_mesh_file`); every parameter of the parameter table is set by its key
+Scenes come from the registry (`hox.scenes()`), a scene file (`Scene.load`, `Scene.from_toml`),
+a Gmsh file (`Scene.from_mesh_file`), numpy arrays (`Scene.from_arrays`) or meshio
+(`hox.from_meshio`); every parameter of the parameter table is set by its key
 (`hox.parameters()`), with the command line's ranges and errors (`ValueError` naming the key).
-Sweeps run through any `concurrent.futures.Executor` (`hox.sweep`): a process pool, a Dask
-client's executor, Ray's or submitit's.
+Sweeps (`hox.sweep`) and the study (`hox.study`) run through any `concurrent.futures.Executor`:
+a process pool, a Dask client's executor, Ray's or submitit's (Slurm).
 """
 
-from ._hox import Scene, Simulation, parameters, scenes
+from ._hox import Scene, Simulation, __version__, elements, machine, parameters, scenes
+from .mesh import from_meshio, mesh_arrays
+from .study import study, study_cells
 from .sweep import Cell, run_cell, sweep
 
-__all__ = ["Cell", "Scene", "Simulation", "parameters", "run_cell", "scenes", "sweep"]
+__all__ = [
+    "Cell",
+    "Scene",
+    "Simulation",
+    "__version__",
+    "elements",
+    "from_meshio",
+    "machine",
+    "mesh_arrays",
+    "parameters",
+    "run_cell",
+    "scenes",
+    "study",
+    "study_cells",
+    "sweep",
+]

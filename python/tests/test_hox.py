@@ -2,28 +2,12 @@
 
 import json
 import math
-import os
-import shutil
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import hox
-
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def hox_binary():
-    """The `hox` command line to compare with: $HOX_BIN, else the release build, else `hox`."""
-    if os.environ.get("HOX_BIN"):
-        return os.environ["HOX_BIN"]
-    target = Path(os.environ.get("CARGO_TARGET_DIR", Path.home() / ".cache/hox-target"))
-    for build in ("release", "debug"):
-        if (target / build / "hox").exists():
-            return str(target / build / "hox")
-    return shutil.which("hox") or pytest.skip("no hox binary (cargo build -p hox, or $HOX_BIN)")
 
 
 def test_the_registry_s_scenes_and_the_parameter_table_are_listed():
@@ -48,6 +32,24 @@ def test_a_bad_parameter_raises_value_error_naming_it(params, named):
         hox.Scene.builtin("bending").with_params(**params)
 
 
+def test_every_parameter_of_the_table_refuses_a_bad_value_naming_it():
+    table = hox.parameters()
+    assert len(table) >= 30
+    for p in table:
+        key = p["key"]
+        with pytest.raises(ValueError, match=key):
+            hox.Scene.builtin("bending").with_params(**{key: "bogus-value"})
+        if "number" in p["expected"]:
+            with pytest.raises(ValueError, match=key):
+                hox.Scene.builtin("bending").with_params(**{key: float("nan")})
+
+
+def test_a_parameter_is_set_by_its_key_with_underscores_for_dashes():
+    scene = hox.Scene.builtin("bending").with_params(solver="vbd", vbd_iterations=7, newton_quasi=True)
+    assert scene.params["solver.vbd_iterations"] == 7
+    assert scene.params["solver.method"] == "vbd"
+
+
 def test_an_unknown_scene_raises_value_error_naming_it_and_the_known_ones():
     with pytest.raises(ValueError, match="bendnig.*bending"):
         hox.Scene.builtin("bendnig")
@@ -63,10 +65,10 @@ def test_the_state_is_numpy_arrays_and_displacement_is_position_minus_rest():
     assert sim.ms_per_frame > 0
 
 
-def test_a_settled_p2_bending_tip_equals_hox_simulate_settle_json():
+def test_a_settled_p2_bending_tip_equals_hox_simulate_settle_json(hox_binary):
     cli = json.loads(
         subprocess.run(
-            [hox_binary(), "simulate", "--scene", "bending", "--element", "p2", "--settle", "--json"],
+            [hox_binary, "simulate", "--scene", "bending", "--element", "p2", "--settle", "--json"],
             check=True, capture_output=True, text=True,
         ).stdout
     )

@@ -2,7 +2,7 @@
 //! locking table and the solver axis), written to a folder.
 
 use anyhow::{Context, Result};
-use hox_scenes::study::solver_axis;
+use hox_scenes::study::shard::{Plan, Shard, StudyPart, Table};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::time::{Duration, Instant};
 
@@ -35,36 +35,65 @@ impl FolderJob {
     }
 }
 
-pub fn study(quick: bool, out: &std::path::Path) -> Result<()> {
+pub fn study(quick: bool, only: Option<&str>, shard: Option<&str>, out: &std::path::Path) -> Result<()> {
+    // every argument checked before the folder is touched
+    let tables = match only {
+        Some(list) => Table::parse_list(list)?,
+        None => Table::ALL.to_vec(),
+    };
+    let plan = Plan { quick, tables };
+    let shard = shard.map(Shard::parse).transpose().map_err(anyhow::Error::msg)?;
     let job = FolderJob::start(out)?;
-    let bar = &job.bar;
     let mut report = |message: &str| job.report(message);
-    let rows = hox_scenes::study::run_study(quick, &mut report)?;
-    let locking = hox_scenes::study::locking(quick, &mut report)?;
-    let solvers = solver_axis::run_solver_axis(quick, &mut report)?;
-    bar.finish_and_clear();
-    let mut files = vec![
-        (
-            "study.md".to_string(),
-            // the machine line under the title: `hox study --summary` and docs/STUDY.md name it
-            hox_scenes::study::markdown(&rows, quick).replacen(
-                "\n\n",
-                &format!("\n\nMachine: {}.\n\n", hox_scenes::bench::machine()),
-                1,
-            ) + "\n"
-                + &solver_axis::solver_markdown(&solvers)
-                + &hox_scenes::study::locking_markdown(&locking),
-        ),
-        ("study.csv".into(), hox_scenes::study::csv(&rows)),
-        ("solvers.csv".into(), solver_axis::solver_csv(&solvers)),
-        ("locking.csv".into(), hox_scenes::study::locking_csv(&locking)),
-        ("study.svg".into(), hox_scenes::study::svg(&rows)),
-    ];
-    for scene in hox_scenes::PAPER_SCENES {
-        if solvers.iter().any(|r| r.scene == scene) {
-            files.push((format!("pareto-{scene}.svg"), hox_scenes::study::pareto::pareto_svg(&solvers, scene)));
+    let machine = hox_scenes::bench::machine();
+    match shard {
+        Some(shard) => {
+            let part = hox_scenes::study::shard::run_part(&plan, shard, &machine, &mut report)?;
+            job.bar.finish_and_clear();
+            write_files(out, vec![(shard.file_name(), part.to_toml()?)])
+        }
+        None => {
+            let tables = hox_scenes::study::shard::run_all(&plan, &mut report)?;
+            job.bar.finish_and_clear();
+            write_files(out, tables.files(&plan, &machine))
         }
     }
+}
+
+/// `hox study merge PART... --out DIR`: every part read and the merge checked before anything
+/// is written.
+pub fn merge(paths: &[std::path::PathBuf], out: &std::path::Path) -> Result<()> {
+    let mut files = Vec::new();
+    for path in paths {
+        if path.is_dir() {
+            let mut found: Vec<_> = std::fs::read_dir(path)
+                .with_context(|| format!("cannot read the folder {}", path.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("study-part-") && n.ends_with(".toml"))
+                })
+                .collect();
+            if found.is_empty() {
+                anyhow::bail!("{} holds no study-part-*.toml file (written by hox study --shard K/N)", path.display());
+            }
+            found.sort();
+            files.extend(found);
+        } else {
+            files.push(path.clone());
+        }
+    }
+    let mut parts = Vec::new();
+    for file in &files {
+        let text = std::fs::read_to_string(file).with_context(|| format!("cannot read the part {}", file.display()))?;
+        parts.push(StudyPart::from_toml(&text, &file.display().to_string())?);
+    }
+    let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
+    let (plan, tables, machine) = hox_scenes::study::shard::merge(&parts, &names)?;
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
+    write_files(out, tables.files(&plan, &machine))
+}
+
+fn write_files(out: &std::path::Path, files: Vec<(String, String)>) -> Result<()> {
     for (name, text) in files {
         let path = out.join(name);
         std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;

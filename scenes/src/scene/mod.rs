@@ -200,6 +200,39 @@ impl Scene {
     ) -> Result<Scene, SceneError> {
         let source = path.display().to_string();
         let base = Scene::from_file(SceneFile::for_mesh_file(path, gravity), &source)?;
+        base.with_groups(clamps, drives)
+    }
+
+    /// [`Scene::from_mesh_file`] for a mesh already in memory ([`ImportedMesh::from_arrays`]:
+    /// the Python package's numpy and meshio meshes), named `name` (its scene file names it as
+    /// its mesh file; nothing is read from disk, and [`Scene::with_overrides`] keeps the mesh).
+    pub fn from_imported(
+        name: &str,
+        imported: Arc<ImportedMesh>,
+        clamps: &[String],
+        drives: &[Drive],
+        gravity: bool,
+    ) -> Result<Scene, SceneError> {
+        let path = PathBuf::from(name);
+        let cached = SceneMesh::File { path: path.clone(), imported };
+        let base = Scene::validate(SceneFile::for_mesh_file(&path, gravity), name, None, Some(&cached))?;
+        base.with_groups(clamps, drives)
+    }
+
+    /// The scene with `probes` added (a probe of the same name replaced), validated again: a
+    /// point outside the mesh is an error naming the probe when the scene is built.
+    pub fn with_probes(&self, probes: &[ProbeSpec]) -> Result<Scene, SceneError> {
+        let mut file = self.file.clone();
+        for probe in probes {
+            file.probes.retain(|p| p.name != probe.name);
+            file.probes.push(probe.clone());
+        }
+        Scene::validate(file, &self.source, self.base_dir.clone(), Some(&self.mesh))
+    }
+
+    /// A mesh-file scene with its groups `clamps` held and `drives` moved.
+    fn with_groups(self, clamps: &[String], drives: &[Drive]) -> Result<Scene, SceneError> {
+        let (base, source) = (&self, self.source.clone());
         let imported = base.mesh.imported().expect("a mesh-file scene");
         for (group, role) in clamps.iter().map(|g| (g, "clamp")).chain(drives.iter().map(|d| (&d.group, "drive"))) {
             imported.node_set(group).map_err(|e| SceneError::MeshFile(format!("{e} (the {role} group)")))?;

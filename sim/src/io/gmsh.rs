@@ -338,7 +338,13 @@ fn build(raw: RawMsh, file: &str) -> Result<ImportedMesh, GmshError> {
         set.sort_unstable();
         set.dedup();
     }
-    // rest shapes: no inverted or flat element
+    check_rest_shapes(&mesh, &element_tags, &node_tags, &file_s)?;
+    Ok(ImportedMesh { source: file_s, mesh, node_sets, element_sets, element_tags, node_tags })
+}
+
+/// No inverted or flat rest element: an error naming the element and its nodes by their tags.
+fn check_rest_shapes(mesh: &Mesh, element_tags: &[Vec<u64>], node_tags: &[u64], file: &str) -> Result<(), GmshError> {
+    let file_s = file.to_string();
     for (b, block) in mesh.blocks.iter().enumerate() {
         if let Err(e) = precompute_block(&mesh.rest_positions, block, None) {
             return Err(match e {
@@ -358,7 +364,43 @@ fn build(raw: RawMsh, file: &str) -> Result<ImportedMesh, GmshError> {
             });
         }
     }
-    Ok(ImportedMesh { source: file_s, mesh, node_sets, element_sets, element_tags, node_tags })
+    Ok(())
+}
+
+impl ImportedMesh {
+    /// A mesh given as arrays rather than read from a file (hox's Python package, issue #60):
+    /// `mesh` in Gmsh's node order, with named node sets for clamps and prescribed motion. The
+    /// reader's checks apply — structure ([`Mesh::validate`]) and rest shapes (no inverted or
+    /// flat element) — and an error names elements and nodes by their index, from 0, in
+    /// `source`'s arrays.
+    pub fn from_arrays(
+        source: &str,
+        mesh: Mesh,
+        mut node_sets: BTreeMap<String, Vec<u32>>,
+    ) -> Result<ImportedMesh, GmshError> {
+        let file = source.to_string();
+        if mesh.blocks.iter().all(ElementBlock::is_empty) {
+            return Err(GmshError::Empty { file, what: "no elements".into() });
+        }
+        let element_tags: Vec<Vec<u64>> = mesh.blocks.iter().map(|b| (0..b.len() as u64).collect()).collect();
+        let node_tags: Vec<u64> = (0..mesh.num_nodes() as u64).collect();
+        mesh.validate().map_err(|e| GmshError::Mesh {
+            file: file.clone(),
+            message: describe_mesh_error(&e, &mesh.blocks, &element_tags, &node_tags),
+        })?;
+        for (name, set) in &mut node_sets {
+            if let Some(&n) = set.iter().find(|&&n| n as usize >= mesh.num_nodes()) {
+                return Err(GmshError::Mesh {
+                    file,
+                    message: format!("group \"{name}\" names node {n}, but the mesh has {} nodes", mesh.num_nodes()),
+                });
+            }
+            set.sort_unstable();
+            set.dedup();
+        }
+        check_rest_shapes(&mesh, &element_tags, &node_tags, &file)?;
+        Ok(ImportedMesh { source: file, mesh, node_sets, element_sets: BTreeMap::new(), element_tags, node_tags })
+    }
 }
 
 fn is_volume(gmsh_type: u32) -> bool {

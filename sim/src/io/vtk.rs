@@ -14,8 +14,7 @@
 
 use crate::Vec3;
 use crate::element::ElementType;
-use crate::fem::energy::for_each_element;
-use crate::fem::geometry::{BlockGeometry, deformation_gradient};
+use crate::fem::geometry::BlockGeometry;
 use crate::material::Material;
 use crate::mesh::Mesh;
 use std::collections::BTreeMap;
@@ -195,20 +194,7 @@ pub fn von_mises_stress_pa(
     material: &Material,
     positions: &[Vec3],
 ) -> Vec<f64> {
-    let mut out = Vec::with_capacity(mesh.num_elements());
-    for_each_element(mesh, geometry, positions, |el| {
-        let (mut sum, mut volume) = (0.0, 0.0);
-        for (q, &v) in el.volumes().iter().enumerate() {
-            let f = deformation_gradient(el.x, el.rest, el.geometry.gradients(el.element, q));
-            let vm = crate::measure::field::von_mises_pa(material, &f);
-            if vm.is_finite() {
-                sum += vm * v;
-                volume += v;
-            }
-        }
-        out.push(if volume > 0.0 { sum / volume } else { f64::NAN });
-    });
-    out
+    crate::measure::field::element_means(crate::measure::field::Field::VonMises, mesh, geometry, material, positions)
 }
 
 /// A time series of VTU files with a ParaView `.pvd` index: `DIR/NAME_000000.vtu`, … and

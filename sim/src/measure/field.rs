@@ -24,7 +24,8 @@
 //! ([`crate::material`]).
 
 use crate::Vec3;
-use crate::fem::geometry::{deformation_gradient_from, jacobian};
+use crate::fem::energy::for_each_element;
+use crate::fem::geometry::{BlockGeometry, deformation_gradient, deformation_gradient_from, jacobian};
 use crate::material::Material;
 use crate::measure::surface::Surface;
 use crate::mesh::Mesh;
@@ -154,6 +155,41 @@ pub fn equivalent_strain(f: &Matrix3<f64>) -> f64 {
     let e = 0.5 * (f.transpose() * f - Matrix3::identity());
     let dev = e - Matrix3::identity() * (e.trace() / 3.0);
     (2.0 / 3.0 * dev.norm_squared()).sqrt()
+}
+
+/// A deformation-gradient field ([`Field::needs_gradient`]) per element: its volume average
+/// `Σ_q f(F_q) V_q / Σ_q V_q` over the element's quadrature points (the points the solver
+/// integrates at), block by block in element order — the cell data of a VTK file and what the
+/// Python package reads per element. A point where the field has no value (`det F ≤ 0` for the
+/// stress) is left out; an element left with none is NaN.
+pub fn element_means(
+    field: Field,
+    mesh: &Mesh,
+    geometry: &[BlockGeometry],
+    material: &Material,
+    positions: &[Vec3],
+) -> Vec<f64> {
+    let mut out = Vec::with_capacity(mesh.num_elements());
+    for_each_element(mesh, geometry, positions, |el| {
+        let (mut sum, mut volume) = (0.0, 0.0);
+        for (q, &v) in el.volumes().iter().enumerate() {
+            let f = deformation_gradient(el.x, el.rest, el.geometry.gradients(el.element, q));
+            let value = field.of_deformation_gradient(material, &f);
+            if value.is_finite() {
+                sum += value * v;
+                volume += v;
+            }
+        }
+        out.push(if volume > 0.0 { sum / volume } else { f64::NAN });
+    });
+    out
+}
+
+/// The rest volume of every element, `Σ_q V_q` over its quadrature points (m³), block by block.
+pub fn element_volumes_m3(mesh: &Mesh, geometry: &[BlockGeometry]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(mesh.num_elements());
+    for_each_element(mesh, geometry, &mesh.rest_positions, |el| out.push(el.volumes().iter().sum()));
+    out
 }
 
 /// The material gradients `∇_X N_i` at every display vertex's element points, computed once.

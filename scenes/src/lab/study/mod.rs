@@ -16,6 +16,7 @@
 
 pub mod motion;
 pub mod pareto;
+pub mod shard;
 pub mod solver_axis;
 pub mod summary;
 
@@ -120,7 +121,7 @@ pub fn configurations(scene: &str) -> Vec<StudyConfig> {
 }
 
 /// One row of the study.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StudyRow {
     pub scene: String,
     pub config: String,
@@ -286,7 +287,7 @@ pub const LOCKING_POISSON_RATIOS: [f64; 4] = [0.35, 0.45, 0.49, 0.499];
 
 /// One cell of the locking table: the static tip deflection of the bending beam on one mesh at
 /// one Poisson ratio, against Q2 16×4×4 at the same ν.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LockingRow {
     pub poisson_ratio: f64,
     pub config: String,
@@ -304,6 +305,16 @@ pub struct LockingRow {
 /// for P1 1,280 (and 10,240 unless `quick`), P2 160 and P3 80, against Q2 16×4×4 at the same ν.
 /// A mesh that locks grows stiffer as ν → 0.5: its share of missing sag grows.
 pub fn locking(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<LockingRow>, SceneError> {
+    let mut rows = Vec::new();
+    for nu in LOCKING_POISSON_RATIOS {
+        rows.extend(locking_at(nu, quick, progress)?);
+    }
+    Ok(rows)
+}
+
+/// The locking table's rows at one Poisson ratio `nu` (a cell of [`shard::Plan`]): Q2 16×4×4
+/// and each mesh of [`locking`] (P1 10,240 left out when `quick`).
+pub fn locking_at(nu: f64, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<LockingRow>, SceneError> {
     use TetSplit::Five;
     let c = StudyConfig::new;
     let q2 = c("q2", [16, 4, 4], Five, 0, false);
@@ -313,20 +324,18 @@ pub fn locking(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<Lockin
         c("p2", [8, 2, 2], Five, 0, false),
         c("p3", [4, 2, 2], Five, 0, false),
     ];
+    let (q2_tip_z_m, _) = static_tip_z("bending", &q2, nu, progress)?;
     let mut rows = Vec::new();
-    for nu in LOCKING_POISSON_RATIOS {
-        let (q2_tip_z_m, _) = static_tip_z("bending", &q2, nu, progress)?;
-        for config in meshes.iter().filter(|m| !(quick && m.heavy)) {
-            let (tip_z_m, elements) = static_tip_z("bending", config, nu, progress)?;
-            rows.push(LockingRow {
-                poisson_ratio: nu,
-                config: config.label(),
-                elements,
-                tip_z_m,
-                q2_tip_z_m,
-                missing_pct: 100.0 * (1.0 - tip_z_m / q2_tip_z_m),
-            });
-        }
+    for config in meshes.iter().filter(|m| !(quick && m.heavy)) {
+        let (tip_z_m, elements) = static_tip_z("bending", config, nu, progress)?;
+        rows.push(LockingRow {
+            poisson_ratio: nu,
+            config: config.label(),
+            elements,
+            tip_z_m,
+            q2_tip_z_m,
+            missing_pct: 100.0 * (1.0 - tip_z_m / q2_tip_z_m),
+        });
     }
     Ok(rows)
 }

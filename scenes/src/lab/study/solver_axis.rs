@@ -124,7 +124,7 @@ fn settle_cap_secs(heavy: bool) -> f64 {
 }
 
 /// One row of the solver axis.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SolverRow {
     pub scene: String,
     pub config: String,
@@ -173,6 +173,22 @@ pub fn run_solver_axis(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Ve
             config_rows(&pool, scene, &config, &motion_reference, progress, &mut rows)?;
         }
     }
+    Ok(rows)
+}
+
+/// The rows of one mesh of the solver axis (a cell of [`super::shard::Plan`]): its static
+/// solution once, then every solver, on one thread.
+pub fn mesh_rows(
+    scene_name: &str,
+    config: &StudyConfig,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<SolverRow>, SceneError> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().map_err(|e| SceneError::Simulation {
+        source_name: "study".into(),
+        message: format!("cannot make a one-thread pool: {e}"),
+    })?;
+    let mut rows = Vec::new();
+    config_rows(&pool, scene_name, config, &reference_motion()?.metrics(), progress, &mut rows)?;
     Ok(rows)
 }
 

@@ -137,3 +137,26 @@ fn duplicate_and_bad_node_lines_are_errors() {
     let e = error(&msh22("4 2 2 1 1 2 3 4").replace("5 5 5 5\n", "5 5 five 5\n"));
     assert!(e.starts_with("bad.msh:15:") && e.contains("bad node line"), "{e}");
 }
+
+#[test]
+fn a_mesh_given_as_arrays_is_checked_as_a_file_is_and_named_by_its_rows() {
+    let read = read_msh_str(&msh22("4 2 1 2 1 2 3 4"), "one.msh").unwrap();
+    let groups: BTreeMap<String, Vec<u32>> = [("bottom".to_string(), vec![2, 0, 1, 0])].into();
+    let arrays = ImportedMesh::from_arrays("arrays", read.mesh.clone(), groups.clone()).unwrap();
+    assert_eq!(arrays.mesh, read.mesh);
+    assert_eq!(arrays.node_sets["bottom"], [0, 1, 2], "sorted and de-duplicated");
+    // an inverted tetrahedron: two nodes swapped, named by its row
+    let mut inverted = read.mesh.clone();
+    inverted.blocks[0].connectivity.swap(0, 1);
+    let e = ImportedMesh::from_arrays("arrays", inverted, BTreeMap::new()).unwrap_err().to_string();
+    assert!(e.contains("arrays") && e.contains("element 0") && e.contains("inverted"), "{e}");
+    let mut out_of_range = read.mesh.clone();
+    out_of_range.blocks[0].connectivity[3] = 9;
+    let e = ImportedMesh::from_arrays("arrays", out_of_range, BTreeMap::new()).unwrap_err().to_string();
+    assert!(e.contains("node 9"), "{e}");
+    let bad_group: BTreeMap<String, Vec<u32>> = [("clamp".to_string(), vec![7])].into();
+    let e = ImportedMesh::from_arrays("arrays", read.mesh.clone(), bad_group).unwrap_err().to_string();
+    assert!(e.contains("\"clamp\"") && e.contains("node 7") && e.contains("4 nodes"), "{e}");
+    let empty = Mesh { rest_positions: read.mesh.rest_positions.clone(), blocks: vec![] };
+    assert!(ImportedMesh::from_arrays("arrays", empty, BTreeMap::new()).is_err());
+}
