@@ -1,6 +1,7 @@
 //! Issue #58: every command README.md shows runs, so that a README command that stops working
 //! fails CI. The commands are read from README's `sh` blocks, not copied here:
-//! - `cargo test --workspace` and `bash scripts/setup.sh` must be what `.ci/run` runs;
+//! - `cargo test --workspace`, `bash scripts/setup.sh` and the Python package's two commands
+//!   (`bash scripts/setup-python.sh`, its pytest) must be what `.ci/run` runs;
 //! - `cargo run --release` (the app) and every `hox app …` run under Xvfb with a screenshot
 //!   taken after a few seconds (`--fresh`, a home of their own; a served app on free ports);
 //! - `bash scripts/build-web.sh --open` builds the app's site into the scratch folder with
@@ -21,6 +22,10 @@ const HOX: &str = env!("CARGO_BIN_EXE_hox");
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
+
+/// README's Python commands: the package built and its tests run, as .ci/run runs them (after
+/// the workspace's tests, sharing their build).
+const PYTHON: [&str; 2] = ["bash scripts/setup-python.sh", "python/.venv/bin/python -m pytest python/tests"];
 
 /// The command lines of README's `sh` blocks, in order (a trailing `# comment` dropped).
 fn readme_commands() -> Vec<String> {
@@ -99,7 +104,7 @@ fn every_command_in_the_readme_runs() {
     let dir = scratch();
     for (k, command) in commands.iter().enumerate() {
         for part in command.split("&&").map(str::trim) {
-            if part == "cargo test --workspace" || part == "bash scripts/setup.sh" {
+            if PYTHON.contains(&part) || part == "cargo test --workspace" || part == "bash scripts/setup.sh" {
                 assert!(ci.lines().any(|l| l.trim() == part), "README's `{part}` is not what .ci/run runs");
                 continue;
             }
@@ -137,6 +142,7 @@ fn the_readme_s_commands_are_read_and_its_first_screen_has_the_four_readers() {
     let known = |part: &str| {
         hox_args(part).is_some()
             || ["cargo test --workspace", "bash scripts/setup.sh", "bash scripts/build-web.sh --open"].contains(&part)
+            || PYTHON.contains(&part)
     };
     assert!(commands.iter().all(|c| c.split("&&").map(str::trim).all(known)), "{commands:?}");
     assert_eq!(hox_args("bash scripts/setup.sh && cargo run --release"), None);

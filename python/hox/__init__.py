@@ -16,10 +16,15 @@ Sweeps (`hox.sweep`) and the study (`hox.study`) run through any `concurrent.fut
 a process pool, a Dask client's executor, Ray's or submitit's (Slurm).
 """
 
-from ._hox import Scene, Simulation, __version__, elements, machine, parameters, scenes
+import os as _os
+
+from ._hox import Scene, Simulation, __version__, _after_fork_in_child, elements, machine, parameters, scenes
 from .mesh import from_meshio, mesh_arrays
 from .study import study, study_cells
 from .sweep import Cell, run_cell, sweep
+
+# a process forked from this one (a ProcessPoolExecutor's worker on Linux) gets threads of its own
+_os.register_at_fork(after_in_child=_after_fork_in_child)
 
 __all__ = [
     "Cell",

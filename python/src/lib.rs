@@ -26,6 +26,46 @@ pub(crate) fn runtime_error(e: impl std::fmt::Display) -> PyErr {
     pyo3::exceptions::PyRuntimeError::new_err(e.to_string())
 }
 
+/// Set in a process forked from one where hox had run (`os.register_at_fork`, hox/__init__.py):
+/// the process pool of `concurrent.futures` forks its workers on Linux before Python 3.14.
+static FORKED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Called in a forked child: its work goes to a thread pool of its own from now on.
+#[pyfunction]
+fn _after_fork_in_child() {
+    FORKED.store(true, std::sync::atomic::Ordering::SeqCst);
+}
+
+/// Runs hox's work `f`: here, with rayon's global pool, or in a process forked from one whose
+/// global pool had started, in a pool made in this process. A fork copies only the forking
+/// thread: the global pool's threads are gone in the child, and work sent to them would wait
+/// for ever (`a_process_pool_forked_after_a_run_does_not_hang`, python/tests/test_study.py).
+pub(crate) fn work<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    if !FORKED.load(std::sync::atomic::Ordering::SeqCst) {
+        return f();
+    }
+    type Pools = std::sync::Mutex<Option<(u32, &'static rayon::ThreadPool)>>;
+    static POOL: Pools = std::sync::Mutex::new(None);
+    let pid = std::process::id();
+    let pool = {
+        let mut mine = POOL.lock().unwrap_or_else(|e| e.into_inner());
+        match *mine {
+            Some((p, pool)) if p == pid => pool,
+            _ => {
+                // a pool of a parent process is never dropped here: its threads are not ours
+                let built = rayon::ThreadPoolBuilder::new().build();
+                let pool: &'static rayon::ThreadPool = match built {
+                    Ok(pool) => Box::leak(Box::new(pool)),
+                    Err(_) => return f(),
+                };
+                *mine = Some((pid, pool));
+                pool
+            }
+        }
+    };
+    pool.install(f)
+}
+
 /// A JSON value as the Python object `json.loads` makes of it.
 pub(crate) fn from_json<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
     py.import("json")?.call_method1("loads", (value.to_string(),))
@@ -87,6 +127,7 @@ fn _hox(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(elements, m)?)?;
     m.add_function(wrap_pyfunction!(parameters, m)?)?;
     m.add_function(wrap_pyfunction!(machine, m)?)?;
+    m.add_function(wrap_pyfunction!(_after_fork_in_child, m)?)?;
     m.add_function(wrap_pyfunction!(study::study_cells, m)?)?;
     m.add_function(wrap_pyfunction!(study::study_cell, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

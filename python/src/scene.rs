@@ -36,7 +36,10 @@ fn drive_from(d: &Bound<'_, PyAny>) -> PyResult<hox_scenes::Drive> {
     for key in d.try_iter()? {
         let key: String = key?.extract()?;
         if !known.contains(&key.as_str()) {
-            return Err(value_error(format!("drive of \"{group}\": unknown key {key:?} (known: {})", known.join(", "))));
+            return Err(value_error(format!(
+                "drive of \"{group}\": unknown key {key:?} (known: {})",
+                known.join(", ")
+            )));
         }
     }
     Ok(hox_scenes::Drive {
@@ -143,7 +146,9 @@ impl PyScene {
             let et = ElementType::from_name(&name).ok_or_else(|| {
                 value_error(format!("elements: unknown element type {name:?} (known: {})", ElementType::names()))
             })?;
-            let expected = || value_error(format!("elements[{name:?}]: expected an (m, {}) array of node indices", et.num_nodes()));
+            let expected = || {
+                value_error(format!("elements[{name:?}]: expected an (m, {}) array of node indices", et.num_nodes()))
+            };
             // an int64 array is read in place; any other sequence of rows element by element
             let conn: Vec<Vec<i64>> = match conn.extract::<PyReadonlyArray2<'_, i64>>() {
                 Ok(a) => a.as_array().rows().into_iter().map(|r| r.to_vec()).collect(),
@@ -169,11 +174,14 @@ impl PyScene {
         let mut node_sets = BTreeMap::new();
         for (name, set) in groups.into_iter().flatten() {
             let name: String = name.extract()?;
-            let set: Vec<i64> =
-                set.extract().map_err(|_| value_error(format!("groups[{name:?}]: expected a sequence of node indices")))?;
+            let set: Vec<i64> = set
+                .extract()
+                .map_err(|_| value_error(format!("groups[{name:?}]: expected a sequence of node indices")))?;
             let set = set
                 .iter()
-                .map(|&n| u32::try_from(n).map_err(|_| value_error(format!("groups[{name:?}]: node index {n} is not valid"))))
+                .map(|&n| {
+                    u32::try_from(n).map_err(|_| value_error(format!("groups[{name:?}]: node index {n} is not valid")))
+                })
                 .collect::<PyResult<Vec<u32>>>()?;
             node_sets.insert(name, set);
         }
@@ -182,7 +190,9 @@ impl PyScene {
         let imported = ImportedMesh::from_arrays("the arrays (rows and nodes counted from 0)", mesh, node_sets)
             .map_err(value_error)?;
         let drives = drives.iter().map(drive_from).collect::<PyResult<Vec<_>>>()?;
-        Scene::from_imported(&name, Arc::new(imported), &clamp, &drives, gravity).map(PyScene::wrap).map_err(value_error)
+        Scene::from_imported(&name, Arc::new(imported), &clamp, &drives, gravity)
+            .map(PyScene::wrap)
+            .map_err(value_error)
     }
 
     /// This scene with parameters set by their keys (`hox.parameters()`): `element="p2"`,
@@ -245,7 +255,11 @@ impl PyScene {
     #[getter]
     fn groups(&self) -> BTreeMap<String, usize> {
         let scene = self.scene();
-        scene.mesh.imported().map(|m| m.node_sets.iter().map(|(k, v)| (k.clone(), v.len())).collect()).unwrap_or_default()
+        scene
+            .mesh
+            .imported()
+            .map(|m| m.node_sets.iter().map(|(k, v)| (k.clone(), v.len())).collect())
+            .unwrap_or_default()
     }
 
     /// The scene file's text (TOML).

@@ -100,7 +100,7 @@ impl PySimulation {
     #[new]
     fn new(py: Python<'_>, scene: &PyScene) -> PyResult<PySimulation> {
         let scene = scene.scene();
-        let instance = py.detach(|| Instance::new(scene)).map_err(value_error)?;
+        let instance = py.detach(|| crate::work(|| Instance::new(scene))).map_err(value_error)?;
         Ok(PySimulation { inner: Mutex::new(Running { instance, frame_ms: Vec::new(), surface: None }) })
     }
 
@@ -110,11 +110,13 @@ impl PySimulation {
     fn step(&self, py: Python<'_>, frames: usize) -> PyResult<()> {
         for _ in 0..frames {
             py.detach(|| {
-                let mut r = self.running();
-                let clock = std::time::Instant::now();
-                let stepped = r.instance.sim.step_frame();
-                r.frame_ms.push(clock.elapsed().as_secs_f64() * 1e3);
-                stepped
+                crate::work(|| {
+                    let mut r = self.running();
+                    let clock = std::time::Instant::now();
+                    let stepped = r.instance.sim.step_frame();
+                    r.frame_ms.push(clock.elapsed().as_secs_f64() * 1e3);
+                    stepped
+                })
             })
             .map_err(runtime_error)?;
             if frames > 1 {
@@ -122,6 +124,26 @@ impl PySimulation {
             }
         }
         Ok(())
+    }
+
+    /// Steps `frames` frames in one loop in Rust, the interpreter released once, and returns each
+    /// frame's wall time in ms: the baseline `python/bench/overhead.py` measures the cost of
+    /// stepping from Python one call per frame against (`step` takes the same frames).
+    fn step_in_rust<'py>(&self, py: Python<'py>, frames: usize) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let ms = py.detach(|| {
+            crate::work(|| {
+                let mut r = self.running();
+                let mut ms = Vec::with_capacity(frames);
+                for _ in 0..frames {
+                    let clock = std::time::Instant::now();
+                    r.instance.sim.step_frame()?;
+                    ms.push(clock.elapsed().as_secs_f64() * 1e3);
+                }
+                r.frame_ms.extend_from_slice(&ms);
+                Ok::<_, hox_sim::solver::SimError>(ms)
+            })
+        });
+        Ok(PyArray1::from_vec(py, ms.map_err(runtime_error)?))
     }
 
     /// Runs until the body settles in equilibrium (or `cap_secs` simulated seconds) and returns
@@ -137,20 +159,22 @@ impl PySimulation {
         };
         let mut interrupted: Option<PyErr> = None;
         let report = py.detach(|| {
-            let mut r = self.running();
-            let mut frames = 0usize;
-            hox_scenes::run::run_observed(&mut r.instance, mode, &mut |_, _| {}, &mut |instance| {
-                frames += 1;
-                if frames.is_multiple_of(FRAMES_PER_SIGNAL_CHECK)
-                    && let Err(e) = Python::attach(|py| py.check_signals())
-                {
-                    interrupted = Some(e);
-                    return Err(hox_scenes::SceneError::Simulation {
-                        source_name: instance.scene.source.clone(),
-                        message: "interrupted".into(),
-                    });
-                }
-                Ok(())
+            crate::work(|| {
+                let mut r = self.running();
+                let mut frames = 0usize;
+                hox_scenes::run::run_observed(&mut r.instance, mode, &mut |_, _| {}, &mut |instance| {
+                    frames += 1;
+                    if frames.is_multiple_of(FRAMES_PER_SIGNAL_CHECK)
+                        && let Err(e) = Python::attach(|py| py.check_signals())
+                    {
+                        interrupted = Some(e);
+                        return Err(hox_scenes::SceneError::Simulation {
+                            source_name: instance.scene.source.clone(),
+                            message: "interrupted".into(),
+                        });
+                    }
+                    Ok(())
+                })
             })
         });
         if let Some(e) = interrupted {
@@ -175,9 +199,11 @@ impl PySimulation {
             )));
         }
         let solved = py.detach(|| {
-            let r = self.running();
-            let (scene, mesh) = (&r.instance.scene, r.instance.sim.mesh());
-            hox_scenes::solve_static(scene, mesh, tolerance, load_steps, &mut |_, _, _| {})
+            crate::work(|| {
+                let r = self.running();
+                let (scene, mesh) = (&r.instance.scene, r.instance.sim.mesh());
+                hox_scenes::solve_static(scene, mesh, tolerance, load_steps, &mut |_, _, _| {})
+            })
         });
         points_array(py, &solved.map_err(runtime_error)?.positions)
     }
@@ -188,7 +214,7 @@ impl PySimulation {
     /// origin, label, mesh, probes, estimated error.
     fn reference<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let scene = self.running().instance.scene.clone();
-        let reference = py.detach(|| hox_scenes::reference::for_scene(&scene, &mut |_, _| {}));
+        let reference = py.detach(|| crate::work(|| hox_scenes::reference::for_scene(&scene, &mut |_, _| {})));
         from_json(py, &reference.map_err(runtime_error)?.to_json())
     }
 
@@ -202,8 +228,9 @@ impl PySimulation {
         if probes.is_empty() {
             return Err(value_error("the scene has no probes to measure an error at (Scene.with_probes)"));
         }
-        let reference =
-            py.detach(|| hox_scenes::reference::for_scene(&scene, &mut |_, _| {})).map_err(runtime_error)?;
+        let reference = py
+            .detach(|| crate::work(|| hox_scenes::reference::for_scene(&scene, &mut |_, _| {})))
+            .map_err(runtime_error)?;
         from_json(
             py,
             &serde_json::json!({
@@ -309,8 +336,11 @@ impl PySimulation {
     fn surface_field<'py>(&self, py: Python<'py>, name: &str, segments: usize) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let field = field_named(name)?;
         let mut r = self.running();
-        let (positions, rest, material) =
-            (r.instance.sim.positions.clone(), r.instance.sim.mesh().rest_positions.clone(), *r.instance.sim.material());
+        let (positions, rest, material) = (
+            r.instance.sim.positions.clone(),
+            r.instance.sim.mesh().rest_positions.clone(),
+            *r.instance.sim.material(),
+        );
         let (_, surface, gradients) = r.surface(segments);
         let mut values = Vec::new();
         if field.needs_gradient() {
@@ -337,9 +367,14 @@ impl PySimulation {
             .map(|(m, (x, x0))| m * g.dot(&(x - x0)))
             .sum::<f64>();
         let (kinetic, elastic) = (sim.kinetic_energy_j(), sim.elastic_energy_j());
-        [("kinetic_j", kinetic), ("elastic_j", elastic), ("gravity_j", gravity), ("total_j", kinetic + elastic + gravity)]
-            .into_iter()
-            .collect()
+        [
+            ("kinetic_j", kinetic),
+            ("elastic_j", elastic),
+            ("gravity_j", gravity),
+            ("total_j", kinetic + elastic + gravity),
+        ]
+        .into_iter()
+        .collect()
     }
 
     /// Each probe's displacement, metres: `{name: (ux, uy, uz)}`.

@@ -27,13 +27,20 @@ pub fn study_cells(quick: bool, tables: Option<Vec<String>>) -> PyResult<Vec<Str
 /// plan's tables).
 #[pyfunction]
 #[pyo3(signature = (index, quick = true, tables = None))]
-pub fn study_cell(py: Python<'_>, index: usize, quick: bool, tables: Option<Vec<String>>) -> PyResult<BTreeMap<String, String>> {
+pub fn study_cell(
+    py: Python<'_>,
+    index: usize,
+    quick: bool,
+    tables: Option<Vec<String>>,
+) -> PyResult<BTreeMap<String, String>> {
     let plan = plan(quick, tables)?;
     let cells = plan.cells();
     let cell = cells
         .get(index)
-        .ok_or_else(|| value_error(format!("cell {index}: the study has cells 0 to {}", cells.len().saturating_sub(1))))?
+        .ok_or_else(|| {
+            value_error(format!("cell {index}: the study has cells 0 to {}", cells.len().saturating_sub(1)))
+        })?
         .clone();
-    let rows = py.detach(|| cell.run(plan.quick, &mut |_| {})).map_err(runtime_error)?;
+    let rows = py.detach(|| crate::work(|| cell.run(plan.quick, &mut |_| {}))).map_err(runtime_error)?;
     Ok(rows.files(&plan, "").into_iter().filter(|(name, _)| name.ends_with(".csv")).collect())
 }

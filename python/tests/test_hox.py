@@ -3,6 +3,7 @@
 import json
 import math
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -93,3 +94,23 @@ def test_a_sweep_on_a_dask_local_cluster_equals_the_serial_run():
     strip = lambda rows: [{k: v for k, v in r.items() if k != "ms_per_frame"} for r in rows]
     assert len(spread) == 8 and strip(spread) == strip(serial)
     assert all(not math.isnan(r["probe_tip_uz_m"]) for r in spread)
+
+
+def test_the_type_stubs_name_everything_the_module_has():
+    import ast
+
+    stubs = ast.parse((Path(hox.__file__).parent / "_hox.pyi").read_text())
+    declared = {n.name for n in stubs.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    members = {
+        c.name: {f.name for f in c.body if isinstance(f, ast.FunctionDef)}
+        for c in stubs.body
+        if isinstance(c, ast.ClassDef)
+    }
+    module = hox._hox
+    public = {n for n in dir(module) if not n.startswith("_")}
+    assert public <= declared, f"not in _hox.pyi: {public - declared}"
+    for cls in ("Scene", "Simulation"):
+        have = {n for n in dir(getattr(module, cls)) if not n.startswith("_")}
+        assert have <= members[cls], f"{cls} members not in _hox.pyi: {have - members[cls]}"
+    assert (Path(hox.__file__).parent / "py.typed").exists()
+    assert hox.Simulation.step.__doc__ and "released" in hox.Simulation.step.__doc__, "help() explains"

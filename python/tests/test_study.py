@@ -73,3 +73,23 @@ def test_hox_study_through_a_process_pool_equals_the_command_line(unsharded):
     assert hox.study_cells(True, ["locking"]) == [f"locking ν = {nu}" for nu in (0.35, 0.45, 0.49, 0.499)]
     with pytest.raises(ValueError, match="speed"):
         hox.study_cells(True, ["speed"])
+
+
+def test_a_process_pool_forked_after_a_run_does_not_hang():
+    """Found running the whole suite (2026-12-01): a process pool forked after a simulation had
+    started rayon's threads waited for ever in its workers (a fork copies one thread)."""
+    import multiprocessing
+
+    sim = hox.Simulation(hox.Scene.builtin("bending").with_params(element="p2", sweep="colour"))
+    sim.step(2)
+    cells = [hox.Cell("bending", {"element": e, "grid": (4, 1, 1)}, seconds=0.1) for e in ("p1", "p2")]
+    pool = ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("fork"))
+    try:
+        rows = list(pool.map(hox.run_cell, cells, timeout=120))
+    finally:
+        # a hung worker would hold a plain shutdown for ever: the test fails instead
+        for worker in list(getattr(pool, "_processes", {}).values()):
+            worker.kill()
+        pool.shutdown(wait=False, cancel_futures=True)
+    strip = lambda rs: [{k: v for k, v in r.items() if k != "ms_per_frame"} for r in rs]
+    assert strip(rows) == strip(hox.sweep(cells))

@@ -70,7 +70,9 @@ pub fn merge(paths: &[std::path::PathBuf], out: &std::path::Path) -> Result<()> 
                 .with_context(|| format!("cannot read the folder {}", path.display()))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| {
-                    p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("study-part-") && n.ends_with(".toml"))
+                    p.file_name()
+                        .and_then(|n| n.to_str())
+                        .is_some_and(|n| n.starts_with("study-part-") && n.ends_with(".toml"))
                 })
                 .collect();
             if found.is_empty() {

@@ -42,6 +42,13 @@ pub fn needs_browser(command: &str) -> bool {
     command.contains("scripts/web_figures.py") || command.contains("scripts/web_speed.py")
 }
 
+/// Whether `command` times the Python package (`python/bench/`): it needs the package built into
+/// its virtual environment (scripts/setup-python.sh), so pytest checks it
+/// (`python/tests/test_docs.py`), after .ci/run has built it.
+pub fn needs_python(command: &str) -> bool {
+    command.contains("python/bench/")
+}
+
 /// Whether `command` is a test that checks its own table (`hox_tests::docs::publish`).
 pub fn is_test(command: &str) -> bool {
     command.starts_with("cargo test ")

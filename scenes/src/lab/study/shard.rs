@@ -216,7 +216,8 @@ impl Shard {
     pub fn parse(text: &str) -> Result<Shard, String> {
         let bad = || format!("--shard {text:?}: expected K/N, two whole numbers with 1 ≤ K ≤ N (e.g. 2/8)");
         let (k, n) = text.split_once('/').ok_or_else(bad)?;
-        let (index, count) = (k.trim().parse::<usize>().map_err(|_| bad())?, n.trim().parse::<usize>().map_err(|_| bad())?);
+        let (index, count) =
+            (k.trim().parse::<usize>().map_err(|_| bad())?, n.trim().parse::<usize>().map_err(|_| bad())?);
         if index == 0 || index > count {
             return Err(bad());
         }
@@ -263,11 +264,23 @@ pub struct PartCell {
 pub const PART_FORMAT: &str = "hox study part, version 1";
 
 /// Runs the cells of `plan` that `shard` holds (every cell without a shard), in order.
-pub fn run_part(plan: &Plan, shard: Shard, machine: &str, progress: &mut dyn FnMut(&str)) -> Result<StudyPart, SceneError> {
+pub fn run_part(
+    plan: &Plan,
+    shard: Shard,
+    machine: &str,
+    progress: &mut dyn FnMut(&str),
+) -> Result<StudyPart, SceneError> {
     let all = plan.cells();
     let mut cells = Vec::new();
     for (index, cell) in all.iter().enumerate().filter(|(i, _)| shard.holds(*i)) {
-        progress(&format!("part {}/{}: cell {} of {}: {}", shard.index, shard.count, index + 1, all.len(), cell.label()));
+        progress(&format!(
+            "part {}/{}: cell {} of {}: {}",
+            shard.index,
+            shard.count,
+            index + 1,
+            all.len(),
+            cell.label()
+        ));
         cells.push(PartCell { index, label: cell.label(), rows: cell.run(plan.quick, progress)? });
     }
     Ok(StudyPart {
@@ -294,7 +307,8 @@ pub fn run_all(plan: &Plan, progress: &mut dyn FnMut(&str)) -> Result<Tables, Sc
 impl StudyPart {
     /// The part file's text.
     pub fn to_toml(&self) -> Result<String, SceneError> {
-        toml::to_string(self).map_err(|e| SceneError::Parse { source_name: "study part".into(), message: e.to_string() })
+        toml::to_string(self)
+            .map_err(|e| SceneError::Parse { source_name: "study part".into(), message: e.to_string() })
     }
 
     /// A part file's text read back; `source` names it in errors.
@@ -329,7 +343,9 @@ pub fn merge(parts: &[StudyPart], names: &[String]) -> Result<(Plan, Tables, Str
             )));
         }
         match seen.get_mut(p.shard.wrapping_sub(1)) {
-            Some(Some(j)) => return Err(bad(format!("{} and {} are both part {}/{}", name(*j), name(i), p.shard, p.of))),
+            Some(Some(j)) => {
+                return Err(bad(format!("{} and {} are both part {}/{}", name(*j), name(i), p.shard, p.of)));
+            }
             Some(slot) => *slot = Some(i),
             None => return Err(bad(format!("{} says it is part {} of {}", name(i), p.shard, p.of))),
         }
@@ -343,7 +359,9 @@ pub fn merge(parts: &[StudyPart], names: &[String]) -> Result<(Plan, Tables, Str
     for cell in parts.iter().flat_map(|p| &p.cells) {
         match by_index.get_mut(cell.index) {
             Some(slot @ None) if first.plan_cells[cell.index] == cell.label => *slot = Some(cell),
-            _ => return Err(bad(format!("cell {} ({}) is not the plan's, or given twice", cell.index + 1, cell.label))),
+            _ => {
+                return Err(bad(format!("cell {} ({}) is not the plan's, or given twice", cell.index + 1, cell.label)));
+            }
         }
     }
     let mut tables = Tables::default();

@@ -1,7 +1,14 @@
 use super::*;
 
 fn locking_row(nu: f64, config: &str) -> LockingRow {
-    LockingRow { poisson_ratio: nu, config: config.into(), elements: 160, tip_z_m: -0.1 * nu, q2_tip_z_m: -0.11, missing_pct: 3.0 }
+    LockingRow {
+        poisson_ratio: nu,
+        config: config.into(),
+        elements: 160,
+        tip_z_m: -0.1 * nu,
+        q2_tip_z_m: -0.11,
+        missing_pct: 3.0,
+    }
 }
 
 fn failed_solver_row() -> SolverRow {
@@ -48,7 +55,10 @@ fn parts(n_cells: usize, of: usize) -> Vec<StudyPart> {
                     .map(|i| PartCell {
                         index: i,
                         label: plan_cells[i].clone(),
-                        rows: Tables { locking: vec![locking_row(i as f64 / 10.0, "P2 8x2x2 five")], ..Default::default() },
+                        rows: Tables {
+                            locking: vec![locking_row(i as f64 / 10.0, "P2 8x2x2 five")],
+                            ..Default::default()
+                        },
                     })
                     .collect(),
             }
@@ -148,7 +158,11 @@ fn a_locking_only_study_writes_the_locking_files_and_says_how_it_was_made() {
     let files = tables.files(&plan, "test machine");
     let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(names, ["study.md", "locking.csv"]);
-    assert!(files[0].1.contains("Machine: test machine.") && files[0].1.contains("volumetric locking"), "{}", files[0].1);
+    assert!(
+        files[0].1.contains("Machine: test machine.") && files[0].1.contains("volumetric locking"),
+        "{}",
+        files[0].1
+    );
     let all = Tables::default().files(&Plan::all(true), "m");
     assert!(all[0].1.contains("Produced by `hox study --quick`"), "{}", all[0].1);
 }
