@@ -127,3 +127,32 @@ def test_the_error_against_the_reference_falls_as_the_beam_settles():
     probed_sim = hox.Simulation(probed)
     probed_sim.step(2)
     assert probed_sim.error()["reference"].startswith("static solution of this mesh")
+
+
+def test_a_group_driven_from_python_moves_by_its_translation():
+    drive = {"group": "tip", "translation_m": (0.0, 0.0, -0.05), "ramp_secs": 0.1}
+    scene = hox.from_meshio(meshio.read(MESHES / "beam-tet10.msh"), clamp=["clamp"], drives=[drive], gravity=False)
+    sim = hox.Simulation(scene)
+    sim.step(12)  # 0.2 s: the ramp done, then held
+    nodes, _, groups = hox.mesh_arrays(meshio.read(MESHES / "beam-tet10.msh"))
+    moved = sim.displacements[groups["tip"]]
+    np.testing.assert_allclose(moved, [[0.0, 0.0, -0.05]] * len(moved), atol=1e-12)
+    assert np.abs(sim.displacements[groups["clamp"]]).max() == 0.0
+    with pytest.raises(ValueError, match='unknown key "speed"'):
+        hox.Scene.from_mesh_file(str(MESHES / "beam-tet10.msh"), drives=[{"group": "tip", "speed": 1}])
+    with pytest.raises(ValueError, match='"nose".*"clamp"'):
+        hox.Scene.from_mesh_file(str(MESHES / "beam-tet10.msh"), drives=[{"group": "nose"}])
+
+
+def test_ctrl_c_stops_a_long_settle_and_the_simulation_is_usable_after():
+    import _thread
+    import threading
+
+    sim = hox.Simulation(hox.Scene.builtin("bending").with_params(element="p2", grid=(16, 4, 4), substeps=200))
+    threading.Timer(0.5, _thread.interrupt_main).start()
+    with pytest.raises(KeyboardInterrupt):
+        sim.settle(cap_secs=3600)
+    t = sim.time_secs
+    assert 0 < t < 3600
+    sim.step(1)
+    assert sim.time_secs == pytest.approx(t + 1 / 60)
