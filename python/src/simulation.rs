@@ -32,14 +32,16 @@ struct Running {
 }
 
 impl Running {
-    fn surface(&mut self, segments: usize) -> &(usize, Surface, SurfaceGradients) {
+    /// The simulation and its display surface cut with `segments`, made on the first call.
+    fn with_surface(&mut self, segments: usize) -> (&Instance, &Surface, &SurfaceGradients) {
         if self.surface.as_ref().is_none_or(|(s, _, _)| *s != segments) {
             let mesh = self.instance.sim.mesh();
             let surface = Surface::new(mesh, segments);
             let gradients = SurfaceGradients::new(mesh, &surface);
             self.surface = Some((segments, surface, gradients));
         }
-        self.surface.as_ref().expect("made above")
+        let (_, surface, gradients) = self.surface.as_ref().expect("made above");
+        (&self.instance, surface, gradients)
     }
 }
 
@@ -315,11 +317,10 @@ impl PySimulation {
     #[pyo3(signature = (segments = 4))]
     fn surface<'py>(&self, py: Python<'py>, segments: usize) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
         let mut r = self.running();
-        let (positions, rest) = (r.instance.sim.positions.clone(), r.instance.sim.mesh().rest_positions.clone());
-        let (_, surface, _) = r.surface(segments);
+        let (instance, surface, _) = r.with_surface(segments);
         let (mut points, mut rest_points) = (Vec::new(), Vec::new());
-        surface.vertices.eval_into(&positions, &mut points);
-        surface.vertices.eval_into(&rest, &mut rest_points);
+        surface.vertices.eval_into(&instance.sim.positions, &mut points);
+        surface.vertices.eval_into(&instance.sim.mesh().rest_positions, &mut rest_points);
         let triangles: Vec<u32> = surface.triangles.iter().flatten().copied().collect();
         let n = surface.triangles.len();
         let d = pyo3::types::PyDict::new(py);
@@ -336,18 +337,15 @@ impl PySimulation {
     fn surface_field<'py>(&self, py: Python<'py>, name: &str, segments: usize) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let field = field_named(name)?;
         let mut r = self.running();
-        let (positions, rest, material) = (
-            r.instance.sim.positions.clone(),
-            r.instance.sim.mesh().rest_positions.clone(),
-            *r.instance.sim.material(),
-        );
-        let (_, surface, gradients) = r.surface(segments);
+        let (instance, surface, gradients) = r.with_surface(segments);
+        let (positions, rest, material) =
+            (&instance.sim.positions, &instance.sim.mesh().rest_positions, instance.sim.material());
         let mut values = Vec::new();
         if field.needs_gradient() {
-            gradients.values_into(field, &material, &positions, &rest, &mut values);
+            gradients.values_into(field, material, positions, rest, &mut values);
         } else {
             let mut u = Vec::new();
-            surface.vertices.displacements_into(&positions, &rest, &mut u);
+            surface.vertices.displacements_into(positions, rest, &mut u);
             values = u.iter().map(|u| u.norm()).collect();
         }
         Ok(PyArray1::from_vec(py, values))

@@ -270,15 +270,11 @@ pub fn study_one(
     })
 }
 
-/// Runs the study over the paper scenes (`quick`: without the heavy configurations).
+/// Runs the study's accuracy table over the paper scenes (`quick`: without the heavy
+/// configurations): its cells ([`shard::Plan`]) one after another.
 pub fn run_study(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<StudyRow>, SceneError> {
-    let mut rows = Vec::new();
-    for scene in crate::scene::builtin::PAPER_SCENES {
-        for config in configurations(scene).iter().filter(|c| !(quick && c.heavy)) {
-            rows.push(study_one(scene, config, progress)?);
-        }
-    }
-    Ok(rows)
+    let plan = shard::Plan { quick, tables: vec![shard::Table::Accuracy] };
+    Ok(shard::run_all(&plan, progress)?.accuracy)
 }
 
 /// The Poisson ratios of the locking table: the paper's 0.35 and the near-incompressible ones of

@@ -160,22 +160,6 @@ pub struct SolverRow {
     pub failure: Option<String>,
 }
 
-/// Runs the solver axis over the paper scenes.
-pub fn run_solver_axis(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<SolverRow>, SceneError> {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().map_err(|e| SceneError::Simulation {
-        source_name: "study".into(),
-        message: format!("cannot make a one-thread pool: {e}"),
-    })?;
-    let motion_reference = reference_motion()?.metrics();
-    let mut rows = Vec::new();
-    for scene in crate::scene::builtin::PAPER_SCENES {
-        for config in solver_configurations(scene, quick) {
-            config_rows(&pool, scene, &config, &motion_reference, progress, &mut rows)?;
-        }
-    }
-    Ok(rows)
-}
-
 /// The rows of one mesh of the solver axis (a cell of [`super::shard::Plan`]): its static
 /// solution once, then every solver, on one thread.
 pub fn mesh_rows(
