@@ -48,6 +48,10 @@ install_missing "the app's window" xvfb xauth libgl1 libegl1 libgl1-mesa-dri mes
 # python3 (scripts/browser_shot.py: the standard library only).
 install_missing "the browser tests" chromium fonts-liberation python3
 
+# The Python tests make a part hox does not ship with Gmsh (python/tests/test_parts.py, issue
+# #61): the gmsh wheel from PyPI loads libGLU and a few X libraries at import.
+install_missing "Gmsh's library" libglu1-mesa libxft2 libxinerama1 libgomp1
+
 # The PositionBasedDynamics table of docs/PERFORMANCE.md (bench/pbd_peer.py, checked by
 # app/tests/doc_tables.rs) installs pypbd from PyPI into bench/.venv: a virtualenv needs venv.
 install_missing "the peer benchmark" python3-venv

@@ -28,6 +28,10 @@ fn the_shape_of_a_line_keeps_its_words_and_drops_its_numbers() {
     );
     assert_eq!(quick("hox study --summary docs/study"), ["hox", "study", "--summary", "docs/study"]);
     assert_eq!(quick("python3 scripts/web_figures.py"), ["python3", "scripts/web_figures.py", "--quick"]);
+    assert_eq!(
+        quick("python3 bench/user_part.py --runs 3"),
+        ["python3", "bench/user_part.py", "--runs", "3", "--frames", "1"]
+    );
 }
 
 /// Found by CI (2026-11-29): docs/WEB.md's frame-rate change was committed as −0.3 % and came out

@@ -46,7 +46,7 @@ def test_every_parameter_of_the_table_refuses_a_bad_value_naming_it():
 
 
 def test_a_parameter_is_set_by_its_key_with_underscores_for_dashes():
-    scene = hox.Scene.builtin("bending").with_params(solver="vbd", vbd_iterations=7, newton_quasi=True)
+    scene = hox.Scene.builtin("bending").with_params(solver="vbd", vbd_iterations=7, newton_policy="interactive")
     assert scene.params["solver.vbd_iterations"] == 7
     assert scene.params["solver.method"] == "vbd"
 

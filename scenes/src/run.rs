@@ -80,10 +80,22 @@ pub struct RunReport {
     /// Implicit steps the step watch rejected and took again in halves (a node moved more than
     /// the body's size against the body's mean motion).
     pub rejected_steps: u64,
+    /// Newton-type solvers' numeric factorisations over the run (a projected retry counted too).
+    pub factorizations: u64,
+    /// Iterations of the implicit solvers over the run (Newton's, VBD's sweeps).
+    pub solver_iterations: u64,
     pub kinetic_energy_j: f64,
     pub elastic_energy_j: f64,
     /// The solver that ran ("xpbd", "vbd", "newton").
     pub solver: String,
+    /// The policy a Newton-type solver's last step ran ("interactive" or "careful",
+    /// [`hox_sim::solver::NewtonPolicy`]); None (`null`) for XPBD and VBD.
+    pub newton_policy: Option<String>,
+    /// Why that policy ran: chosen by the problem (`auto`), asked for, or the fall-back after a
+    /// rejected step.
+    pub newton_policy_why: Option<String>,
+    /// Which solver fits this body better, when the one chosen does not ([`solver_advice`]).
+    pub solver_advice: Option<String>,
 }
 
 impl RunReport {
@@ -199,9 +211,14 @@ pub fn run_observed(
         wall_secs: started.elapsed().as_secs_f64(),
         unconverged_steps: instance.sim.counters().unconverged_steps,
         rejected_steps: instance.sim.counters().rejected_steps,
+        factorizations: instance.sim.counters().factorizations,
+        solver_iterations: instance.sim.counters().solver_iterations,
         kinetic_energy_j: instance.sim.kinetic_energy_j(),
         elastic_energy_j: instance.sim.elastic_energy_j(),
         solver: instance.sim.method().name().to_string(),
+        newton_policy: instance.sim.newton_policy().map(|p| p.ran.name().to_string()),
+        newton_policy_why: instance.sim.newton_policy().map(|p| p.why.clone()),
+        solver_advice: solver_advice(instance),
     })
 }
 
@@ -358,4 +375,37 @@ pub fn driven_until_secs(effects: &[EffectSpec]) -> f64 {
             _ => 0.0,
         })
         .fold(0.0, f64::max)
+}
+
+/// The least share of its rest bounding box a mesh-file body fills for VBD to be offered without
+/// a word ([`solver_advice`]): Gmsh's box beam fills all of it, the hollow tube 40 %, the elbow,
+/// the hook and the bracket of issue #61 under 20 %.
+pub const VBD_LEAST_BOX_FILL: f64 = 0.5;
+
+/// What the app and `hox simulate` say when the solver chosen is not the one for this body (issue
+/// #61, item 3): VBD on a part from a mesh file that fills less than [`VBD_LEAST_BOX_FILL`] of its
+/// bounding box — a curved or hollow part — where its node-by-node sweeps settle far slower than
+/// Newton (the P2 tube: 208 frames and 9.6 s against Newton's 3.4 s in the same hour, session
+/// 23; issue #61's P2 bracket of 4,982 nodes: 219 frames and 8.3 s against 90 frames and 0.9 s,
+/// session 31 of docs/journal/performance.md); None otherwise.
+pub fn solver_advice(instance: &Instance) -> Option<String> {
+    use crate::params::MeshKind;
+    let sim = &instance.sim;
+    if sim.method() != hox_sim::solver::Method::Vbd || instance.scene.mesh_kind() == MeshKind::Box {
+        return None;
+    }
+    let rest = &sim.mesh().rest_positions;
+    let (lo, hi) = rest
+        .iter()
+        .fold((hox_sim::Vec3::repeat(f64::INFINITY), hox_sim::Vec3::repeat(f64::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.inf(p), hi.sup(p))
+        });
+    let box_m3 = (hi - lo).iter().product::<f64>();
+    let fill = hox_sim::fem::geometry::total_volume_m3(sim.geometry()) / box_m3;
+    (fill < VBD_LEAST_BOX_FILL).then(|| {
+        format!(
+            "vbd is not the solver for this part: it fills {:.0} % of its bounding box, and on curved and hollow parts VBD's sweeps settle far slower than Newton's (a P2 bracket of 4,982 nodes: 8.3 s against 0.9 s on one thread); newton is (--solver newton, the default for a mesh file)",
+            100.0 * fill
+        )
+    })
 }

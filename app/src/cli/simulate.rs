@@ -28,6 +28,9 @@ pub fn simulate(
     };
     let mut instance = Instance::new(scene)?;
     let stability = note_stability(&mut instance);
+    if let Some(advice) = hox_scenes::run::solver_advice(&instance) {
+        eprintln!("note: {advice}");
+    }
     let mut vtk_writer = gmsh::VtkWriter::create(vtk, &instance)?;
     let mut bar = DelayedBar::new();
     let mut on_frame = |i: &Instance| vtk_writer.as_mut().map_or(Ok(()), |w| w.frame(i));
@@ -93,6 +96,9 @@ pub fn simulate(
                 format!(", {}", report.solver)
             }
         );
+        if let (Some(policy), Some(why)) = (&report.newton_policy, &report.newton_policy_why) {
+            println!("  newton policy: {policy} ({why})");
+        }
         for (name, u) in &report.probes {
             println!("  probe {name}: u = ({:+.6}, {:+.6}, {:+.6}) m", u[0], u[1], u[2]);
         }

@@ -303,6 +303,10 @@ fn param_ui(cx: &mut Ctx, ui: &mut egui::Ui, p: &'static Param) {
     }
     if p.key == "solver" {
         solver_motion_ui(ui, config.method, config.integrator);
+        // issue #61: the solver that is not the one for this part says so, and names the one
+        if let Some(advice) = hox_scenes::run::solver_advice(&session.instance) {
+            ui.label(egui::RichText::new(advice).color(ui.visuals().warn_fg_color));
+        }
     }
 }
 

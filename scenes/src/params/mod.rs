@@ -48,7 +48,7 @@ use hox_sim::element::ElementType;
 use hox_sim::material::{DENSITY_KG_M3, MaterialModel, POISSON_RATIO, YOUNGS_MODULUS_PA};
 use hox_sim::measure::field::Field;
 use hox_sim::mesh::structured::TetSplit;
-use hox_sim::solver::{Integrator, Method, SolverSettings, Sweep, VbdInit};
+use hox_sim::solver::{Integrator, Method, NewtonPolicy, SolverSettings, Sweep, VbdInit};
 use hox_sim::xpbd::constraint::Formulation;
 use value::as_text;
 
@@ -236,11 +236,12 @@ params! {
         help: "Newton iterations per step at most (the implicit solvers of the Newton family). The default runs a step to its tolerance; a budget of 2 keeps a large part at the display's rate: a step left above the tolerance carries its unbalanced force into the next, so a swinging body lags slightly and a settled one is as exact as ever (docs/journal/performance.md, session 24).",
         kind: Kind::of_range(SolverSettings::NEWTON_ITERATIONS.range), ..BASE
     }
-    /// Newton's interactive mode.
-    newton_quasi: bool = solver().newton.quasi_newton => {
-        key: "newton-quasi", group: Group::Solver, file_key: "newton_quasi", label: "Newton keeps its factor",
-        help: "Newton's interactive mode: the factor kept across steps in single precision, corrected by secant pairs (L-BFGS) and refreshed only when keeping it costs more than a factorisation (the curved parts: 3–4 factorisations to settle instead of 13–18). Off: refreshed whenever an iteration reduces the residual less than 4×, in double precision, as the robustness suite measures (docs/journal/performance.md session 24).",
-        kind: Kind::Flag, switch: Some(("newton-quasi", true)), ..BASE
+    /// How Newton keeps its factor: auto | interactive | careful.
+    #[serde(with = "as_text")]
+    newton_policy: NewtonPolicy = solver().newton.policy => {
+        key: "newton-policy", group: Group::Solver, file_key: "newton_policy", label: "Newton's factor",
+        help: "How Newton keeps its factor. auto (the default): interactive where a factorisation costs at least 6 iterations with the kept factor (a part of thousands of nodes), careful on smaller meshes, and careful from the first step the step watch rejects; `--json` says which ran and why. interactive: the factor kept across steps in single precision, corrected by secant pairs (L-BFGS) and refreshed only when keeping it costs more than a factorisation. careful: refreshed whenever an iteration reduces the residual less than 4×, in double precision.",
+        kind: Kind::Choice(newton_policy_options), ..BASE
     }
     /// energy | split.
     #[serde(with = "as_text")]

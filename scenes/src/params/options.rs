@@ -4,7 +4,7 @@
 use hox_sim::element::ElementType;
 use hox_sim::material::MaterialModel;
 use hox_sim::mesh::structured::TetSplit;
-use hox_sim::solver::{Integrator, Method, Sweep, VbdInit};
+use hox_sim::solver::{Integrator, Method, NewtonPolicy, Sweep, VbdInit};
 use hox_sim::xpbd::constraint::Formulation;
 
 pub(super) fn element_options() -> Vec<(&'static str, String)> {
@@ -42,6 +42,10 @@ pub(super) fn field_options() -> Vec<(&'static str, String)> {
 pub(super) fn method_options() -> Vec<(&'static str, String)> {
     Method::ALL.iter().map(|m| (m.name(), m.long_name().to_string())).collect()
 }
+pub(super) fn newton_policy_options() -> Vec<(&'static str, String)> {
+    NewtonPolicy::ALL.iter().map(|p| (p.name(), p.name().to_string())).collect()
+}
+
 pub(super) fn vbd_init_options() -> Vec<(&'static str, String)> {
     VbdInit::ALL.iter().map(|i| (i.name(), i.name().to_string())).collect()
 }

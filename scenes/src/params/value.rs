@@ -6,7 +6,7 @@ use hox_sim::element::ElementType;
 use hox_sim::material::MaterialModel;
 use hox_sim::measure::field::Field;
 use hox_sim::mesh::structured::TetSplit;
-use hox_sim::solver::{Integrator, Method, Sweep, VbdInit};
+use hox_sim::solver::{Integrator, Method, NewtonPolicy, Sweep, VbdInit};
 use hox_sim::xpbd::constraint::Formulation;
 
 /// A parameter value, untyped (the typed values are the fields of [`Params`]).
@@ -142,6 +142,7 @@ choice! {
     Sweep => Sweep::ALL.to_vec(), |o| Sweep::name(o);
     Formulation => Formulation::ALL.to_vec(), |o| Formulation::name(o);
     VbdInit => VbdInit::ALL.to_vec(), |o| VbdInit::name(o);
+    NewtonPolicy => NewtonPolicy::ALL.to_vec(), |o| NewtonPolicy::name(o);
     Integrator => Integrator::ALL.to_vec(), |o| Integrator::name(o);
     Field => Field::ALL.to_vec(), |o| Field::name(o);
 }

@@ -243,8 +243,9 @@ impl SceneFile {
     }
 
     /// A scene around a mesh file: the bending scene's material (the paper's beam: StVK,
-    /// E = 3 MPa, ν = 0.35, ρ = 1000 kg/m³, read from assets/scenes/bending.toml), the default
-    /// solver settings, and gravity unless `gravity` is false. Callers add clamps and drives
+    /// E = 3 MPa, ν = 0.35, ρ = 1000 kg/m³, read from assets/scenes/bending.toml), Newton with
+    /// the default solver settings (its factor policy `auto`), and gravity unless `gravity` is
+    /// false. Callers add clamps and drives
     /// (`NodeSelector::group`).
     pub fn for_mesh_file(path: &Path, gravity: bool) -> SceneFile {
         let bending =
@@ -257,6 +258,10 @@ impl SceneFile {
                 given.insert(p.key);
             }
         }
+        // a user's part runs on the fastest safe path without a flag (issue #61): Newton, its
+        // factor policy chosen by the part's size; the paper's scenes keep XPBD
+        params.method = hox_sim::solver::Method::Newton;
+        given.insert("solver");
         SceneFile {
             name: path.file_stem().map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned()),
             description: format!("the mesh {}", path.display()),

@@ -158,7 +158,7 @@ impl Scene {
             newton: NewtonSettings {
                 tolerance: p.newton_tolerance,
                 max_iterations: u32::try_from(p.newton_iterations).unwrap_or(u32::MAX),
-                quasi_newton: p.newton_quasi,
+                policy: p.newton_policy,
                 ..Default::default()
             },
         }

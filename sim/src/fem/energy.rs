@@ -25,6 +25,7 @@ use crate::material::{Material, contract, contract_left, contract_right};
 use crate::mesh::Mesh;
 use nalgebra::DMatrix;
 
+mod chunks;
 mod fixed;
 pub use fixed::point_energy_and_gradient;
 
@@ -258,8 +259,16 @@ fn mesh_pass(
     }
     let mut total = 0.0;
     for (bi, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
-        let pass = fixed::Pass { block, geometry: g, rest: &mesh.rest_positions, x: positions };
+        let pass =
+            fixed::Pass { block, geometry: g, rest: &mesh.rest_positions, x: positions, elements: 0..block.len() };
+        let ranges = chunks::ranges_for(block.len());
         total += match gradient_out.as_deref_mut() {
+            // a large block on every thread, in ranges fixed by its size (`chunks.rs`)
+            Some(grad) if specialised && ranges > 1 && fixed::has_kernel(block.nodes_per_element()) => {
+                chunks::energy_and_gradient_in_ranges(pass, ranges, grad, &|p, buf| {
+                    fixed::block_energy_and_gradient::<true>(p, material, buf).unwrap_or_default()
+                })
+            }
             Some(grad) => specialised
                 .then(|| fixed::block_energy_and_gradient::<true>(pass, material, grad))
                 .flatten()

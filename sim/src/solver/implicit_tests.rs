@@ -71,8 +71,12 @@ fn newton_converges_quadratically_near_the_solution() {
     let material = Material::new(MaterialModel::StableNeoHookean, 2.0e4, 0.3, 1000.0).unwrap();
     let clamped = clamped_at_x0(&mesh);
     let mut settings = implicit(Method::Newton, 20.0);
-    settings.newton =
-        NewtonSettings { tolerance: 1e-13, max_iterations: 50, refactor_every_iteration: true, quasi_newton: false };
+    settings.newton = NewtonSettings {
+        tolerance: 1e-13,
+        max_iterations: 50,
+        refactor_every_iteration: true,
+        policy: NewtonPolicy::Careful,
+    };
     let mut sim = Simulation::new(mesh, material, settings, cantilever_effects(&clamped, 0.0)).unwrap();
     sim.step_frame().unwrap();
     let r = sim.last_step_residuals().to_vec();
@@ -149,7 +153,7 @@ fn the_kept_factor_follows_pure_newton_with_fewer_factorisations() {
                 tolerance: 1e-10,
                 max_iterations: 60,
                 refactor_every_iteration,
-                quasi_newton: !refactor_every_iteration,
+                policy: if refactor_every_iteration { NewtonPolicy::Careful } else { NewtonPolicy::Interactive },
             };
             let mut sim = Simulation::new(mesh.clone(), material, settings, cantilever_effects(&clamped, 0.0)).unwrap();
             for _ in 0..40 {
@@ -181,7 +185,7 @@ fn a_newton_budget_settles_on_the_static_solution() {
         let frames = (30.0 / omega_min * fps).ceil() as usize;
         let mut settings = implicit(Method::Newton, fps);
         settings.newton.max_iterations = 2;
-        settings.newton.quasi_newton = true;
+        settings.newton.policy = NewtonPolicy::Interactive;
         let mut sim = Simulation::new(mesh, material, settings, cantilever_effects(&clamped, omega_min)).unwrap();
         for _ in 0..frames {
             sim.step_frame().unwrap();
@@ -528,4 +532,51 @@ fn a_newton_step_left_far_from_solved_is_taken_again_in_halves() {
         }
         assert!(sim.positions.iter().all(|p| p.iter().all(|c| c.is_finite())));
     }
+}
+
+/// Issue #61: Newton's default policy is chosen by what a factorisation costs and says why —
+/// careful on a small beam, interactive on a larger one — and a step the step watch rejects
+/// turns it careful for the rest of the run on that mesh and material; a new material chooses
+/// again.
+#[test]
+fn the_auto_policy_follows_the_factor_s_cost_and_turns_careful_after_a_rejected_step() {
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 3.0e6, 0.35, 1000.0).unwrap();
+    let run = |mesh: Mesh| {
+        let clamped = clamped_at_x0(&mesh);
+        let mut sim =
+            Simulation::new(mesh, material, implicit(Method::Newton, 60.0), cantilever_effects(&clamped, 0.0)).unwrap();
+        assert_eq!(sim.settings().newton.policy, NewtonPolicy::Auto, "the default");
+        sim.step_frame().unwrap();
+        sim
+    };
+    let small = run(beam(ElementType::from_name("p2").unwrap(), [4, 1, 1]));
+    let said = small.newton_policy().unwrap();
+    assert_eq!(said.ran, NewtonPolicy::Careful, "{}", said.why);
+    assert!(said.why.starts_with("auto: a factorisation of the") && said.why.ends_with("refreshing it is cheap"));
+    let mut large = run(beam(ElementType::from_name("p3").unwrap(), [8, 2, 2]));
+    let said = large.newton_policy().unwrap();
+    assert_eq!(said.ran, NewtonPolicy::Interactive, "{}", said.why);
+    assert!(said.why.contains("3144 unknowns") && said.why.contains("kept across steps"), "{}", said.why);
+    let time_secs = large.time_secs();
+    large.step_solver_mut().step_rejected(time_secs);
+    large.step_frame().unwrap();
+    let said = large.newton_policy().unwrap();
+    assert_eq!(said.ran, NewtonPolicy::Careful, "{}", said.why);
+    assert!(said.why.contains("step watch rejected the step from 0.017 s"), "{}", said.why);
+    large.step_frame().unwrap();
+    assert_eq!(large.newton_policy().unwrap().ran, NewtonPolicy::Careful, "for the rest of the run");
+    // asked for, a policy is kept whatever the factor costs
+    let mut settings = *large.settings();
+    settings.newton.policy = NewtonPolicy::Interactive;
+    large.set_settings(settings).unwrap();
+    large.step_frame().unwrap();
+    let said = large.newton_policy().unwrap();
+    assert_eq!((said.ran, said.why.as_str()), (NewtonPolicy::Interactive, "asked for (newton_policy = interactive)"));
+    // a new material is a new problem: auto chooses again
+    let mut settings = *large.settings();
+    settings.newton.policy = NewtonPolicy::Auto;
+    large.set_settings(settings).unwrap();
+    large.set_material(Material::new(MaterialModel::StVenantKirchhoff, 4.0e6, 0.35, 1000.0).unwrap()).unwrap();
+    large.step_frame().unwrap();
+    assert_eq!(large.newton_policy().unwrap().ran, NewtonPolicy::Interactive);
 }

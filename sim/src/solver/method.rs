@@ -126,7 +126,7 @@ pub const INFO: [MethodInfo; 4] = [
         long_name: "Newton (implicit step)",
         implicit: true,
         honours: &[ImplicitRole::Hooks, ImplicitRole::Potential],
-        parameters: &["steps_per_frame", "integrator", "newton_tolerance", "newton_iterations", "newton_quasi"],
+        parameters: &["steps_per_frame", "integrator", "newton_tolerance", "newton_iterations", "newton_policy"],
         step_word: "step",
         remedy: "more steps per frame, a softer material or stable Neo-Hookean",
         motion: "Solves the implicit step to convergence; the motion is its integrator's (below). Its equilibrium is right: Settle shows it.",

@@ -78,7 +78,9 @@ pub use integrator::{Integrator, IntegratorInfo, Prediction, Scheme, SchemeState
 pub use method::{INFO as METHODS, Method, MethodInfo, SweepsPerStep};
 pub use node_loops::NODE_LOOP_MIN_NODES_PER_THREAD;
 pub use residual::StaticResidual;
-pub use settings::{NewtonSettings, Range, RangeValue, Setting, SolverSettings, Sweep, VbdInit, VbdSettings};
+pub use settings::{
+    NewtonPolicy, NewtonSettings, Range, RangeValue, Setting, SolverSettings, Sweep, VbdInit, VbdSettings,
+};
 pub use simulation::Simulation;
 
 #[cfg(test)]

@@ -27,6 +27,14 @@
 //!   step then costs a gradient and one back-substitution. With
 //!   [`super::NewtonSettings::refactor_every_iteration`] it is pure Newton (quadratic near the
 //!   solution).
+//! - **Policy** ([`NewtonPolicy`], issue #61): `Auto` (the default) keeps the factor across
+//!   steps — the interactive mode of `newton_core.rs` — where a factorisation costs at least
+//!   [`NewtonPolicy::INTERACTIVE_FROM_ITERATIONS`] iterations with the kept factor
+//!   ([`LinearSolver::refresh_cost_in_iterations`], counted from the factor's size, never timed),
+//!   and refreshes it carefully elsewhere; from the first step the step watch rejects
+//!   ([`StepSolver::step_rejected`]: a node flung, an unsolved step, energy gained) it is careful
+//!   for the rest of the run, on the same mesh and material. What ran and why is
+//!   [`NewtonPolicyReport`].
 //! - The factorisation runs on one thread (`Par::Seq`), so results do not depend on the thread
 //!   count; the element Hessians are computed in parallel and summed in a fixed order.
 
@@ -34,7 +42,7 @@ use super::error::SolverCounters;
 use super::nan_guard::{BadElement, ORIGIN_NEWTON};
 use super::newton_core::{Failure, HessianModel, LinearSolver, Objective, Outcome, Scratch, minimise};
 use super::potential::Potential;
-use super::settings::SolverSettings;
+use super::settings::{NewtonPolicy, NewtonPolicyReport, NewtonSettings, SolverSettings};
 use super::sparse::SparsePattern;
 use super::step::{Hooks, StepInput, StepSolver};
 use crate::Vec3;
@@ -52,6 +60,12 @@ pub(crate) struct Newton<L: LinearSolver = SparsePattern> {
     scratch: Scratch,
     /// Whether the last step reached its iteration limit above [`UNSOLVED_RESIDUAL`] of the load.
     failed: bool,
+    /// The policy the last step ran and why.
+    report: Option<NewtonPolicyReport>,
+    /// Whether the last step's settings asked for `Auto`.
+    asked_auto: bool,
+    /// Why `Auto` turned careful for good (a step the watch rejected under the interactive one).
+    fell_back: Option<String>,
 }
 
 /// A step left by the iteration limit with an unbalanced force above this fraction of the load
@@ -61,8 +75,39 @@ const UNSOLVED_RESIDUAL: f64 = 1e-1;
 
 impl<L: LinearSolver> Newton<L> {
     pub fn new(_mesh: &Mesh) -> Self {
-        Self { pattern: None, made_for: (u64::MAX, 0.0), y: Vec::new(), scratch: Scratch::default(), failed: false }
+        Self {
+            pattern: None,
+            made_for: (u64::MAX, 0.0),
+            y: Vec::new(),
+            scratch: Scratch::default(),
+            failed: false,
+            report: None,
+            asked_auto: false,
+            fell_back: None,
+        }
     }
+}
+
+/// `asked` with its policy resolved ([`NewtonPolicy::Auto`] by the problem: module docs), and why.
+fn resolve(asked: NewtonSettings, refresh_cost: f64, free_dofs: usize, fell_back: Option<&str>) -> NewtonPolicyReport {
+    let threshold = NewtonPolicy::INTERACTIVE_FROM_ITERATIONS;
+    let (ran, why) = match (asked.policy, fell_back) {
+        (NewtonPolicy::Auto, Some(why)) => (NewtonPolicy::Careful, why.to_string()),
+        (NewtonPolicy::Auto, None) if refresh_cost >= threshold && !asked.refactor_every_iteration => (
+            NewtonPolicy::Interactive,
+            format!(
+                "auto: a factorisation of the {free_dofs} unknowns costs about {refresh_cost:.0} iterations with the kept factor (interactive from {threshold:.0}), so the factor is kept across steps"
+            ),
+        ),
+        (NewtonPolicy::Auto, None) => (
+            NewtonPolicy::Careful,
+            format!(
+                "auto: a factorisation of the {free_dofs} unknowns costs about {refresh_cost:.0} iterations with the kept factor (interactive from {threshold:.0}): refreshing it is cheap"
+            ),
+        ),
+        (policy, _) => (policy, format!("asked for (newton_policy = {})", policy.name())),
+    };
+    NewtonPolicyReport { ran, why }
 }
 
 impl Objective for Potential<'_> {
@@ -84,6 +129,7 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
 
     fn rebuild(&mut self, _mesh: &Mesh, _geometry: &[BlockGeometry], _settings: &SolverSettings, _geo: bool) {
         self.pattern = None;
+        self.fell_back = None;
     }
 
     fn last_step_residuals(&self) -> &[f64] {
@@ -92,6 +138,19 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
 
     fn last_step_failed(&self) -> bool {
         self.failed
+    }
+
+    fn step_rejected(&mut self, time_secs: f64) {
+        let interactive = self.report.as_ref().is_some_and(|r| r.ran == NewtonPolicy::Interactive);
+        if interactive && self.asked_auto && self.fell_back.is_none() {
+            self.fell_back = Some(format!(
+                "auto: interactive until the step watch rejected the step from {time_secs:.3} s; careful since (on this mesh and material)"
+            ));
+        }
+    }
+
+    fn newton_policy(&self) -> Option<&NewtonPolicyReport> {
+        self.report.as_ref()
     }
 
     fn solve_step(
@@ -112,10 +171,18 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
                     pattern.forget_model();
                 }
             }
-            _ => self.pattern = Some(L::for_mesh(s.mesh, &|i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?),
+            _ => {
+                self.pattern = Some(L::for_mesh(s.mesh, &|i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?);
+                self.fell_back = None;
+            }
         }
         self.made_for = (s.model_version, s.inertia_h);
         let pattern = self.pattern.as_mut().expect("made above");
+        let report =
+            resolve(settings, pattern.refresh_cost_in_iterations(), pattern.free_dofs(), self.fell_back.as_deref());
+        self.asked_auto = settings.policy == NewtonPolicy::Auto;
+        let settings = NewtonSettings { policy: report.ran, ..settings };
+        self.report = Some(report);
         self.y.clear();
         self.y.extend_from_slice(positions);
         for (i, x) in positions.iter_mut().enumerate() {

@@ -16,8 +16,8 @@
 //! - **Factor reuse:** the numeric factor is kept between iterations (and, by the caller's
 //!   pattern, between steps) and refreshed at the current iterate when the line search had to cut
 //!   the step or the residual fell less than 4× in an iteration. In the interactive mode
-//!   ([`super::NewtonSettings::quasi_newton`]; off by default, the robustness suite's hard cases
-//!   are measured without it) the 4× rule gives way to a weighing: the factor is refreshed when
+//!   ([`super::NewtonPolicy::Interactive`]; chosen by the problem by default, `newton.rs`) the
+//!   4× rule gives way to a weighing: the factor is refreshed when
 //!   the residual no longer halves, or when keeping it costs more than a refresh:
 //!   a refresh costs [`LinearSolver::refresh_cost_in_iterations`] iterations `R`; an iteration
 //!   whose residual fell by less than 4× (ratio `ρ`) predicts `n = ln(tol/r)/ln ρ` more kept-factor
@@ -49,21 +49,24 @@
 //!   (`t = 1`) that moves no coordinate by more than `1e-12` of the body's size and no longer
 //!   reduces the residual 4× (stalled at round-off: converged for a time step, whose start may
 //!   already be the minimiser; the static solver asks for the tolerance).
-//! - **Bits:** the factorisation and solves run on one thread (`Par::Seq`) and the element
-//!   Hessians are summed in a fixed order, so results do not depend on the thread count.
+//! - **Bits:** the factorisation and solves run on one thread (`Par::Seq`), the element
+//!   Hessians are summed in a fixed order and the gradient passes add their ranges in a fixed
+//!   order (`fem::energy`), so results do not depend on the thread count. (faer's parallel
+//!   factorisation on two threads made the 34k-unknown bracket's factorising frames slower,
+//!   p95 297 ms against 211, docs/journal/performance.md session 31.)
 //! - **Settings:** tolerance, iteration limit and refactoring from [`super::NewtonSettings`].
 
 use super::error::SolverCounters;
 use super::residual::load_scale;
-use super::settings::NewtonSettings;
+use super::settings::{NewtonPolicy, NewtonSettings};
 use super::sparse::{SparseError, SparsePattern};
+
+/// The factorisation runs on one thread: results independent of the thread count.
+const SEQ: faer::Par = faer::Par::Seq;
 use crate::Vec3;
 use crate::fem::geometry::BlockGeometry;
 use crate::material::Material;
 use crate::mesh::Mesh;
-
-/// The factorisation runs on one thread: results independent of the thread count.
-const SEQ: faer::Par = faer::Par::Seq;
 
 /// Residual decrease per iteration at or below which the kept factor is kept without weighing.
 const SLOW_RATIO: f64 = 0.25;
@@ -380,8 +383,10 @@ pub(crate) fn minimise(
     }
     let mut refactor = settings.refactor_every_iteration || !linear.is_ready();
     let refresh_cost = linear.refresh_cost_in_iterations();
-    linear.set_single_precision(settings.quasi_newton);
-    let correct_by_secants = settings.quasi_newton && linear.solves_exactly() && !settings.refactor_every_iteration;
+    // the caller resolves `Auto` (`newton.rs`); left unresolved it is the careful policy
+    let interactive = settings.policy == NewtonPolicy::Interactive;
+    linear.set_single_precision(interactive);
+    let correct_by_secants = interactive && linear.solves_exactly() && !settings.refactor_every_iteration;
     if scratch.pairs.pairs.front().is_some_and(|(s, _, _)| s.len() != linear.free_dofs()) {
         scratch.pairs.clear();
     }
@@ -479,7 +484,7 @@ pub(crate) fn minimise(
         // a step's first iteration says little of the factor: from the predictor even a fresh
         // factor's full Newton step contracts the residual only 2–3× on a swinging body (the
         // nonlinearity), and a fresh factor then converges quadratically
-        let slow = if settings.quasi_newton {
+        let slow = if interactive {
             iteration > 0 && kept_factor_costs_more(old_norm, new_norm, target, refresh_cost, scratch.debt_iterations)
         } else {
             new_norm > SLOW_RATIO * old_norm

@@ -151,16 +151,61 @@ pub struct NewtonSettings {
     /// Refactor the stiffness at every iteration (pure Newton) instead of reusing the last
     /// factorisation while it keeps converging fast.
     pub refactor_every_iteration: bool,
-    /// The interactive mode (issue #37, `newton_core.rs`): the factor kept across steps in single
-    /// precision, corrected by secant pairs (L-BFGS) and refreshed when keeping it costs more
-    /// than a factorisation. Off: the factor refreshed whenever the residual falls less than 4×
-    /// in an iteration, in double precision (the robustness suite's hard cases are measured so).
-    pub quasi_newton: bool,
+    /// How the factor is kept between iterations and steps ([`NewtonPolicy`]): by default
+    /// chosen by the problem.
+    pub policy: NewtonPolicy,
 }
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { tolerance: 1e-6, max_iterations: 30, refactor_every_iteration: false, quasi_newton: false }
+        Self { tolerance: 1e-6, max_iterations: 30, refactor_every_iteration: false, policy: NewtonPolicy::Auto }
+    }
+}
+
+/// How Newton keeps its factor (`newton_core.rs`; issue #61: the interactive mode made the
+/// default where it pays).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum NewtonPolicy {
+    /// Chosen by the problem (`newton.rs`): interactive for a time step whose factorisation costs
+    /// at least [`NewtonPolicy::INTERACTIVE_FROM_ITERATIONS`] iterations with the kept factor (a
+    /// large part: the P2 tube's costs 17), careful for a smaller one (refreshing is cheap there)
+    /// and for a static solve; and careful from the first step the step watch rejects on, for the
+    /// rest of the run. Which ran and why is reported ([`crate::solver::Simulation::newton_policy`]).
+    #[default]
+    Auto,
+    /// The interactive mode (issue #37): the factor kept across steps in single precision,
+    /// corrected by secant pairs (L-BFGS) and refreshed when keeping it costs more than a
+    /// factorisation.
+    Interactive,
+    /// The factor refreshed whenever the residual falls less than 4× in an iteration, in double
+    /// precision.
+    Careful,
+}
+
+/// The policy a Newton step ran ([`NewtonPolicy::Interactive`] or [`NewtonPolicy::Careful`]) and
+/// why, in words (`hox simulate --json`'s `newton_policy` and `newton_policy_why`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewtonPolicyReport {
+    pub ran: NewtonPolicy,
+    pub why: String,
+}
+
+impl NewtonPolicy {
+    pub const ALL: [NewtonPolicy; 3] = [NewtonPolicy::Auto, NewtonPolicy::Interactive, NewtonPolicy::Careful];
+    /// Auto's threshold: the refresh cost, in iterations with the kept factor, from which a time
+    /// step is solved interactively. The P2 8×2×2 beam's costs 4 (careful, as the robustness
+    /// suite's small meshes); the P3 8×2×2 beam's 9, P1 refined twice 15, the P2 hook's 14, the
+    /// P2 tube's 18 (interactive).
+    pub const INTERACTIVE_FROM_ITERATIONS: f64 = 6.0;
+    pub fn name(self) -> &'static str {
+        match self {
+            NewtonPolicy::Auto => "auto",
+            NewtonPolicy::Interactive => "interactive",
+            NewtonPolicy::Careful => "careful",
+        }
+    }
+    pub fn from_name(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == s)
     }
 }
 

@@ -17,6 +17,7 @@ use super::xpbd::Xpbd;
 
 /// The guards of a step: the step watch and the NaN guard's check and roll-back.
 mod guard;
+mod said;
 use crate::Vec3;
 use crate::effect::{Effect, EffectState};
 use crate::fem::energy::total_energy;
@@ -217,20 +218,15 @@ impl Simulation {
     }
 
     /// The XPBD solver's state, when it is the one running (tests of its schedule).
+    /// The step solver, to tell it what the step watch would (tests).
+    #[cfg(test)]
+    pub(crate) fn step_solver_mut(&mut self) -> &mut dyn super::step::StepSolver {
+        self.solver.as_mut()
+    }
+
     #[cfg(test)]
     pub(crate) fn xpbd_solver(&self) -> Option<&Xpbd> {
         self.solver.as_any().downcast_ref::<Xpbd>()
-    }
-
-    /// A few words on the solver's work for a status line ("xpbd, 1,200 constraints").
-    pub fn work_summary(&self) -> String {
-        self.solver.work_summary(&self.settings, &self.counters)
-    }
-
-    /// The relative residual of each Newton iteration of the last step (empty for the others).
-    #[doc(hidden)]
-    pub fn last_step_residuals(&self) -> &[f64] {
-        self.solver.last_step_residuals()
     }
 
     /// The acceleration every free node feels from the effects (gravity), m/s².

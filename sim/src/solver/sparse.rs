@@ -70,7 +70,7 @@ pub(crate) struct SparsePattern {
     factor_single: Vec<f32>,
     /// Whether the held factor is [`Self::factor_single`].
     single: bool,
-    /// Whether a time step's factor may be single precision (`NewtonSettings::quasi_newton`).
+    /// Whether a time step's factor may be single precision (`NewtonPolicy::Interactive`).
     pub single_precision: bool,
     factored: bool,
     /// What the pattern's work has cost so far.

@@ -18,7 +18,7 @@
 
 use super::error::SolverCounters;
 use super::newton_core::{Failure, HessianModel, Objective, Outcome, Scratch, minimise};
-use super::settings::NewtonSettings;
+use super::settings::{NewtonPolicy, NewtonSettings};
 pub use super::sparse::SparseCost;
 use super::sparse::{SparseError, SparsePattern};
 use crate::Vec3;
@@ -152,7 +152,7 @@ impl StaticProblem<'_> {
             tolerance: self.tolerance,
             max_iterations: MAX_ITERATIONS_PER_INCREMENT,
             refactor_every_iteration: false,
-            quasi_newton: false,
+            policy: NewtonPolicy::Careful,
         }
     }
 }

@@ -120,6 +120,12 @@ pub(crate) trait StepSolver: Send {
     fn last_step_failed(&self) -> bool {
         false
     }
+    /// The step watch rejected the step that started at `time_secs` (it is taken again in halves).
+    fn step_rejected(&mut self, _time_secs: f64) {}
+    /// The policy a Newton-type solver's last step ran and why.
+    fn newton_policy(&self) -> Option<&super::settings::NewtonPolicyReport> {
+        None
+    }
     /// The relative residual of each iteration of the last step (Newton; for tests).
     fn last_step_residuals(&self) -> &[f64] {
         &[]

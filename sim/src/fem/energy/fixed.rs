@@ -64,12 +64,14 @@ pub fn point_energy_and_gradient<const P: usize, const FMA: bool, const GRAD: bo
 }
 
 /// One block's mesh pass: its elements, their geometry, the rest positions and the positions.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub(super) struct Pass<'a> {
     pub block: &'a ElementBlock,
     pub geometry: &'a BlockGeometry,
     pub rest: &'a [Vec3],
     pub x: &'a [Vec3],
+    /// The block's elements this pass visits.
+    pub elements: std::ops::Range<usize>,
 }
 
 /// `Σ_e U_e` over the pass's block, and with `GRAD` each element's `∇_i U_e` added to
@@ -82,10 +84,10 @@ fn block_pass<const N: usize, const P: usize, const FMA: bool, const GRAD: bool,
     material: &M,
     grad_out: &mut [Vec3],
 ) -> f64 {
-    let Pass { block, geometry, rest, x } = pass;
+    let Pass { block, geometry, rest, x, elements } = pass;
     let mut total = 0.0;
-    for (e, nodes) in block.elements().enumerate() {
-        let nodes: &[u32; N] = nodes.try_into().expect("N nodes");
+    for e in elements {
+        let nodes: &[u32; N] = block.element(e).try_into().expect("N nodes");
         let mut u = [[0.0; P]; 3];
         for i in 0..N {
             let d = x[nodes[i] as usize] - rest[nodes[i] as usize];
@@ -177,4 +179,14 @@ pub(super) fn block_energy_and_gradient_fused<const GRAD: bool>(
         };
     }
     crate::fem::specialised_node_counts!(dispatch)
+}
+
+/// Whether blocks of `nodes_per_element` nodes have a kernel here.
+pub(super) fn has_kernel(nodes_per_element: usize) -> bool {
+    macro_rules! listed {
+        ($(($n:literal, $p:literal)),*) => {
+            matches!(nodes_per_element, $($n)|*)
+        };
+    }
+    crate::fem::specialised_node_counts!(listed)
 }

@@ -110,8 +110,14 @@ fn the_fixed_node_count_kernel_matches_the_generic_one_for_every_element_type_an
             let name = format!("{et} {:?}", material.model);
             for fma in [false, true] {
                 let mut g = vec![Vec3::zeros(); x.len()];
-                let pass = fixed::Pass { block: &mesh.blocks[0], geometry: &geo[0], rest: &mesh.rest_positions, x: &x };
-                let e = fixed::block_energy_and_gradient_fused::<true>(pass, &material, &mut g, fma)
+                let pass = fixed::Pass {
+                    block: &mesh.blocks[0],
+                    geometry: &geo[0],
+                    rest: &mesh.rest_positions,
+                    x: &x,
+                    elements: 0..mesh.blocks[0].len(),
+                };
+                let e = fixed::block_energy_and_gradient_fused::<true>(pass.clone(), &material, &mut g, fma)
                     .unwrap_or_else(|| panic!("{name}: no specialised kernel"));
                 let e_only = fixed::block_energy_and_gradient_fused::<false>(pass, &material, &mut [], fma)
                     .expect("specialised");

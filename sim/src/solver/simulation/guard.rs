@@ -65,6 +65,7 @@ impl Simulation {
         self.prev_positions.copy_from_slice(&self.positions);
         self.history.clear();
         self.solver.reset_history(false, self.positions.len());
+        self.solver.step_rejected(start_time);
         self.counters.rejected_steps += 1;
         if halvings == MAX_HALVINGS {
             let err = match excess {
