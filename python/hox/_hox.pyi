@@ -107,6 +107,12 @@ class Simulation:
     @property
     def ms_per_frame(self) -> float: ...
     @property
+    def newton_policy(self) -> tuple[str, str] | None:
+        """(policy, why) of Newton's last step; None for XPBD and VBD."""
+    @property
+    def solver_advice(self) -> str | None:
+        """Which solver fits this body better, when the one chosen does not."""
+    @property
     def frame_ms(self) -> npt.NDArray[np.float64]: ...
     @property
     def num_nodes(self) -> int: ...

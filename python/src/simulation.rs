@@ -394,6 +394,20 @@ impl PySimulation {
         if ms.is_empty() { f64::NAN } else { hox_sim::measure::median(&mut ms) }
     }
 
+    /// The policy Newton's last step ran ("interactive" or "careful") and why, as `hox simulate
+    /// --json`'s `newton_policy` and `newton_policy_why`; None for XPBD, VBD and before a step.
+    #[getter]
+    fn newton_policy(&self) -> Option<(String, String)> {
+        self.running().instance.sim.newton_policy().map(|p| (p.ran.name().to_string(), p.why.clone()))
+    }
+
+    /// What the app and `hox simulate` say when the solver is not the one for this body (VBD on
+    /// a curved or hollow part), naming the one that is; None otherwise.
+    #[getter]
+    fn solver_advice(&self) -> Option<String> {
+        hox_scenes::run::solver_advice(&self.running().instance)
+    }
+
     /// The wall-clock time of every frame stepped by `step`, milliseconds.
     #[getter]
     fn frame_ms<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {

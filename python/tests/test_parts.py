@@ -62,3 +62,19 @@ def test_vbd_on_the_part_says_it_is_not_the_solver_and_names_newton(hox_binary, 
     # a box beam, which VBD's coarse grid fills, is not advised against
     beam, stderr = hox_json(hox_binary, "simulate", "--scene", "bending", "--solver", "vbd", "--seconds", "0.05")
     assert beam["solver_advice"] is None and "not the solver" not in stderr
+
+
+def test_python_says_the_policy_and_the_advice_as_the_command_line(bracket):
+    import hox
+
+    scene = hox.Scene.from_mesh_file(str(bracket), clamp=["clamp"])
+    sim = hox.Simulation(scene)
+    assert sim.newton_policy is None, "before a step"
+    sim.step(1)
+    policy, why = sim.newton_policy
+    assert policy == "interactive" and why.startswith("auto: a factorisation of the"), why
+    assert sim.solver_advice is None
+    vbd = hox.Simulation(scene.with_params(solver="vbd"))
+    vbd.step(1)
+    assert vbd.newton_policy is None
+    assert vbd.solver_advice.startswith("vbd is not the solver for this part"), vbd.solver_advice
