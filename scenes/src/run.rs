@@ -394,12 +394,7 @@ pub fn solver_advice(instance: &Instance) -> Option<String> {
     if sim.method() != hox_sim::solver::Method::Vbd || instance.scene.mesh_kind() == MeshKind::Box {
         return None;
     }
-    let rest = &sim.mesh().rest_positions;
-    let (lo, hi) = rest
-        .iter()
-        .fold((hox_sim::Vec3::repeat(f64::INFINITY), hox_sim::Vec3::repeat(f64::NEG_INFINITY)), |(lo, hi), p| {
-            (lo.inf(p), hi.sup(p))
-        });
+    let (lo, hi) = sim.mesh().bounding_box();
     let box_m3 = (hi - lo).iter().product::<f64>();
     let fill = hox_sim::fem::geometry::total_volume_m3(sim.geometry()) / box_m3;
     (fill < VBD_LEAST_BOX_FILL).then(|| {

@@ -62,8 +62,9 @@ pub(crate) struct Newton<L: LinearSolver = SparsePattern> {
     failed: bool,
     /// The policy the last step ran and why.
     report: Option<NewtonPolicyReport>,
-    /// Whether the last step's settings asked for `Auto`.
-    asked_auto: bool,
+    /// The policy and `refactor_every_iteration` the report was resolved for (it is resolved
+    /// again when they change, the pattern is remade or `Auto` falls back: not every step).
+    asked: Option<(NewtonPolicy, bool)>,
     /// Why `Auto` turned careful for good (a step the watch rejected under the interactive one).
     fell_back: Option<String>,
 }
@@ -82,7 +83,7 @@ impl<L: LinearSolver> Newton<L> {
             scratch: Scratch::default(),
             failed: false,
             report: None,
-            asked_auto: false,
+            asked: None,
             fell_back: None,
         }
     }
@@ -130,6 +131,7 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
     fn rebuild(&mut self, _mesh: &Mesh, _geometry: &[BlockGeometry], _settings: &SolverSettings, _geo: bool) {
         self.pattern = None;
         self.fell_back = None;
+        self.report = None;
     }
 
     fn last_step_residuals(&self) -> &[f64] {
@@ -142,10 +144,12 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
 
     fn step_rejected(&mut self, time_secs: f64) {
         let interactive = self.report.as_ref().is_some_and(|r| r.ran == NewtonPolicy::Interactive);
-        if interactive && self.asked_auto && self.fell_back.is_none() {
+        let auto = self.asked.is_some_and(|(policy, _)| policy == NewtonPolicy::Auto);
+        if interactive && auto && self.fell_back.is_none() {
             self.fell_back = Some(format!(
                 "auto: interactive until the step watch rejected the step from {time_secs:.3} s; careful since (on this mesh and material)"
             ));
+            self.report = None;
         }
     }
 
@@ -174,15 +178,19 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
             _ => {
                 self.pattern = Some(L::for_mesh(s.mesh, &|i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?);
                 self.fell_back = None;
+                self.report = None;
             }
         }
         self.made_for = (s.model_version, s.inertia_h);
         let pattern = self.pattern.as_mut().expect("made above");
-        let report =
-            resolve(settings, pattern.refresh_cost_in_iterations(), pattern.free_dofs(), self.fell_back.as_deref());
-        self.asked_auto = settings.policy == NewtonPolicy::Auto;
-        let settings = NewtonSettings { policy: report.ran, ..settings };
-        self.report = Some(report);
+        let asked = (settings.policy, settings.refactor_every_iteration);
+        if self.report.is_none() || self.asked != Some(asked) {
+            let (cost, dofs) = (pattern.refresh_cost_in_iterations(), pattern.free_dofs());
+            self.report = Some(resolve(settings, cost, dofs, self.fell_back.as_deref()));
+            self.asked = Some(asked);
+        }
+        let ran = self.report.as_ref().map_or(NewtonPolicy::Careful, |r| r.ran);
+        let settings = NewtonSettings { policy: ran, ..settings };
         self.y.clear();
         self.y.extend_from_slice(positions);
         for (i, x) in positions.iter_mut().enumerate() {
