@@ -77,9 +77,14 @@ pub fn solve_static(
     progress: hox_sim::solver::statics::Progress<'_>,
 ) -> Result<hox_sim::solver::statics::StaticSolution, SceneError> {
     let (acceleration_m_s2, dirichlet) = static_problem(scene, mesh)?;
+    // the formulation's material: the mixed one measures its hydrostatic term per element
+    let material = scene.settings().formulated(&scene.material(), mesh).map_err(|e| SceneError::Simulation {
+        source_name: scene.source.clone(),
+        message: format!("static solve: {e}"),
+    })?;
     let problem = hox_sim::solver::statics::StaticProblem {
         mesh,
-        material: scene.material(),
+        material,
         quadrature_degree: scene.settings().quadrature_degree,
         acceleration_m_s2,
         dirichlet,

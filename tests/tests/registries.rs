@@ -185,8 +185,15 @@ fn every_registered_element_and_material_meshes_steps_and_exports() {
             for formulation in Formulation::ALL {
                 for parallel in [false, true] {
                     let what = format!("{et} {model} {formulation} {}", if parallel { "parallel" } else { "serial" });
-                    let mut instance = Instance::new(bending(et, model, parallel, formulation))
-                        .unwrap_or_else(|e| panic!("{what}: {e}"));
+                    let built = Instance::new(bending(et, model, parallel, formulation));
+                    // the mixed formulation runs high order with stvk or nh, and refuses the rest by name
+                    if formulation == Formulation::Mixed && (et.order() < 2 || !["stvk", "nh"].contains(&model.name()))
+                    {
+                        let refused = built.err().unwrap_or_else(|| panic!("{what}: not refused")).to_string();
+                        assert!(refused.contains("mixed formulation"), "{what}: {refused}");
+                        continue;
+                    }
+                    let mut instance = built.unwrap_or_else(|e| panic!("{what}: {e}"));
                     let mesh = instance.sim.mesh();
                     assert!(mesh.blocks.len() == 1 && mesh.blocks[0].element_type == et, "{what}: a box of {et}");
                     assert_eq!(instance.sim.material().model, model, "{what}");

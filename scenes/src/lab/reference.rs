@@ -427,7 +427,8 @@ impl Lookup {
     /// quadrature it is integrated with.
     pub fn key(&self, scene: &Scene) -> String {
         if scene.is_box() {
-            format!("{}; Q2 levels up to {} cells", physics_key(scene), self.finest_cells)
+            let kind = compute::Levels::of(scene).element_name();
+            format!("{}; {kind} levels up to {} cells", physics_key(scene), self.finest_cells)
         } else if scene.mesh_kind() == MeshKind::Files {
             format!(
                 "{}; the part's highest order, quadrature {:?}",
@@ -584,7 +585,7 @@ impl Lookup {
         let grid = levels(p.box_min_m, p.box_max_m, self.finest_cells)[2];
         let level = level_scene(scene, grid)?;
         let mesh = level.build_mesh()?;
-        let what = format!("computing reference field: static Q2 {}×{}×{}", grid[0], grid[1], grid[2]);
+        let what = format!("computing reference field: static {}", compute::Levels::of(scene).name(grid));
         let solution = crate::instance::solve_static(
             &level,
             &mesh,

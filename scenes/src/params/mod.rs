@@ -243,11 +243,11 @@ params! {
         help: "How Newton keeps its factor. auto (the default): interactive where a factorisation costs at least 6 iterations with the kept factor (a part of thousands of nodes), careful on smaller meshes, and careful from the first step the step watch rejects; `--json` says which ran and why. interactive: the factor kept across steps in single precision, corrected by secant pairs (L-BFGS) and refreshed only when keeping it costs more than a factorisation. careful: refreshed whenever an iteration reduces the residual less than 4×, in double precision.",
         kind: Kind::Choice(newton_policy_options), ..BASE
     }
-    /// energy | split.
+    /// energy | split | mixed.
     #[serde(with = "as_text")]
     formulation: Formulation = solver().formulation => {
         key: "formulation", group: Group::Solver, file_key: "formulation", label: "Formulation",
-        help: "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point.",
+        help: "Energy: one constraint C = √(2U) per element (the paper's); split: deviatoric and hydrostatic constraints per quadrature point (XPBD); mixed: the volume measured once per element (one constant pressure), which cures volumetric locking near ν = 0.5, on every solver (P2, P3, Q2; stvk, nh).",
         kind: Kind::Choice(formulation_options), ..BASE
     }
     /// None: each element type's default degree.

@@ -21,17 +21,52 @@
 
 use crate::Vec3;
 use crate::fem::geometry::{BlockGeometry, deformation_gradient};
-use crate::material::{Material, contract, contract_left, contract_right};
+use crate::material::{Material, NodeVisit, VolumeMeasure, contract, contract_left, contract_right};
 use crate::mesh::Mesh;
 use nalgebra::DMatrix;
 
 mod chunks;
 mod fixed;
+pub mod mixed;
 pub use fixed::point_energy_and_gradient;
+
+/// `Σ_q V_q (P(F_q) g_q, B(F_q, g_q))` over one node's visit of an element (vertex block descent):
+/// the material's [`Material::node_visit`], or the mixed formulation's when its hydrostatic term
+/// is measured over the element ([`mixed::node_visit`]).
+#[inline]
+pub fn node_visit(
+    material: &Material,
+    l: crate::material::Lame,
+    visit: NodeVisit<'_>,
+) -> (Vec3, nalgebra::Matrix3<f64>) {
+    match material.volume_measure {
+        VolumeMeasure::Point => material.node_visit(l, visit),
+        VolumeMeasure::Element => mixed::node_visit(material, visit),
+    }
+}
+
+/// `Σ_q V_q ψ(F_q)` of the element a visit's points are (or the mixed formulation's energy).
+pub fn visit_energy(material: &Material, l: crate::material::Lame, visit: NodeVisit<'_>) -> f64 {
+    if material.volume_measure != VolumeMeasure::Point {
+        return mixed::visit_energy(material, visit);
+    }
+    let law = material.model.law();
+    let mut e = 0.0;
+    for (p, &v) in visit.volumes.iter().enumerate() {
+        if v != 0.0 {
+            let (f, _, _) = visit.point(p / visit.width, p % visit.width);
+            e += v * law.energy_density(l, &f);
+        }
+    }
+    e
+}
 
 /// `U_e` for gathered positions `x` (one per element node); `grads` holds the material
 /// gradients of all quadrature points (`points × nodes`), `volumes` one entry per point.
 pub fn element_energy(x: &[Vec3], rest: &[Vec3], grads: &[Vec3], volumes: &[f64], material: &Material) -> f64 {
+    if material.volume_measure != VolumeMeasure::Point {
+        return mixed::element_energy(x, rest, grads, volumes, material);
+    }
     let n = x.len();
     volumes
         .iter()
@@ -49,6 +84,9 @@ pub fn element_energy_and_gradient(
     material: &Material,
     grad_out: &mut [Vec3],
 ) -> f64 {
+    if material.volume_measure != VolumeMeasure::Point {
+        return mixed::element_energy_and_gradient(x, rest, grads, volumes, material, grad_out);
+    }
     let n = x.len();
     grad_out.iter_mut().for_each(|g| *g = Vec3::zeros());
     let mut energy = 0.0;
@@ -75,23 +113,45 @@ pub fn element_hessian(
     material: &Material,
     projected: bool,
 ) -> DMatrix<f64> {
+    if material.volume_measure != VolumeMeasure::Point {
+        return mixed::element_hessian(x, rest, grads, volumes, material, projected);
+    }
     let n = x.len();
-    let m = 3 * n;
-    let mut h = DMatrix::zeros(m, m);
-    let out = h.as_mut_slice();
-    let mut right = vec![[0.0; 27]; n];
+    let mut h = PointBlocks::new(n);
     for (q, v) in volumes.iter().enumerate() {
         let g = &grads[q * n..(q + 1) * n];
         let f = deformation_gradient(x, rest, g);
         let c = if projected { material.dpdf_projected(&f) } else { material.dpdf(&f) };
+        h.add(&c, g, *v);
+    }
+    h.finish()
+}
+
+/// An element Hessian summed point by point, `Σ_q V_q C_q(∇_X N_i, ∇_X N_j)` for a symmetric
+/// tangent `C_q` (9×9) at each point: the one assembly [`element_hessian`] and the mixed
+/// formulation's share.
+pub(crate) struct PointBlocks {
+    h: DMatrix<f64>,
+    right: Vec<[f64; 27]>,
+}
+
+impl PointBlocks {
+    pub(crate) fn new(nodes: usize) -> Self {
+        Self { h: DMatrix::zeros(3 * nodes, 3 * nodes), right: vec![[0.0; 27]; nodes] }
+    }
+
+    /// Adds `V C(∇N_i, ∇N_j)` of one point (`g` its material gradients) to the upper blocks.
+    pub(crate) fn add(&mut self, c: &crate::material::Mat9, g: &[Vec3], v: f64) {
+        let m = self.h.nrows();
+        let out = self.h.as_mut_slice();
         // the contraction in two stages (`contract_right` once per node, then 27 products per
         // pair) over the pairs `i ≥ j` only: `C` is symmetric (a Hessian), so block `(j, i)` is
         // block `(i, j)` transposed: the lower triangle is mirrored at the end (the diagonal
         // blocks' too, so that the result is exactly symmetric)
-        for (t, gj) in right.iter_mut().zip(g) {
-            *t = contract_right(&c, &(gj * *v));
+        for (t, gj) in self.right.iter_mut().zip(g) {
+            *t = contract_right(c, &(gj * v));
         }
-        for (j, t) in right.iter().enumerate() {
+        for (j, t) in self.right.iter().enumerate() {
             for (i, gi) in g.iter().enumerate().skip(j) {
                 let block = contract_left(t, gi);
                 for b in 0..3 {
@@ -103,12 +163,18 @@ pub fn element_hessian(
             }
         }
     }
-    for col in 0..m {
-        for row in col + 1..m {
-            out[row * m + col] = out[col * m + row];
+
+    /// The upper blocks mirrored: the exactly symmetric Hessian (3n × 3n, node-major).
+    pub(crate) fn finish(mut self) -> DMatrix<f64> {
+        let m = self.h.nrows();
+        let out = self.h.as_mut_slice();
+        for col in 0..m {
+            for row in col + 1..m {
+                out[row * m + col] = out[col * m + row];
+            }
         }
+        self.h
     }
-    h
 }
 
 /// One node's share of an element: `∂U_e/∂x_a = Σ_q V_q P(F_q) ∇_X N_a(r_q)` and the diagonal
@@ -124,6 +190,9 @@ pub fn element_node_gradient_and_block(
     a: usize,
     projected: bool,
 ) -> (Vec3, nalgebra::Matrix3<f64>) {
+    if material.volume_measure != VolumeMeasure::Point {
+        return mixed::element_node_gradient_and_block(x, rest, grads, volumes, material, a, projected);
+    }
     let n = x.len();
     let mut grad = Vec3::zeros();
     let mut block = nalgebra::Matrix3::zeros();
@@ -257,6 +326,8 @@ fn mesh_pass(
     if let Some(g) = gradient_out.as_deref_mut() {
         g.iter_mut().for_each(|v| *v = Vec3::zeros());
     }
+    // the specialised kernels are the point law's: the mixed element takes the generic ones
+    let specialised = specialised && material.volume_measure == VolumeMeasure::Point;
     let mut total = 0.0;
     for (bi, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
         let pass =

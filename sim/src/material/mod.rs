@@ -34,7 +34,9 @@
 //!   stiffnesses k_t are [`Material::split_stiffness_pa`]. The XPBD compliance
 //!   of term t at a quadrature point of reference volume V_q is 1/(k_t · V_q).
 
-use nalgebra::{SMatrix, Vector3};
+use nalgebra::{SMatrix, SVector, Vector3};
+
+type Vector9 = SVector<f64, 9>;
 
 #[cfg(test)]
 mod testing;
@@ -155,6 +157,9 @@ pub trait SplitModel: Sync + Send {
     fn split_stiffness_pa(&self, l: Lame) -> [f64; 2];
     /// The constant c with ψ = Σ_t k_t/2 C_t² + c.
     fn split_energy_offset(&self, l: Lame) -> f64;
+    /// `∂²C_h/∂F²` of the hydrostatic term (9×9 on column-major vec(F), symmetric): what the mixed
+    /// formulation's Hessian needs besides the model's tangent (`crate::fem::energy::mixed`).
+    fn hydrostatic_hessian(&self, l: Lame, f: &Mat3) -> Mat9;
 }
 
 /// One node's visit of one element (vertex block descent): the element's `F_q` at its points,
@@ -295,6 +300,20 @@ pub enum MaterialError {
     /// ρ is not a finite number > 0.
     #[error("density must be a finite positive number of kg/m³, got {density_kg_m3}")]
     Density { density_kg_m3: f64 },
+    /// The mixed formulation asked of a model without a split.
+    #[error(
+        "the mixed formulation measures a material's hydrostatic term over the element, and {model} has no \
+         deviatoric/hydrostatic split; use stvk or nh"
+    )]
+    NoSplit { model: MaterialModel },
+    /// The mixed formulation asked of a model whose deviatoric term is not stable alone.
+    #[error(
+        "the mixed formulation leaves {model}'s deviatoric term to hold each quadrature point alone, and that \
+         term is not stable alone: its tangent at rest has the eigenvalue {min_eigenvalue_pa:.3e} Pa (it \
+         carries a stress at rest that the hydrostatic term cancels, so a dilatation inside an element would \
+         release energy); use stvk or nh"
+    )]
+    DeviatoricUnstable { model: MaterialModel, min_eigenvalue_pa: f64 },
     /// E and ν are individually valid but μ or λ overflows `f64`.
     #[error(
         "Young's modulus {youngs_modulus_pa} Pa with Poisson ratio {poisson_ratio} gives \
@@ -317,8 +336,23 @@ pub struct Material {
     pub youngs_modulus_pa: f64,
     pub poisson_ratio: f64,
     pub density_kg_m3: f64,
+    /// Where the hydrostatic term of the model's split is measured: at each quadrature point
+    /// (the default: ψ itself), or over each element (the mixed formulation; set through
+    /// [`Material::with_volume_measure`], which checks the model can be measured so).
+    pub volume_measure: VolumeMeasure,
     /// Forces construction through [`Material::new`].
     _validated: (),
+}
+
+/// Where a material's hydrostatic term is measured ([`Material::volume_measure`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum VolumeMeasure {
+    /// At every quadrature point: the element's energy is `Σ_q V_q ψ(F_q)`.
+    #[default]
+    Point,
+    /// Over the element: the hydrostatic term of the split at the element's mean `C̄_h`, the
+    /// deviatoric term at each point (the mixed formulation, `crate::fem::energy::mixed`).
+    Element,
 }
 
 /// One split constraint at a quadrature point.
@@ -406,7 +440,40 @@ impl Material {
                 lambda_pa: lame.lambda_pa,
             });
         }
-        Ok(Material { model, youngs_modulus_pa, poisson_ratio, density_kg_m3, _validated: () })
+        Ok(Material {
+            model,
+            youngs_modulus_pa,
+            poisson_ratio,
+            density_kg_m3,
+            volume_measure: VolumeMeasure::Point,
+            _validated: (),
+        })
+    }
+
+    /// This material with its hydrostatic term measured at `measure`. Measuring it over the element
+    /// needs the model's split (`NoSplit` else) with a deviatoric term that is stable alone: the
+    /// tangent a point keeps at rest, `∂P/∂F − k_h (G_h ⊗ G_h + C_h ∂²C_h/∂F²) + p ∂²C_h/∂F²` with
+    /// the element's pressure `p = k_h C_h` there, i.e. `∂P/∂F − k_h G_h ⊗ G_h` at F = I, positive
+    /// semi-definite (`DeviatoricUnstable` else: stable Neo-Hookean's, whose deviatoric term
+    /// carries μ at rest, balanced by a pressure −μ that then softens every point's dilatation).
+    pub fn with_volume_measure(self, measure: VolumeMeasure) -> Result<Material, MaterialError> {
+        if measure == VolumeMeasure::Element {
+            let Some(split) = self.model.law().split() else {
+                return Err(MaterialError::NoSplit { model: self.model });
+            };
+            let (l, i) = (self.lame(), Mat3::identity());
+            let [_, h] = split.split_terms(l, &i);
+            let k_h = split.split_stiffness_pa(l)[1];
+            let g = Vector9::from_column_slice(h.grad_f_scaled.as_slice());
+            let a = self.dpdf(&i) - g * g.transpose() * k_h;
+            let sym = (a + a.transpose()) * 0.5;
+            let min = sym.symmetric_eigenvalues().min();
+            let scale = sym.amax();
+            if min < -1e-9 * scale {
+                return Err(MaterialError::DeviatoricUnstable { model: self.model, min_eigenvalue_pa: min });
+            }
+        }
+        Ok(Material { volume_measure: measure, ..self })
     }
 
     /// Lamé parameters μ, λ of this material.
@@ -443,6 +510,9 @@ impl Material {
     /// The point law the XPBD sweep runs inline for this material, if its model offers one
     /// ([`HyperelasticModel::fast_law`]).
     pub fn fast_law(&self) -> Option<FastLaw> {
+        if self.volume_measure != VolumeMeasure::Point {
+            return None;
+        }
         self.model.law().fast_law(self.lame())
     }
 
@@ -467,7 +537,11 @@ impl Material {
     }
 
     /// [`HyperelasticModel::node_visit_kernel`].
+    /// None when the hydrostatic term is measured over the element (the kernels are the point law's).
     pub fn node_visit_kernel(&self, width: usize) -> Option<NodeVisitKernel> {
+        if self.volume_measure != VolumeMeasure::Point {
+            return None;
+        }
         self.model.law().node_visit_kernel(width)
     }
 
@@ -506,6 +580,14 @@ impl Material {
     /// Whether the model offers XPBD's split constraints ([`HyperelasticModel::split`]).
     pub fn has_split(&self) -> bool {
         self.model.law().split().is_some()
+    }
+
+    /// `∂²C_h/∂F²` of the hydrostatic split term ([`SplitModel::hydrostatic_hessian`]).
+    ///
+    /// # Panics
+    /// As [`Material::split_terms`].
+    pub fn hydrostatic_hessian(&self, f: &Mat3) -> Mat9 {
+        self.split_law().hydrostatic_hessian(self.lame(), f)
     }
 
     fn split_law(&self) -> &dyn SplitModel {

@@ -136,6 +136,14 @@ impl SplitModel for NeoHookean {
     fn split_energy_offset(&self, _l: Lame) -> f64 {
         0.0
     }
+
+    /// `C_h = ln J` (continued linearly below the floor): `d(L' cof F)[dF] = L' d(cof F)[dF] +
+    /// L'' (cof F : dF) cof F`.
+    fn hydrostatic_hessian(&self, _l: Lame, f: &Mat3) -> Mat9 {
+        let log = log_j(f);
+        let cof = cofactor(f);
+        dpdf_from_directional(|df| cofactor_directional(f, df) * log.d1 + cof * (log.d2 * cof.dot(df)))
+    }
 }
 
 /// `dP[dF] = μ dF + g'(J) (cof F : dF) cof F + g(J) d(cof F)[dF]`, `g = (λ ln J − μ) (ln J)'`.

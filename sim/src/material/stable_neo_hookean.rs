@@ -118,6 +118,11 @@ impl SplitModel for StableNeoHookean {
         // −3μ/2 − μ²/(2λ̂), with μ²/λ̂ = μ r.
         -1.5 * l.mu_pa - 0.5 * l.mu_pa * r
     }
+
+    /// `C_h = J − α`: its second derivative is `d(cof F)[dF]`.
+    fn hydrostatic_hessian(&self, _l: Lame, f: &Mat3) -> Mat9 {
+        dpdf_from_directional(|df| cofactor_directional(f, df))
+    }
 }
 
 /// The node block `μ |g|² I + λ̂ w ⊗ w` for `w = cof F g` (`node_force_and_block`'s doc).

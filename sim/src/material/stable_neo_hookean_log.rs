@@ -156,6 +156,11 @@ impl SplitModel for StableNeoHookeanLog {
         // c − 3μ̂/2, c = μ̂ log 2 − 9μ̂²/(32λ̂) = μ̂ log 2 − (3/8) μ̂ r.
         p.mu_hat * (std::f64::consts::LN_2 - 1.5 - 0.375 * p.r)
     }
+
+    /// `C_h = J − α`: its second derivative is `d(cof F)[dF]`.
+    fn hydrostatic_hessian(&self, _l: Lame, f: &Mat3) -> Mat9 {
+        dpdf_from_directional(|df| cofactor_directional(f, df))
+    }
 }
 
 /// `dP[dF] = a dF + a' (F : dF) F + λ̂ (cof F : dF) cof F + g d(cof F)[dF]`.

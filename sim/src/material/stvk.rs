@@ -294,6 +294,11 @@ impl SplitModel for StVenantKirchhoff {
     fn split_energy_offset(&self, _l: Lame) -> f64 {
         0.0
     }
+
+    /// `C_h = tr E = (F : F − 3)/2`: its second derivative is the identity.
+    fn hydrostatic_hessian(&self, _l: Lame, _f: &Mat3) -> Mat9 {
+        Mat9::identity()
+    }
 }
 
 /// `dP[dF] = dF S + F S(dE)`, `dE = (dFᵀ F + Fᵀ dF)/2`.

@@ -94,7 +94,7 @@ pub const INFO: [MethodInfo; 4] = [
         long_name: "XPBD (the paper's)",
         implicit: false,
         honours: &[ImplicitRole::Hooks, ImplicitRole::Projection, ImplicitRole::Potential, ImplicitRole::Unsupported],
-        parameters: &["substeps", "iterations", "formulation", "sweep", "stability_guard"],
+        parameters: &["substeps", "iterations", "sweep", "stability_guard"],
         step_word: "substep",
         remedy: "more substeps, a softer material or stable Neo-Hookean",
         motion: "Keeps the motion: its small substeps barely damp the swing (0.1–2.7 % of the amplitude lost by 2 s on P2, P3 and Q2).",

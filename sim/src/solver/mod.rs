@@ -88,4 +88,6 @@ mod implicit_tests;
 #[cfg(test)]
 mod integrator_tests;
 #[cfg(test)]
+mod mixed_tests;
+#[cfg(test)]
 mod tests;

@@ -290,17 +290,25 @@ impl SolverSettings {
         }
         Ok(())
     }
-    /// Refuses a material these settings cannot run: XPBD's split formulation with a model that
-    /// offers no split constraints ([`crate::material::HyperelasticModel::split`], an optional
-    /// capability; every registered model has them).
-    pub fn check_material(&self, material: &Material) -> Result<(), SimError> {
+    /// The material as these settings run it on `mesh`: its hydrostatic term measured where the
+    /// formulation says ([`Formulation::volume_measure`]). Refuses what they cannot run: XPBD's
+    /// split formulation with a model that offers no split constraints
+    /// ([`crate::material::HyperelasticModel::split`], an optional capability; every registered
+    /// model has them); the mixed formulation with a model whose split it cannot measure per
+    /// element ([`Material::with_volume_measure`]) or on an element type with no stable constant
+    /// pressure ([`crate::fem::energy::mixed::refusal`]), named.
+    pub fn formulated(&self, material: &Material, mesh: &crate::mesh::Mesh) -> Result<Material, SimError> {
         if !self.method.is_implicit() && self.formulation == Formulation::Split && !material.has_split() {
             return Err(SimError::Settings(format!(
                 "the split formulation needs the material's split constraints, which {} does not offer (the energy formulation needs none)",
                 material.model.long_name()
             )));
         }
-        Ok(())
+        let refusal = |b: &crate::mesh::ElementBlock| crate::fem::energy::mixed::refusal(b.element_type);
+        if let Some(why) = mesh.blocks.iter().find_map(refusal).filter(|_| self.formulation == Formulation::Mixed) {
+            return Err(SimError::Settings(why));
+        }
+        material.with_volume_measure(self.formulation.volume_measure()).map_err(|e| SimError::Settings(e.to_string()))
     }
 
     /// The substep length `h`, seconds.

@@ -79,7 +79,7 @@ impl Simulation {
     ) -> Result<Self, SimError> {
         mesh.validate()?;
         settings.validate()?;
-        settings.check_material(&material)?;
+        let material = settings.formulated(&material, &mesh)?;
         let geometry = precompute(&mesh, settings.quadrature_degree)?;
         let masses_kg = lumped_masses_kg(&mesh, material.density_kg_m3)?;
         let inv_mass: Vec<f64> = masses_kg.iter().map(|m| 1.0 / m).collect();
@@ -322,7 +322,7 @@ impl Simulation {
 
     /// Changes the material, keeping positions and velocities (masses follow the density).
     pub fn set_material(&mut self, material: Material) -> Result<(), SimError> {
-        self.settings.check_material(&material)?;
+        let material = self.settings.formulated(&material, &self.mesh)?;
         self.model_version += 1;
         if material.density_kg_m3 != self.material.density_kg_m3 {
             let masses = lumped_masses_kg(&self.mesh, material.density_kg_m3)?;
@@ -377,9 +377,14 @@ impl Simulation {
     /// is refused (nothing changes).
     pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), SimError> {
         settings.validate()?;
-        settings.check_material(&self.material)?;
+        let material = settings.formulated(&self.material, &self.mesh)?;
         check_effects(settings.method, self.effects.iter().map(|e| e.as_ref()))?;
         let geometry_changed = settings.quadrature_degree != self.settings.quadrature_degree;
+        if material.volume_measure != self.material.volume_measure {
+            self.material = material; // another energy: another fastest mode
+            self.model_version += 1;
+            self.omega2_per_e_over_rho = None;
+        }
         if geometry_changed {
             self.geometry = precompute(&self.mesh, settings.quadrature_degree)?;
             self.omega2_per_e_over_rho = None;

@@ -65,7 +65,9 @@ pub const NEAR_INCOMPRESSIBLE_POISSON_RATIO: f64 = 0.45;
 /// [`GUARD_TRIGGER_H_OMEGA`], or [`GUARD_TRIGGER_NEAR_INCOMPRESSIBLE_ENERGY_H_OMEGA`] for the
 /// energy formulation at ν ≥ [`NEAR_INCOMPRESSIBLE_POISSON_RATIO`].
 pub fn guard_trigger_h_omega(formulation: Formulation, material: &Material) -> f64 {
-    if formulation == Formulation::Energy && material.poisson_ratio >= NEAR_INCOMPRESSIBLE_POISSON_RATIO {
+    if matches!(formulation, Formulation::Energy | Formulation::Mixed)
+        && material.poisson_ratio >= NEAR_INCOMPRESSIBLE_POISSON_RATIO
+    {
         GUARD_TRIGGER_NEAR_INCOMPRESSIBLE_ENERGY_H_OMEGA
     } else {
         GUARD_TRIGGER_H_OMEGA

@@ -12,9 +12,12 @@
 //! `g_i = ∇_i U` and `s = C = √(2U)`, with λ = 0 this is the issue's
 //! `Δλ' = −2U / (Σ_i w_i |∇_i U|² + 2U α̃)`.
 //!
-//! **Formulations** (both have exactly the FE model's potential energy, up to a constant):
+//! **Formulations** (energy and split have exactly the FE model's potential energy, up to a constant):
 //! - [`Formulation::Energy`]: one constraint per element, `C = √(2 U_e)`, unit compliance
 //!   (`α = 1`), so the XPBD potential `C²/(2α) = U_e`. This is the paper's formulation.
+//! - [`Formulation::Mixed`]: one constraint per element as for the energy formulation, of the
+//!   mixed element's energy (the hydrostatic term measured over the element,
+//!   `crate::fem::energy::mixed`): no longer the same potential, but one that does not lock.
 //! - [`Formulation::Split`]: per quadrature point, the deviatoric and hydrostatic constraints of
 //!   [`Material::split_terms`] (Macklin & Müller 2021, "A constraint-based formulation of stable
 //!   Neo-Hookean materials"), with compliances `α_t = 1/(k_t V_q)`, so that
@@ -64,14 +67,20 @@ pub enum Formulation {
     Energy,
     /// Deviatoric and hydrostatic constraints per quadrature point (Macklin & Müller 2021).
     Split,
+    /// The mixed formulation: the material's hydrostatic term measured over the element (one
+    /// constant pressure per element, `crate::fem::energy::mixed`), which cures volumetric
+    /// locking; for XPBD one constraint `C = √(2 U_e)` of that energy per element. Every solver
+    /// runs it (the implicit ones minimise the same energy).
+    Mixed,
 }
 
 impl Formulation {
-    pub const ALL: [Formulation; 2] = [Formulation::Energy, Formulation::Split];
+    pub const ALL: [Formulation; 3] = [Formulation::Energy, Formulation::Split, Formulation::Mixed];
     pub fn name(self) -> &'static str {
         match self {
             Self::Energy => "energy",
             Self::Split => "split",
+            Self::Mixed => "mixed",
         }
     }
     pub fn from_name(s: &str) -> Option<Self> {
@@ -80,8 +89,15 @@ impl Formulation {
     /// Number of multipliers λ per element with `points` quadrature points.
     pub fn multipliers_per_element(self, points: usize) -> usize {
         match self {
-            Self::Energy => 1,
+            Self::Energy | Self::Mixed => 1,
             Self::Split => 2 * points,
+        }
+    }
+    /// Where the formulation measures the material's hydrostatic term.
+    pub fn volume_measure(self) -> crate::material::VolumeMeasure {
+        match self {
+            Self::Energy | Self::Split => crate::material::VolumeMeasure::Point,
+            Self::Mixed => crate::material::VolumeMeasure::Element,
         }
     }
 }

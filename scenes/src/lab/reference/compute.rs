@@ -1,4 +1,5 @@
-//! Solving a reference: six static Q2 levels of the scene's box, coarse to fine, with a
+//! Solving a reference: six static levels of the scene's box (Q2, or P2 with one pressure per
+//! element near incompressibility: [`Levels`]), coarse to fine, with a
 //! provisional estimate as soon as three are solved (issue #35: a class that changes ν gets a
 //! number with its error bar within seconds, refined in the background), and the static
 //! solution of a mesh file's own mesh.
@@ -34,6 +35,10 @@ use crate::params::SceneOverrides;
 use crate::scene::Scene;
 use hox_sim::Vec3;
 use hox_sim::element::ElementType;
+use hox_sim::material::VolumeMeasure;
+use hox_sim::mesh::structured::TetSplit;
+use hox_sim::solver::stability::NEAR_INCOMPRESSIBLE_POISSON_RATIO;
+use hox_sim::xpbd::constraint::Formulation;
 
 /// Progress of a computation: (what is being done, overall fraction 0–1).
 pub type Progress<'p> = &'p mut dyn FnMut(&str, f64);
@@ -56,15 +61,60 @@ pub const UNCONVERGED_SAFETY_FACTOR: f64 = 3.0;
 /// How many levels a computed reference solves.
 pub const LEVELS: usize = 6;
 
-/// The scene of one reference level: the physics of `scene` on a Q2 box mesh of `grid` cells,
-/// with the element's own quadrature and no refinement, whatever the configuration's mesh
-/// (issue #35: a refined P1 passed its refinement on to the Q2 levels, which refused it).
+/// What a reference's levels are solved with: Q2, or near incompressibility (ν ≥
+/// [`NEAR_INCOMPRESSIBLE_POISSON_RATIO`], `λ ≥ 9μ`) with a model the mixed formulation runs
+/// (stvk, nh) P2 with one pressure per element (`--formulation mixed`), since Q2 with its full
+/// rule locks there itself (issue #62). Measured on the bending beam: P2 mixed 16×4×4, 24×6×6 and
+/// 32×8×8 agree within 0.04 % at ν = 0.45, 0.499 and 0.4999 (Q2's levels within 0.5 % at 0.499),
+/// and in the linear regime (E = 3 GPa) P2 mixed 32×8×8 is within 0.2 % of scikit-fem's
+/// Taylor–Hood limit (`scripts/taylor_hood.py`, `python/tests/test_taylor_hood.py`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Levels {
+    Q2,
+    P2Mixed,
+}
+
+impl Levels {
+    /// The levels a scene's reference is solved with.
+    pub fn of(scene: &Scene) -> Levels {
+        let mixed_runs = scene.material().with_volume_measure(VolumeMeasure::Element).is_ok();
+        if scene.params().poisson_ratio >= NEAR_INCOMPRESSIBLE_POISSON_RATIO && mixed_runs {
+            Levels::P2Mixed
+        } else {
+            Levels::Q2
+        }
+    }
+
+    /// "Q2" or "P2 mixed".
+    pub fn element_name(self) -> &'static str {
+        match self {
+            Levels::Q2 => "Q2",
+            Levels::P2Mixed => "P2 mixed",
+        }
+    }
+
+    /// The name of the level on `grid`: "Q2 32×8×8", "P2 mixed 32×8×8".
+    pub fn name(self, g: [usize; 3]) -> String {
+        format!("{} {}×{}×{}", self.element_name(), g[0], g[1], g[2])
+    }
+}
+
+/// The scene of one reference level: the physics of `scene` on a box mesh of `grid` cells of
+/// its [`Levels`] (Q2, or P2 mixed on the five-tetrahedron split), with the element's own
+/// quadrature and no refinement, whatever the configuration's mesh (issue #35: a refined P1
+/// passed its refinement on to the Q2 levels, which refused it).
 pub fn level_scene(scene: &Scene, grid: [usize; 3]) -> Result<Scene, SceneError> {
+    let (element, formulation) = match Levels::of(scene) {
+        Levels::Q2 => ("q2", Formulation::Energy),
+        Levels::P2Mixed => ("p2", Formulation::Mixed),
+    };
     let o = SceneOverrides {
-        element: ElementType::from_name("q2"),
+        element: ElementType::from_name(element),
         grid: Some(grid),
+        split: Some(TetSplit::Five),
         refine: Some(0),
         quadrature_degree: Some(None),
+        formulation: Some(formulation),
         ..Default::default()
     };
     scene.with_overrides(&o)
@@ -90,10 +140,6 @@ pub(super) fn cell_size(scene: &Scene, grid: [usize; 3]) -> f64 {
     (0..3).map(|d| (p.box_max_m[d] - p.box_min_m[d]) / grid[d] as f64).fold(0.0, f64::max)
 }
 
-fn grid_name(g: [usize; 3]) -> String {
-    format!("Q2 {}×{}×{}", g[0], g[1], g[2])
-}
-
 /// The provisional reference from the levels solved so far, `(cell size, probes)` coarse to
 /// fine (module docs); None before three.
 pub fn provisional(
@@ -101,7 +147,9 @@ pub fn provisional(
     finest: [usize; 3],
     levels: usize,
     poisson_ratio: f64,
+    kind: Levels,
 ) -> Option<Reference> {
+    let grid_name = |g| kind.name(g);
     let [.., b, c, d] = solved else { return None };
     let order = |x: &(f64, Probes), y: &(f64, Probes)| observed_order(&[x.clone(), y.clone(), d.clone()]);
     let extrapolated = format!("{} extrapolated", grid_name(finest));
@@ -160,6 +208,7 @@ pub fn compute_with(
 ) -> Result<Reference, SceneError> {
     let p = scene.params();
     let grids = grids(p.box_min_m, p.box_max_m, finest_cells);
+    let kind = Levels::of(scene);
     let cells: Vec<f64> = grids.iter().map(|g| (g[0] * g[1] * g[2]) as f64).collect();
     let total: f64 = cells.iter().sum();
     let mut done = 0.0;
@@ -169,7 +218,7 @@ pub fn compute_with(
     for (k, grid) in grids.iter().enumerate() {
         let level = level_scene(scene, *grid)?;
         let mesh = level.build_mesh()?;
-        let what = format!("computing reference, level {} of {n} (static {})", k + 1, grid_name(*grid));
+        let what = format!("computing reference, level {} of {n} (static {})", k + 1, kind.name(*grid));
         let solution = crate::instance::solve_static(&level, &mesh, TOLERANCE, LOAD_STEPS, &mut |fraction, _, _| {
             progress(&what, (done + fraction * cells[k]) / total)
         })?;
@@ -177,11 +226,11 @@ pub fn compute_with(
         solved.push((cell_size(scene, *grid), probes_at(&level, &mesh, &solution.positions)?));
         if k + 1 == n {
             finest_field = ReferenceField::lattice(&mesh, &solution.positions, p.box_min_m, p.box_max_m, *grid);
-        } else if let Some(r) = provisional(&solved, *grid, n, p.poisson_ratio) {
+        } else if let Some(r) = provisional(&solved, *grid, n, p.poisson_ratio, kind) {
             on_estimate(&r);
         }
     }
-    Ok(finish(&solved, &grids, p.poisson_ratio, finest_field))
+    Ok(finish(&solved, &grids, p.poisson_ratio, finest_field, kind))
 }
 
 /// The final reference from every level (module docs).
@@ -190,7 +239,9 @@ fn finish(
     grids: &[[usize; 3]],
     poisson_ratio: f64,
     field: Option<ReferenceField>,
+    kind: Levels,
 ) -> Reference {
+    let grid_name = |g| kind.name(g);
     let n = solved.len();
     let fine = grids[n - 1];
     // the halving levels: a half and a quarter as many cells per direction as the finest

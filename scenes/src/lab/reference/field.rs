@@ -24,9 +24,11 @@ pub enum ReferenceField {
 }
 
 impl ReferenceField {
-    /// The lattice field of a solution `positions` on `mesh`, a Q2 mesh of the box
-    /// `[box_min_m, box_max_m]` with `cells`; None when a node is off the lattice (a biased or
-    /// unstructured mesh).
+    /// The lattice field of a solution `positions` on `mesh`, a mesh of the box
+    /// `[box_min_m, box_max_m]` whose nodes are lattice points of `cells` (Q2: all of them; P2 on
+    /// the five-tetrahedron split: all but the cell centres, whose displacement is then its
+    /// shape functions' where the point lies); None when a node is off the lattice (a biased or
+    /// unstructured mesh) or a missing point is in no element.
     pub fn lattice(
         mesh: &Mesh,
         positions: &[Vec3],
@@ -50,8 +52,13 @@ impl ReferenceField {
             let u = x - rest;
             displacements_m[index[0] + points[0] * (index[1] + points[1] * index[2])] = [u.x, u.y, u.z];
         }
-        if displacements_m.iter().flatten().any(|v| v.is_nan()) {
-            return None;
+        for (i, u) in displacements_m.iter_mut().enumerate().filter(|(_, u)| u[0].is_nan()) {
+            let index = [i % points[0], (i / points[0]) % points[1], i / (points[0] * points[1])];
+            let at = Vec3::from_fn(|d, _| {
+                box_min_m[d] + (box_max_m[d] - box_min_m[d]) * index[d] as f64 / (2 * cells[d]) as f64
+            });
+            let probe = hox_sim::measure::probe::Probe::locate(mesh, "lattice", at).ok()?;
+            *u = probe.displacement(positions, &mesh.rest_positions).into();
         }
         Some(ReferenceField::Lattice { box_min_m, box_max_m, cells, displacements_m })
     }
@@ -134,5 +141,20 @@ mod tests {
             assert!((field.lattice_at(&p) - u(&p)).norm() < 1e-12, "{p}");
         }
         assert!(ReferenceField::lattice(&mesh, &x, lo, hi, [3, 1, 1]).is_none());
+        // P2 on the five-tetrahedron split has no node at the cell centres: its shape functions
+        // give them, and P2 holds the quadratic exactly too
+        let p2 = BoxMeshSpec {
+            grid: BoxGrid { min_m: Vec3::from(lo), max_m: Vec3::from(hi), cells },
+            element_type: ElementType::from_name("p2").unwrap(),
+            split: TetSplit::Five,
+            refine: 0,
+        }
+        .build()
+        .unwrap();
+        let x: Vec<Vec3> = p2.rest_positions.iter().map(|p| p + u(p)).collect();
+        let field = ReferenceField::lattice(&p2, &x, lo, hi, cells).expect("on the lattice");
+        for p in [Vec3::new(0.3, 0.1, 0.45), Vec3::new(1.75, 0.25, 0.25), Vec3::new(0.0, 0.5, 0.5)] {
+            assert!((field.lattice_at(&p) - u(&p)).norm() < 1e-12, "{p}");
+        }
     }
 }

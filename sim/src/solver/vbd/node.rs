@@ -91,7 +91,7 @@ impl NodeUpdate<'_> {
             let (force, block) = match l.kernel {
                 // SAFETY: the material's kernel for this width on this CPU
                 Some(kernel) => unsafe { kernel(self.lame, visit) },
-                None => s.material.node_visit(self.lame, visit),
+                None => crate::fem::energy::node_visit(s.material, self.lame, visit),
             };
             f -= force;
             h += project_psd3(&block);
@@ -148,7 +148,6 @@ impl NodeUpdate<'_> {
     #[inline(always)]
     unsafe fn local_energy(&self, i: usize, xi: Vec3, lanes: &[LaneView<'_>]) -> f64 {
         let s = self.input;
-        let law = s.material.model.law();
         let mut e = 0.5 * s.masses_kg[i] * self.w * (xi - self.y[i]).norm_squared();
         for inc in self.incidence.of(i) {
             let (b, el) = (inc.block as usize, inc.element as usize);
@@ -157,12 +156,7 @@ impl NodeUpdate<'_> {
             let fq = unsafe { l.f_mut(el) };
             let g = &l.geometry;
             let visit = NodeVisit { width: g.width, f: fq, grads: g.node_grads(el, 0), volumes: g.volumes(el) };
-            for (p, &v) in visit.volumes.iter().enumerate() {
-                if v != 0.0 {
-                    let (f, _, _) = visit.point(p / g.width, p % g.width);
-                    e += v * law.energy_density(self.lame, &f);
-                }
-            }
+            e += crate::fem::energy::visit_energy(s.material, self.lame, visit);
         }
         for sp in self.springs.iter().filter(|sp| sp.node as usize == i) {
             e += 0.5 * sp.stiffness_n_per_m * (xi - sp.target_m).norm_squared();

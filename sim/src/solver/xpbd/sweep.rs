@@ -234,7 +234,8 @@ impl ProjectionContext<'_> {
         }
         gather(self.rest, nodes, rest);
         match self.formulation {
-            Formulation::Energy => {
+            // the mixed element's energy: the material measures its hydrostatic term per element
+            Formulation::Energy | Formulation::Mixed => {
                 project_energy_constraint(
                     x,
                     rest,

@@ -136,6 +136,14 @@ proptest! {
                             let mut l = vec![0.0; 2 * g.points_per_element];
                             project_split_constraints(&mut x, &mesh.rest_positions, &w, element_grads(g, 0), g.volumes(0), &material, 1e3, &mut l);
                         }
+                        // the mixed element's energy, where the formulation runs (high order; stvk, nh)
+                        Formulation::Mixed => {
+                            let Ok(mixed) = material.with_volume_measure(crate::material::VolumeMeasure::Element) else { continue };
+                            if et.order() < 2 {
+                                continue;
+                            }
+                            project_energy_constraint(&mut x, &mesh.rest_positions, &w, element_grads(g, 0), g.volumes(0), &mixed, 1e3, &mut 0.0);
+                        }
                     }
                     let mut p = Vec3::zeros();
                     let mut l = Vec3::zeros();

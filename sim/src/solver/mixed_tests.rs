@@ -1,0 +1,146 @@
+//! The mixed formulation (`crate::fem::energy::mixed`) through the solvers: the static solver,
+//! Newton, VBD and XPBD minimise its energy, and it is refused by name where it cannot run.
+
+use super::tests::{G, beam, clamped_at_x0};
+use super::*;
+use crate::Vec3;
+use crate::effect::{Clamp, Damping, Effect, Gravity};
+use crate::element::ElementType;
+use crate::material::{Material, MaterialModel, VolumeMeasure};
+use crate::mesh::Mesh;
+use crate::xpbd::constraint::Formulation;
+
+/// Static tip deflection (z, m) of `mesh` clamped at x = 0 under gravity, the material's volume
+/// measured as `measure`.
+fn static_tip_z(mesh: &Mesh, material: Material, measure: VolumeMeasure) -> f64 {
+    let problem = statics::StaticProblem {
+        mesh,
+        material: material.with_volume_measure(measure).unwrap(),
+        quadrature_degree: None,
+        acceleration_m_s2: G,
+        dirichlet: vec![statics::clamp(clamped_at_x0(mesh))],
+        tolerance: 1e-10,
+        load_steps: 1,
+    };
+    let x = statics::solve(&problem, &mut |_, _, _| {}).unwrap().positions;
+    tip_z(mesh, &x)
+}
+
+/// The mean z displacement of the nodes at x = 1 (the beam's end).
+fn tip_z(mesh: &Mesh, x: &[Vec3]) -> f64 {
+    let tip = mesh.nodes_where(|p| (p.x - 1.0).abs() < 1e-12);
+    tip.iter().map(|&n| x[n as usize].z - mesh.rest_positions[n as usize].z).sum::<f64>() / tip.len() as f64
+}
+
+/// A stiff StVK (E = 10⁸ Pa: a sag of a few millimetres, the linear regime) at `nu`.
+fn stiff(nu: f64) -> Material {
+    Material::new(MaterialModel::StVenantKirchhoff, 1.0e8, nu, 1000.0).unwrap()
+}
+
+#[test]
+fn the_mixed_formulation_gives_a_locked_p2_beam_its_sag_back() {
+    // locking's symptom: the pointwise sag falls as ν → 0.5 (the volume constrained at every
+    // point); measured once per element it stays (the body's own sag changes by a few per cent
+    // between ν = 0.3 and 0.4999), and it is the sag of the finer mixed beam within
+    // the coarse mesh's own error (one element through the thickness; 0.2 % on 8×2×2 at 0.499,
+    // docs/study/locking.md)
+    let p2 = ElementType::from_name("p2").unwrap();
+    let (coarse, fine) = (beam(p2, [4, 1, 1]), beam(p2, [8, 2, 2]));
+    let sag = |mesh: &Mesh, nu: f64, m: VolumeMeasure| static_tip_z(mesh, stiff(nu), m);
+    let [point, mixed] =
+        [VolumeMeasure::Point, VolumeMeasure::Element].map(|m| [sag(&coarse, 0.3, m), sag(&coarse, 0.4999, m)]);
+    let reference = sag(&fine, 0.4999, VolumeMeasure::Element);
+    let seen = format!("ν = 0.3, 0.4999: point {point:?}, mixed {mixed:?}; fine mixed at 0.4999 {reference}");
+    assert!(point[1] / point[0] < 0.8, "the pointwise P2 beam should lock: {seen}");
+    assert!((mixed[1] / mixed[0] - 1.0).abs() < 0.03, "the mixed P2 beam should not: {seen}");
+    assert!(1.0 - point[1] / reference > 0.25, "{seen}");
+    assert!((1.0 - mixed[1] / reference).abs() < 0.15, "{seen}");
+}
+
+fn settings(method: Method, formulation: Formulation) -> SolverSettings {
+    SolverSettings { method, formulation, frames_per_second: 60.0, ..SolverSettings::default() }
+}
+
+fn effects(mesh: &Mesh, damping_per_sec: f64) -> Vec<Box<dyn Effect>> {
+    vec![
+        Box::new(Gravity::new(G)),
+        Box::new(Clamp { nodes: clamped_at_x0(mesh) }),
+        Box::new(Damping { rate_per_sec: damping_per_sec }),
+    ]
+}
+
+#[test]
+fn every_solver_runs_the_mixed_formulation_towards_its_static_equilibrium() {
+    let mesh = beam(ElementType::from_name("p2").unwrap(), [2, 1, 1]);
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 2.0e5, 0.49, 1000.0).unwrap();
+    let reference = static_tip_z(&mesh, material, VolumeMeasure::Element);
+    let plain = static_tip_z(&mesh, material, VolumeMeasure::Point);
+    assert!(reference < plain * 1.02, "mixed {reference} vs plain {plain}: the mixed beam is softer");
+    for method in Method::ALL {
+        let mut sim =
+            Simulation::new(mesh.clone(), material, settings(method, Formulation::Mixed), effects(&mesh, 8.0))
+                .unwrap_or_else(|e| panic!("{method}: {e}"));
+        assert_eq!(sim.material().volume_measure, VolumeMeasure::Element, "{method}");
+        for _ in 0..240 {
+            sim.step_frame().unwrap_or_else(|e| panic!("{method}: {e}"));
+        }
+        let tip = tip_z(&mesh, &sim.positions);
+        assert!(
+            (tip / reference - 1.0).abs() < 0.02,
+            "{method}: settled tip {tip} against the mixed static {reference}"
+        );
+    }
+}
+
+#[test]
+fn switching_to_the_mixed_formulation_in_a_run_changes_the_energy_and_back() {
+    let mesh = beam(ElementType::from_name("q2").unwrap(), [2, 1, 1]);
+    let material = Material::new(MaterialModel::NeoHookean, 2.0e5, 0.45, 1000.0).unwrap();
+    let mut sim =
+        Simulation::new(mesh.clone(), material, settings(Method::Newton, Formulation::Energy), effects(&mesh, 0.0))
+            .unwrap();
+    for _ in 0..5 {
+        sim.step_frame().unwrap();
+    }
+    let plain = sim.elastic_energy_j();
+    sim.set_settings(settings(Method::Newton, Formulation::Mixed)).unwrap();
+    assert_eq!(sim.material().volume_measure, VolumeMeasure::Element);
+    let mixed = sim.elastic_energy_j();
+    assert!(mixed < plain && mixed > 0.5 * plain, "plain {plain} J, mixed {mixed} J at the same state");
+    // a new material keeps the formulation's measure
+    sim.set_material(Material::new(MaterialModel::NeoHookean, 3.0e5, 0.45, 1000.0).unwrap()).unwrap();
+    assert_eq!(sim.material().volume_measure, VolumeMeasure::Element);
+    sim.set_settings(settings(Method::Newton, Formulation::Energy)).unwrap();
+    assert_eq!(sim.material().volume_measure, VolumeMeasure::Point);
+    sim.step_frame().unwrap();
+}
+
+#[test]
+fn the_mixed_formulation_is_refused_by_name_where_it_cannot_run() {
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 2.0e5, 0.49, 1000.0).unwrap();
+    for (et, says) in [
+        (ElementType::from_name("p1").unwrap(), "one quadrature point"),
+        (ElementType::from_name("q1").unwrap(), "inf–sup"),
+    ] {
+        let mesh = beam(et, [2, 1, 1]);
+        let err =
+            Simulation::new(mesh.clone(), material, settings(Method::Newton, Formulation::Mixed), effects(&mesh, 0.0))
+                .err()
+                .unwrap_or_else(|| panic!("{et}: not refused"))
+                .to_string();
+        assert!(err.contains(says) && err.contains(&et.to_string()), "{et}: {err}");
+    }
+    let mesh = beam(ElementType::from_name("p2").unwrap(), [2, 1, 1]);
+    let snh = Material::new(MaterialModel::StableNeoHookean, 2.0e5, 0.49, 1000.0).unwrap();
+    let err = Simulation::new(mesh.clone(), snh, settings(Method::Xpbd, Formulation::Mixed), effects(&mesh, 0.0))
+        .err()
+        .expect("snh refused")
+        .to_string();
+    assert!(err.contains("snh") && err.contains("use stvk or nh"), "{err}");
+    // and a running simulation keeps its formulation when asked for a material it cannot measure so
+    let mut sim =
+        Simulation::new(mesh.clone(), material, settings(Method::Newton, Formulation::Mixed), effects(&mesh, 0.0))
+            .unwrap();
+    assert!(sim.set_material(snh).is_err());
+    assert_eq!(sim.material().model, MaterialModel::StVenantKirchhoff);
+}
