@@ -118,9 +118,14 @@ fn points<'a>(
 
 /// `U_e` (as [`super::element_energy`]'s arguments).
 pub fn element_energy(x: &[Vec3], rest: &[Vec3], grads: &[Vec3], volumes: &[f64], material: &Material) -> f64 {
+    energy_of(material, points(x, rest, grads, volumes))
+}
+
+/// `U_e = Σ_q V_q ψ_d(F_q) + V_e k_h/2 C̄²` of an element's points `(F_q, V_q)`: the one sum.
+fn energy_of(material: &Material, pts: impl Iterator<Item = (Mat3, f64)>) -> f64 {
     let k_h = hydrostatic_stiffness_pa(material);
     let (mut u, mut v_e, mut sum) = (0.0, 0.0, 0.0);
-    for (f, v) in points(x, rest, grads, volumes) {
+    for (f, v) in pts {
         let pt = point(material, k_h, &f);
         u += v * pt.psi_d;
         v_e += v;
@@ -236,16 +241,7 @@ pub fn node_visit(material: &Material, visit: NodeVisit<'_>) -> (Vec3, Matrix3<f
 
 /// [`super::visit_energy`] for the mixed formulation: `U_e` from the visit's `F_q`.
 pub fn visit_energy(material: &Material, visit: NodeVisit<'_>) -> f64 {
-    let k_h = hydrostatic_stiffness_pa(material);
-    let (mut u, mut v_e, mut sum) = (0.0, 0.0, 0.0);
-    for (f, _, v) in visit_points(visit) {
-        let pt = point(material, k_h, &f);
-        u += v * pt.psi_d;
-        v_e += v;
-        sum += v * pt.c_h;
-    }
-    let c_bar = if v_e > 0.0 { sum / v_e } else { 0.0 };
-    u + 0.5 * v_e * k_h * c_bar * c_bar
+    energy_of(material, visit_points(visit).map(|(f, _, v)| (f, v)))
 }
 
 /// A visit's points `(F_q, ∇N_a, V_q)`, its padding skipped.
