@@ -90,9 +90,10 @@ fn the_medium_and_fine_torsion_references_are_reproduced_from_their_recipe() {
 }
 
 /// Issue #35's acceptance: with an empty cache, compare P1 refined once against P2 at ν = 0.49:
-/// a reference number comes from the three coarsest Q2 levels (396 of the 3,808 cells the
-/// recipe solves; about 3 s on the project's 2-core machine, docs/APP.md), and it agrees with
-/// the full recipe's value within its stated error; so does each estimate after it.
+/// a reference number comes from the three coarsest levels (since issue #62 P2 mixed on the even
+/// grids: 1,152 of the 3,200 cells the recipe solves; about 3 s on the project's 2-core machine),
+/// and it agrees with the full recipe's value within its stated error; so does each estimate
+/// after it.
 /// The time is printed, not asserted (machines differ).
 #[test]
 #[ignore = "a minute and a half in release: CI runs it with --release --ignored"]
@@ -125,7 +126,12 @@ fn the_first_reference_estimate_at_nu_0_49_holds_against_the_full_recipe() {
     for (what, secs) in &level_started {
         eprintln!("{secs:7.2} s  {what}");
     }
-    assert_eq!(estimates.len(), 3);
+    // near incompressibility the levels are P2 mixed on the even grids (four for bending)
+    let p = p1.params();
+    let kind = hox_scenes::reference::compute::Levels::of(&p1);
+    assert_eq!(kind, hox_scenes::reference::compute::Levels::P2Mixed);
+    let grids = kind.grids(p.box_min_m, p.box_max_m, lookup.finest_cells);
+    assert_eq!(estimates.len(), grids.len() - 3);
     let size = full.size_m();
     for (e, secs) in &estimates {
         let r = e.refining.unwrap();
@@ -142,10 +148,8 @@ fn the_first_reference_estimate_at_nu_0_49_holds_against_the_full_recipe() {
         assert!(off <= stated, "{}: {off:e} off the full recipe's value, stated {stated:e}", e.label());
     }
     eprintln!("{:7.2} s  final: {}", start.elapsed().as_secs_f64(), full.label());
-    // the first estimate came after the three coarsest levels: an eighth of the recipe's cells
-    let p = p1.params();
-    let grids = hox_scenes::reference::grids(p.box_min_m, p.box_max_m, lookup.finest_cells);
+    // the first estimate came after the three coarsest levels: under half the recipe's cells
     let cells: Vec<usize> = grids.iter().map(|g| g.iter().product()).collect();
     assert_eq!(estimates[0].0.refining.unwrap().levels_done, 3);
-    assert!(8 * cells[..3].iter().sum::<usize>() < cells.iter().sum::<usize>(), "{cells:?}");
+    assert!(2 * cells[..3].iter().sum::<usize>() < cells.iter().sum::<usize>(), "{cells:?}");
 }

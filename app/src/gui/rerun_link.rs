@@ -48,6 +48,10 @@ struct RerunLink {
     logged_until: Option<(i64, f64)>,
     /// Streamed to a viewer or browsers (not saved to a file).
     live: bool,
+    /// Configuration entity names retired in this stream: their static empties shadow whatever
+    /// is logged there later at every time, so a configuration coming back under such a name
+    /// (a lesson's step repeating an earlier step's beam) is streamed under a fresh one.
+    retired_names: std::collections::HashSet<String>,
 }
 
 /// At most so many frames a second: a frame is admitted when the one admitted before it is
@@ -132,6 +136,7 @@ impl RerunLink {
                 time_offset: (0, 0.0),
                 logged_until: None,
                 live,
+                retired_names: Default::default(),
             }),
             Err(e) => Err(format!("Rerun: {e}")),
         }
@@ -176,7 +181,7 @@ impl RerunLink {
                 .zip(offsets)
                 .enumerate()
                 .map(|(k, (s, o))| Configuration {
-                    name: format!("{}_{}", ["a", "b"][k.min(1)], s.label()),
+                    name: fresh_name(&self.retired_names, &format!("{}_{}", ["a", "b"][k.min(1)], s.label())),
                     instance: &s.instance,
                     offset_m: *o,
                     reference: s.reference.reference(),
@@ -215,6 +220,9 @@ impl RerunLink {
             // do not, hidden at every time: the clear above hides only the rest, after it
             if let Some(old) = &retired {
                 old.retire(&self.rec, r)?;
+                let kept = r.names();
+                let gone = old.names().into_iter().filter(|n| !kept.contains(n)).map(str::to_string);
+                self.retired_names.extend(gone.collect::<Vec<_>>());
             }
         }
         self.last_logged_frame = sessions.first().map(|s| s.instance.sim.frames());
@@ -234,6 +242,17 @@ impl RerunLink {
         }
         Ok(())
     }
+}
+
+/// The entity name of configuration `label` in a stream that retired `retired`: the label's
+/// own, or with the first suffix `_2`, `_3`, … not retired (regression test
+/// `gui::tests::a_lesson_step_repeating_an_earlier_step_s_beam_draws_its_chart_lines`).
+fn fresh_name(retired: &std::collections::HashSet<String>, label: &str) -> String {
+    let base = crate::recording::entity_name(label);
+    (1..)
+        .map(|k| if k == 1 { base.clone() } else { format!("{base}_{k}") })
+        .find(|n| !retired.contains(n))
+        .unwrap_or(base)
 }
 
 /// The live Rerun output as a service of the app: at most one link open, fed the model's frames.
@@ -313,6 +332,14 @@ impl Rerun {
                 Some(format!("Rerun: {e}"))
             }
         }
+    }
+
+    /// The entity names (`world/<name>`) the open link streams the configurations on screen
+    /// under, in order (the UI tests read them).
+    #[cfg(test)]
+    pub fn streamed_names(&self) -> Vec<String> {
+        let recorder = self.link.as_ref().and_then(|l| l.recorder.as_ref());
+        recorder.map(|r| r.names().into_iter().map(str::to_string).collect()).unwrap_or_default()
     }
 
     /// What the open link sent (the UI tests read it).

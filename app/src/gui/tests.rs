@@ -1064,7 +1064,7 @@ fn a_classroom_session_at_projector_and_full_hd_sizes() {
         assert_layout_fits(&h, &at("lesson step 1"));
         h.key_press(egui::Key::ArrowRight);
         lesson_ready(&mut h);
-        h.get_by_label_contains("Step 2 of 3");
+        h.get_by_label_contains("Step 2 of 4");
         assert_eq!(h.query_all_by_label_contains("Poisson ratio ν 0.49").count(), 2, "A and B at ν = 0.49");
         h.key_press(egui::Key::A);
         h.run_steps(2);
@@ -1072,7 +1072,7 @@ fn a_classroom_session_at_projector_and_full_hd_sizes() {
         assert_layout_fits(&h, &at("lesson step 2, answered"));
         h.key_press(egui::Key::ArrowLeft);
         lesson_ready(&mut h);
-        h.get_by_label_contains("Step 1 of 3");
+        h.get_by_label_contains("Step 1 of 4");
         // presenter mode: the caption below the view, the labels short, nothing overlapping
         h.key_press(egui::Key::P);
         h.run_steps(3);
@@ -1376,10 +1376,19 @@ fn shown_at_latest_frame(path: &std::path::Path) -> (std::collections::BTreeSet<
 }
 
 /// The entity names (`world/<name>`) of the configurations on screen in the app's stream.
+/// Each is its session's label (`a_…`, `b_…`), or that with a suffix where an earlier step's
+/// configuration of that name was retired from the stream.
 fn stream_names(h: &Harness<'_, HoxApp>) -> std::collections::BTreeSet<String> {
     let sessions = h.state().model().sessions();
-    let names = sessions.iter().enumerate().map(|(k, s)| format!("{}_{}", ["a", "b"][k.min(1)], s.label()));
-    names.map(|n| crate::recording::entity_name(&n)).collect()
+    let labels = sessions.iter().enumerate().map(|(k, s)| format!("{}_{}", ["a", "b"][k.min(1)], s.label()));
+    let streamed = h.state().rerun.streamed_names();
+    assert_eq!(streamed.len(), sessions.len(), "{streamed:?}");
+    for (name, label) in streamed.iter().zip(labels) {
+        let own = crate::recording::entity_name(&label);
+        let suffix = name.strip_prefix(own.as_str()).unwrap_or_else(|| panic!("{name} streams {label}"));
+        assert!(suffix.is_empty() || suffix.strip_prefix('_').is_some_and(|k| k.parse::<u32>().is_ok()), "{name}");
+    }
+    streamed.into_iter().collect()
 }
 
 /// Issue #57: after → to the next lesson step, the class's browsers drew the last step's beams
