@@ -3,7 +3,7 @@ with each cell run where an executor sends it.
 
     import hox
     tables = hox.study(quick=True, tables=["locking"])            # here, one cell after another
-    tables["locking"][0]            # {'poisson_ratio': 0.35, 'configuration': 'P1 16x4x4 five', ...}
+    tables["locking"][0]            # {'poisson_ratio': 0.35, 'configuration': 'P1 16x4x4 five', 'formulation': 'energy', ...}
 
     from dask.distributed import Client
     with Client("scheduler:8786") as client:                      # or a LocalCluster, a Ray or

@@ -245,8 +245,9 @@ impl RerunLink {
 }
 
 /// The entity name of configuration `label` in a stream that retired `retired`: the label's
-/// own, or with the first suffix `_2`, `_3`, … not retired (regression test
-/// `gui::tests::a_lesson_step_repeating_an_earlier_step_s_beam_draws_its_chart_lines`).
+/// own, or with the first suffix `_2`, `_3`, … not retired (regression: the locking lesson's
+/// cure step repeats step 2's B and step 3's A, and drew no chart line of its own;
+/// `gui::tests::a_browser_following_a_lesson_shows_only_the_current_step_s_bodies`).
 fn fresh_name(retired: &std::collections::HashSet<String>, label: &str) -> String {
     let base = crate::recording::entity_name(label);
     (1..)

@@ -14,6 +14,7 @@
 //! static on this mesh). Each error is the largest probe-displacement difference (m), and in % of
 //! the largest reference probe displacement.
 
+pub mod locking;
 pub mod motion;
 pub mod pareto;
 pub mod shard;
@@ -22,6 +23,7 @@ pub mod summary;
 
 /// An element type's colour in the study's charts (`study.svg` and the app's).
 pub use crate::present::colour::element_colour;
+pub use locking::{LOCKING_POISSON_RATIOS, LockingRow, locking, locking_at, locking_csv, locking_markdown};
 
 use crate::error::SceneError;
 use crate::instance::Instance;
@@ -275,138 +277,6 @@ pub fn study_one(
 pub fn run_study(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<StudyRow>, SceneError> {
     let plan = shard::Plan { quick, tables: vec![shard::Table::Accuracy] };
     Ok(shard::run_all(&plan, progress)?.accuracy)
-}
-
-/// The Poisson ratios of the locking table: the paper's 0.35 and the near-incompressible ones of
-/// the robustness suite (docs/STABILITY.md, case 2).
-pub const LOCKING_POISSON_RATIOS: [f64; 4] = [0.35, 0.45, 0.49, 0.499];
-
-/// One cell of the locking table: the static tip deflection of the bending beam on one mesh at
-/// one Poisson ratio, against Q2 16×4×4 at the same ν.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct LockingRow {
-    pub poisson_ratio: f64,
-    pub config: String,
-    pub elements: usize,
-    /// Vertical displacement of the tip probe, m (negative: down).
-    pub tip_z_m: f64,
-    /// The same on Q2 16×4×4 (7,776 DOFs), m.
-    pub q2_tip_z_m: f64,
-    /// Share of Q2's sag that this mesh misses, % (positive: stiffer, i.e. locking).
-    pub missing_pct: f64,
-}
-
-/// Volumetric locking, measured statically: the bending scene's static tip deflection
-/// ([`hox_sim::solver::statics`], 4 load steps, the scene's StVK) at each of [`LOCKING_POISSON_RATIOS`],
-/// for P1 1,280 (and 10,240 unless `quick`), P2 160 and P3 80, against Q2 16×4×4 at the same ν.
-/// A mesh that locks grows stiffer as ν → 0.5: its share of missing sag grows.
-pub fn locking(quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<LockingRow>, SceneError> {
-    let mut rows = Vec::new();
-    for nu in LOCKING_POISSON_RATIOS {
-        rows.extend(locking_at(nu, quick, progress)?);
-    }
-    Ok(rows)
-}
-
-/// The locking table's rows at one Poisson ratio `nu` (a cell of [`shard::Plan`]): Q2 16×4×4
-/// and each mesh of [`locking`] (P1 10,240 left out when `quick`).
-pub fn locking_at(nu: f64, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<Vec<LockingRow>, SceneError> {
-    use TetSplit::Five;
-    let c = StudyConfig::new;
-    let q2 = c("q2", [16, 4, 4], Five, 0, false);
-    let meshes = [
-        c("p1", [16, 4, 4], Five, 0, false),
-        c("p1", [16, 4, 4], Five, 1, true),
-        c("p2", [8, 2, 2], Five, 0, false),
-        c("p3", [4, 2, 2], Five, 0, false),
-    ];
-    let (q2_tip_z_m, _) = static_tip_z("bending", &q2, nu, progress)?;
-    let mut rows = Vec::new();
-    for config in meshes.iter().filter(|m| !(quick && m.heavy)) {
-        let (tip_z_m, elements) = static_tip_z("bending", config, nu, progress)?;
-        rows.push(LockingRow {
-            poisson_ratio: nu,
-            config: config.label(),
-            elements,
-            tip_z_m,
-            q2_tip_z_m,
-            missing_pct: 100.0 * (1.0 - tip_z_m / q2_tip_z_m),
-        });
-    }
-    Ok(rows)
-}
-
-/// The static vertical displacement of `scene`'s "tip" probe on `config` at Poisson ratio `nu`,
-/// and the element count.
-fn static_tip_z(
-    scene_name: &str,
-    config: &StudyConfig,
-    nu: f64,
-    progress: &mut dyn FnMut(&str),
-) -> Result<(f64, usize), SceneError> {
-    let label = config.label();
-    progress(&format!("locking: {scene_name} {label} at ν = {nu}: static solution"));
-    let scene = crate::scene::builtin::by_name(scene_name)?
-        .with_overrides(&SceneOverrides { poisson_ratio: Some(nu), ..config.overrides() })?;
-    let mesh = scene.build_mesh()?;
-    let fail =
-        |m: String| SceneError::Simulation { source_name: format!("{scene_name} {label} at ν = {nu}"), message: m };
-    let solution =
-        crate::instance::solve_static(&scene, &mesh, 1e-8, 4, &mut |_, _, _| {}).map_err(|e| fail(e.to_string()))?;
-    let tip = scene
-        .file
-        .probes
-        .iter()
-        .find(|p| p.name == "tip")
-        .ok_or_else(|| fail("the scene has no probe named tip".into()))?;
-    let probe = hox_sim::measure::probe::Probe::locate(&mesh, &tip.name, Vec3::from(tip.point_m))
-        .map_err(|e| fail(e.to_string()))?;
-    Ok((probe.displacement(&solution.positions, &mesh.rest_positions).z, mesh.num_elements()))
-}
-
-/// `study.md`'s locking section: one row per ν, one column per mesh.
-pub fn locking_markdown(rows: &[LockingRow]) -> String {
-    let mut configs: Vec<(&str, usize)> = Vec::new();
-    for r in rows {
-        if !configs.iter().any(|(c, _)| *c == r.config) {
-            configs.push((&r.config, r.elements));
-        }
-    }
-    let mut s = String::from(
-        "## Near incompressibility: volumetric locking (bending, static)\n\nStatic tip deflection `u_z` of the bending beam (the scene's StVK, E = 3 MPa, 4 load steps) against Q2 16×4×4 (7,776 DOFs) at the same ν; in brackets the share of Q2's sag the mesh misses. A mesh that locks grows stiffer as ν → 0.5. Q2 with its full 27-point rule is not free of locking at ν = 0.499 itself, so these shares are lower bounds.\n\n| ν |",
-    );
-    for (c, n) in &configs {
-        s.push_str(&format!(" {c} ({n}) |"));
-    }
-    s.push_str(" Q2 16x4x4 |\n|---|");
-    s.push_str(&"---|".repeat(configs.len() + 1));
-    s.push('\n');
-    for nu in LOCKING_POISSON_RATIOS {
-        let at: Vec<&LockingRow> = rows.iter().filter(|r| r.poisson_ratio == nu).collect();
-        let Some(first) = at.first() else { continue };
-        s.push_str(&format!("| {nu} |"));
-        for (c, _) in &configs {
-            match at.iter().find(|r| r.config == *c) {
-                Some(r) => s.push_str(&format!(" {:.4} m ({:+.1} %) |", r.tip_z_m, -r.missing_pct)),
-                None => s.push_str(" — |"),
-            }
-        }
-        s.push_str(&format!(" {:.4} m |\n", first.q2_tip_z_m));
-    }
-    s.push('\n');
-    s
-}
-
-/// `locking.csv`: the locking rows.
-pub fn locking_csv(rows: &[LockingRow]) -> String {
-    let mut s = String::from("poisson_ratio,configuration,elements,tip_z_m,q2_tip_z_m,missing_pct\n");
-    for r in rows {
-        s.push_str(&format!(
-            "{},{},{},{},{},{}\n",
-            r.poisson_ratio, r.config, r.elements, r.tip_z_m, r.q2_tip_z_m, r.missing_pct
-        ));
-    }
-    s
 }
 
 /// `study.md`: one table per scene.

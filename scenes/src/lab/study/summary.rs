@@ -13,8 +13,9 @@
 //!    ≤ 1 % of the reference; the least ms per frame on one thread);
 //! 3. **the bending beam in motion** (`solvers.csv`): the first period's and the amplitude's error
 //!    around 2 s against the reference motion, per solver and integrator, on the paper's meshes;
-//! 4. **volumetric locking** (`locking.csv`): the static tip deflection as ν → 0.5 against Q2,
-//!    the table of `study.md` ([`super::locking_markdown`]).
+//! 4. **volumetric locking and its cure** (`locking.csv`): the static tip deflection as ν → 0.5
+//!    in both formulations against the computed reference, and XPBD's ms per frame, the table of
+//!    `study.md` ([`super::locking_markdown`]).
 //!
 //! The machine line is `study.md`'s (written by the run that measured the figures).
 
@@ -104,16 +105,19 @@ fn locking(t: &Table) -> Result<String, SceneError> {
             Ok(LockingRow {
                 poisson_ratio: t.number(r, "poisson_ratio")?,
                 config: t.get(r, "configuration")?.to_string(),
+                formulation: t.get(r, "formulation")?.to_string(),
                 elements: t.number(r, "elements")? as usize,
                 tip_z_m: t.number(r, "tip_z_m")?,
-                q2_tip_z_m: t.number(r, "q2_tip_z_m")?,
+                reference_tip_z_m: t.number(r, "reference_tip_z_m")?,
+                reference_mesh: t.get(r, "reference_mesh")?.to_string(),
                 missing_pct: t.number(r, "missing_pct")?,
+                ms_per_frame: t.number(r, "ms_per_frame_1_thread")?,
             })
         })
         .collect::<Result<Vec<_>, SceneError>>()?;
     let md = locking_markdown(&rows);
     // the table alone: study.md's heading and paragraph are docs/STUDY.md's text
-    Ok(md.find("| ν |").map_or(md.clone(), |k| md[k..].to_string()).trim_end().to_string() + "\n")
+    Ok(md.find("| configuration |").map_or(md.clone(), |k| md[k..].to_string()).trim_end().to_string() + "\n")
 }
 
 fn paper_settings(t: &Table) -> Result<String, SceneError> {
@@ -241,7 +245,7 @@ fn motion(t: &Table) -> Result<String, SceneError> {
 mod tests {
     use super::*;
 
-    const LOCKING: &str = "poisson_ratio,configuration,elements,tip_z_m,q2_tip_z_m,missing_pct\n0.35,P1 16x4x4 five,1280,-0.28,-0.32,11.8\n";
+    const LOCKING: &str = "poisson_ratio,configuration,formulation,elements,tip_z_m,reference_tip_z_m,reference_mesh,missing_pct,ms_per_frame_1_thread\n0.35,P1 16x4x4 five,energy,1280,-0.28,-0.32,Q2 32×8×8 extrapolated,11.8,3.1\n";
 
     fn folder(study_md: &str, study_csv: &str, solvers_csv: &str) -> std::path::PathBuf {
         let dir = std::env::temp_dir().join(format!("hox-summary-{}-{}", std::process::id(), study_md.len()));
@@ -272,8 +276,10 @@ mod tests {
         assert!(s.contains("| P2 8x2x2 five | newton | — | -0.1 / +0.6 %, 2.34 ms | — | — |"), "{s}");
         assert!(s.contains("| P2 8x2x2 five | xpbd | — | — | — | +0.6 / -1.2 %, 1.30 ms |"), "{s}");
         assert!(
-            s.contains("| ν | P1 16x4x4 five (1280) | Q2 16x4x4 |")
-                && s.contains("| 0.35 | -0.2800 m (-11.8 %) | -0.3200 m |"),
+            s.contains("| configuration | formulation | ν = 0.35 | ms/frame (ν = 0.35) |")
+                && s.contains("| reference | | -0.3200 m | |")
+                && s.contains("| P1 16x4x4 five (1280) | energy | -0.2800 m (-11.8 %) | 3.1 |")
+                && s.contains("References: ν = 0.35: Q2 32×8×8 extrapolated."),
             "{s}"
         );
     }

@@ -4,10 +4,13 @@ fn locking_row(nu: f64, config: &str) -> LockingRow {
     LockingRow {
         poisson_ratio: nu,
         config: config.into(),
+        formulation: "energy".into(),
         elements: 160,
         tip_z_m: -0.1 * nu,
-        q2_tip_z_m: -0.11,
+        reference_tip_z_m: -0.11,
+        reference_mesh: "Q2 32×8×8 extrapolated".into(),
         missing_pct: 3.0,
+        ms_per_frame: 2.5,
     }
 }
 
