@@ -38,7 +38,10 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
     }
     // the locking table: P1 misses far more of the reference's sag than P2 and P3 as ν → 0.5,
     // and more than at ν = 0.35; the mixed P2 160 is within 1.5 % of it at ν = 0.499 (issue #62)
-    assert!(md.contains("## Near incompressibility: volumetric locking and its cure"), "study.md lacks the locking table");
+    assert!(
+        md.contains("## Near incompressibility: volumetric locking and its cure"),
+        "study.md lacks the locking table"
+    );
     let locking = std::fs::read_to_string(out.join("locking.csv")).unwrap();
     let mut lines = locking.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -47,7 +50,9 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
     let cell = |nu: &str, config: &str, formulation: &str, column: &str| -> f64 {
         let row = rows
             .iter()
-            .find(|r| r[at("poisson_ratio")] == nu && r[at("configuration")] == config && r[at("formulation")] == formulation)
+            .find(|r| {
+                r[at("poisson_ratio")] == nu && r[at("configuration")] == config && r[at("formulation")] == formulation
+            })
             .unwrap_or_else(|| panic!("no locking row {nu} {config} {formulation}"));
         assert_eq!(row.len(), header.len());
         row[at(column)].parse().unwrap()
@@ -59,7 +64,10 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
     assert!(p1 > missing("0.35", "P1 16x4x4 five") + 10.0, "P1 must stiffen as ν → 0.5");
     let cured = cell("0.499", "P2 8x2x2 five", "mixed", "missing_pct");
     assert!(cured.abs() < 1.5, "P2 160 mixed at ν = 0.499: {cured} % from the reference");
-    assert!(rows.iter().all(|r| r[at("formulation")] != "mixed" || r[at("configuration")] != "P1 16x4x4 five"), "P1 is refused");
+    assert!(
+        rows.iter().all(|r| r[at("formulation")] != "mixed" || r[at("configuration")] != "P1 16x4x4 five"),
+        "P1 is refused"
+    );
     for r in &rows {
         let ms: f64 = r[at("ms_per_frame_1_thread")].parse().unwrap();
         assert!(ms > 0.0 && ms.is_finite(), "{r:?}");

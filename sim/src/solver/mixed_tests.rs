@@ -144,3 +144,66 @@ fn the_mixed_formulation_is_refused_by_name_where_it_cannot_run() {
     assert!(sim.set_material(snh).is_err());
     assert_eq!(sim.material().model, MaterialModel::StVenantKirchhoff);
 }
+
+/// Issue #62's acceptance, "no pressure checkerboard": the element pressures of the mixed P2 beam
+/// at ν = 0.4999 vary smoothly. A checkerboard alternates between neighbours, so the mean jump
+/// across a shared face is about twice the pressures' standard deviation; a smooth field (the
+/// bending beam's pressure runs linearly through its thickness, tension above, compression
+/// below) jumps across faces by a fraction of it. Both figures are stated.
+#[test]
+fn the_mixed_p2_beam_s_element_pressures_show_no_checkerboard() {
+    let p2 = ElementType::from_name("p2").unwrap();
+    let mesh = beam(p2, [8, 2, 2]);
+    let material = stiff(0.4999).with_volume_measure(VolumeMeasure::Element).unwrap();
+    let problem = statics::StaticProblem {
+        mesh: &mesh,
+        material,
+        quadrature_degree: None,
+        acceleration_m_s2: G,
+        dirichlet: vec![statics::clamp(clamped_at_x0(&mesh))],
+        tolerance: 1e-10,
+        load_steps: 1,
+    };
+    let x = statics::solve(&problem, &mut |_, _, _| {}).unwrap().positions;
+    let geometry = crate::fem::geometry::precompute(&mesh, None).unwrap();
+    let (block, g) = (&mesh.blocks[0], &geometry[0]);
+    let n = g.nodes_per_element;
+    let pressures: Vec<f64> = (0..g.num_elements())
+        .map(|e| {
+            let nodes = block.element(e);
+            let xs: Vec<Vec3> = nodes.iter().map(|&i| x[i as usize]).collect();
+            let rest: Vec<Vec3> = nodes.iter().map(|&i| mesh.rest_positions[i as usize]).collect();
+            let grads = &g.grad_in_material[e * g.points_per_element * n..(e + 1) * g.points_per_element * n];
+            crate::fem::energy::mixed::element_pressure_pa(&xs, &rest, grads, g.volumes(e), &material)
+        })
+        .collect();
+    // face neighbours: tetrahedra sharing three corners (Gmsh order: the first four nodes)
+    let corners = |e: usize| {
+        let mut c: Vec<u32> = block.element(e)[..4].to_vec();
+        c.sort_unstable();
+        c
+    };
+    let mut faces: std::collections::HashMap<[u32; 3], Vec<usize>> = Default::default();
+    for e in 0..pressures.len() {
+        let c = corners(e);
+        for skip in 0..4 {
+            let f: Vec<u32> = c.iter().enumerate().filter(|(k, _)| *k != skip).map(|(_, v)| *v).collect();
+            faces.entry([f[0], f[1], f[2]]).or_default().push(e);
+        }
+    }
+    let jumps: Vec<f64> =
+        faces.values().filter(|es| es.len() == 2).map(|es| (pressures[es[0]] - pressures[es[1]]).abs()).collect();
+    let mean = pressures.iter().sum::<f64>() / pressures.len() as f64;
+    let sd = (pressures.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / pressures.len() as f64).sqrt();
+    let mean_jump = jumps.iter().sum::<f64>() / jumps.len() as f64;
+    let (lo, hi) = pressures.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &p| (a.min(p), b.max(p)));
+    let seen = format!(
+        "{} elements, {} inner faces: pressures {lo:.3e}..{hi:.3e} Pa, sd {sd:.3e} Pa, mean jump across a face {mean_jump:.3e} Pa ({:.2} sd)",
+        pressures.len(),
+        jumps.len(),
+        mean_jump / sd
+    );
+    println!("{seen}");
+    assert!(sd > 0.0 && lo < 0.0 && hi > 0.0, "tension and compression: {seen}");
+    assert!(mean_jump < 0.5 * sd, "a checkerboard jumps by about 2 sd: {seen}");
+}
