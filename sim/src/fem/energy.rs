@@ -328,8 +328,16 @@ fn mesh_pass(
     }
     // the specialised kernels are the point law's: the mixed element takes the generic ones
     let specialised = specialised && material.volume_measure == VolumeMeasure::Point;
-    let mut total = 0.0;
+    // linear tetrahedra in the mixed formulation: measured per node patch, all blocks at once
+    let mut total = if mixed::patch::has_patches(mesh, material) {
+        mixed::patch::energy_and_gradient(mesh, geometry, material, positions, gradient_out.as_deref_mut())
+    } else {
+        0.0
+    };
     for (bi, (block, g)) in mesh.blocks.iter().zip(geometry).enumerate() {
+        if mixed::patch::is_patch_block(block, material) {
+            continue;
+        }
         let pass =
             fixed::Pass { block, geometry: g, rest: &mesh.rest_positions, x: positions, elements: 0..block.len() };
         let ranges = chunks::ranges_for(block.len());

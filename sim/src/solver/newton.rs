@@ -176,7 +176,7 @@ impl<L: LinearSolver + Send + 'static> StepSolver for Newton<L> {
                 }
             }
             _ => {
-                self.pattern = Some(L::for_mesh(s.mesh, &|i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?);
+                self.pattern = Some(L::for_mesh(s.mesh, s.material, &|i| s.inv_mass[i] == 0.0).map_err(|_| bad(0))?);
                 self.fell_back = None;
                 self.report = None;
             }

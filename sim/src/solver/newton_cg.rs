@@ -37,6 +37,7 @@ use super::error::SolverCounters;
 use super::newton_core::{HessianModel, LinearSolver};
 use super::sparse::{SparseError, SparsePattern, map_element_hessians};
 use crate::Vec3;
+use crate::material::Material;
 use crate::mesh::Mesh;
 use nalgebra::Matrix3;
 
@@ -132,7 +133,7 @@ impl ConjugateGradients {
 }
 
 impl LinearSolver for ConjugateGradients {
-    fn for_mesh(mesh: &Mesh, held: &dyn Fn(usize) -> bool) -> Result<Self, SparseError> {
+    fn for_mesh(mesh: &Mesh, material: &Material, held: &dyn Fn(usize) -> bool) -> Result<Self, SparseError> {
         let n = mesh.num_nodes();
         let mut dof_of = vec![usize::MAX; 3 * n];
         let mut free_dofs = 0;
@@ -159,7 +160,7 @@ impl LinearSolver for ConjugateGradients {
             diagonal: Vec::new(),
             block_inverse: vec![Matrix3::identity(); n],
             ready: false,
-            factor: SparsePattern::new(mesh, held).ok(),
+            factor: SparsePattern::new(mesh, material, held).ok(),
             use_factor: false,
             last_iterations: usize::MAX,
             residual: Vec::new(),
@@ -344,7 +345,7 @@ mod tests {
             let held = |i: usize| mesh.rest_positions[i].x < 1e-9;
             let x: Vec<Vec3> =
                 mesh.rest_positions.iter().map(|p| p + Vec3::new(0.0, 0.1 * p.x * p.x, 0.05 * p.x * p.y)).collect();
-            let mut cg = ConjugateGradients::for_mesh(&mesh, &held).unwrap();
+            let mut cg = ConjugateGradients::for_mesh(&mesh, &material, &held).unwrap();
             let diagonal = vec![50.0; cg.free_dofs()];
             let model = HessianModel { mesh: &mesh, geometry: &geometry, material: &material, diagonal: &diagonal };
             cg.update(&model, &x, &mut SolverCounters::default()).unwrap();

@@ -126,8 +126,10 @@ pub(crate) enum Failure {
 /// How the one Newton solves `K Δ = r` (module docs): it keeps a model of `K` (a factor, element
 /// Hessians), made at an iterate when [`minimise`] asks, and solves with the last one made.
 pub(crate) trait LinearSolver {
-    /// A solver for `mesh` without the degrees of freedom of the nodes where `held(i)`.
-    fn for_mesh(mesh: &Mesh, held: &dyn Fn(usize) -> bool) -> Result<Self, SparseError>
+    /// A solver for `mesh` under `material` (whose formulation may widen the coupling:
+    /// [`crate::fem::energy::mixed::patch`]) without the degrees of freedom of the nodes where
+    /// `held(i)`.
+    fn for_mesh(mesh: &Mesh, material: &Material, held: &dyn Fn(usize) -> bool) -> Result<Self, SparseError>
     where
         Self: Sized;
     /// Global DOF `3 i + a` → free DOF, `usize::MAX` for a held one.
@@ -169,8 +171,8 @@ pub(crate) trait LinearSolver {
 }
 
 impl LinearSolver for SparsePattern {
-    fn for_mesh(mesh: &Mesh, held: &dyn Fn(usize) -> bool) -> Result<Self, SparseError> {
-        SparsePattern::new(mesh, held)
+    fn for_mesh(mesh: &Mesh, material: &Material, held: &dyn Fn(usize) -> bool) -> Result<Self, SparseError> {
+        SparsePattern::new(mesh, material, held)
     }
     fn dof_of(&self) -> &[usize] {
         &self.dof_of

@@ -16,6 +16,7 @@
 //! than AMD on every mesh of the project (session 22).
 
 use crate::Vec3;
+use crate::fem::energy::mixed::patch;
 use crate::fem::energy::{element_grads, element_hessian};
 use crate::fem::geometry::BlockGeometry;
 use crate::material::Material;
@@ -104,8 +105,10 @@ pub struct SparseCost {
 const ASSEMBLY_CHUNK: usize = 64;
 
 impl SparsePattern {
-    /// The pattern of `mesh` with the DOFs of nodes where `held(i)` left out.
-    pub fn new(mesh: &Mesh, held: impl Fn(usize) -> bool) -> Result<Self, SparseError> {
+    /// The pattern of `mesh` under `material` with the DOFs of nodes where `held(i)` left out
+    /// (widened to every node patch's pairs where the formulation measures the volume per patch:
+    /// [`crate::fem::energy::mixed::patch`]).
+    pub fn new(mesh: &Mesh, material: &Material, held: impl Fn(usize) -> bool) -> Result<Self, SparseError> {
         let started = web_time::Instant::now();
         let pattern = |e: &dyn std::fmt::Debug| SparseError::Pattern(format!("{e:?}"));
         let n = mesh.num_nodes();
@@ -122,7 +125,7 @@ impl SparsePattern {
             .collect();
         let free_dofs = 3 * free_nodes;
         // the node graph (natural order), its AMD ordering, then the graph in that order
-        let natural = node_graph(mesh, &free_of, free_nodes);
+        let natural = node_graph(mesh, material, &free_of, free_nodes);
         let (mut perm, mut place_of_free) = (vec![0u32; free_nodes], vec![0u32; free_nodes]);
         {
             let graph = SymbolicSparseColMat::new_checked(free_nodes, free_nodes, natural.0, None, natural.1);
@@ -139,7 +142,7 @@ impl SparsePattern {
         }
         let place_of_node: Vec<u32> =
             free_of.iter().map(|&k| if k == u32::MAX { u32::MAX } else { place_of_free[k as usize] }).collect();
-        let (node_col_ptr, node_rows) = node_graph(mesh, &place_of_node, free_nodes);
+        let (node_col_ptr, node_rows) = node_graph(mesh, material, &place_of_node, free_nodes);
         let node_col_ptr: Vec<usize> = node_col_ptr.iter().map(|&v| v as usize).collect();
         // the scalar pattern, column by column
         let mut col_ptr = Vec::with_capacity(free_dofs + 1);
@@ -259,7 +262,13 @@ impl SparsePattern {
         self.factored = false;
         let started = web_time::Instant::now();
         self.values.iter_mut().for_each(|v| *v = 0.0);
+        if patch::has_patches(mesh, material) {
+            patch::hessian_terms(mesh, geo, material, x, projected, |nodes, h| self.add_element(nodes, h));
+        }
         for (b, g) in mesh.blocks.iter().zip(geo) {
+            if patch::is_patch_block(b, material) {
+                continue;
+            }
             for chunk_start in (0..b.len()).step_by(ASSEMBLY_CHUNK) {
                 let chunk = chunk_start..(chunk_start + ASSEMBLY_CHUNK).min(b.len());
                 let hessians: Vec<DMatrix<f64>> = chunk
@@ -405,8 +414,8 @@ fn transposed(n: usize, col_ptr: &[u32], row_idx: &[u32]) -> SymbolicSparseColMa
 
 /// The lower triangle of the free nodes' graph, the diagonal included, in the numbering
 /// `index[node]` (`u32::MAX` for a held node): `(col_ptr, rows)`, each column's rows sorted, its
-/// own node first.
-fn node_graph(mesh: &Mesh, index: &[u32], free_nodes: usize) -> (Vec<u32>, Vec<u32>) {
+/// own node first; with every node patch's pairs where `material` measures the volume per patch.
+fn node_graph(mesh: &Mesh, material: &Material, index: &[u32], free_nodes: usize) -> (Vec<u32>, Vec<u32>) {
     let mut pairs: Vec<(u32, u32)> = (0..free_nodes as u32).map(|k| (k, k)).collect();
     for block in &mesh.blocks {
         for nodes in block.elements() {
@@ -419,6 +428,9 @@ fn node_graph(mesh: &Mesh, index: &[u32], free_nodes: usize) -> (Vec<u32>, Vec<u
                 }
             }
         }
+    }
+    if patch::has_patches(mesh, material) {
+        patch::pattern_pairs(mesh, material, index, &mut pairs);
     }
     pairs.sort_unstable();
     pairs.dedup();
@@ -480,18 +492,26 @@ pub(crate) fn element_hessian_at(
 pub fn assemble_dense(mesh: &Mesh, geo: &[BlockGeometry], material: &Material, x: &[Vec3]) -> DMatrix<f64> {
     let n = mesh.num_nodes();
     let mut k = DMatrix::zeros(3 * n, 3 * n);
-    for (b, gb) in mesh.blocks.iter().zip(geo) {
-        for (e, nodes) in b.elements().enumerate() {
-            let he = element_hessian_at(mesh, gb, e, nodes, material, x, true);
-            for (li, &i) in nodes.iter().enumerate() {
-                for (lj, &j) in nodes.iter().enumerate() {
-                    for a in 0..3 {
-                        for c in 0..3 {
-                            k[(3 * i as usize + a, 3 * j as usize + c)] += he[(3 * li + a, 3 * lj + c)];
-                        }
+    let mut add = |nodes: &[u32], he: &DMatrix<f64>| {
+        for (li, &i) in nodes.iter().enumerate() {
+            for (lj, &j) in nodes.iter().enumerate() {
+                for a in 0..3 {
+                    for c in 0..3 {
+                        k[(3 * i as usize + a, 3 * j as usize + c)] += he[(3 * li + a, 3 * lj + c)];
                     }
                 }
             }
+        }
+    };
+    if patch::has_patches(mesh, material) {
+        patch::hessian_terms(mesh, geo, material, x, true, &mut add);
+    }
+    for (b, gb) in mesh.blocks.iter().zip(geo) {
+        if patch::is_patch_block(b, material) {
+            continue;
+        }
+        for (e, nodes) in b.elements().enumerate() {
+            add(nodes, &element_hessian_at(mesh, gb, e, nodes, material, x, true));
         }
     }
     k
@@ -502,15 +522,18 @@ mod tests {
     use super::*;
     use crate::element::ElementType;
     use crate::fem::geometry::precompute;
-    use crate::material::MaterialModel;
+    use crate::material::{MaterialModel, VolumeMeasure};
     use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
 
     /// `K` assembled into its columns in elimination order, factored and solved, is the dense
     /// Hessian (plus the diagonal) on the free degrees of freedom: `K s = r` agrees with the dense
     /// solve, for every element type, with some nodes held (their rows and columns left out).
+    /// The mixed formulation's too: per element, and on P1 per node patch (the pattern widened to
+    /// the patch pairs, without which the assembly would panic).
     #[test]
     fn the_sparse_solve_is_the_dense_solve_on_the_free_dofs() {
-        for et in ElementType::all() {
+        let measures = [VolumeMeasure::Point, VolumeMeasure::Element];
+        for (et, measure) in ElementType::all().flat_map(|et| measures.map(|m| (et, m))) {
             let mesh = BoxMeshSpec {
                 grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(1.0, 0.4, 0.3), cells: [3, 2, 1] },
                 element_type: et,
@@ -520,14 +543,18 @@ mod tests {
             .build()
             .unwrap();
             let geo = precompute(&mesh, None).unwrap();
-            let material = Material::new(MaterialModel::StVenantKirchhoff, 1e5, 0.3, 1000.0).unwrap();
+            let material = Material::new(MaterialModel::StVenantKirchhoff, 1e5, 0.3, 1000.0)
+                .unwrap()
+                .with_volume_measure(measure)
+                .unwrap();
+            let et = format!("{et} {measure:?}");
             let x: Vec<Vec3> = mesh
                 .rest_positions
                 .iter()
                 .map(|p| p + Vec3::new(0.05 * (3.0 * p.y).sin(), 0.02 * p.x * p.x, -0.04 * p.x * p.z))
                 .collect();
             let held = |i: usize| mesh.rest_positions[i].x < 1e-9;
-            let mut pattern = SparsePattern::new(&mesh, held).unwrap();
+            let mut pattern = SparsePattern::new(&mesh, &material, held).unwrap();
             let n = pattern.free_dofs;
             let diagonal: Vec<f64> = (0..n).map(|d| 10.0 + d as f64).collect();
             pattern.assemble_and_factor(&mesh, &geo, &material, &x, &diagonal, true, false, Par::Seq).unwrap();

@@ -86,7 +86,7 @@ pub fn solve(problem: &StaticProblem<'_>, progress: Progress<'_>) -> Result<Stat
             prescribed_node[node as usize] = true;
         }
     }
-    let mut pattern = SparsePattern::new(mesh, |i| prescribed_node[i])?;
+    let mut pattern = SparsePattern::new(mesh, &problem.material, |i| prescribed_node[i])?;
     let free_dofs = pattern.free_dofs;
     let mut x = mesh.rest_positions.clone();
     let mut total_iterations = 0;

@@ -36,25 +36,37 @@ use crate::fem::geometry::deformation_gradient;
 use crate::material::{Mat3, Mat9, Material, NodeVisit, contract, project_psd};
 use nalgebra::{DMatrix, Matrix3};
 
+pub mod patch;
+
 /// Why the mixed formulation refuses an element type, if it does: a constant pressure per element
 /// is stable (inf–sup) with P2, P3 and Q2 (every element of order 2 or more); P1 has one point, so
-/// its element mean is its point and the formulation would not change it; Q1, the prism and the
-/// pyramid with a constant pressure violate the inf–sup condition (Q1's pressures checkerboard).
+/// its pressure is one per node instead ([`patch`], the averaged nodal pressure); Q1, the prism and
+/// the pyramid with a constant pressure violate the inf–sup condition (Q1's pressures
+/// checkerboard).
 pub fn refusal(element: crate::element::ElementType) -> Option<String> {
     use crate::element::ReferenceShape;
-    if element.order() >= 2 {
+    if element.order() >= 2 || element.shape() == ReferenceShape::Tetrahedron {
         return None;
     }
-    Some(if element.shape() == ReferenceShape::Tetrahedron {
+    Some(format!(
+        "the mixed formulation's constant pressure per element violates the inf–sup condition on {element} \
+         (the element pressures form a checkerboard, as Q1's do): use Q2, P2, P3 or P1 (whose pressure is one per \
+         node)"
+    ))
+}
+
+/// Why a solver refuses the mixed formulation on an element type, if it does: P1's pressure per
+/// node patch couples the elements around each node, which the sparse Newton solver assembles
+/// (the pattern widened to the patches) and XPBD's, VBD's and Newton-CG's element-by-element
+/// loops do not yet.
+pub fn solver_refusal(element: crate::element::ElementType, method: crate::solver::Method) -> Option<String> {
+    use crate::element::ReferenceShape;
+    let patch = element.order() == 1 && element.shape() == ReferenceShape::Tetrahedron;
+    (patch && method != crate::solver::Method::Newton).then(|| {
         format!(
-            "the mixed formulation measures the volume once per element, and {element} has one quadrature point, so \
-             it would stay {element} and lock as before: use P2 or P3 (a P1 cure needs a pressure shared by the \
-             elements around each node)"
-        )
-    } else {
-        format!(
-            "the mixed formulation's constant pressure per element violates the inf–sup condition on {element} \
-             (the element pressures form a checkerboard, as Q1's do): use Q2, P2 or P3"
+            "the mixed formulation on {element} shares one pressure among the elements around each node (the averaged \
+             nodal pressure), which the {} solver does not run yet: use --solver newton, or P2 mixed",
+            method.info().name
         )
     })
 }

@@ -141,3 +141,86 @@ fn the_mixed_formulation_refuses_a_model_whose_deviatoric_term_is_unstable_alone
         }
     }
 }
+
+/// P1 measured per node patch (`patch`): over a deformed 3×2×2 box of five tetrahedra per cell,
+/// the mesh gradient is the energy's central difference, the assembled Hessian (exact and
+/// projected: one pass of `patch::hessian_terms`) the gradient's, and every node's patch term
+/// reaches nodes two edges apart.
+#[test]
+fn the_patch_gradient_and_hessian_match_finite_differences_over_the_mesh() {
+    use crate::fem::energy::{total_energy, total_energy_and_gradient};
+    use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+    let mesh = BoxMeshSpec {
+        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(0.6, 0.4, 0.4), cells: [3, 2, 2] },
+        element_type: ElementType::from_name("p1").unwrap(),
+        split: TetSplit::Five,
+        refine: 0,
+    }
+    .build()
+    .unwrap();
+    let geo = crate::fem::geometry::precompute(&mesh, None).unwrap();
+    let x: Vec<Vec3> = mesh
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let k = i as f64;
+            Vec3::new(1.1 * p.x + 0.2 * p.y, 0.95 * p.y - 0.1 * p.z, p.z + 0.3 * p.x * p.y)
+                + 0.01 * Vec3::new((1.3 * k).sin(), (2.1 * k).cos(), (0.7 * k).sin())
+        })
+        .collect();
+    let n = mesh.num_nodes();
+    for m in mixed_materials() {
+        assert!(patch::has_patches(&mesh, &m));
+        let mut grad = vec![Vec3::zeros(); n];
+        let u = total_energy_and_gradient(&mesh, &geo, &m, &x, &mut grad);
+        assert!((u - total_energy(&mesh, &geo, &m, &x)).abs() <= 1e-12 * u.abs());
+        let plain = m.with_volume_measure(VolumeMeasure::Point).unwrap();
+        assert!(u < total_energy(&mesh, &geo, &plain, &x), "the patch mean relaxes the volume: {u}");
+        let mut hess = DMatrix::<f64>::zeros(3 * n, 3 * n);
+        patch::hessian_terms(&mesh, &geo, &m, &x, false, |nodes, h| {
+            for (li, &i) in nodes.iter().enumerate() {
+                for (lj, &j) in nodes.iter().enumerate() {
+                    for (a, b) in (0..3).flat_map(|a| (0..3).map(move |b| (a, b))) {
+                        hess[(3 * i as usize + a, 3 * j as usize + b)] += h[(3 * li + a, 3 * lj + b)];
+                    }
+                }
+            }
+        });
+        let (gscale, hscale) = (grad.iter().map(|g| g.amax()).fold(0.0, f64::max), hess.amax());
+        let h = 1e-6;
+        for d in 0..3 * n {
+            let shifted = |s: f64| {
+                let mut xs = x.clone();
+                xs[d / 3][d % 3] += s;
+                xs
+            };
+            let (xp, xm) = (shifted(h), shifted(-h));
+            let fd = (total_energy(&mesh, &geo, &m, &xp) - total_energy(&mesh, &geo, &m, &xm)) / (2.0 * h);
+            assert!(
+                (fd - grad[d / 3][d % 3]).abs() <= 1e-6 * gscale,
+                "{:?} dof {d}: {fd} vs {}",
+                m.model,
+                grad[d / 3][d % 3]
+            );
+            let (mut gp, mut gm) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
+            total_energy_and_gradient(&mesh, &geo, &m, &xp, &mut gp);
+            total_energy_and_gradient(&mesh, &geo, &m, &xm, &mut gm);
+            for e in 0..3 * n {
+                let fd = (gp[e / 3][e % 3] - gm[e / 3][e % 3]) / (2.0 * h);
+                assert!(
+                    (fd - hess[(e, d)]).abs() <= 1e-5 * hscale,
+                    "{:?} ({e}, {d}): {fd} vs {}",
+                    m.model,
+                    hess[(e, d)]
+                );
+            }
+        }
+        // the patch terms couple nodes two edges apart: more pairs than the elements' own
+        let coupled = |k: &DMatrix<f64>| {
+            (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).filter(|&(i, j)| k[(3 * i, 3 * j)] != 0.0).count()
+        };
+        let plain_k = crate::solver::statics::assemble_dense(&mesh, &geo, &plain, &x);
+        assert!(coupled(&hess) > coupled(&plain_k), "{} vs {}", coupled(&hess), coupled(&plain_k));
+    }
+}
