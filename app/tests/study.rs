@@ -64,13 +64,18 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
     assert!(p1 > missing("0.35", "P1 16x4x4 five") + 10.0, "P1 must stiffen as ν → 0.5");
     let cured = cell("0.499", "P2 8x2x2 five", "mixed", "missing_pct");
     assert!(cured.abs() < 1.5, "P2 160 mixed at ν = 0.499: {cured} % from the reference");
-    assert!(
-        rows.iter().all(|r| r[at("formulation")] != "mixed" || r[at("configuration")] != "P1 16x4x4 five"),
-        "P1 is refused"
-    );
+    let eased = cell("0.499", "P1 16x4x4 five", "mixed", "missing_pct");
+    assert!(eased < p1 - 3.0, "P1 1,280's patch pressure eases its locking at ν = 0.499: {eased} % against {p1} %");
     for r in &rows {
-        let ms: f64 = r[at("ms_per_frame_1_thread")].parse().unwrap();
-        assert!(ms > 0.0 && ms.is_finite(), "{r:?}");
+        let newton: f64 = r[at("newton_ms_per_frame_1_thread")].parse().unwrap();
+        assert!(newton > 0.0 && newton.is_finite(), "{r:?}");
+        let xpbd = r[at("ms_per_frame_1_thread")];
+        if r[at("formulation")] == "mixed" && r[at("configuration")].starts_with("P1") {
+            assert!(xpbd.is_empty(), "XPBD refuses P1 mixed: {r:?}");
+        } else {
+            let ms: f64 = xpbd.parse().unwrap();
+            assert!(ms > 0.0 && ms.is_finite(), "{r:?}");
+        }
     }
     // the solver axis: every solver on the quick meshes, the Pareto chart, the cheapest sentence
     assert!(md.contains("## The solver axis"), "study.md lacks the solver axis");

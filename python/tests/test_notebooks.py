@@ -65,11 +65,21 @@ def check_locking_lesson(results):
     assert p1["0.499"] > p1["0.35"] + 10, "P1 misses over 10 points more of the sag at ν 0.499 than at 0.35"
     for nu in ("0.35", "0.45", "0.49", "0.499"):
         assert p2[nu] < p1[nu] and p3[nu] < p1[nu], nu
-    assert p2["0.49"] < 10 and p3["0.49"] < 10, "P2 and P3 hardly lock"
+    assert p2["0.49"] < 10 and p3["0.49"] < 10, "P2 and P3 lock far less than P1"
+    assert p2["0.499"] > p2["0.35"] + 3, "the energy P2 locks too: it misses more of the sag as ν grows"
+    mixed = results["mixed_missing_pct"]
+    p1_mixed = next(v for k, v in mixed.items() if k.startswith("P1"))
+    assert p1_mixed["0.499"] < p1["0.499"] - 3, "P1's pressure per node eases its locking"
+    assert p1_mixed["0.499"] > 10, "but does not cure it"
+    p2_mixed = next(v for k, v in mixed.items() if k.startswith("P2"))
+    assert all(abs(v) < 1.5 for v in p2_mixed.values()), f"the cure: P2 mixed within 1.5 % at every ν {p2_mixed}"
     tip = results["dynamic_tip_z_m"]
-    (p1_name, p1_tip), (p2_name, p2_tip) = sorted(tip.items())
-    assert p1_name.startswith("P1") and p2_name.startswith("P2")
+    (p1_name, p1_tip), (p2_name, p2_tip), (p2m_name, p2m_tip) = sorted(tip.items())
+    assert p1_name.startswith("P1") and p2_name.startswith("P2") and p2m_name.endswith("mixed")
     assert -p1_tip < 0.9 * -p2_tip, "settled at ν 0.49, P1 sags over 10 % less than P2"
+    reference = results["reference_sag_049_m"]
+    assert abs(-p2m_tip - reference) < 0.03 * reference, "settled, the mixed P2 sags within 3 % of the reference"
+    assert -p2_tip < -p2m_tip, "settled, the energy P2 sags less than the mixed one"
     assert all(results["dynamic_at_rest"].values())
 
 

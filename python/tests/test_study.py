@@ -1,7 +1,7 @@
 """`hox study --shard K/N` + `hox study merge` against one run, and `hox.study` through an
 executor against the command line (issue #60). The locking table is the plan: its cells are
-static solves, so every number of it is the same on every run but XPBD's ms per frame (its last
-column), which is left out of the comparisons."""
+static solves, so every number of it is the same on every run but XPBD's and Newton's ms per
+frame (its last two columns), which are left out of the comparisons."""
 
 import subprocess
 from concurrent.futures import ProcessPoolExecutor
@@ -13,13 +13,14 @@ from hox.study import _rows
 
 
 TIMING = "ms_per_frame_1_thread"
+TIMINGS = (TIMING, "newton_ms_per_frame_1_thread")
 
 
 def without_timing(name, text):
-    """locking.csv without its timing column; study.md without its tables' last cell (ms/frame)."""
+    """locking.csv without its timing columns; study.md without its tables' last two cells (ms/frame)."""
     if name.endswith(".csv"):
-        return [{k: v for k, v in row.items() if k != TIMING} for row in _rows(text)]
-    return [line.rsplit("|", 2)[0] if line.startswith("| ") else line for line in text.splitlines()]
+        return [{k: v for k, v in row.items() if k not in TIMINGS} for row in _rows(text)]
+    return [line.rsplit("|", 3)[0] if line.startswith("| ") else line for line in text.splitlines()]
 
 
 def run(hox_binary, *args, ok=True):
@@ -48,8 +49,11 @@ def test_study_shard_parts_merged_equal_the_unsharded_study(hox_binary, unsharde
         merged_text, whole_text = (merged / name).read_text(), (unsharded / name).read_text()
         assert without_timing(name, merged_text) == without_timing(name, whole_text), name
     rows = _rows((merged / "locking.csv").read_text())
-    assert len(rows) == 4 * 5, "4 Poisson ratios × P1, P2 and P3 plain, P2 and P3 mixed"
-    assert all(row[TIMING] > 0 for row in rows), "every cell's ms per frame"
+    assert len(rows) == 4 * 6, "4 Poisson ratios × P1, P2 and P3, plain and mixed"
+    assert all(row[TIMINGS[1]] > 0 for row in rows), "every cell's Newton ms per frame"
+    for row in rows:
+        refused = row["configuration"].startswith("P1") and row["formulation"] == "mixed"
+        assert (row[TIMING] is None) == refused, f"XPBD's ms per frame but where it refuses P1 mixed: {row}"
 
 
 def test_a_merge_missing_a_part_or_given_one_twice_writes_nothing(hox_binary, tmp_path):
@@ -82,12 +86,13 @@ def test_hox_study_through_a_process_pool_equals_the_command_line(unsharded):
     assert isinstance(frame, pandas.DataFrame), "a DataFrame when pandas is installed"
     assert list(frame.columns) == [
         "poisson_ratio", "configuration", "formulation", "elements", "tip_z_m", "reference_tip_z_m", "reference_mesh",
-        "missing_pct", TIMING,
+        "missing_pct", *TIMINGS,
     ]
-    records = [{k: v for k, v in row.items() if k != TIMING} for row in frame.to_dict("records")]
+    records = [{k: v for k, v in row.items() if k not in TIMINGS} for row in frame.to_dict("records")]
     assert records == without_timing("locking.csv", (unsharded / "locking.csv").read_text())
-    p1 = frame[(frame.configuration == "P1 16x4x4 five")].set_index("poisson_ratio").missing_pct
-    assert p1[0.499] > p1[0.35] + 10, "P1 locks as ν → 0.5"
+    p1 = frame[frame.configuration == "P1 16x4x4 five"].set_index(["formulation", "poisson_ratio"]).missing_pct
+    assert p1["energy", 0.499] > p1["energy", 0.35] + 10, "P1 locks as ν → 0.5"
+    assert p1["mixed", 0.499] < p1["energy", 0.499] - 3, "its patch pressure eases it"
     p2 = frame[frame.configuration == "P2 8x2x2 five"].set_index(["formulation", "poisson_ratio"]).missing_pct
     assert p2["energy", 0.499] > 4 and abs(p2["mixed", 0.499]) < 1.5, "the mixed P2 160 is within 1.5 % at ν = 0.499"
     assert hox.study_cells(True, ["locking"]) == [f"locking ν = {nu}" for nu in (0.35, 0.45, 0.49, 0.499)]

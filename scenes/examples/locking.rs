@@ -1,6 +1,6 @@
 //! The locking table of `hox study` on its own (the full set of meshes, P1 10,240 included):
 //! static tip deflections of the bending beam at ν = 0.35, 0.45, 0.49, 0.499 in both formulations
-//! (energy, mixed) against the computed reference, and XPBD's ms per frame of each.
+//! (energy, mixed) against the computed reference, and XPBD's and Newton's ms per frame of each.
 //! Writes the markdown section to stdout and the CSV to the path given, if any.
 //! docs/study/locking.md and locking.csv are its output.
 //!

@@ -77,8 +77,11 @@ pub fn solve_static(
     progress: hox_sim::solver::statics::Progress<'_>,
 ) -> Result<hox_sim::solver::statics::StaticSolution, SceneError> {
     let (acceleration_m_s2, dirichlet) = static_problem(scene, mesh)?;
-    // the formulation's material: the mixed one measures its hydrostatic term per element
-    let material = scene.settings().formulated(&scene.material(), mesh).map_err(|e| SceneError::Simulation {
+    // the formulation's material: the mixed one measures its hydrostatic term per element (per
+    // node patch on P1), which the static solver assembles as Newton does whatever the scene's
+    // solver
+    let settings = hox_sim::solver::SolverSettings { method: hox_sim::solver::Method::Newton, ..scene.settings() };
+    let material = settings.formulated(&scene.material(), mesh).map_err(|e| SceneError::Simulation {
         source_name: scene.source.clone(),
         message: format!("static solve: {e}"),
     })?;

@@ -50,8 +50,8 @@ pub type OnEstimate<'p> = &'p mut dyn FnMut(&Reference);
 /// Static tolerance and load steps of a computed reference: a residual of 1e-9 of the load is
 /// far below the mesh error (the committed ones went to 1e-10, which the twist scene's large
 /// rotation cannot always reach).
-pub(super) const TOLERANCE: f64 = 1e-9;
-pub(super) const LOAD_STEPS: usize = 10;
+pub const TOLERANCE: f64 = 1e-9;
+pub const LOAD_STEPS: usize = 10;
 
 /// Roache's safety factor of a grid convergence index from three levels.
 pub const SAFETY_FACTOR: f64 = 1.25;

@@ -9,9 +9,12 @@
 //! reference** at the same ν ([`crate::reference`]: the committed fine Q2 solution at the
 //! paper's ν, Q2 levels below ν = 0.45 and P2 mixed levels from it, extrapolated), which no
 //! longer locks itself: the share of its sag a mesh misses is the mesh's locking and
-//! discretisation error, not a lower bound. The cost of each is XPBD's median ms per frame at the
-//! scene's settings (50 substeps × 1 iteration, 60 fps) on one thread over half a simulated
-//! second from rest, measured in the same run as its neighbours (compare them as ratios).
+//! discretisation error, not a lower bound. P1's mixed formulation is one pressure per node patch
+//! ([`hox_sim::fem::energy::mixed::patch`]). The cost of each is the median ms per frame of XPBD
+//! at the scene's settings (50 substeps × 1 iteration, 60 fps; none where XPBD refuses the
+//! formulation: P1 mixed) and of Newton (one implicit Euler step per frame), on one thread over
+//! half a simulated second from rest, measured in the same run as its neighbours (compare them as
+//! ratios).
 
 use super::StudyConfig;
 use crate::error::SceneError;
@@ -19,6 +22,7 @@ use crate::params::SceneOverrides;
 use crate::run::{RunMode, run};
 use hox_sim::Vec3;
 use hox_sim::mesh::structured::TetSplit;
+use hox_sim::solver::Method;
 use hox_sim::xpbd::constraint::Formulation;
 
 /// The Poisson ratios of the locking table: the paper's 0.35 and the near-incompressible ones of
@@ -46,8 +50,11 @@ pub struct LockingRow {
     pub reference_mesh: String,
     /// Share of the reference's sag that this mesh misses, % (positive: stiffer, i.e. locking).
     pub missing_pct: f64,
-    /// XPBD's median ms per frame at the scene's settings, one thread (module docs).
-    pub ms_per_frame: f64,
+    /// XPBD's median ms per frame at the scene's settings, one thread (module docs); None where
+    /// XPBD refuses the formulation (P1 mixed).
+    pub ms_per_frame: Option<f64>,
+    /// Newton's median ms per frame (implicit Euler, one step per frame), one thread.
+    pub newton_ms_per_frame: f64,
 }
 
 /// The meshes of the locking table (P1 10,240 is heavy).
@@ -86,6 +93,10 @@ pub fn locking_at(nu: f64, quick: bool, progress: &mut dyn FnMut(&str)) -> Resul
     for config in meshes().iter().filter(|m| !(quick && m.heavy)) {
         for formulation in LOCKING_FORMULATIONS {
             let element = hox_sim::element::ElementType::from_name(config.element);
+            let refused = |method| {
+                element.and_then(|e| hox_sim::fem::energy::mixed::solver_refusal(e, method)).is_some()
+                    && formulation == Formulation::Mixed
+            };
             if formulation == Formulation::Mixed && element.and_then(hox_sim::fem::energy::mixed::refusal).is_some() {
                 continue;
             }
@@ -95,8 +106,10 @@ pub fn locking_at(nu: f64, quick: bool, progress: &mut dyn FnMut(&str)) -> Resul
             let label = format!("{} {}", config.label(), formulation.name());
             progress(&format!("locking: bending {label} at ν = {nu}: static solution"));
             let (tip_z_m, elements) = static_tip_z(&scene, &label, nu)?;
-            progress(&format!("locking: bending {label} at ν = {nu}: XPBD, one thread"));
-            let ms_per_frame = xpbd_ms_per_frame(&scene, &label, nu)?;
+            progress(&format!("locking: bending {label} at ν = {nu}: XPBD and Newton, one thread"));
+            let ms_per_frame =
+                if refused(Method::Xpbd) { None } else { Some(median_ms_per_frame(&scene, Method::Xpbd)?) };
+            let newton_ms_per_frame = median_ms_per_frame(&scene, Method::Newton)?;
             rows.push(LockingRow {
                 poisson_ratio: nu,
                 config: config.label(),
@@ -107,6 +120,7 @@ pub fn locking_at(nu: f64, quick: bool, progress: &mut dyn FnMut(&str)) -> Resul
                 reference_mesh: reference.mesh.replace(',', ";"),
                 missing_pct: 100.0 * (1.0 - tip_z_m / reference_tip_z_m),
                 ms_per_frame,
+                newton_ms_per_frame,
             });
         }
     }
@@ -130,25 +144,19 @@ fn static_tip_z(scene: &crate::scene::Scene, label: &str, nu: f64) -> Result<(f6
     Ok((probe.displacement(&solution.positions, &mesh.rest_positions).z, mesh.num_elements()))
 }
 
-/// XPBD's median ms per frame on `scene` at its settings, one thread, over half a simulated
-/// second from rest.
-fn xpbd_ms_per_frame(scene: &crate::scene::Scene, label: &str, nu: f64) -> Result<f64, SceneError> {
-    let fail = |m: String| SceneError::Simulation { source_name: format!("bending {label} at ν = {nu}"), message: m };
-    let xpbd =
-        scene.with_overrides(&SceneOverrides { method: Some(hox_sim::solver::Method::Xpbd), ..Default::default() })?;
-    let mut instance = crate::instance::Instance::new(xpbd)?;
-    let one_thread = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .map_err(|e| fail(format!("cannot make a one-thread pool: {e}")))?;
-    Ok(one_thread.install(|| run(&mut instance, RunMode::Seconds(0.5), &mut |_, _| {}))?.ms_per_frame)
+/// The median ms per frame of `method` on `scene` at its settings, one thread, over half a
+/// simulated second from rest.
+fn median_ms_per_frame(scene: &crate::scene::Scene, method: Method) -> Result<f64, SceneError> {
+    let solver = scene.with_overrides(&SceneOverrides { method: Some(method), ..Default::default() })?;
+    let mut instance = crate::instance::Instance::new(solver)?;
+    Ok(super::one_thread()?.install(|| run(&mut instance, RunMode::Seconds(0.5), &mut |_, _| {}))?.ms_per_frame)
 }
 
 /// `study.md`'s locking section: one row per mesh and formulation, one column per ν, and the
 /// cost per frame at the last ν.
 pub fn locking_markdown(rows: &[LockingRow]) -> String {
     let mut s = String::from(
-        "## Near incompressibility: volumetric locking and its cure (bending, static)\n\nStatic tip deflection `u_z` of the bending beam (the scene's StVK, E = 3 MPa, 4 load steps) with the volume measured at every quadrature point (`energy`) and once per element (`mixed`: one constant pressure per element, P2 and P3; P1 is refused, its one quadrature point already measures the element's volume), against the computed reference at the same ν; in brackets the share of the reference's sag the mesh misses (negative: stiffer, i.e. locking). The last column: XPBD's median ms per frame at the scene's settings (50 substeps × 1 iteration, the substep shortened by the stability guard near incompressibility), one thread, over half a second from rest at the last ν.\n\n| configuration | formulation |",
+        "## Near incompressibility: volumetric locking and its cure (bending, static)\n\nStatic tip deflection `u_z` of the bending beam (the scene's StVK, E = 3 MPa, 4 load steps) with the volume measured at every quadrature point (`energy`) and once per element (`mixed`: one constant pressure per element on P2 and P3; on P1, whose one quadrature point already measures the element's volume, one pressure per node, the mean over the elements around it), against the computed reference at the same ν; in brackets the share of the reference's sag the mesh misses (negative: stiffer, i.e. locking). The last columns: the median ms per frame of XPBD at the scene's settings (50 substeps × 1 iteration, the substep shortened by the stability guard near incompressibility; — where XPBD refuses the formulation) and of Newton (one implicit Euler step per frame), one thread, over half a second from rest at the last ν.\n\n| configuration | formulation |",
     );
     let nus: Vec<f64> =
         LOCKING_POISSON_RATIOS.iter().copied().filter(|nu| rows.iter().any(|r| r.poisson_ratio == *nu)).collect();
@@ -156,8 +164,9 @@ pub fn locking_markdown(rows: &[LockingRow]) -> String {
         s.push_str(&format!(" ν = {nu} |"));
     }
     let last = nus.last().copied();
-    s.push_str(&format!(" ms/frame{} |\n|---|---|", last.map(|nu| format!(" (ν = {nu})")).unwrap_or_default()));
-    s.push_str(&"---|".repeat(nus.len() + 1));
+    let at = last.map(|nu| format!(" (ν = {nu})")).unwrap_or_default();
+    s.push_str(&format!(" XPBD ms/frame{at} | Newton ms/frame{at} |\n|---|---|"));
+    s.push_str(&"---|".repeat(nus.len() + 2));
     s.push_str("\n| reference | |");
     for nu in &nus {
         match rows.iter().find(|r| r.poisson_ratio == *nu) {
@@ -165,7 +174,7 @@ pub fn locking_markdown(rows: &[LockingRow]) -> String {
             None => s.push_str(" — |"),
         }
     }
-    s.push_str(" |\n");
+    s.push_str(" | |\n");
     let mut lines: Vec<(&str, &str, usize)> = Vec::new();
     for r in rows {
         if !lines.iter().any(|(c, f, _)| *c == r.config && *f == r.formulation) {
@@ -183,9 +192,10 @@ pub fn locking_markdown(rows: &[LockingRow]) -> String {
                 None => s.push_str(" — |"),
             }
         }
+        let ms = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{v:.1}"));
         match last.and_then(of) {
-            Some(r) => s.push_str(&format!(" {:.1} |\n", r.ms_per_frame)),
-            None => s.push_str(" — |\n"),
+            Some(r) => s.push_str(&format!(" {} | {} |\n", ms(r.ms_per_frame), ms(Some(r.newton_ms_per_frame)))),
+            None => s.push_str(" — | — |\n"),
         }
     }
     s.push_str("\nReferences:");
@@ -201,11 +211,11 @@ pub fn locking_markdown(rows: &[LockingRow]) -> String {
 /// `locking.csv`: the locking rows.
 pub fn locking_csv(rows: &[LockingRow]) -> String {
     let mut s = String::from(
-        "poisson_ratio,configuration,formulation,elements,tip_z_m,reference_tip_z_m,reference_mesh,missing_pct,ms_per_frame_1_thread\n",
+        "poisson_ratio,configuration,formulation,elements,tip_z_m,reference_tip_z_m,reference_mesh,missing_pct,ms_per_frame_1_thread,newton_ms_per_frame_1_thread\n",
     );
     for r in rows {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{}\n",
             r.poisson_ratio,
             r.config,
             r.formulation,
@@ -214,7 +224,8 @@ pub fn locking_csv(rows: &[LockingRow]) -> String {
             r.reference_tip_z_m,
             r.reference_mesh,
             r.missing_pct,
-            r.ms_per_frame
+            r.ms_per_frame.map_or(String::new(), |v| v.to_string()),
+            r.newton_ms_per_frame
         ));
     }
     s

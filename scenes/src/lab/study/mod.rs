@@ -207,10 +207,7 @@ pub fn study_one(
     progress(&format!("{scene_name} {label}: XPBD at 50 substeps"));
     let (first_cap, warm_cap) = caps(config.heavy);
     // timed on one thread (the colour sweep, the default, would otherwise take every thread)
-    let one_thread = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .map_err(|e| fail(format!("cannot make a one-thread pool: {e}")))?;
+    let one_thread = one_thread()?;
     let report = one_thread.install(|| run(&mut instance, RunMode::Settle { cap_secs: first_cap }, &mut |_, _| {}))?;
     let xpbd_probes = settled_probes(&report);
     let solver_m = probe_distance(&xpbd_probes, &static_probes);
@@ -423,4 +420,13 @@ pub fn svg(rows: &[StudyRow]) -> String {
 "##, lx + 10.0, ly + 4.0, ly + 18.0, lx + 10.0, ly + 22.0, lx - 5.0, ly + 31.0, lx + 5.0, ly + 41.0, lx - 5.0, ly + 41.0, lx + 5.0, ly + 31.0, lx + 10.0, ly + 40.0));
     s.push_str("</svg>\n");
     s
+}
+
+/// A pool of one thread, for the study's timings (the colour sweep would otherwise take every
+/// thread).
+pub(crate) fn one_thread() -> Result<rayon::ThreadPool, SceneError> {
+    rayon::ThreadPoolBuilder::new().num_threads(1).build().map_err(|e| SceneError::Simulation {
+        source_name: "study".into(),
+        message: format!("cannot make a one-thread pool: {e}"),
+    })
 }

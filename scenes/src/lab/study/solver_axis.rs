@@ -167,10 +167,7 @@ pub fn mesh_rows(
     config: &StudyConfig,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Vec<SolverRow>, SceneError> {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().map_err(|e| SceneError::Simulation {
-        source_name: "study".into(),
-        message: format!("cannot make a one-thread pool: {e}"),
-    })?;
+    let pool = super::one_thread()?;
     let mut rows = Vec::new();
     config_rows(&pool, scene_name, config, &reference_motion()?.metrics(), progress, &mut rows)?;
     Ok(rows)

@@ -111,7 +111,8 @@ fn locking(t: &Table) -> Result<String, SceneError> {
                 reference_tip_z_m: t.number(r, "reference_tip_z_m")?,
                 reference_mesh: t.get(r, "reference_mesh")?.to_string(),
                 missing_pct: t.number(r, "missing_pct")?,
-                ms_per_frame: t.number(r, "ms_per_frame_1_thread")?,
+                ms_per_frame: t.optional(r, "ms_per_frame_1_thread")?,
+                newton_ms_per_frame: t.number(r, "newton_ms_per_frame_1_thread")?,
             })
         })
         .collect::<Result<Vec<_>, SceneError>>()?;
@@ -245,7 +246,7 @@ fn motion(t: &Table) -> Result<String, SceneError> {
 mod tests {
     use super::*;
 
-    const LOCKING: &str = "poisson_ratio,configuration,formulation,elements,tip_z_m,reference_tip_z_m,reference_mesh,missing_pct,ms_per_frame_1_thread\n0.35,P1 16x4x4 five,energy,1280,-0.28,-0.32,Q2 32×8×8 extrapolated,11.8,3.1\n";
+    const LOCKING: &str = "poisson_ratio,configuration,formulation,elements,tip_z_m,reference_tip_z_m,reference_mesh,missing_pct,ms_per_frame_1_thread,newton_ms_per_frame_1_thread\n0.35,P1 16x4x4 five,energy,1280,-0.28,-0.32,Q2 32×8×8 extrapolated,11.8,3.1,2.2\n0.35,P1 16x4x4 five,mixed,1280,-0.29,-0.32,Q2 32×8×8 extrapolated,9.4,,4.1\n";
 
     fn folder(study_md: &str, study_csv: &str, solvers_csv: &str) -> std::path::PathBuf {
         let dir = std::env::temp_dir().join(format!("hox-summary-{}-{}", std::process::id(), study_md.len()));
@@ -276,9 +277,11 @@ mod tests {
         assert!(s.contains("| P2 8x2x2 five | newton | — | -0.1 / +0.6 %, 2.34 ms | — | — |"), "{s}");
         assert!(s.contains("| P2 8x2x2 five | xpbd | — | — | — | +0.6 / -1.2 %, 1.30 ms |"), "{s}");
         assert!(
-            s.contains("| configuration | formulation | ν = 0.35 | ms/frame (ν = 0.35) |")
-                && s.contains("| reference | | -0.3200 m | |")
-                && s.contains("| P1 16x4x4 five (1280) | energy | -0.2800 m (-11.8 %) | 3.1 |")
+            s.contains(
+                "| configuration | formulation | ν = 0.35 | XPBD ms/frame (ν = 0.35) | Newton ms/frame (ν = 0.35) |"
+            ) && s.contains("| reference | | -0.3200 m | | |")
+                && s.contains("| P1 16x4x4 five (1280) | energy | -0.2800 m (-11.8 %) | 3.1 | 2.2 |")
+                && s.contains("| P1 16x4x4 five (1280) | mixed | -0.2900 m (-9.4 %) | — | 4.1 |")
                 && s.contains("References: ν = 0.35: Q2 32×8×8 extrapolated."),
             "{s}"
         );

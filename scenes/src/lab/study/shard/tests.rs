@@ -10,7 +10,8 @@ fn locking_row(nu: f64, config: &str) -> LockingRow {
         reference_tip_z_m: -0.11,
         reference_mesh: "Q2 32×8×8 extrapolated".into(),
         missing_pct: 3.0,
-        ms_per_frame: 2.5,
+        ms_per_frame: Some(2.5),
+        newton_ms_per_frame: 1.5,
     }
 }
 
@@ -109,6 +110,10 @@ fn the_plan_lists_only_the_tables_asked_for_and_names_its_command() {
 fn a_part_file_keeps_nan_infinity_and_absent_values() {
     let mut part = parts(3, 2).remove(0);
     part.cells[0].rows.solvers.push(failed_solver_row());
+    // a cell XPBD refuses (P1 mixed) has no XPBD ms per frame, and keeps none
+    let refused =
+        LockingRow { formulation: "mixed".into(), ms_per_frame: None, ..locking_row(0.499, "P1 16x4x4 five") };
+    part.cells[0].rows.locking.push(refused);
     let text = part.to_toml().unwrap();
     let back = StudyPart::from_toml(&text, "part.toml").unwrap();
     let (a, b) = (&part.cells[0].rows.solvers[0], &back.cells[0].rows.solvers[0]);
