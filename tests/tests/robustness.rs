@@ -546,11 +546,18 @@ fn near_incompressible_cantilevers_with_the_mixed_formulation_do_not_blow_up() {
 }
 
 fn near_incompressible_mixed(known: &[(f64, &[&str])]) -> Vec<String> {
-    let configs: Vec<Solve> = Method::ALL.into_iter().map(|m| Solve::Mixed(m, Integrator::Euler)).collect();
     let mut problems = Vec::new();
     for nu in [0.499, 0.4999] {
         let known = known.iter().find(|(v, _)| *v == nu).map_or(&[][..], |(_, k)| *k);
         let case = format!("2 ν = {nu}, {NH}, mixed");
+        // VBD at ν = 0.4999 (λ/μ = 4999) converges slowly: the P2 cantilever had not finished
+        // after 3 minutes (session 34), so only [`full`] runs it
+        let slow = |m: Method| m == Method::Vbd && nu > 0.499 && !full();
+        if Method::ALL.into_iter().any(slow) {
+            eprintln!("SKIP {case} | every type | vbd euler mixed | HOX_ROBUSTNESS_FULL=1 runs it");
+        }
+        let configs: Vec<Solve> =
+            Method::ALL.into_iter().filter(|&m| !slow(m)).map(|m| Solve::Mixed(m, Integrator::Euler)).collect();
         problems.extend(configurations(&case, &["p1", "p2", "p3", "q2"], &configs, known, |et, f| {
             if et == "p1" && !matches!(f, Solve::Mixed(Method::Newton, _)) {
                 // refused by name (checked in hox-sim's mixed tests): nothing to run
