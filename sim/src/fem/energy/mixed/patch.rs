@@ -53,6 +53,26 @@ fn patch_blocks<'a>(mesh: &'a Mesh, material: &'a Material) -> impl Iterator<Ite
     (0..mesh.blocks.len()).filter(move |&b| is_patch_block(&mesh.blocks[b], material))
 }
 
+/// Visits every patch element (block by block, in mesh order) with its deformed and rest corner
+/// positions gathered: `visit(block, element, nodes, geometry, x, rest)`.
+fn for_each_patch_element(
+    mesh: &Mesh,
+    geometry: &[BlockGeometry],
+    material: &Material,
+    x: &[Vec3],
+    mut visit: impl FnMut(usize, usize, &[u32], &BlockGeometry, &[Vec3; CORNERS], &[Vec3; CORNERS]),
+) {
+    let (mut xl, mut rest) = ([Vec3::zeros(); CORNERS], [Vec3::zeros(); CORNERS]);
+    for bi in patch_blocks(mesh, material) {
+        let (block, g) = (&mesh.blocks[bi], &geometry[bi]);
+        for (e, nodes) in block.elements().enumerate() {
+            gather(x, nodes, &mut xl);
+            gather(&mesh.rest_positions, nodes, &mut rest);
+            visit(bi, e, nodes, g, &xl, &rest);
+        }
+    }
+}
+
 /// The nodal means at `x`: per node `W_a` and `C̄_a` (zero where no patch element touches it).
 pub struct NodeMeans {
     pub weight_m3: Vec<f64>,
@@ -63,19 +83,13 @@ impl NodeMeans {
     pub fn new(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material, x: &[Vec3]) -> Self {
         let n = mesh.num_nodes();
         let (mut weight_m3, mut sum) = (vec![0.0; n], vec![0.0; n]);
-        let (mut xl, mut rest) = ([Vec3::zeros(); CORNERS], [Vec3::zeros(); CORNERS]);
-        for bi in patch_blocks(mesh, material) {
-            let (block, g) = (&mesh.blocks[bi], &geometry[bi]);
-            for (e, nodes) in block.elements().enumerate() {
-                gather(x, nodes, &mut xl);
-                gather(&mesh.rest_positions, nodes, &mut rest);
-                let (v_e, c_sum) = element_sums(g, e, &xl, &rest, material);
-                for &a in nodes {
-                    weight_m3[a as usize] += v_e / CORNERS as f64;
-                    sum[a as usize] += c_sum / CORNERS as f64;
-                }
+        for_each_patch_element(mesh, geometry, material, x, |_, e, nodes, g, xl, rest| {
+            let (v_e, c_sum) = element_sums(g, e, xl, rest, material);
+            for &a in nodes {
+                weight_m3[a as usize] += v_e / CORNERS as f64;
+                sum[a as usize] += c_sum / CORNERS as f64;
             }
-        }
+        });
         let c_bar = sum.iter().zip(&weight_m3).map(|(s, w)| if *w > 0.0 { s / w } else { 0.0 }).collect();
         Self { weight_m3, c_bar }
     }
@@ -115,27 +129,21 @@ pub fn energy_and_gradient(
     let k_h = hydrostatic_stiffness_pa(material);
     let means = NodeMeans::new(mesh, geometry, material, x);
     let mut total = means.hydrostatic_energy(k_h);
-    let (mut xl, mut rest) = ([Vec3::zeros(); CORNERS], [Vec3::zeros(); CORNERS]);
-    for bi in patch_blocks(mesh, material) {
-        let (block, g) = (&mesh.blocks[bi], &geometry[bi]);
-        for (e, nodes) in block.elements().enumerate() {
-            gather(x, nodes, &mut xl);
-            gather(&mesh.rest_positions, nodes, &mut rest);
-            let pressure = means.element_pressure_pa(nodes, k_h);
-            let grads = element_grads(g, e);
-            for (q, &v) in g.volumes(e).iter().enumerate() {
-                let gq = &grads[q * CORNERS..(q + 1) * CORNERS];
-                let pt = point(material, k_h, &deformation_gradient(&xl, &rest, gq));
-                total += v * pt.psi_d;
-                if let Some(out) = gradient_out.as_deref_mut() {
-                    let stress = (pt.p_d + pt.g_h * pressure) * v;
-                    for (&a, gi) in nodes.iter().zip(gq) {
-                        out[a as usize] += stress * gi;
-                    }
+    for_each_patch_element(mesh, geometry, material, x, |_, e, nodes, g, xl, rest| {
+        let pressure = means.element_pressure_pa(nodes, k_h);
+        let grads = element_grads(g, e);
+        for (q, &v) in g.volumes(e).iter().enumerate() {
+            let gq = &grads[q * CORNERS..(q + 1) * CORNERS];
+            let pt = point(material, k_h, &deformation_gradient(xl, rest, gq));
+            total += v * pt.psi_d;
+            if let Some(out) = gradient_out.as_deref_mut() {
+                let stress = (pt.p_d + pt.g_h * pressure) * v;
+                for (&a, gi) in nodes.iter().zip(gq) {
+                    out[a as usize] += stress * gi;
                 }
             }
         }
-    }
+    });
     total
 }
 
@@ -153,31 +161,25 @@ pub fn hessian_terms(
 ) {
     let k_h = hydrostatic_stiffness_pa(material);
     let means = NodeMeans::new(mesh, geometry, material, x);
-    let (mut xl, mut rest) = ([Vec3::zeros(); CORNERS], [Vec3::zeros(); CORNERS]);
     // per element, its corners' `Σ_q V_q G_h ∇N_i` (for the patch terms)
     let mut hydro: Vec<(usize, usize, [Vec3; CORNERS])> = Vec::new();
-    for bi in patch_blocks(mesh, material) {
-        let (block, g) = (&mesh.blocks[bi], &geometry[bi]);
-        for (e, nodes) in block.elements().enumerate() {
-            gather(x, nodes, &mut xl);
-            gather(&mesh.rest_positions, nodes, &mut rest);
-            let pressure = means.element_pressure_pa(nodes, k_h);
-            let grads = element_grads(g, e);
-            let mut blocks = PointBlocks::new(CORNERS);
-            let mut gh = [Vec3::zeros(); CORNERS];
-            for (q, &v) in g.volumes(e).iter().enumerate() {
-                let gq = &grads[q * CORNERS..(q + 1) * CORNERS];
-                let f = deformation_gradient(&xl, &rest, gq);
-                let pt = point(material, k_h, &f);
-                blocks.add(&point_tangent(material, k_h, pressure, &f, &pt, projected), gq, v);
-                for (h, gi) in gh.iter_mut().zip(gq) {
-                    *h += pt.g_h * gi * v;
-                }
+    for_each_patch_element(mesh, geometry, material, x, |bi, e, nodes, g, xl, rest| {
+        let pressure = means.element_pressure_pa(nodes, k_h);
+        let grads = element_grads(g, e);
+        let mut blocks = PointBlocks::new(CORNERS);
+        let mut gh = [Vec3::zeros(); CORNERS];
+        for (q, &v) in g.volumes(e).iter().enumerate() {
+            let gq = &grads[q * CORNERS..(q + 1) * CORNERS];
+            let f = deformation_gradient(xl, rest, gq);
+            let pt = point(material, k_h, &f);
+            blocks.add(&point_tangent(material, k_h, pressure, &f, &pt, projected), gq, v);
+            for (h, gi) in gh.iter_mut().zip(gq) {
+                *h += pt.g_h * gi * v;
             }
-            add(nodes, &blocks.finish());
-            hydro.push((bi, e, gh));
         }
-    }
+        add(nodes, &blocks.finish());
+        hydro.push((bi, e, gh));
+    });
     // the patches: node → the elements around it
     let around = elements_around(mesh, material);
     let mut patch_nodes: Vec<u32> = Vec::new();
