@@ -94,7 +94,7 @@ pub fn locking_at(nu: f64, quick: bool, progress: &mut dyn FnMut(&str)) -> Resul
         for formulation in LOCKING_FORMULATIONS {
             let element = hox_sim::element::ElementType::from_name(config.element);
             let refused = |method| {
-                element.and_then(|e| hox_sim::fem::energy::mixed::solver_refusal(e, method)).is_some()
+                element.and_then(|e| hox_sim::solver::Method::mixed_refusal(method, e)).is_some()
                     && formulation == Formulation::Mixed
             };
             if formulation == Formulation::Mixed && element.and_then(hox_sim::fem::energy::mixed::refusal).is_some() {

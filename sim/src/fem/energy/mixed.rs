@@ -55,22 +55,6 @@ pub fn refusal(element: crate::element::ElementType) -> Option<String> {
     ))
 }
 
-/// Why a solver refuses the mixed formulation on an element type, if it does: P1's pressure per
-/// node patch couples the elements around each node, which the sparse Newton solver assembles
-/// (the pattern widened to the patches) and XPBD's, VBD's and Newton-CG's element-by-element
-/// loops do not yet.
-pub fn solver_refusal(element: crate::element::ElementType, method: crate::solver::Method) -> Option<String> {
-    use crate::element::ReferenceShape;
-    let patch = element.order() == 1 && element.shape() == ReferenceShape::Tetrahedron;
-    (patch && method != crate::solver::Method::Newton).then(|| {
-        format!(
-            "the mixed formulation on {element} shares one pressure among the elements around each node (the averaged \
-             nodal pressure), which the {} solver does not run yet: use --solver newton, or P2 mixed",
-            method.info().name
-        )
-    })
-}
-
 /// Nodes up to which the gradient's scratch is on the stack (Q2's 27).
 const STACK_NODES: usize = 27;
 
