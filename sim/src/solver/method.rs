@@ -173,14 +173,15 @@ impl Method {
     /// Why this solver refuses the mixed formulation on an element type, if it does: P1's
     /// pressure per node patch ([`crate::fem::energy::mixed::patch`]) couples the elements around
     /// each node, which the sparse Newton solver assembles (the pattern widened to the patches)
-    /// and XPBD's, VBD's and Newton-CG's element-by-element loops do not yet.
+    /// and XPBD projects as one constraint per patch ([`crate::xpbd::patch`]); VBD's and
+    /// Newton-CG's element-by-element loops do not yet.
     pub fn mixed_refusal(self, element: crate::element::ElementType) -> Option<String> {
         use crate::element::ReferenceShape;
         let patch = element.order() == 1 && element.shape() == ReferenceShape::Tetrahedron;
-        (patch && self != Method::Newton).then(|| {
+        (patch && !matches!(self, Method::Newton | Method::Xpbd)).then(|| {
             format!(
                 "the mixed formulation on {element} shares one pressure among the elements around each node (the \
-                 averaged nodal pressure), which the {} solver does not run yet: use --solver newton, or P2 mixed",
+                 averaged nodal pressure), which the {} solver does not run yet: use --solver newton or xpbd, or P2 mixed",
                 self.info().name
             )
         })

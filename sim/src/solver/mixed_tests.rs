@@ -93,24 +93,49 @@ fn every_solver_runs_the_mixed_formulation_towards_its_static_equilibrium() {
 }
 
 #[test]
-fn newton_runs_the_p1_patch_pressure_towards_its_static_equilibrium() {
-    // the sparse pattern widened to the patches (nodes two edges apart), the frame's potential
-    // with the patch energy: implicit Euler settles on the static mixed P1 beam, softer than
-    // the pointwise one, at ν = 0.4999
+fn newton_and_xpbd_run_the_p1_patch_pressure_towards_its_static_equilibrium() {
+    // Newton: the sparse pattern widened to the patches (nodes two edges apart), the frame's
+    // potential with the patch energy; XPBD: a deviatoric constraint per element and a
+    // hydrostatic one per node patch, whose potential is the same energy. Both settle on the
+    // static mixed P1 beam, softer than the pointwise one, at ν = 0.4999
     let mesh = beam(ElementType::from_name("p1").unwrap(), [8, 2, 2]);
     let material = Material::new(MaterialModel::StVenantKirchhoff, 2.0e5, 0.4999, 1000.0).unwrap();
     let reference = static_tip_z(&mesh, material, VolumeMeasure::Element);
     let plain = static_tip_z(&mesh, material, VolumeMeasure::Point);
     assert!(reference < plain * 1.05, "patch {reference} vs plain {plain}: the patch beam is softer");
-    let mut sim =
-        Simulation::new(mesh.clone(), material, settings(Method::Newton, Formulation::Mixed), effects(&mesh, 8.0))
-            .unwrap();
-    assert_eq!(sim.material().volume_measure, VolumeMeasure::Element);
-    for _ in 0..240 {
-        sim.step_frame().unwrap();
+    for (method, tolerance) in [(Method::Newton, 0.02), (Method::Xpbd, 0.05)] {
+        let mut sim =
+            Simulation::new(mesh.clone(), material, settings(method, Formulation::Mixed), effects(&mesh, 8.0))
+                .unwrap_or_else(|e| panic!("{method}: {e}"));
+        assert_eq!(sim.material().volume_measure, VolumeMeasure::Element);
+        for _ in 0..240 {
+            sim.step_frame().unwrap_or_else(|e| panic!("{method}: {e}"));
+        }
+        let tip = tip_z(&mesh, &sim.positions);
+        assert!(
+            (tip / reference - 1.0).abs() < tolerance,
+            "{method}: settled tip {tip} against the patch static {reference} (plain {plain})"
+        );
     }
-    let tip = tip_z(&mesh, &sim.positions);
-    assert!((tip / reference - 1.0).abs() < 0.02, "settled tip {tip} against the patch static {reference}");
+}
+
+/// The symptom a split projected one term after the other would show: a P1 beam at rest in the
+/// mixed formulation, with no load, stays at rest under XPBD (the deviatoric and hydrostatic
+/// terms both vanish at rest with their gradients).
+#[test]
+fn xpbd_keeps_a_p1_beam_at_rest_in_the_mixed_formulation() {
+    let mesh = beam(ElementType::from_name("p1").unwrap(), [4, 1, 1]);
+    for model in [MaterialModel::StVenantKirchhoff, MaterialModel::NeoHookean] {
+        let material = Material::new(model, 2.0e5, 0.499, 1000.0).unwrap();
+        let effects: Vec<Box<dyn Effect>> = vec![Box::new(Clamp { nodes: clamped_at_x0(&mesh) })];
+        let mut sim =
+            Simulation::new(mesh.clone(), material, settings(Method::Xpbd, Formulation::Mixed), effects).unwrap();
+        for _ in 0..10 {
+            sim.step_frame().unwrap();
+        }
+        let moved = sim.positions.iter().zip(&mesh.rest_positions).map(|(x, r)| (x - r).amax()).fold(0.0, f64::max);
+        assert!(moved < 1e-12, "{model:?}: a rest beam moved {moved} m");
+    }
 }
 
 #[test]
@@ -148,9 +173,10 @@ fn the_mixed_formulation_is_refused_by_name_where_it_cannot_run() {
     };
     let err = refused(q1, Method::Newton).expect("Q1 mixed refused");
     assert!(err.contains("inf–sup") && err.contains("Q1"), "{err}");
-    // P1's pressure per node patch runs on the sparse Newton solver only, for now
+    // P1's pressure per node patch runs on the sparse Newton solver and XPBD, for now
     assert_eq!(refused(p1, Method::Newton), None, "P1 mixed on Newton");
-    for method in [Method::Xpbd, Method::Vbd, Method::NewtonCg] {
+    assert_eq!(refused(p1, Method::Xpbd), None, "P1 mixed on XPBD");
+    for method in [Method::Vbd, Method::NewtonCg] {
         let err = refused(p1, method).unwrap_or_else(|| panic!("P1 mixed on {method:?}: not refused"));
         assert!(err.contains("averaged nodal pressure") && err.contains("--solver newton"), "{method:?}: {err}");
     }

@@ -17,7 +17,10 @@
 //!   (`α = 1`), so the XPBD potential `C²/(2α) = U_e`. This is the paper's formulation.
 //! - [`Formulation::Mixed`]: one constraint per element as for the energy formulation, of the
 //!   mixed element's energy (the hydrostatic term measured over the element,
-//!   `crate::fem::energy::mixed`): no longer the same potential, but one that does not lock.
+//!   `crate::fem::energy::mixed`): no longer the same potential, but one that does not lock. On
+//!   linear tetrahedra, whose pressure is one per node patch, the element keeps its deviatoric
+//!   energy ([`project_deviatoric_constraint`]) and each node patch has a hydrostatic constraint
+//!   ([`super::patch`]): together exactly the patch energy.
 //! - [`Formulation::Split`]: per quadrature point, the deviatoric and hydrostatic constraints of
 //!   [`Material::split_terms`] (Macklin & Müller 2021, "A constraint-based formulation of stable
 //!   Neo-Hookean materials"), with compliances `α_t = 1/(k_t V_q)`, so that
@@ -186,7 +189,7 @@ pub fn xpbd_step(c: f64, s: f64, sum_w_grad2: f64, alpha_tilde: f64, lambda: f64
 
 /// Applies `Δx_i = step · w_i g_i` to gathered positions.
 #[inline]
-fn apply(x: &mut [Vec3], w: &[f64], g: &[Vec3], step: f64) {
+pub(crate) fn apply(x: &mut [Vec3], w: &[f64], g: &[Vec3], step: f64) {
     for ((xi, wi), gi) in x.iter_mut().zip(w).zip(g) {
         *xi += gi * (step * wi);
     }
@@ -194,7 +197,7 @@ fn apply(x: &mut [Vec3], w: &[f64], g: &[Vec3], step: f64) {
 
 /// `Σ_i w_i a_i · b_i`.
 #[inline]
-fn weighted_dot(w: &[f64], a: &[Vec3], b: &[Vec3]) -> f64 {
+pub(crate) fn weighted_dot(w: &[f64], a: &[Vec3], b: &[Vec3]) -> f64 {
     w.iter().zip(a).zip(b).map(|((wi, ai), bi)| wi * ai.dot(bi)).sum()
 }
 
@@ -215,9 +218,36 @@ pub fn project_energy_constraint(
 ) -> f64 {
     let mut grad = NodeScratch::new(Vec3::zeros(), x.len());
     let grad = grad.as_mut_slice();
+    let energy = element_energy_and_gradient(x, rest, grads, volumes, material, grad);
+    project_square_root(x, w, grad, energy, inv_dt2, lambda)
+}
+
+/// Projects the deviatoric energy constraint `C = √(2 U_d)`, `U_d = Σ_q V_q ψ_d(F_q)` (compliance
+/// 1), of one element whose pressure is one per node patch ([`super::patch`]): as
+/// [`project_energy_constraint`], with the hydrostatic term left to the patch constraints.
+#[allow(clippy::too_many_arguments)]
+pub fn project_deviatoric_constraint(
+    x: &mut [Vec3],
+    rest: &[Vec3],
+    w: &[f64],
+    grads: &[Vec3],
+    volumes: &[f64],
+    material: &Material,
+    inv_dt2: f64,
+    lambda: &mut f64,
+) -> f64 {
+    let mut grad = NodeScratch::new(Vec3::zeros(), x.len());
+    let grad = grad.as_mut_slice();
+    let energy = crate::fem::energy::mixed::deviatoric_energy_and_gradient(x, rest, grads, volumes, material, grad);
+    project_square_root(x, w, grad, energy, inv_dt2, lambda)
+}
+
+/// The update of `C = √(2U)` with `∇U` in `grad`: `s = C`, unit compliance. Returns `U`.
+#[inline]
+fn project_square_root(x: &mut [Vec3], w: &[f64], grad: &[Vec3], energy: f64, inv_dt2: f64, lambda: &mut f64) -> f64 {
     // ψ ≥ 0 for StVK and Neo-Hookean; the stable Neo-Hookean energy can dip below its rest
     // value under extreme compression: the constraint then has nothing to restore.
-    let energy = element_energy_and_gradient(x, rest, grads, volumes, material, grad).max(0.0);
+    let energy = energy.max(0.0);
     let c = (2.0 * energy).sqrt();
     if let Some((d_lambda, step)) = xpbd_step(c, c, weighted_dot(w, grad, grad), inv_dt2, *lambda) {
         *lambda += d_lambda;

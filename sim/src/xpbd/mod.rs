@@ -9,6 +9,9 @@
 //! - [`kernels`]: the hot loop — the energy-constraint sweep specialised per node count, the
 //!   packed element data it reads, four linear tetrahedra per AVX2 register, and the parallel
 //!   schedules (colour chunks, slabs).
+//! - [`patch`]: the node-patch hydrostatic constraints of P1 in the mixed formulation (Bonet &
+//!   Burton's averaged nodal pressure), coloured so that patches sharing no node run
+//!   concurrently.
 //! - [`colouring`]: greedy element colouring (no two elements of a colour share a node), which
 //!   makes a colour safe to project in parallel.
 //!
@@ -18,3 +21,4 @@
 pub mod colouring;
 pub mod constraint;
 pub mod kernels;
+pub mod patch;

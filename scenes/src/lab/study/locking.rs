@@ -11,8 +11,9 @@
 //! longer locks itself: the share of its sag a mesh misses is the mesh's locking and
 //! discretisation error, not a lower bound. P1's mixed formulation is one pressure per node patch
 //! ([`hox_sim::fem::energy::mixed::patch`]). The cost of each is the median ms per frame of XPBD
-//! at the scene's settings (50 substeps × 1 iteration, 60 fps; none where XPBD refuses the
-//! formulation: P1 mixed) and of Newton (one implicit Euler step per frame), on one thread over
+//! at the scene's settings (50 substeps × 1 iteration, 60 fps; P1 mixed with a deviatoric
+//! constraint per element and a hydrostatic one per node patch, [`hox_sim::xpbd::patch`]; none
+//! where XPBD refuses the formulation) and of Newton (one implicit Euler step per frame), on one thread over
 //! half a simulated second from rest, measured in the same run as its neighbours (compare them as
 //! ratios).
 
@@ -51,7 +52,8 @@ pub struct LockingRow {
     /// Share of the reference's sag that this mesh misses, % (positive: stiffer, i.e. locking).
     pub missing_pct: f64,
     /// XPBD's median ms per frame at the scene's settings, one thread (module docs); None where
-    /// XPBD refuses the formulation (P1 mixed).
+    /// XPBD refuses the formulation ([`hox_sim::solver::Method::mixed_refusal`]; none of the
+    /// table's today).
     pub ms_per_frame: Option<f64>,
     /// Newton's median ms per frame (implicit Euler, one step per frame), one thread.
     pub newton_ms_per_frame: f64,

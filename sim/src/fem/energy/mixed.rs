@@ -177,6 +177,32 @@ pub fn element_energy_and_gradient(
     u + 0.5 * v_e * k_h * c_bar * c_bar
 }
 
+/// The element's deviatoric share alone, `Σ_q V_q ψ_d(F_q)`, and its gradient
+/// `Σ_q V_q P_d(F_q) ∇_X N_i(r_q)` into `grad_out`: what XPBD keeps per element when the pressure
+/// is one per node patch ([`patch`]; XPBD's `crate::xpbd::patch`).
+pub fn deviatoric_energy_and_gradient(
+    x: &[Vec3],
+    rest: &[Vec3],
+    grads: &[Vec3],
+    volumes: &[f64],
+    material: &Material,
+    grad_out: &mut [Vec3],
+) -> f64 {
+    let n = x.len();
+    let k_h = hydrostatic_stiffness_pa(material);
+    grad_out.iter_mut().for_each(|g| *g = Vec3::zeros());
+    let mut u = 0.0;
+    for (q, (f, v)) in points(x, rest, grads, volumes).enumerate() {
+        let pt = point(material, k_h, &f);
+        u += v * pt.psi_d;
+        let vp = pt.p_d * v;
+        for (out, gi) in grad_out.iter_mut().zip(&grads[q * n..(q + 1) * n]) {
+            *out += vp * gi;
+        }
+    }
+    u
+}
+
 /// The element Hessian (as [`super::element_hessian`]).
 pub fn element_hessian(
     x: &[Vec3],

@@ -37,6 +37,10 @@ pub(crate) struct Xpbd {
     pub(crate) partitions: Vec<(usize, Option<crate::xpbd::kernels::Partition>)>,
     /// Fewest elements per slab ([`crate::xpbd::kernels::slab_count`]).
     pub(crate) partition_min_per_slab: usize,
+    /// The node-patch constraints of P1 in the mixed formulation ([`crate::xpbd::patch`]) and
+    /// their multipliers, built on the first step that needs them (None: none yet, or the mesh
+    /// and material have none).
+    pub(crate) patches: Option<(crate::xpbd::patch::Patches, Vec<f64>)>,
 }
 
 impl Xpbd {
@@ -51,6 +55,7 @@ impl Xpbd {
             lanes: None,
             partitions: Vec::new(),
             partition_min_per_slab: crate::xpbd::kernels::PARTITION_MIN_ELEMENTS_PER_SLAB,
+            patches: None,
         };
         xpbd.pack(mesh, geometry);
         xpbd.lambdas = Self::multipliers(geometry, settings.formulation);
@@ -76,7 +81,46 @@ impl Xpbd {
 
     /// Number of constraints per iteration.
     pub fn num_constraints(&self) -> usize {
-        self.lambdas.iter().map(Vec::len).sum()
+        self.lambdas.iter().map(Vec::len).sum::<usize>() + self.patches.as_ref().map_or(0, |(p, _)| p.len())
+    }
+
+    /// Brings the patch constraints in line with the step's mesh and material: built when the
+    /// material measures P1 per node patch and they are missing, dropped when it no longer does.
+    fn sync_patches(&mut self, input: &StepInput<'_>) {
+        let wanted = crate::fem::energy::mixed::patch::has_patches(input.mesh, input.material);
+        if wanted != self.patches.is_some() {
+            self.patches = crate::xpbd::patch::Patches::new(input.mesh, input.geometry, input.material).map(|p| {
+                let lambdas = vec![0.0; p.len()];
+                (p, lambdas)
+            });
+        }
+    }
+
+    /// One sweep over the patch constraints (none without patches).
+    fn project_patches(
+        &mut self,
+        input: &StepInput<'_>,
+        positions: &mut [Vec3],
+        counters: &mut SolverCounters,
+    ) -> Result<(), BadElement> {
+        let Some((patches, lambdas)) = self.patches.as_mut() else { return Ok(()) };
+        let patch_input = crate::xpbd::patch::PatchInput {
+            mesh: input.mesh,
+            geometry: input.geometry,
+            material: input.material,
+            inv_mass: input.inv_mass,
+            inv_dt2: 1.0 / (input.h * input.h),
+        };
+        match patches.sweep(&patch_input, positions, lambdas) {
+            Ok(projected) => {
+                counters.element_projections += projected as u64;
+                Ok(())
+            }
+            Err(bad) => {
+                let nodes = input.mesh.blocks[bad.block].element(bad.element);
+                Err(BadElement::projected(bad.block, bad.element, bad.node, nodes, |i| positions[i]))
+            }
+        }
     }
 }
 
@@ -101,8 +145,13 @@ impl StepSolver for Xpbd {
         counters: &mut SolverCounters,
     ) -> Result<(), BadElement> {
         self.lambdas.iter_mut().for_each(|l| crate::math::par::fill(l, 0.0));
+        self.sync_patches(input);
+        if let Some((_, lambdas)) = self.patches.as_mut() {
+            lambdas.iter_mut().for_each(|l| *l = 0.0);
+        }
         for _ in 0..input.settings.iterations {
             self.project_elements(input, positions, counters)?;
+            self.project_patches(input, positions, counters)?;
             hooks.after_projection(positions, None);
         }
         Ok(())
@@ -113,6 +162,7 @@ impl StepSolver for Xpbd {
             self.pack(mesh, geometry);
         }
         self.lambdas = Self::multipliers(geometry, settings.formulation);
+        self.patches = None;
     }
 
     fn work_summary(&self, _settings: &SolverSettings, _counters: &SolverCounters) -> String {

@@ -12,7 +12,9 @@ use crate::material::Material;
 use crate::solver::error::SolverCounters;
 use crate::solver::nan_guard::{BadElement, non_finite_node};
 use crate::solver::step::StepInput;
-use crate::xpbd::constraint::{Formulation, NodeScratch, project_energy_constraint, project_split_constraints};
+use crate::xpbd::constraint::{
+    Formulation, NodeScratch, project_deviatoric_constraint, project_energy_constraint, project_split_constraints,
+};
 
 impl Xpbd {
     /// One Gauss–Seidel sweep over every element constraint: in element order, or colour by
@@ -72,13 +74,7 @@ impl Xpbd {
             let x = x.as_mut_slice();
             for (e, nodes) in block.elements().enumerate() {
                 let lambda = &mut lambdas[e * per_element..(e + 1) * per_element];
-                let ctx = ProjectionContext {
-                    rest: &s.mesh.rest_positions,
-                    inv_mass: s.inv_mass,
-                    material: s.material,
-                    formulation: s.settings.formulation,
-                    inv_dt2,
-                };
+                let ctx = ProjectionContext::new(s, bi, inv_dt2);
                 let read = &*positions;
                 if ctx.project(|i| read[i], &s.geometry[bi], e, nodes, lambda, x) {
                     if let Some(node) = non_finite_node(x, nodes) {
@@ -167,13 +163,7 @@ impl Xpbd {
                         // SAFETY: no two elements of a colour share a node (colouring.rs), and
                         // each element owns its multipliers: concurrent writes are disjoint.
                         let lambda = unsafe { lambdas.slice_mut(e * per_element, per_element) };
-                        let ctx = ProjectionContext {
-                            rest: &s.mesh.rest_positions,
-                            inv_mass: s.inv_mass,
-                            material: s.material,
-                            formulation: s.settings.formulation,
-                            inv_dt2,
-                        };
+                        let ctx = ProjectionContext::new(s, bi, inv_dt2);
                         let mut x = NodeScratch::new(Vec3::zeros(), n);
                         let x = x.as_mut_slice();
                         // SAFETY: reads only this element's nodes, which no other thread writes.
@@ -204,10 +194,24 @@ struct ProjectionContext<'a> {
     inv_mass: &'a [f64],
     material: &'a Material,
     formulation: Formulation,
+    /// The block's pressure is one per node patch (P1 mixed): the element keeps its deviatoric
+    /// energy alone ([`crate::xpbd::patch`] holds the rest).
+    deviatoric_only: bool,
     inv_dt2: f64,
 }
 
-impl ProjectionContext<'_> {
+impl<'a> ProjectionContext<'a> {
+    fn new(s: &StepInput<'a>, block: usize, inv_dt2: f64) -> Self {
+        Self {
+            rest: &s.mesh.rest_positions,
+            inv_mass: s.inv_mass,
+            material: s.material,
+            formulation: s.settings.formulation,
+            deviatoric_only: crate::fem::energy::mixed::patch::is_patch_block(&s.mesh.blocks[block], s.material),
+            inv_dt2,
+        }
+    }
+
     /// Gathers element `e`, projects its constraints into `x` (updating its multipliers) and
     /// returns true, or false when all its nodes are pinned.
     #[inline]
@@ -234,6 +238,18 @@ impl ProjectionContext<'_> {
         }
         gather(self.rest, nodes, rest);
         match self.formulation {
+            Formulation::Mixed if self.deviatoric_only => {
+                project_deviatoric_constraint(
+                    x,
+                    rest,
+                    w,
+                    element_grads(g, e),
+                    g.volumes(e),
+                    self.material,
+                    self.inv_dt2,
+                    &mut lambda[0],
+                );
+            }
             // the mixed element's energy: the material measures its hydrostatic term per element
             Formulation::Energy | Formulation::Mixed => {
                 project_energy_constraint(

@@ -110,7 +110,7 @@ fn the_plan_lists_only_the_tables_asked_for_and_names_its_command() {
 fn a_part_file_keeps_nan_infinity_and_absent_values() {
     let mut part = parts(3, 2).remove(0);
     part.cells[0].rows.solvers.push(failed_solver_row());
-    // a cell XPBD refuses (P1 mixed) has no XPBD ms per frame, and keeps none
+    // a cell XPBD refused would have no XPBD ms per frame, and keeps none
     let refused =
         LockingRow { formulation: "mixed".into(), ms_per_frame: None, ..locking_row(0.499, "P1 16x4x4 five") };
     part.cells[0].rows.locking.push(refused);

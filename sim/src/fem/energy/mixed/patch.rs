@@ -190,7 +190,7 @@ pub fn hessian_terms(
         }
         patch_nodes.clear();
         g_bar.clear();
-        for &k in &around.elements[around.start[a]..around.start[a + 1]] {
+        for &k in around.of(a) {
             let (bi, e, gh) = &hydro[k];
             for (&i, h) in mesh.blocks[*bi].element(*e).iter().zip(gh) {
                 let share = h / (CORNERS as f64 * w_a);
@@ -211,13 +211,25 @@ pub fn hessian_terms(
 }
 
 /// Per node, the patch elements around it as indices into the patch elements in mesh order
-/// (block by block): a compressed list.
-struct Around {
+/// (block by block, [`patch_elements`]): a compressed list.
+pub struct Around {
     start: Vec<usize>,
     elements: Vec<usize>,
 }
 
-fn elements_around(mesh: &Mesh, material: &Material) -> Around {
+impl Around {
+    /// The patch elements around node `a`.
+    pub fn of(&self, a: usize) -> &[usize] {
+        &self.elements[self.start[a]..self.start[a + 1]]
+    }
+}
+
+/// The patch elements `(block, element)` in mesh order, block by block: what [`Around`] indexes.
+pub fn patch_elements(mesh: &Mesh, material: &Material) -> Vec<(usize, usize)> {
+    patch_blocks(mesh, material).flat_map(|bi| (0..mesh.blocks[bi].len()).map(move |e| (bi, e))).collect()
+}
+
+pub fn elements_around(mesh: &Mesh, material: &Material) -> Around {
     let n = mesh.num_nodes();
     let mut start = vec![0usize; n + 1];
     for bi in patch_blocks(mesh, material) {
@@ -253,7 +265,7 @@ pub fn pattern_pairs(mesh: &Mesh, material: &Material, index: &[u32], pairs: &mu
     let mut patch: Vec<u32> = Vec::new();
     for a in 0..mesh.num_nodes() {
         patch.clear();
-        for &k in &around.elements[around.start[a]..around.start[a + 1]] {
+        for &k in around.of(a) {
             patch.extend(flat[k].iter().map(|&i| index[i as usize]).filter(|&i| i != u32::MAX));
         }
         patch.sort_unstable();

@@ -1,0 +1,165 @@
+use super::*;
+use crate::element::ElementType;
+use crate::fem::energy::mixed::patch;
+use crate::material::{MaterialModel, VolumeMeasure};
+use crate::mesh::structured::{BoxGrid, BoxMeshSpec, TetSplit};
+
+/// A 3×2×2 box of five tetrahedra per cell, and a deformed state of it (a stretch, a shear and a
+/// wobble of every node).
+fn deformed_box() -> (Mesh, Vec<BlockGeometry>, Vec<Vec3>) {
+    let mesh = BoxMeshSpec {
+        grid: BoxGrid { min_m: Vec3::zeros(), max_m: Vec3::new(0.6, 0.4, 0.4), cells: [3, 2, 2] },
+        element_type: ElementType::from_name("p1").unwrap(),
+        split: TetSplit::Five,
+        refine: 0,
+    }
+    .build()
+    .unwrap();
+    let geometry = crate::fem::geometry::precompute(&mesh, None).unwrap();
+    let x = mesh
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let k = i as f64;
+            Vec3::new(1.1 * p.x + 0.2 * p.y, 0.95 * p.y - 0.1 * p.z, p.z + 0.3 * p.x * p.y)
+                + 0.01 * Vec3::new((1.3 * k).sin(), (2.1 * k).cos(), (0.7 * k).sin())
+        })
+        .collect();
+    (mesh, geometry, x)
+}
+
+/// StVK and Neo-Hookean at ν = 0.45, measured per element (per node patch on P1).
+fn materials() -> Vec<Material> {
+    [MaterialModel::StVenantKirchhoff, MaterialModel::NeoHookean]
+        .into_iter()
+        .map(|m| Material::new(m, 1.0e5, 0.45, 1000.0).unwrap().with_volume_measure(VolumeMeasure::Element).unwrap())
+        .collect()
+}
+
+fn input<'a>(mesh: &'a Mesh, geometry: &'a [BlockGeometry], material: &'a Material, w: &'a [f64]) -> PatchInput<'a> {
+    PatchInput { mesh, geometry, material, inv_mass: w, inv_dt2: 3600.0 }
+}
+
+#[test]
+fn every_node_has_one_patch_and_patches_of_one_colour_share_no_node() {
+    let (mesh, geometry, _) = deformed_box();
+    let patches = Patches::new(&mesh, &geometry, &materials()[0]).unwrap();
+    assert_eq!(patches.len(), mesh.num_nodes());
+    let mut seen = vec![0; patches.len()];
+    for colour in &patches.colours {
+        let mut owner = vec![false; mesh.num_nodes()];
+        for &p in colour {
+            seen[p as usize] += 1;
+            for &i in patches.nodes(p as usize) {
+                assert!(!owner[i as usize], "node {i} in two patches of one colour");
+                owner[i as usize] = true;
+            }
+        }
+    }
+    assert!(seen.iter().all(|&s| s == 1));
+    // a patch is the node and its neighbours through the elements around it
+    let centre = patches.centre[7] as usize;
+    assert!(patches.nodes(7).contains(&(centre as u32)));
+    // the pointwise measure has no patches
+    let plain = materials()[0].with_volume_measure(VolumeMeasure::Point).unwrap();
+    assert!(Patches::new(&mesh, &geometry, &plain).is_none());
+}
+
+#[test]
+fn the_patch_constraint_gradient_matches_finite_differences() {
+    let (mesh, geometry, x) = deformed_box();
+    let w = vec![1.0; mesh.num_nodes()];
+    for material in materials() {
+        let patches = Patches::new(&mesh, &geometry, &material).unwrap();
+        let input = input(&mesh, &geometry, &material, &w);
+        for p in [0, 5, 17, patches.len() - 1] {
+            let xp: Vec<Vec3> = patches.nodes(p).iter().map(|&i| x[i as usize]).collect();
+            let mut grad = vec![Vec3::zeros(); xp.len()];
+            let c = patches.constraint_and_gradient(p, &input, &xp, &mut grad);
+            assert!(c.abs() > 1e-3, "the deformed patch has a volume change: {c}");
+            let scale = grad.iter().map(|g| g.amax()).fold(0.0, f64::max);
+            let h = 1e-6;
+            for d in 0..3 * xp.len() {
+                let at = |s: f64| {
+                    let mut xs = xp.clone();
+                    xs[d / 3][d % 3] += s;
+                    patches.constraint_and_gradient(p, &input, &xs, &mut vec![Vec3::zeros(); xs.len()])
+                };
+                let fd = (at(h) - at(-h)) / (2.0 * h);
+                assert!((fd - grad[d / 3][d % 3]).abs() < 1e-6 * scale, "patch {p}, dof {d}: {fd} vs {grad:?}");
+            }
+        }
+    }
+}
+
+/// The constraints' potential, every element's `V_e ψ_d` plus every patch's `C_a²/(2α_a)`, is the
+/// patch energy of the static and Newton solvers: XPBD settles where they do.
+#[test]
+fn the_constraints_potential_is_the_patch_energy() {
+    let (mesh, geometry, x) = deformed_box();
+    let w = vec![1.0; mesh.num_nodes()];
+    for material in materials() {
+        let patches = Patches::new(&mesh, &geometry, &material).unwrap();
+        let input = input(&mesh, &geometry, &material, &w);
+        let block = &mesh.blocks[0];
+        let deviatoric: f64 = block
+            .elements()
+            .enumerate()
+            .map(|(e, nodes)| {
+                let (mut xl, mut rest, mut g) = ([Vec3::zeros(); 4], [Vec3::zeros(); 4], [Vec3::zeros(); 4]);
+                gather(&x, nodes, &mut xl);
+                gather(&mesh.rest_positions, nodes, &mut rest);
+                crate::fem::energy::mixed::deviatoric_energy_and_gradient(
+                    &xl,
+                    &rest,
+                    element_grads(&geometry[0], e),
+                    geometry[0].volumes(e),
+                    &material,
+                    &mut g,
+                )
+            })
+            .sum();
+        let potential = deviatoric + patches.potential_j(&input, &x);
+        let energy = patch::energy_and_gradient(&mesh, &geometry, &material, &x, None);
+        assert!((potential / energy - 1.0).abs() < 1e-12, "{:?}: {potential} J vs {energy} J", material.model);
+    }
+}
+
+/// One sweep lowers the patch constraints' violation, leaves pinned nodes where they are and
+/// gives the same positions whatever the thread count.
+#[test]
+fn a_sweep_lowers_the_volume_change_keeps_pins_and_does_not_depend_on_threads() {
+    let (mesh, geometry, x) = deformed_box();
+    let material = materials()[1];
+    let mut w = vec![1.0; mesh.num_nodes()];
+    let pinned = mesh.nodes_where(|p| p.x < 1e-12);
+    for &i in &pinned {
+        w[i as usize] = 0.0;
+    }
+    let patches = Patches::new(&mesh, &geometry, &material).unwrap();
+    let input = input(&mesh, &geometry, &material, &w);
+    let violation = |x: &[Vec3]| {
+        (0..patches.len())
+            .map(|p| {
+                let xp: Vec<Vec3> = patches.nodes(p).iter().map(|&i| x[i as usize]).collect();
+                patches.constraint_and_gradient(p, &input, &xp, &mut vec![Vec3::zeros(); xp.len()]).powi(2)
+            })
+            .sum::<f64>()
+    };
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let (mut y, mut lambdas) = (x.clone(), vec![0.0; patches.len()]);
+            let projected = patches.sweep(&input, &mut y, &mut lambdas).unwrap();
+            assert_eq!(projected, patches.len());
+            y
+        })
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one, two, "the sweep depends on the thread count");
+    assert!(violation(&one) < 0.5 * violation(&x), "{} → {}", violation(&x), violation(&one));
+    for &i in &pinned {
+        assert_eq!(one[i as usize], x[i as usize]);
+    }
+}
