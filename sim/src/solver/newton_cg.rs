@@ -10,7 +10,8 @@
 //!   of freedom wherever a step has mass: what conjugate gradients need. It is kept as the element
 //!   Hessians, computed in parallel at the iterate the Newton asks for (every iteration whose
 //!   residual fell less than 4×: with an inexact solve, most of them), and applied element by
-//!   element; it is never assembled for the product.
+//!   element; it is never assembled for the product. Where P1's pressure is one per node patch
+//!   (the mixed formulation), the node patches' rank-one terms join the element terms.
 //! - **Preconditioner**: the sparse Cholesky factor of `K` at an earlier iterate (`sparse.rs`,
 //!   projected), kept across iterations and steps and remade only when a solve needed more than
 //!   [`SLOW_CG_ITERATIONS`] iterations; where it cannot be made, block Jacobi (each free node's
@@ -35,8 +36,9 @@
 
 use super::error::SolverCounters;
 use super::newton_core::{HessianModel, LinearSolver};
-use super::sparse::{SparseError, SparsePattern, map_element_hessians};
+use super::sparse::{SparseError, SparsePattern, element_hessian_at, map_element_hessians};
 use crate::Vec3;
+use crate::fem::energy::mixed::patch;
 use crate::material::Material;
 use crate::mesh::Mesh;
 use nalgebra::Matrix3;
@@ -110,6 +112,30 @@ impl ConjugateGradients {
                 out[f] += dot(&h[row * m..row * m + m], &self.local);
             }
         }
+    }
+
+    /// `K`'s terms where P1's pressure is one per node patch (the mixed formulation,
+    /// [`patch`]): every patch element's term and every node patch's rank-one term
+    /// ([`patch::hessian_terms`], projected), then every other block's element Hessians; the
+    /// term list (`nodes`, `node_start`) is remade to match.
+    fn patch_hessians(&mut self, model: &HessianModel<'_>, x: &[Vec3]) {
+        let (mesh, geometry, material) = (model.mesh, model.geometry, model.material);
+        let (mut nodes, mut node_start, mut hessians) = (Vec::new(), vec![0], Vec::new());
+        let mut add = |term: &[u32], h: &nalgebra::DMatrix<f64>| {
+            nodes.extend_from_slice(term);
+            node_start.push(nodes.len());
+            hessians.extend_from_slice(h.as_slice());
+        };
+        patch::hessian_terms(mesh, geometry, material, x, true, &mut add);
+        for (b, g) in mesh.blocks.iter().zip(geometry) {
+            if patch::is_patch_block(b, material) {
+                continue;
+            }
+            for (e, element) in b.elements().enumerate() {
+                add(element, &element_hessian_at(mesh, g, e, element, material, x, true));
+            }
+        }
+        (self.nodes, self.node_start, self.hessians) = (nodes, node_start, hessians);
     }
 
     /// `z = P r`: the kept factor's solve, else block Jacobi.
@@ -192,8 +218,12 @@ impl LinearSolver for ConjugateGradients {
     ) -> Result<(), SparseError> {
         self.ready = false;
         self.hessians.clear();
-        let per_element = map_element_hessians(model.mesh, model.geometry, model.material, x, true, |_, h| h);
-        per_element.iter().for_each(|h| self.hessians.extend_from_slice(h.as_slice()));
+        if patch::has_patches(model.mesh, model.material) {
+            self.patch_hessians(model, x);
+        } else {
+            let per_element = map_element_hessians(model.mesh, model.geometry, model.material, x, true, |_, h| h);
+            per_element.iter().for_each(|h| self.hessians.extend_from_slice(h.as_slice()));
+        }
         if !self.hessians.iter().all(|v| v.is_finite()) {
             return Err(SparseError::NotPositiveDefinite);
         }

@@ -257,31 +257,35 @@ impl Patches {
         let positions = crate::math::shared::SharedMut::new(positions);
         let lambdas = crate::math::shared::SharedMut::new(lambdas);
         let mut projected = 0;
+        let mut serial_scratch = Scratch::default();
         for colour in &self.colours {
-            projected += colour
-                .par_iter()
-                .with_min_len(MIN_PATCHES_PER_TASK)
-                .map_init(Scratch::default, |scratch, &p| {
-                    let p = p as usize;
-                    // SAFETY: no two patches of a colour share a node, and each patch owns its
-                    // multiplier: the reads and writes of concurrent patches are disjoint.
-                    let read = |i: usize| unsafe { positions.read(i) };
-                    let lambda = unsafe { &mut lambdas.slice_mut(p, 1)[0] };
-                    if !self.project(p, input, read, lambda, scratch) {
-                        return Ok(0);
-                    }
-                    let nodes = self.nodes(p);
-                    if let Some(at) = scratch.x.iter().position(|x| !x.iter().all(|v| v.is_finite())) {
-                        let (bi, e, _) = self.members[self.member_start[p]];
-                        return Err(BadPatch { block: bi as usize, element: e as usize, node: nodes[at] });
-                    }
-                    for (x, &i) in scratch.x.iter().zip(nodes) {
-                        // SAFETY: as above.
-                        unsafe { positions.write(i as usize, *x) };
-                    }
-                    Ok(1)
-                })
-                .sum::<Result<usize, BadPatch>>()?;
+            let one = |scratch: &mut Scratch, &p: &u32| -> Result<usize, BadPatch> {
+                let p = p as usize;
+                // SAFETY: no two patches of a colour share a node, and each patch owns its
+                // multiplier: the reads and writes of concurrent patches are disjoint.
+                let read = |i: usize| unsafe { positions.read(i) };
+                let lambda = unsafe { &mut lambdas.slice_mut(p, 1)[0] };
+                if !self.project(p, input, read, lambda, scratch) {
+                    return Ok(0);
+                }
+                let nodes = self.nodes(p);
+                if let Some(at) = scratch.x.iter().position(|x| !x.iter().all(|v| v.is_finite())) {
+                    let (bi, e, _) = self.members[self.member_start[p]];
+                    return Err(BadPatch { block: bi as usize, element: e as usize, node: nodes[at] });
+                }
+                for (x, &i) in scratch.x.iter().zip(nodes) {
+                    // SAFETY: as above.
+                    unsafe { positions.write(i as usize, *x) };
+                }
+                Ok(1)
+            };
+            // a colour too small to share runs on this thread (the same bits either way)
+            let done: Result<usize, BadPatch> = if colour.len() < 2 * MIN_PATCHES_PER_TASK {
+                colour.iter().map(|p| one(&mut serial_scratch, p)).sum()
+            } else {
+                colour.par_iter().with_min_len(MIN_PATCHES_PER_TASK).map_init(Scratch::default, one).sum()
+            };
+            projected += done?;
         }
         Ok(projected)
     }
