@@ -11,7 +11,7 @@
 //!   Hessians, computed in parallel at the iterate the Newton asks for (every iteration whose
 //!   residual fell less than 4×: with an inexact solve, most of them), and applied element by
 //!   element; it is never assembled for the product. Where P1's pressure is one per node patch
-//!   (the mixed formulation), the node patches' rank-one terms join the element terms.
+//!   (the mixed formulation), the node patches' dense terms (nodal strain and pressure) join the element terms.
 //! - **Preconditioner**: the sparse Cholesky factor of `K` at an earlier iterate (`sparse.rs`,
 //!   projected), kept across iterations and steps and remade only when a solve needed more than
 //!   [`SLOW_CG_ITERATIONS`] iterations; where it cannot be made, block Jacobi (each free node's
@@ -114,8 +114,8 @@ impl ConjugateGradients {
         }
     }
 
-    /// `K`'s terms where P1's pressure is one per node patch (the mixed formulation,
-    /// [`patch`]): every patch element's term and every node patch's rank-one term
+    /// `K`'s terms where P1's pressure and nodal strain are one per node patch (the mixed
+    /// formulation, [`patch`]): every patch element's term and every node patch's dense term
     /// ([`patch::hessian_terms`], projected), then every other block's element Hessians; the
     /// term list (`nodes`, `node_start`) is remade to match.
     fn patch_hessians(&mut self, model: &HessianModel<'_>, x: &[Vec3]) {

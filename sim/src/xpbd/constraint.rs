@@ -222,9 +222,10 @@ pub fn project_energy_constraint(
     project_square_root(x, w, grad, energy, inv_dt2, lambda)
 }
 
-/// Projects the deviatoric energy constraint `C = √(2 U_d)`, `U_d = Σ_q V_q ψ_d(F_q)` (compliance
-/// 1), of one element whose pressure is one per node patch ([`super::patch`]): as
-/// [`project_energy_constraint`], with the hydrostatic term left to the patch constraints.
+/// Projects the deviatoric energy constraint `C = √(2 β U_d)`, `U_d = Σ_q V_q ψ_d(F_q)`
+/// (compliance 1, `β` the elements' share of the deviatoric energy), of one element whose
+/// pressure and nodal strain are one per node patch ([`super::patch`]): as
+/// [`project_energy_constraint`], with the rest left to the patch constraints.
 #[allow(clippy::too_many_arguments)]
 pub fn project_deviatoric_constraint(
     x: &mut [Vec3],
@@ -239,7 +240,10 @@ pub fn project_deviatoric_constraint(
     let mut grad = NodeScratch::new(Vec3::zeros(), x.len());
     let grad = grad.as_mut_slice();
     let energy = crate::fem::energy::mixed::deviatoric_energy_and_gradient(x, rest, grads, volumes, material, grad);
-    project_square_root(x, w, grad, energy, inv_dt2, lambda)
+    // the element keeps its share β of the deviatoric energy; the node patches hold the rest
+    let beta = crate::fem::energy::mixed::patch::ELEMENT_DEVIATORIC_SHARE;
+    grad.iter_mut().for_each(|g| *g *= beta);
+    project_square_root(x, w, grad, beta * energy, inv_dt2, lambda)
 }
 
 /// The update of `C = √(2U)` with `∇U` in `grad`: `s = C`, unit compliance. Returns `U`.

@@ -1,20 +1,26 @@
-//! XPBD's constraints of P1's averaged nodal pressure (Bonet & Burton 1998, "A simple average
-//! nodal pressure tetrahedral element for incompressible and nearly incompressible dynamic
-//! explicit applications"; the energy is `crate::fem::energy::mixed::patch`'s).
+//! XPBD's constraints of P1's nodal-strain tetrahedron with its averaged nodal pressure (Bonet &
+//! Burton 1998, "A simple average nodal pressure tetrahedral element for incompressible and
+//! nearly incompressible dynamic explicit applications"; Gee, Dohrmann, Key & Wall 2009, "A
+//! uniform nodal strain tetrahedron with isochoric stabilization"; the energy is
+//! `crate::fem::energy::mixed::patch`'s).
 //!
-//! The patch energy `U = Σ_e V_e ψ_d(F_e) + Σ_a W_a k_h/2 C̄_a²` becomes two kinds of XPBD
-//! constraints (Macklin, Müller & Chentanez 2016, with the split of Macklin & Müller 2021 into
-//! deviatoric and hydrostatic terms):
-//! - per element, `C_e = √(2 V_e ψ_d(F_e))`, unit compliance
+//! The patch energy `U = β Σ_e V_e ψ_d(F_e) + Σ_a W_a [(1 − β) ψ_d(F̄_a) + k_h/2 C̄_a²]` becomes
+//! three kinds of XPBD constraints (Macklin, Müller & Chentanez 2016, with the split of Macklin &
+//! Müller 2021 into deviatoric and hydrostatic terms):
+//! - per element, `C_e = √(2 β V_e ψ_d(F_e))`, unit compliance
 //!   ([`super::constraint::project_deviatoric_constraint`]);
-//! - per node `a`, `C_a = C̄_a = Σ_{e∋a} V_e C_h(F_e)/4 / W_a`, `W_a = Σ_{e∋a} V_e/4`, with
-//!   compliance `α_a = 1/(k_h W_a)`, so that `C_a²/(2α_a) = W_a k_h/2 C̄_a²`; its gradient
+//! - per node `a`, its hydrostatic term `C_a = C̄_a = Σ_{e∋a} V_e C_h(F_e)/4 / W_a`,
+//!   `W_a = Σ_{e∋a} V_e/4`, with compliance `α_a = 1/(k_h W_a)`, so that
+//!   `C_a²/(2α_a) = W_a k_h/2 C̄_a²`; its gradient
 //!   `∇_i C_a = Σ_{e∋a, e∋i} V_e/(4 W_a) G_h(F_e) ∇N_i^e` reaches every node of the patch (the
-//!   elements around `a`).
+//!   elements around `a`);
+//! - per node `a`, its deviatoric term `D_a = √(2 W_a (1 − β) ψ_d(F̄_a))`, unit compliance, at
+//!   the averaged `F̄_a = Σ_{e∋a} V_e F_e/4 / W_a`, with `∇_i (D_a²/2) = W_a (1 − β) P_d(F̄_a)
+//!   b̄_i`, `b̄_i = Σ_{e∋a, e∋i} V_e ∇N_i^e / (4 W_a)`.
 //!
 //! Together the constraints' potential is exactly the patch energy, so XPBD converges on the
-//! same equilibrium as the static and Newton solvers. Both terms vanish at rest with their
-//! gradients for the models the mixed formulation takes (StVK, Neo-Hookean;
+//! same equilibrium as the static and Newton solvers. Every term vanishes at rest with its
+//! gradient for the models the mixed formulation takes (StVK, Neo-Hookean;
 //! `crate::material::Material::with_volume_measure` refuses stable Neo-Hookean), so projecting
 //! them one after the other keeps a rest mesh at rest.
 //!
@@ -23,12 +29,14 @@
 //! count.
 
 use crate::Vec3;
+use crate::fem::energy::mixed::deviatoric_density_and_stress;
+use crate::fem::energy::mixed::patch::ELEMENT_DEVIATORIC_SHARE;
 use crate::fem::energy::mixed::patch::{elements_around, patch_elements};
 use crate::fem::energy::{element_grads, gather};
 use crate::fem::geometry::{BlockGeometry, deformation_gradient};
-use crate::material::Material;
+use crate::material::{Mat3, Material};
 use crate::mesh::Mesh;
-use crate::xpbd::constraint::{apply, weighted_dot, xpbd_step};
+use crate::xpbd::constraint::{apply, weighted_dot, xpbd_block_step};
 
 /// Corners of a linear tetrahedron: each takes a quarter of its element's volume.
 const CORNERS: usize = 4;
@@ -119,7 +127,7 @@ impl Patches {
         Some(patches)
     }
 
-    /// Number of patch constraints.
+    /// Number of patches (each holds two constraints).
     pub fn len(&self) -> usize {
         self.centre.len()
     }
@@ -167,13 +175,23 @@ impl Patches {
         })
     }
 
-    /// `C_a` and its gradient on patch `p`'s nodes (`grad_out`, one entry per node) at the patch
-    /// positions `x` (gathered in the patch's node order).
-    pub fn constraint_and_gradient(&self, p: usize, input: &PatchInput<'_>, x: &[Vec3], grad_out: &mut [Vec3]) -> f64 {
-        grad_out.iter_mut().for_each(|g| *g = Vec3::zeros());
+    /// Patch `p`'s two terms at the patch positions `x` (gathered in the patch's node order),
+    /// from one visit of its elements: its hydrostatic constraint `C_a` with its gradient in
+    /// `grad_h`, and its deviatoric energy `U_a = D_a²/2 = W_a (1 − β) ψ_d(F̄_a)` with its
+    /// gradient in `grad_d` (one entry per patch node each).
+    pub fn terms(
+        &self,
+        p: usize,
+        input: &PatchInput<'_>,
+        x: &[Vec3],
+        grad_h: &mut [Vec3],
+        grad_d: &mut [Vec3],
+    ) -> (f64, f64) {
+        grad_h.iter_mut().for_each(|g| *g = Vec3::zeros());
+        grad_d.iter_mut().for_each(|g| *g = Vec3::zeros());
         let (mut xl, mut rest) = ([Vec3::zeros(); CORNERS], [Vec3::zeros(); CORNERS]);
         let share = 1.0 / (CORNERS as f64 * self.weight_m3[p]);
-        let mut c = 0.0;
+        let (mut c, mut f_bar) = (0.0, Mat3::zeros());
         for &(bi, e, local) in &self.members[self.member_start[p]..self.member_start[p + 1]] {
             let (bi, e) = (bi as usize, e as usize);
             for (xc, &l) in xl.iter_mut().zip(&local) {
@@ -184,41 +202,54 @@ impl Patches {
             let grads = element_grads(g, e);
             for (q, &v) in g.volumes(e).iter().enumerate() {
                 let gq = &grads[q * CORNERS..(q + 1) * CORNERS];
-                let [_, h] = input.material.split_terms(&deformation_gradient(&xl, &rest, gq));
+                let f = deformation_gradient(&xl, &rest, gq);
+                let [_, h] = input.material.split_terms(&f);
                 debug_assert_eq!(h.scale, 1.0, "a hydrostatic term is not a square root");
-                c += v * share * h.value;
-                let vg = h.grad_f_scaled * (v * share);
+                let vs = v * share;
+                c += vs * h.value;
+                f_bar += f * vs;
+                let vg = h.grad_f_scaled * vs;
                 for (&l, gi) in local.iter().zip(gq) {
-                    grad_out[l as usize] += vg * gi;
+                    grad_h[l as usize] += vg * gi;
+                    // `b̄_i`, multiplied by the stress below
+                    grad_d[l as usize] += gi * vs;
                 }
             }
         }
-        c
+        let scale = self.weight_m3[p] * (1.0 - ELEMENT_DEVIATORIC_SHARE);
+        let (psi_d, p_d) = deviatoric_density_and_stress(input.material, &f_bar);
+        let stress = p_d * scale;
+        for b in grad_d.iter_mut() {
+            *b = stress * *b;
+        }
+        (c, scale * psi_d)
     }
 
-    /// The patch constraints' potential `Σ_a C_a²/(2 α_a) = Σ_a W_a k_h/2 C̄_a²` at `positions`.
+    /// The patch constraints' potential `Σ_a [C_a²/(2 α_a) + D_a²/2] = Σ_a W_a [k_h/2 C̄_a² +
+    /// (1 − β) ψ_d(F̄_a)]` at `positions`.
     pub fn potential_j(&self, input: &PatchInput<'_>, positions: &[Vec3]) -> f64 {
         let k_h = input.material.split_stiffness_pa()[1];
         let mut total = 0.0;
         for p in 0..self.len() {
             let x: Vec<Vec3> = self.nodes(p).iter().map(|&i| positions[i as usize]).collect();
-            let mut g = vec![Vec3::zeros(); x.len()];
-            let c = self.constraint_and_gradient(p, input, &x, &mut g);
-            total += 0.5 * k_h * self.weight_m3[p] * c * c;
+            let (mut gh, mut gd) = (vec![Vec3::zeros(); x.len()], vec![Vec3::zeros(); x.len()]);
+            let (c, u) = self.terms(p, input, &x, &mut gh, &mut gd);
+            total += 0.5 * k_h * self.weight_m3[p] * c * c + u;
         }
         total
     }
 
-    /// Projects patch `p` (`Δλ = −(C + α̃λ)/(Σ_i w_i |∇_i C|² + α̃)`, `α̃ = 1/(k_h W_a h²)`) from
-    /// positions read by `read`, updating `lambda`; the corrected patch positions are left in
-    /// `x` (gathered in the patch's node order). False when every node of the patch is pinned or
-    /// nothing moves.
+    /// Projects patch `p`'s hydrostatic constraint `C_a` (compliance `1/(k_h W_a)`) and its
+    /// deviatoric one `D_a` (unit compliance) together, the 2 × 2 block update
+    /// ([`crate::xpbd::constraint::xpbd_block_step`]), from positions read by `read`, updating
+    /// `lambdas` (the two multipliers); the corrected patch positions are left in `x` (gathered
+    /// in the patch's node order). False when every node of the patch is pinned or nothing moves.
     fn project(
         &self,
         p: usize,
         input: &PatchInput<'_>,
         read: impl Fn(usize) -> Vec3,
-        lambda: &mut f64,
+        lambdas: &mut [f64],
         scratch: &mut Scratch,
     ) -> bool {
         let nodes = self.nodes(p);
@@ -230,12 +261,19 @@ impl Patches {
         if scratch.w.iter().all(|&w| w == 0.0) {
             return false;
         }
-        let c = self.constraint_and_gradient(p, input, &scratch.x, &mut scratch.g);
-        let alpha_tilde = input.inv_dt2 / (input.material.split_stiffness_pa()[1] * self.weight_m3[p]);
-        match xpbd_step(c, 1.0, weighted_dot(&scratch.w, &scratch.g, &scratch.g), alpha_tilde, *lambda) {
+        let (c, energy) = self.terms(p, input, &scratch.x, &mut scratch.gh, &mut scratch.gd);
+        // ψ_d ≥ 0 for StVK and Neo-Hookean (the models the mixed formulation takes)
+        let d = (2.0 * energy.max(0.0)).sqrt();
+        let (w, gh, gd) = (&scratch.w, &scratch.gh, &scratch.gd);
+        let off = weighted_dot(w, gh, gd);
+        let gram = [[weighted_dot(w, gh, gh), off], [off, weighted_dot(w, gd, gd)]];
+        let alpha_tilde = [input.inv_dt2 / (input.material.split_stiffness_pa()[1] * self.weight_m3[p]), input.inv_dt2];
+        match xpbd_block_step::<2>([c, d], [1.0, d], gram, alpha_tilde, [lambdas[0], lambdas[1]]) {
             Some((d_lambda, step)) => {
-                *lambda += d_lambda;
-                apply(&mut scratch.x, &scratch.w, &scratch.g, step);
+                lambdas[0] += d_lambda[0];
+                lambdas[1] += d_lambda[1];
+                apply(&mut scratch.x, &scratch.w, &scratch.gh, step[0]);
+                apply(&mut scratch.x, &scratch.w, &scratch.gd, step[1]);
                 true
             }
             None => false,
@@ -243,7 +281,7 @@ impl Patches {
     }
 
     /// One Gauss–Seidel sweep over every patch constraint, colour by colour (the patches of a
-    /// colour concurrently): `lambdas` holds one multiplier per patch. Returns the number of
+    /// colour concurrently): `lambdas` holds two multipliers per patch (hydrostatic, deviatoric). Returns the number of
     /// patches projected, or the first patch whose corrections came out non-finite (not
     /// written).
     pub fn sweep(
@@ -253,7 +291,7 @@ impl Patches {
         lambdas: &mut [f64],
     ) -> Result<usize, BadPatch> {
         use rayon::prelude::*;
-        assert_eq!(lambdas.len(), self.len(), "one multiplier per patch");
+        assert_eq!(lambdas.len(), 2 * self.len(), "two multipliers per patch");
         let positions = crate::math::shared::SharedMut::new(positions);
         let lambdas = crate::math::shared::SharedMut::new(lambdas);
         let mut projected = 0;
@@ -264,7 +302,7 @@ impl Patches {
                 // SAFETY: no two patches of a colour share a node, and each patch owns its
                 // multiplier: the reads and writes of concurrent patches are disjoint.
                 let read = |i: usize| unsafe { positions.read(i) };
-                let lambda = unsafe { &mut lambdas.slice_mut(p, 1)[0] };
+                let lambda = unsafe { lambdas.slice_mut(2 * p, 2) };
                 if !self.project(p, input, read, lambda, scratch) {
                     return Ok(0);
                 }
@@ -291,19 +329,22 @@ impl Patches {
     }
 }
 
-/// A patch's gathered positions, inverse masses and constraint gradient (reused across patches).
+/// A patch's gathered positions, inverse masses and its two terms' gradients (reused across
+/// patches).
 #[derive(Default)]
 struct Scratch {
     x: Vec<Vec3>,
     w: Vec<f64>,
-    g: Vec<Vec3>,
+    gh: Vec<Vec3>,
+    gd: Vec<Vec3>,
 }
 
 impl Scratch {
     fn resize(&mut self, len: usize) {
         self.x.resize(len, Vec3::zeros());
         self.w.resize(len, 0.0);
-        self.g.resize(len, Vec3::zeros());
+        self.gh.resize(len, Vec3::zeros());
+        self.gd.resize(len, Vec3::zeros());
     }
 }
 

@@ -84,11 +84,28 @@ fn point(material: &Material, k_h: f64, f: &Mat3) -> Point {
     }
 }
 
-/// The tangent `A_d + p H_h` of one point (projected to positive semi-definite when asked).
-fn point_tangent(material: &Material, k_h: f64, pressure_pa: f64, f: &Mat3, pt: &Point, projected: bool) -> Mat9 {
+/// The deviatoric energy density `ψ_d(F)` (J/m³) and its stress `P_d(F)` (Pa): what XPBD's
+/// patch constraints measure at a node's averaged deformation gradient ([`patch`]).
+pub fn deviatoric_density_and_stress(material: &Material, f: &Mat3) -> (f64, Mat3) {
+    let pt = point(material, hydrostatic_stiffness_pa(material), f);
+    (pt.psi_d, pt.p_d)
+}
+
+/// The tangent `β A_d + p H_h` of one point, `β` the deviatoric term's share (1 but on P1's
+/// patches, [`patch`]), projected to positive semi-definite when asked.
+fn point_tangent(
+    material: &Material,
+    k_h: f64,
+    deviatoric_share: f64,
+    pressure_pa: f64,
+    f: &Mat3,
+    pt: &Point,
+    projected: bool,
+) -> Mat9 {
     let g = nalgebra::SVector::<f64, 9>::from_column_slice(pt.g_h.as_slice());
     let hh = material.hydrostatic_hessian(f);
-    let c = material.dpdf(f) - g * g.transpose() * k_h + hh * (pressure_pa - k_h * pt.c_h);
+    let a_d = material.dpdf(f) - g * g.transpose() * k_h - hh * (k_h * pt.c_h);
+    let c = a_d * deviatoric_share + hh * pressure_pa;
     if projected { project_psd(&c) } else { (c + c.transpose()) * 0.5 }
 }
 
@@ -221,7 +238,7 @@ pub fn element_hessian(
     for (q, (f, v)) in points(x, rest, grads, volumes).enumerate() {
         let pt = point(material, k_h, &f);
         let g = &grads[q * n..(q + 1) * n];
-        blocks.add(&point_tangent(material, k_h, pressure, &f, &pt, projected), g, v);
+        blocks.add(&point_tangent(material, k_h, 1.0, pressure, &f, &pt, projected), g, v);
         for (gb, gi) in g_bar.iter_mut().zip(g) {
             *gb += pt.g_h * gi * (v / v_e);
         }
@@ -290,7 +307,7 @@ fn node_share(
     for (f, g, v) in pts {
         let pt = point(material, k_h, &f);
         grad += (pt.p_d + pt.g_h * pressure) * g * v;
-        block += contract(&point_tangent(material, k_h, pressure, &f, &pt, projected), &g, &g) * v;
+        block += contract(&point_tangent(material, k_h, 1.0, pressure, &f, &pt, projected), &g, &g) * v;
         g_bar += pt.g_h * g * v;
     }
     if v_e > 0.0 {

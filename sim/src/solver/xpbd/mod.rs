@@ -81,7 +81,7 @@ impl Xpbd {
 
     /// Number of constraints per iteration.
     pub fn num_constraints(&self) -> usize {
-        self.lambdas.iter().map(Vec::len).sum::<usize>() + self.patches.as_ref().map_or(0, |(p, _)| p.len())
+        self.lambdas.iter().map(Vec::len).sum::<usize>() + self.patches.as_ref().map_or(0, |(_, lambdas)| lambdas.len())
     }
 
     /// Brings the patch constraints in line with the step's mesh and material: built when the
@@ -90,7 +90,7 @@ impl Xpbd {
         let wanted = crate::fem::energy::mixed::patch::has_patches(input.mesh, input.material);
         if wanted != self.patches.is_some() {
             self.patches = crate::xpbd::patch::Patches::new(input.mesh, input.geometry, input.material).map(|p| {
-                let lambdas = vec![0.0; p.len()];
+                let lambdas = vec![0.0; 2 * p.len()];
                 (p, lambdas)
             });
         }

@@ -66,6 +66,40 @@ fn every_node_has_one_patch_and_patches_of_one_colour_share_no_node() {
     assert!(Patches::new(&mesh, &geometry, &plain).is_none());
 }
 
+/// The deviatoric term at the averaged `F̄_a`: its gradient matches finite differences.
+#[test]
+fn the_patch_deviatoric_gradient_matches_finite_differences() {
+    let (mesh, geometry, x) = deformed_box();
+    let w = vec![1.0; mesh.num_nodes()];
+    for material in materials() {
+        let patches = Patches::new(&mesh, &geometry, &material).unwrap();
+        let input = input(&mesh, &geometry, &material, &w);
+        for p in [0, 5, 17, patches.len() - 1] {
+            let xp: Vec<Vec3> = patches.nodes(p).iter().map(|&i| x[i as usize]).collect();
+            let mut grad = vec![Vec3::zeros(); xp.len()];
+            let u = patches.terms(p, &input, &xp, &mut vec![Vec3::zeros(); xp.len()], &mut grad).1;
+            assert!(u > 0.0, "the deformed patch has a deviatoric energy: {u}");
+            let scale = grad.iter().map(|g| g.amax()).fold(0.0, f64::max);
+            let h = 1e-6;
+            for d in 0..3 * xp.len() {
+                let at = |s: f64| {
+                    let mut xs = xp.clone();
+                    xs[d / 3][d % 3] += s;
+                    patches
+                        .terms(p, &input, &xs, &mut vec![Vec3::zeros(); xs.len()], &mut vec![Vec3::zeros(); xs.len()])
+                        .1
+                };
+                let fd = (at(h) - at(-h)) / (2.0 * h);
+                assert!(
+                    (fd - grad[d / 3][d % 3]).abs() < 1e-6 * scale,
+                    "patch {p}, dof {d}: {fd} vs {}",
+                    grad[d / 3][d % 3]
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn the_patch_constraint_gradient_matches_finite_differences() {
     let (mesh, geometry, x) = deformed_box();
@@ -76,7 +110,7 @@ fn the_patch_constraint_gradient_matches_finite_differences() {
         for p in [0, 5, 17, patches.len() - 1] {
             let xp: Vec<Vec3> = patches.nodes(p).iter().map(|&i| x[i as usize]).collect();
             let mut grad = vec![Vec3::zeros(); xp.len()];
-            let c = patches.constraint_and_gradient(p, &input, &xp, &mut grad);
+            let c = patches.terms(p, &input, &xp, &mut grad, &mut vec![Vec3::zeros(); xp.len()]).0;
             assert!(c.abs() > 1e-3, "the deformed patch has a volume change: {c}");
             let scale = grad.iter().map(|g| g.amax()).fold(0.0, f64::max);
             let h = 1e-6;
@@ -84,7 +118,9 @@ fn the_patch_constraint_gradient_matches_finite_differences() {
                 let at = |s: f64| {
                     let mut xs = xp.clone();
                     xs[d / 3][d % 3] += s;
-                    patches.constraint_and_gradient(p, &input, &xs, &mut vec![Vec3::zeros(); xs.len()])
+                    patches
+                        .terms(p, &input, &xs, &mut vec![Vec3::zeros(); xs.len()], &mut vec![Vec3::zeros(); xs.len()])
+                        .0
                 };
                 let fd = (at(h) - at(-h)) / (2.0 * h);
                 assert!((fd - grad[d / 3][d % 3]).abs() < 1e-6 * scale, "patch {p}, dof {d}: {fd} vs {grad:?}");
@@ -93,8 +129,8 @@ fn the_patch_constraint_gradient_matches_finite_differences() {
     }
 }
 
-/// The constraints' potential, every element's `V_e ψ_d` plus every patch's `C_a²/(2α_a)`, is the
-/// patch energy of the static and Newton solvers: XPBD settles where they do.
+/// The constraints' potential, every element's `β V_e ψ_d` plus every patch's `C_a²/(2α_a) +
+/// D_a²/2`, is the patch energy of the static and Newton solvers: XPBD settles where they do.
 #[test]
 fn the_constraints_potential_is_the_patch_energy() {
     let (mesh, geometry, x) = deformed_box();
@@ -120,16 +156,16 @@ fn the_constraints_potential_is_the_patch_energy() {
                 )
             })
             .sum();
-        let potential = deviatoric + patches.potential_j(&input, &x);
+        let potential = ELEMENT_DEVIATORIC_SHARE * deviatoric + patches.potential_j(&input, &x);
         let energy = patch::energy_and_gradient(&mesh, &geometry, &material, &x, None);
         assert!((potential / energy - 1.0).abs() < 1e-12, "{:?}: {potential} J vs {energy} J", material.model);
     }
 }
 
-/// One sweep lowers the patch constraints' violation, leaves pinned nodes where they are and
+/// One sweep lowers the patch constraints' potential, leaves pinned nodes where they are and
 /// gives the same positions whatever the thread count.
 #[test]
-fn a_sweep_lowers_the_volume_change_keeps_pins_and_does_not_depend_on_threads() {
+fn a_sweep_lowers_the_patch_potential_keeps_pins_and_does_not_depend_on_threads() {
     let (mesh, geometry, x) = deformed_box();
     let material = materials()[1];
     let mut w = vec![1.0; mesh.num_nodes()];
@@ -139,18 +175,10 @@ fn a_sweep_lowers_the_volume_change_keeps_pins_and_does_not_depend_on_threads() 
     }
     let patches = Patches::new(&mesh, &geometry, &material).unwrap();
     let input = input(&mesh, &geometry, &material, &w);
-    let violation = |x: &[Vec3]| {
-        (0..patches.len())
-            .map(|p| {
-                let xp: Vec<Vec3> = patches.nodes(p).iter().map(|&i| x[i as usize]).collect();
-                patches.constraint_and_gradient(p, &input, &xp, &mut vec![Vec3::zeros(); xp.len()]).powi(2)
-            })
-            .sum::<f64>()
-    };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
-            let (mut y, mut lambdas) = (x.clone(), vec![0.0; patches.len()]);
+            let (mut y, mut lambdas) = (x.clone(), vec![0.0; 2 * patches.len()]);
             let projected = patches.sweep(&input, &mut y, &mut lambdas).unwrap();
             assert_eq!(projected, patches.len());
             y
@@ -158,7 +186,11 @@ fn a_sweep_lowers_the_volume_change_keeps_pins_and_does_not_depend_on_threads() 
     };
     let (one, two) = (run(1), run(2));
     assert_eq!(one, two, "the sweep depends on the thread count");
-    assert!(violation(&one) < 0.5 * violation(&x), "{} → {}", violation(&x), violation(&one));
+    // the hydrostatic and deviatoric terms solved together: their potential falls (the volume
+    // change alone need not: the deformed box's shear dominates, and its projection moves the
+    // volumes of the neighbouring patches)
+    let potential = |y: &[Vec3]| patches.potential_j(&input, y);
+    assert!(potential(&one) < 0.9 * potential(&x), "{} J → {} J", potential(&x), potential(&one));
     for &i in &pinned {
         assert_eq!(one[i as usize], x[i as usize]);
     }
