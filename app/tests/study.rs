@@ -64,8 +64,8 @@ fn the_quick_study_writes_its_three_files_and_ranks_p2_ahead_of_p1() {
     assert!(p1 > missing("0.35", "P1 16x4x4 five") + 10.0, "P1 must stiffen as ν → 0.5");
     let cured = cell("0.499", "P2 8x2x2 five", "mixed", "missing_pct");
     assert!(cured.abs() < 1.5, "P2 160 mixed at ν = 0.499: {cured} % from the reference");
-    let eased = cell("0.499", "P1 16x4x4 five", "mixed", "missing_pct");
-    assert!(eased < p1 - 3.0, "P1 1,280's patch pressure eases its locking at ν = 0.499: {eased} % against {p1} %");
+    let cured_p1 = cell("0.499", "P1 16x4x4 five", "mixed", "missing_pct");
+    assert!(cured_p1.abs() < 5.0, "P1 1,280 mixed (node patches) at ν = 0.499: {cured_p1} % against {p1} % plain");
     for r in &rows {
         let newton: f64 = r[at("newton_ms_per_frame_1_thread")].parse().unwrap();
         assert!(newton > 0.0 && newton.is_finite(), "{r:?}");

@@ -69,8 +69,8 @@ def check_locking_lesson(results):
     assert p2["0.499"] > p2["0.35"] + 3, "the energy P2 locks too: it misses more of the sag as ν grows"
     mixed = results["mixed_missing_pct"]
     p1_mixed = next(v for k, v in mixed.items() if k.startswith("P1"))
-    assert p1_mixed["0.499"] < p1["0.499"] - 3, "P1's pressure per node eases its locking"
-    assert p1_mixed["0.499"] > 10, "but does not cure it"
+    assert abs(p1_mixed["0.499"]) < 5, f"P1's pressure and strain per node cure its locking within 5 % {p1_mixed}"
+    assert p1_mixed["0.35"] < 0, f"but it is soft where nothing locks {p1_mixed}"
     p2_mixed = next(v for k, v in mixed.items() if k.startswith("P2"))
     assert abs(p2_mixed["0.499"]) < 1.5, f"the cure: P2 mixed within 1.5 % at ν 0.499 {p2_mixed}"
     assert all(abs(v) < 2.5 for v in p2_mixed.values()), f"and within 2.5 % at every ν {p2_mixed}"

@@ -90,7 +90,7 @@ def test_hox_study_through_a_process_pool_equals_the_command_line(unsharded):
     assert records == without_timing("locking.csv", (unsharded / "locking.csv").read_text())
     p1 = frame[frame.configuration == "P1 16x4x4 five"].set_index(["formulation", "poisson_ratio"]).missing_pct
     assert p1["energy", 0.499] > p1["energy", 0.35] + 10, "P1 locks as ν → 0.5"
-    assert p1["mixed", 0.499] < p1["energy", 0.499] - 3, "its patch pressure eases it"
+    assert abs(p1["mixed", 0.499]) < 5, "its node patches cure it: P1 1,280 mixed within 5 % at ν = 0.499"
     p2 = frame[frame.configuration == "P2 8x2x2 five"].set_index(["formulation", "poisson_ratio"]).missing_pct
     assert p2["energy", 0.499] > 4 and abs(p2["mixed", 0.499]) < 1.5, "the mixed P2 160 is within 1.5 % at ν = 0.499"
     assert hox.study_cells(True, ["locking"]) == [f"locking ν = {nu}" for nu in (0.35, 0.45, 0.49, 0.499)]

@@ -9,10 +9,11 @@
 //! reference** at the same ν ([`crate::reference`]: the committed fine Q2 solution at the
 //! paper's ν, Q2 levels below ν = 0.45 and P2 mixed levels from it, extrapolated), which no
 //! longer locks itself: the share of its sag a mesh misses is the mesh's locking and
-//! discretisation error, not a lower bound. P1's mixed formulation is one pressure per node patch
-//! ([`hox_sim::fem::energy::mixed::patch`]). The cost of each is the median ms per frame of XPBD
-//! at the scene's settings (50 substeps × 1 iteration, 60 fps; P1 mixed with a deviatoric
-//! constraint per element and a hydrostatic one per node patch, [`hox_sim::xpbd::patch`]; none
+//! discretisation error, not a lower bound. P1's mixed formulation is one pressure and one averaged strain per node
+//! patch ([`hox_sim::fem::energy::mixed::patch`]). The cost of each is the median ms per frame of
+//! XPBD at the scene's settings (50 substeps × 1 iteration, 60 fps; P1 mixed with a deviatoric
+//! constraint per element and a hydrostatic and a deviatoric one per node patch,
+//! [`hox_sim::xpbd::patch`]; none
 //! where XPBD refuses the formulation) and of Newton (one implicit Euler step per frame), on one thread over
 //! half a simulated second from rest, measured in the same run as its neighbours (compare them as
 //! ratios).
@@ -158,7 +159,7 @@ fn median_ms_per_frame(scene: &crate::scene::Scene, method: Method) -> Result<f6
 /// cost per frame at the last ν.
 pub fn locking_markdown(rows: &[LockingRow]) -> String {
     let mut s = String::from(
-        "## Near incompressibility: volumetric locking and its cure (bending, static)\n\nStatic tip deflection `u_z` of the bending beam (the scene's StVK, E = 3 MPa, 4 load steps) with the volume measured at every quadrature point (`energy`) and once per element (`mixed`: one constant pressure per element on P2 and P3; on P1, whose one quadrature point already measures the element's volume, one pressure per node, the mean over the elements around it), against the computed reference at the same ν; in brackets the share of the reference's sag the mesh misses (negative: stiffer, i.e. locking). The last columns: the median ms per frame of XPBD at the scene's settings (50 substeps × 1 iteration, the substep shortened by the stability guard near incompressibility; — where XPBD refuses the formulation) and of Newton (one implicit Euler step per frame), one thread, over half a second from rest at the last ν.\n\n| configuration | formulation |",
+        "## Near incompressibility: volumetric locking and its cure (bending, static)\n\nStatic tip deflection `u_z` of the bending beam (the scene's StVK, E = 3 MPa, 4 load steps) with the volume measured at every quadrature point (`energy`) and once per element (`mixed`: one constant pressure per element on P2 and P3; on P1, whose one quadrature point already measures the element's volume, one pressure per node, the mean over the elements around it, and the deviatoric term at the nodes' averaged deformation gradients, a tenth left on the elements), against the computed reference at the same ν; in brackets the share of the reference's sag the mesh misses (negative: stiffer, i.e. locking). The last columns: the median ms per frame of XPBD at the scene's settings (50 substeps × 1 iteration, the substep shortened by the stability guard near incompressibility; — where XPBD refuses the formulation) and of Newton (one implicit Euler step per frame), one thread, over half a second from rest at the last ν.\n\n| configuration | formulation |",
     );
     let nus: Vec<f64> =
         LOCKING_POISSON_RATIOS.iter().copied().filter(|nu| rows.iter().any(|r| r.poisson_ratio == *nu)).collect();
