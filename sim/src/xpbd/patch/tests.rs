@@ -66,67 +66,51 @@ fn every_node_has_one_patch_and_patches_of_one_colour_share_no_node() {
     assert!(Patches::new(&mesh, &geometry, &plain).is_none());
 }
 
-/// The deviatoric term at the averaged `F̄_a`: its gradient matches finite differences.
-#[test]
-fn the_patch_deviatoric_gradient_matches_finite_differences() {
+/// Checks the gradient of patch term `term` (0: the hydrostatic `C_a`, 1: the deviatoric `U_a`)
+/// against central finite differences on a few patches of the deformed box, after `nonzero`
+/// holds for its value.
+fn term_gradient_matches_finite_differences(term: usize, nonzero: impl Fn(f64) -> bool, what: &str) {
     let (mesh, geometry, x) = deformed_box();
     let w = vec![1.0; mesh.num_nodes()];
     for material in materials() {
         let patches = Patches::new(&mesh, &geometry, &material).unwrap();
         let input = input(&mesh, &geometry, &material, &w);
+        // the term's value and its gradient at the patch positions `xs`
+        let eval = |p: usize, xs: &[Vec3]| {
+            let mut grads = [vec![Vec3::zeros(); xs.len()], vec![Vec3::zeros(); xs.len()]];
+            let [gh, gd] = &mut grads;
+            let values = patches.terms(p, &input, xs, gh, gd);
+            let [gh, gd] = grads;
+            if term == 0 { (values.0, gh) } else { (values.1, gd) }
+        };
         for p in [0, 5, 17, patches.len() - 1] {
             let xp: Vec<Vec3> = patches.nodes(p).iter().map(|&i| x[i as usize]).collect();
-            let mut grad = vec![Vec3::zeros(); xp.len()];
-            let u = patches.terms(p, &input, &xp, &mut vec![Vec3::zeros(); xp.len()], &mut grad).1;
-            assert!(u > 0.0, "the deformed patch has a deviatoric energy: {u}");
+            let (value, grad) = eval(p, &xp);
+            assert!(nonzero(value), "the deformed patch has {what}: {value}");
             let scale = grad.iter().map(|g| g.amax()).fold(0.0, f64::max);
             let h = 1e-6;
             for d in 0..3 * xp.len() {
                 let at = |s: f64| {
                     let mut xs = xp.clone();
                     xs[d / 3][d % 3] += s;
-                    patches
-                        .terms(p, &input, &xs, &mut vec![Vec3::zeros(); xs.len()], &mut vec![Vec3::zeros(); xs.len()])
-                        .1
-                };
-                let fd = (at(h) - at(-h)) / (2.0 * h);
-                assert!(
-                    (fd - grad[d / 3][d % 3]).abs() < 1e-6 * scale,
-                    "patch {p}, dof {d}: {fd} vs {}",
-                    grad[d / 3][d % 3]
-                );
-            }
-        }
-    }
-}
-
-#[test]
-fn the_patch_constraint_gradient_matches_finite_differences() {
-    let (mesh, geometry, x) = deformed_box();
-    let w = vec![1.0; mesh.num_nodes()];
-    for material in materials() {
-        let patches = Patches::new(&mesh, &geometry, &material).unwrap();
-        let input = input(&mesh, &geometry, &material, &w);
-        for p in [0, 5, 17, patches.len() - 1] {
-            let xp: Vec<Vec3> = patches.nodes(p).iter().map(|&i| x[i as usize]).collect();
-            let mut grad = vec![Vec3::zeros(); xp.len()];
-            let c = patches.terms(p, &input, &xp, &mut grad, &mut vec![Vec3::zeros(); xp.len()]).0;
-            assert!(c.abs() > 1e-3, "the deformed patch has a volume change: {c}");
-            let scale = grad.iter().map(|g| g.amax()).fold(0.0, f64::max);
-            let h = 1e-6;
-            for d in 0..3 * xp.len() {
-                let at = |s: f64| {
-                    let mut xs = xp.clone();
-                    xs[d / 3][d % 3] += s;
-                    patches
-                        .terms(p, &input, &xs, &mut vec![Vec3::zeros(); xs.len()], &mut vec![Vec3::zeros(); xs.len()])
-                        .0
+                    eval(p, &xs).0
                 };
                 let fd = (at(h) - at(-h)) / (2.0 * h);
                 assert!((fd - grad[d / 3][d % 3]).abs() < 1e-6 * scale, "patch {p}, dof {d}: {fd} vs {grad:?}");
             }
         }
     }
+}
+
+/// The deviatoric term at the averaged `F̄_a`: its gradient matches finite differences.
+#[test]
+fn the_patch_deviatoric_gradient_matches_finite_differences() {
+    term_gradient_matches_finite_differences(1, |u| u > 0.0, "a deviatoric energy");
+}
+
+#[test]
+fn the_patch_constraint_gradient_matches_finite_differences() {
+    term_gradient_matches_finite_differences(0, |c| c.abs() > 1e-3, "a volume change");
 }
 
 /// The constraints' potential, every element's `β V_e ψ_d` plus every patch's `C_a²/(2α_a) +
