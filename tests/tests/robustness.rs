@@ -537,8 +537,9 @@ fn near_incompressible(model: MaterialModel, configs: &[Solve], known: &[(f64, &
 /// Case 2 with the cure (issue #62): the cantilever of [`near_incompressible`] at ν = 0.499 and
 /// 0.4999 (λ/μ = 499, 4999), Neo-Hookean (the mixed formulation refuses stable Neo-Hookean, whose
 /// deviatoric term is not stable alone), with the mixed formulation on every solver: P2, P3 and Q2
-/// with one pressure per element, P1 with one per node (Newton, Newton-CG, and XPBD with a constraint per
-/// node patch: VBD refuses it by name, a `SKIP` line). The same bounds as the energy formulation's family.
+/// with one pressure per element, P1 with one per node (Newton and Newton-CG through the patch
+/// terms, XPBD with a constraint per node patch, VBD's node updates reading every patch around
+/// the node). The same bounds as the energy formulation's family.
 #[test]
 #[ignore = "release: CI runs it with --release --ignored (ν = 0.4999 under XPBD's stability guard)"]
 fn near_incompressible_cantilevers_with_the_mixed_formulation_do_not_blow_up() {
@@ -559,10 +560,6 @@ fn near_incompressible_mixed(known: &[(f64, &[&str])]) -> Vec<String> {
         let configs: Vec<Solve> =
             Method::ALL.into_iter().filter(|&m| !slow(m)).map(|m| Solve::Mixed(m, Integrator::Euler)).collect();
         problems.extend(configurations(&case, &["p1", "p2", "p3", "q2"], &configs, known, |et, f| {
-            if et == "p1" && matches!(f, Solve::Mixed(Method::Vbd, _)) {
-                // refused by name (checked in hox-sim's mixed tests): nothing to run
-                return Ok("refused by name: P1's node pressure does not run on VBD yet".into());
-            }
             load_and_release_within(
                 gravity_cantilever(et, 1.0, 4, material(NH, 1.0e6, nu), f, 50, 60.0),
                 1.0,

@@ -160,6 +160,12 @@ pub trait SplitModel: Sync + Send {
     /// `∂²C_h/∂F²` of the hydrostatic term (9×9 on column-major vec(F), symmetric): what the mixed
     /// formulation's Hessian needs besides the model's tangent (`crate::fem::energy::mixed`).
     fn hydrostatic_hessian(&self, l: Lame, f: &Mat3) -> Mat9;
+    /// `H_h(g, g)_{rk} = Σ_{c,d} ∂²C_h/∂F_{rc}∂F_{kd} g_c g_d`: one node's 3 × 3 block of
+    /// [`SplitModel::hydrostatic_hessian`] (a vertex block descent visit of the mixed
+    /// formulation). Default: [`contract`] of the 9 × 9.
+    fn hydrostatic_node_block(&self, l: Lame, f: &Mat3, g: &Vector3<f64>) -> Mat3 {
+        contract(&self.hydrostatic_hessian(l, f), g, g)
+    }
 }
 
 /// One node's visit of one element (vertex block descent): the element's `F_q` at its points,
@@ -588,6 +594,14 @@ impl Material {
     /// As [`Material::split_terms`].
     pub fn hydrostatic_hessian(&self, f: &Mat3) -> Mat9 {
         self.split_law().hydrostatic_hessian(self.lame(), f)
+    }
+
+    /// [`SplitModel::hydrostatic_node_block`].
+    ///
+    /// # Panics
+    /// As [`Material::split_terms`].
+    pub fn hydrostatic_node_block(&self, f: &Mat3, g: &Vector3<f64>) -> Mat3 {
+        self.split_law().hydrostatic_node_block(self.lame(), f, g)
     }
 
     fn split_law(&self) -> &dyn SplitModel {

@@ -140,10 +140,20 @@ impl SplitModel for NeoHookean {
     /// `C_h = ln J` (continued linearly below the floor): `d(L' cof F)[dF] = L' d(cof F)[dF] +
     /// L'' (cof F : dF) cof F`.
     fn hydrostatic_hessian(&self, _l: Lame, f: &Mat3) -> Mat9 {
-        let log = log_j(f);
-        let cof = cofactor(f);
-        dpdf_from_directional(|df| cofactor_directional(f, df) * log.d1 + cof * (log.d2 * cof.dot(df)))
+        dpdf_from_directional(hydrostatic_directional(f))
     }
+
+    /// Three directional derivatives where the 9 × 9 takes nine.
+    fn hydrostatic_node_block(&self, _l: Lame, f: &Mat3, g: &nalgebra::Vector3<f64>) -> Mat3 {
+        node_block_from_directional(hydrostatic_directional(f), g)
+    }
+}
+
+/// `d(∂C_h/∂F)[dF]` of `C_h = ln J` ([`SplitModel::hydrostatic_hessian`]'s doc).
+fn hydrostatic_directional(f: &Mat3) -> impl Fn(&Mat3) -> Mat3 + '_ {
+    let log = log_j(f);
+    let cof = cofactor(f);
+    move |df| cofactor_directional(f, df) * log.d1 + cof * (log.d2 * cof.dot(df))
 }
 
 /// `dP[dF] = μ dF + g'(J) (cof F : dF) cof F + g(J) d(cof F)[dF]`, `g = (λ ln J − μ) (ln J)'`.

@@ -299,6 +299,11 @@ impl SplitModel for StVenantKirchhoff {
     fn hydrostatic_hessian(&self, _l: Lame, _f: &Mat3) -> Mat9 {
         Mat9::identity()
     }
+
+    /// `|g|² I`.
+    fn hydrostatic_node_block(&self, _l: Lame, _f: &Mat3, g: &Vector3<f64>) -> Mat3 {
+        Mat3::identity() * g.norm_squared()
+    }
 }
 
 /// `dP[dF] = dF S + F S(dE)`, `dE = (dFᵀ F + Fᵀ dF)/2`.

@@ -170,23 +170,6 @@ impl Method {
         self.info().honours.contains(&role)
     }
     /// Whether the method reads the parameter-table entry `key`.
-    /// Why this solver refuses the mixed formulation on an element type, if it does: P1's
-    /// pressure per node patch ([`crate::fem::energy::mixed::patch`]) couples the elements around
-    /// each node, which the sparse Newton solver assembles (the pattern widened to the patches)
-    /// and Newton-CG applies (the patch terms beside the element Hessians), and XPBD projects as
-    /// one constraint per patch ([`crate::xpbd::patch`]); VBD's node updates do not yet (a node
-    /// would need the pressure of every patch it lies in).
-    pub fn mixed_refusal(self, element: crate::element::ElementType) -> Option<String> {
-        use crate::element::ReferenceShape;
-        let patch = element.order() == 1 && element.shape() == ReferenceShape::Tetrahedron;
-        (patch && self == Method::Vbd).then(|| {
-            format!(
-                "the mixed formulation on {element} shares one pressure among the elements around each node (the \
-                 averaged nodal pressure), which the {} solver does not run yet: use --solver newton, newton-cg or xpbd, or P2 mixed",
-                self.info().name
-            )
-        })
-    }
     pub fn reads_parameter(self, key: &str) -> bool {
         self.info().parameters.contains(&key)
     }

@@ -93,17 +93,20 @@ fn every_solver_runs_the_mixed_formulation_towards_its_static_equilibrium() {
 }
 
 #[test]
-fn newton_newton_cg_and_xpbd_run_the_p1_patch_pressure_towards_its_static_equilibrium() {
+fn every_solver_runs_the_p1_patch_pressure_towards_its_static_equilibrium() {
     // Newton: the sparse pattern widened to the patches (nodes two edges apart), the frame's
-    // potential with the patch energy; Newton-CG: the patch terms beside the element Hessians; XPBD: a deviatoric constraint per element and a
-    // hydrostatic one per node patch, whose potential is the same energy. Both settle on the
-    // static mixed P1 beam, softer than the pointwise one, at ν = 0.4999
+    // potential with the patch energy; Newton-CG: the patch terms beside the element Hessians;
+    // XPBD: a deviatoric constraint per element and per node patch with a hydrostatic one, whose
+    // potential is the same energy; VBD: each node's update reading every patch around it. All
+    // settle on the static mixed P1 beam, softer than the pointwise one, at ν = 0.4999
     let mesh = beam(ElementType::from_name("p1").unwrap(), [8, 2, 2]);
     let material = Material::new(MaterialModel::StVenantKirchhoff, 2.0e5, 0.4999, 1000.0).unwrap();
     let reference = static_tip_z(&mesh, material, VolumeMeasure::Element);
     let plain = static_tip_z(&mesh, material, VolumeMeasure::Point);
     assert!(reference < plain * 1.05, "patch {reference} vs plain {plain}: the patch beam is softer");
-    for (method, tolerance) in [(Method::Newton, 0.02), (Method::NewtonCg, 0.02), (Method::Xpbd, 0.05)] {
+    for (method, tolerance) in
+        [(Method::Newton, 0.02), (Method::NewtonCg, 0.02), (Method::Xpbd, 0.05), (Method::Vbd, 0.05)]
+    {
         let mut sim =
             Simulation::new(mesh.clone(), material, settings(method, Formulation::Mixed), effects(&mesh, 8.0))
                 .unwrap_or_else(|e| panic!("{method}: {e}"));
@@ -173,12 +176,10 @@ fn the_mixed_formulation_is_refused_by_name_where_it_cannot_run() {
     };
     let err = refused(q1, Method::Newton).expect("Q1 mixed refused");
     assert!(err.contains("inf–sup") && err.contains("Q1"), "{err}");
-    // P1's pressure per node patch runs on Newton, Newton-CG and XPBD, not yet on VBD
-    for method in [Method::Newton, Method::NewtonCg, Method::Xpbd] {
+    // P1's pressure per node patch runs on every solver
+    for method in Method::ALL {
         assert_eq!(refused(p1, method), None, "P1 mixed on {method:?}");
     }
-    let err = refused(p1, Method::Vbd).expect("P1 mixed on VBD: not refused");
-    assert!(err.contains("averaged nodal pressure") && err.contains("--solver newton"), "{err}");
     let mesh = beam(ElementType::from_name("p2").unwrap(), [2, 1, 1]);
     let snh = Material::new(MaterialModel::StableNeoHookean, 2.0e5, 0.49, 1000.0).unwrap();
     let err = Simulation::new(mesh.clone(), snh, settings(Method::Xpbd, Formulation::Mixed), effects(&mesh, 0.0))

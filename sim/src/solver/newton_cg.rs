@@ -36,7 +36,7 @@
 
 use super::error::SolverCounters;
 use super::newton_core::{HessianModel, LinearSolver};
-use super::sparse::{SparseError, SparsePattern, element_hessian_at, map_element_hessians};
+use super::sparse::{SparseError, SparsePattern, map_element_hessians};
 use crate::Vec3;
 use crate::fem::energy::mixed::patch;
 use crate::material::Material;
@@ -126,15 +126,7 @@ impl ConjugateGradients {
             node_start.push(nodes.len());
             hessians.extend_from_slice(h.as_slice());
         };
-        patch::hessian_terms(mesh, geometry, material, x, true, &mut add);
-        for (b, g) in mesh.blocks.iter().zip(geometry) {
-            if patch::is_patch_block(b, material) {
-                continue;
-            }
-            for (e, element) in b.elements().enumerate() {
-                add(element, &element_hessian_at(mesh, g, e, element, material, x, true));
-            }
-        }
+        crate::solver::sparse::for_each_hessian_term(mesh, geometry, material, x, true, &mut add);
         (self.nodes, self.node_start, self.hessians) = (nodes, node_start, hessians);
     }
 

@@ -304,9 +304,7 @@ impl SolverSettings {
                 material.model.long_name()
             )));
         }
-        let refusal = |b: &crate::mesh::ElementBlock| {
-            crate::fem::energy::mixed::refusal(b.element_type).or_else(|| self.method.mixed_refusal(b.element_type))
-        };
+        let refusal = |b: &crate::mesh::ElementBlock| crate::fem::energy::mixed::refusal(b.element_type);
         if let Some(why) = mesh.blocks.iter().find_map(refusal).filter(|_| self.formulation == Formulation::Mixed) {
             return Err(SimError::Settings(why));
         }

@@ -503,18 +503,32 @@ pub fn assemble_dense(mesh: &Mesh, geo: &[BlockGeometry], material: &Material, x
             }
         }
     };
+    for_each_hessian_term(mesh, geo, material, x, true, &mut add);
+    k
+}
+
+/// Every term of the elastic Hessian at `x` with its nodes (`projected`: PSD-projected per
+/// quadrature point): P1's node patches' terms under the mixed formulation first
+/// ([`patch::hessian_terms`]), then every other block's element Hessians, in mesh order.
+pub(crate) fn for_each_hessian_term(
+    mesh: &Mesh,
+    geo: &[BlockGeometry],
+    material: &Material,
+    x: &[Vec3],
+    projected: bool,
+    mut add: impl FnMut(&[u32], &DMatrix<f64>),
+) {
     if patch::has_patches(mesh, material) {
-        patch::hessian_terms(mesh, geo, material, x, true, &mut add);
+        patch::hessian_terms(mesh, geo, material, x, projected, &mut add);
     }
     for (b, gb) in mesh.blocks.iter().zip(geo) {
         if patch::is_patch_block(b, material) {
             continue;
         }
         for (e, nodes) in b.elements().enumerate() {
-            add(nodes, &element_hessian_at(mesh, gb, e, nodes, material, x, true));
+            add(nodes, &element_hessian_at(mesh, gb, e, nodes, material, x, projected));
         }
     }
-    k
 }
 
 #[cfg(test)]

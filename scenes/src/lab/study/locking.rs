@@ -52,9 +52,9 @@ pub struct LockingRow {
     pub reference_mesh: String,
     /// Share of the reference's sag that this mesh misses, % (positive: stiffer, i.e. locking).
     pub missing_pct: f64,
-    /// XPBD's median ms per frame at the scene's settings, one thread (module docs); None where
-    /// XPBD refuses the formulation ([`hox_sim::solver::Method::mixed_refusal`]; none of the
-    /// table's today).
+    /// XPBD's median ms per frame at the scene's settings, one thread (module docs); None in
+    /// tables written when XPBD refused P1 mixed (every solver runs every formulation the
+    /// element admits today).
     pub ms_per_frame: Option<f64>,
     /// Newton's median ms per frame (implicit Euler, one step per frame), one thread.
     pub newton_ms_per_frame: f64,
@@ -96,10 +96,6 @@ pub fn locking_at(nu: f64, quick: bool, progress: &mut dyn FnMut(&str)) -> Resul
     for config in meshes().iter().filter(|m| !(quick && m.heavy)) {
         for formulation in LOCKING_FORMULATIONS {
             let element = hox_sim::element::ElementType::from_name(config.element);
-            let refused = |method| {
-                element.and_then(|e| hox_sim::solver::Method::mixed_refusal(method, e)).is_some()
-                    && formulation == Formulation::Mixed
-            };
             if formulation == Formulation::Mixed && element.and_then(hox_sim::fem::energy::mixed::refusal).is_some() {
                 continue;
             }
@@ -110,8 +106,7 @@ pub fn locking_at(nu: f64, quick: bool, progress: &mut dyn FnMut(&str)) -> Resul
             progress(&format!("locking: bending {label} at ν = {nu}: static solution"));
             let (tip_z_m, elements) = static_tip_z(&scene, &label, nu)?;
             progress(&format!("locking: bending {label} at ν = {nu}: XPBD and Newton, one thread"));
-            let ms_per_frame =
-                if refused(Method::Xpbd) { None } else { Some(median_ms_per_frame(&scene, Method::Xpbd)?) };
+            let ms_per_frame = Some(median_ms_per_frame(&scene, Method::Xpbd)?);
             let newton_ms_per_frame = median_ms_per_frame(&scene, Method::Newton)?;
             rows.push(LockingRow {
                 poisson_ratio: nu,

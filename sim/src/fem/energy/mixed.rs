@@ -109,6 +109,24 @@ fn point_tangent(
     if projected { project_psd(&c) } else { (c + c.transpose()) * 0.5 }
 }
 
+/// [`point_tangent`] (not projected) contracted with one node's gradient, `C(β A_d + p H_h)(g, g)`,
+/// from the model's node blocks (`C(g, g)`, `H_h(g, g)`: three directional derivatives each where
+/// the 9 × 9 tangents take nine; a P1 node's vertex block descent visit, [`patch`]).
+fn point_node_block(
+    material: &Material,
+    k_h: f64,
+    deviatoric_share: f64,
+    pressure_pa: f64,
+    f: &Mat3,
+    pt: &Point,
+    g: &Vec3,
+) -> Matrix3<f64> {
+    let hh = material.hydrostatic_node_block(f, g);
+    let gh = pt.g_h * g;
+    let a_d = material.node_block(f, g) - (gh * gh.transpose() + hh * pt.c_h) * k_h;
+    a_d * deviatoric_share + hh * pressure_pa
+}
+
 /// The element's `V_e` and `C̄` from its points' `F_q`.
 fn mean_hydrostatic(material: &Material, points: impl Iterator<Item = (Mat3, f64)>) -> (f64, f64) {
     let (mut v_e, mut sum) = (0.0, 0.0);

@@ -197,6 +197,23 @@ impl CoarseSpace {
                 add_node_diag(&mut a, sp.node as usize, sp.stiffness_n_per_m);
             }
         }
+        if s.material.volume_measure == crate::material::VolumeMeasure::Point {
+            self.add_point_stiffness(&mut a, s, x);
+        } else {
+            self.add_term_stiffness(&mut a, s, x);
+        }
+        // coarse nodes no free node reaches: identity rows (their δ is then zero); and a relative
+        // 1e-9 on the diagonal, as where the grid resolves more than the mesh `U z = 0` for some
+        // `z`: the factor then exists, and such a `z` in `δ` moves no node
+        for d in 0..n {
+            a[(d, d)] = if a[(d, d)] == 0.0 { 1.0 } else { a[(d, d)] * (1.0 + REGULARISATION) };
+        }
+        self.factor = Cholesky::new(a);
+    }
+
+    /// `Uᵀ K U` of the elastic stiffness, point by point (the point law's projected tangent).
+    fn add_point_stiffness(&self, a: &mut DMatrix<f64>, s: &StepInput<'_>, x: &[Vec3]) {
+        let free = |i: usize| s.inv_mass[i] > 0.0;
         // per element: its free nodes' coarse nodes `J` (local list) and, per point, the coarse
         // gradients `G_J = Σ_a φ_J(X_a) ∇_X N_a(r_q)`, so that `δF_q = Σ_J δ_J ⊗ G_J` and the
         // element adds `V_q Σ_{c,d} ∂P_{rc}/∂F_{kd} (G_J)_c (G_K)_d` to block `(J, K)`
@@ -260,13 +277,36 @@ impl CoarseSpace {
                 }
             }
         });
-        // coarse nodes no free node reaches: identity rows (their δ is then zero); and a relative
-        // 1e-9 on the diagonal, as where the grid resolves more than the mesh `U z = 0` for some
-        // `z`: the factor then exists, and such a `z` in `δ` moves no node
-        for d in 0..n {
-            a[(d, d)] = if a[(d, d)] == 0.0 { 1.0 } else { a[(d, d)] * (1.0 + REGULARISATION) };
-        }
-        self.factor = Cholesky::new(a);
+    }
+
+    /// `Uᵀ K U` of the elastic stiffness term by term where the formulation's Hessian is not the
+    /// point law's (the mixed formulation: each element's Hessian with its pressure, P1's node
+    /// patches' dense terms, [`crate::fem::energy::mixed::patch::hessian_terms`]; projected): the
+    /// locked pointwise tangent made the coarse correction all but useless at ν = 0.4999.
+    fn add_term_stiffness(&self, a: &mut DMatrix<f64>, s: &StepInput<'_>, x: &[Vec3]) {
+        let corners = &self.corners;
+        let free = |i: usize| s.inv_mass[i] > 0.0;
+        let add = |nodes: &[u32], h: &DMatrix<f64>| {
+            for (li, &i) in nodes.iter().enumerate().filter(|(_, i)| free(**i as usize)) {
+                for (lj, &j) in nodes.iter().enumerate().filter(|(_, j)| free(**j as usize)) {
+                    for &(ci, wi) in &corners[i as usize] {
+                        for &(cj, wj) in &corners[j as usize] {
+                            let w = wi * wj;
+                            if w == 0.0 {
+                                continue;
+                            }
+                            let (row, col) = (3 * ci as usize, 3 * cj as usize);
+                            for r in 0..3 {
+                                for k in 0..3 {
+                                    a[(row + r, col + k)] += w * h[(3 * li + r, 3 * lj + k)];
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        };
+        crate::solver::sparse::for_each_hessian_term(s.mesh, s.geometry, s.material, x, true, add);
     }
 
     /// Starts a step: the coarse matrix is remade when it is [`REFRESH_STEPS`] old, when the

@@ -62,10 +62,12 @@ use super::step::{Hooks, StepInput, StepSolver};
 use coarse::{CoarseSpace, coarse_cells};
 use lanes::{Fused, LaneView, PointLanes, Snapshots};
 use node::NodeUpdate;
+use patch::{PatchView, Patches};
 
 mod coarse;
 mod lanes;
 mod node;
+mod patch;
 use crate::Vec3;
 use crate::effect::{ImplicitRole, NodeSpring};
 use crate::fem::geometry::BlockGeometry;
@@ -97,6 +99,9 @@ pub(crate) struct Vbd {
     coarse: Option<CoarseSpace>,
     /// The last step's residual stayed above [`ACCEPT_RESIDUAL`].
     failed: bool,
+    /// P1's node patches under the mixed formulation ([`patch`]), built at the first step that
+    /// needs them.
+    patches: Option<Patches>,
 }
 
 impl Vbd {
@@ -117,6 +122,7 @@ impl Vbd {
             fused: Fused::detect(),
             coarse: CoarseSpace::for_settings(mesh, settings),
             failed: false,
+            patches: None,
         }
     }
 }
@@ -156,6 +162,7 @@ impl StepSolver for Vbd {
     fn rebuild(&mut self, mesh: &Mesh, geometry: &[BlockGeometry], settings: &SolverSettings, geometry_changed: bool) {
         if geometry_changed {
             self.lanes = PointLanes::new(mesh, geometry);
+            self.patches = None;
         }
         if geometry_changed || self.coarse.as_ref().map(CoarseSpace::target_cells) != coarse_cells(settings) {
             self.coarse = CoarseSpace::for_settings(mesh, settings);
@@ -171,6 +178,11 @@ impl StepSolver for Vbd {
     ) -> Result<(), BadElement> {
         let h = s.h;
         super::nan_guard::check_input(s.mesh, positions)?;
+        // the patches follow the material's formulation (a live switch to or from mixed)
+        let wants_patches = crate::fem::energy::mixed::patch::has_patches(s.mesh, s.material);
+        if !wants_patches || !self.patches.as_ref().is_some_and(|p| p.fits(s.mesh)) {
+            self.patches = if wants_patches { Patches::new(s.mesh, s.geometry, s.material) } else { None };
+        }
         self.y.clear();
         self.y.extend_from_slice(positions);
         // the initial guess
@@ -260,9 +272,18 @@ impl StepSolver for Vbd {
                     self.f_snapshots.start(&self.lanes);
                 }
                 let lanes = LaneView::of(&mut self.lanes, s.material);
-                for colour in &self.colours {
-                    counters.node_updates +=
-                        sweep_colour(&update, colour, positions, &lanes, s.settings.sweep.is_colour())?;
+                let parallel = s.settings.sweep.is_colour();
+                if let Some(p) = &mut self.patches {
+                    p.refresh(s.mesh, s.material, &lanes);
+                    let (view, colours) = p.view();
+                    for colour in colours {
+                        counters.node_updates +=
+                            sweep_colour(&update, colour, positions, &lanes, Some(&view), parallel)?;
+                    }
+                } else {
+                    for colour in &self.colours {
+                        counters.node_updates += sweep_colour(&update, colour, positions, &lanes, None, parallel)?;
+                    }
                 }
                 if rho > 0.0 {
                     omega = match k {
@@ -334,18 +355,20 @@ fn sweep_colour(
     colour: &[u32],
     positions: &mut [Vec3],
     lanes: &[LaneView<'_>],
+    patches: Option<&PatchView<'_>>,
     parallel: bool,
 ) -> Result<u64, BadElement> {
     let inv_mass = update.input.inv_mass;
     let shared = SharedMut::new(positions);
     // SAFETY: nodes of one colour share no element, so each task touches only its node and the
-    // F_q of elements no other task of this colour touches.
+    // F_q of elements no other task of this colour touches; with patches, they lie more than two
+    // edges apart, so no two tasks touch one node's means.
     let node = |&i: &u32| -> Result<u64, BadElement> {
         let i = i as usize;
         if inv_mass[i] == 0.0 {
             return Ok(0);
         }
-        Ok(u64::from(unsafe { update.step(i, shared, lanes) }?))
+        Ok(u64::from(unsafe { update.step(i, shared, lanes, patches) }?))
     };
     if !parallel {
         return colour.iter().map(node).sum();

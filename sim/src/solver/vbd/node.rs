@@ -4,6 +4,7 @@
 //! until the node's share of the potential does not rise (at most [`MAX_BACKTRACKS`] times).
 
 use super::lanes::{Fused, LaneView, add_outer_any};
+use super::patch::PatchView;
 use crate::Vec3;
 use crate::effect::NodeSpring;
 use crate::material::{Lame, NodeVisit, project_psd3};
@@ -40,14 +41,15 @@ impl NodeUpdate<'_> {
         i: usize,
         positions: SharedMut<Vec3>,
         lanes: &[LaneView<'_>],
+        patches: Option<&PatchView<'_>>,
     ) -> Result<bool, BadElement> {
         #[cfg(target_arch = "x86_64")]
         if self.fused.0 {
             // SAFETY: the CPU has AVX2 and FMA (detected); the caller's promise
-            return unsafe { self.step_fused(i, positions, lanes) };
+            return unsafe { self.step_fused(i, positions, lanes, patches) };
         }
         // SAFETY: the caller's promise
-        unsafe { self.step_in::<false>(i, positions, lanes) }
+        unsafe { self.step_in::<false>(i, positions, lanes, patches) }
     }
 
     /// [`NodeUpdate::step`] compiled for AVX2 and FMA.
@@ -61,9 +63,10 @@ impl NodeUpdate<'_> {
         i: usize,
         positions: SharedMut<Vec3>,
         lanes: &[LaneView<'_>],
+        patches: Option<&PatchView<'_>>,
     ) -> Result<bool, BadElement> {
         // SAFETY: the caller's promise
-        unsafe { self.step_in::<true>(i, positions, lanes) }
+        unsafe { self.step_in::<true>(i, positions, lanes, patches) }
     }
 
     /// # Safety
@@ -74,6 +77,7 @@ impl NodeUpdate<'_> {
         i: usize,
         positions: SharedMut<Vec3>,
         lanes: &[LaneView<'_>],
+        patches: Option<&PatchView<'_>>,
     ) -> Result<bool, BadElement> {
         let s = self.input;
         // SAFETY: the caller's promise
@@ -83,6 +87,9 @@ impl NodeUpdate<'_> {
         let mut h = Matrix3::identity() * m_w;
         for inc in self.incidence.of(i) {
             let (b, e, a) = (inc.block as usize, inc.element as usize, inc.local as usize);
+            if patches.is_some_and(|p| p.is_patch(b)) {
+                continue;
+            }
             let l = &lanes[b];
             // SAFETY: an element holding node i
             let fq = unsafe { l.f_mut(e) };
@@ -95,6 +102,12 @@ impl NodeUpdate<'_> {
             };
             f -= force;
             h += project_psd3(&block);
+        }
+        if let Some(p) = patches {
+            // SAFETY: the caller's promise (nodes of one colour lie more than two edges apart)
+            let (force, block) = unsafe { p.node_share(s.material, i, lanes) };
+            f -= force;
+            h += block;
         }
         for sp in self.springs.iter().filter(|sp| sp.node as usize == i) {
             f -= (xi - sp.target_m) * sp.stiffness_n_per_m;
@@ -111,22 +124,26 @@ impl NodeUpdate<'_> {
             unsafe {
                 positions.write(i, xi + d);
                 carry_points::<FMA>(self.incidence, i, d, lanes);
+                carry_patches(s.material, patches, i, d, lanes);
             }
             return Ok(true);
         }
         // the step, backtracked until the node's potential does not rise (a full Newton step on
         // the projected block overshot near incompressibility: ν = 0.499 under torsion blew up)
         // SAFETY: the caller's promise
-        let before = unsafe { self.local_energy(i, xi, lanes) };
+        let before = unsafe { self.local_energy(i, xi, lanes, patches) };
         let mut t = 1.0;
         let mut moved = Vec3::zeros();
         for _ in 0..=MAX_BACKTRACKS {
             let step = d * t - moved;
             // SAFETY: the caller's promise
-            unsafe { carry_points::<FMA>(self.incidence, i, step, lanes) };
+            unsafe {
+                carry_points::<FMA>(self.incidence, i, step, lanes);
+                carry_patches(s.material, patches, i, step, lanes);
+            }
             moved += step;
             // SAFETY: the caller's promise
-            let after = unsafe { self.local_energy(i, xi + moved, lanes) };
+            let after = unsafe { self.local_energy(i, xi + moved, lanes, patches) };
             if after <= before {
                 // SAFETY: the caller's promise
                 unsafe { positions.write(i, xi + moved) };
@@ -136,7 +153,10 @@ impl NodeUpdate<'_> {
         }
         // no decrease along the step (round-off at a minimum): the node stays
         // SAFETY: the caller's promise
-        unsafe { carry_points::<FMA>(self.incidence, i, -moved, lanes) };
+        unsafe {
+            carry_points::<FMA>(self.incidence, i, -moved, lanes);
+            carry_patches(s.material, patches, i, -moved, lanes);
+        }
         Ok(false)
     }
 
@@ -146,11 +166,18 @@ impl NodeUpdate<'_> {
     /// # Safety
     /// As [`NodeUpdate::step`].
     #[inline(always)]
-    unsafe fn local_energy(&self, i: usize, xi: Vec3, lanes: &[LaneView<'_>]) -> f64 {
+    unsafe fn local_energy(&self, i: usize, xi: Vec3, lanes: &[LaneView<'_>], patches: Option<&PatchView<'_>>) -> f64 {
         let s = self.input;
         let mut e = 0.5 * s.masses_kg[i] * self.w * (xi - self.y[i]).norm_squared();
+        if let Some(p) = patches {
+            // SAFETY: the caller's promise
+            e += unsafe { p.local_energy(s.material, i, lanes) };
+        }
         for inc in self.incidence.of(i) {
             let (b, el) = (inc.block as usize, inc.element as usize);
+            if patches.is_some_and(|p| p.is_patch(b)) {
+                continue;
+            }
             let l = &lanes[b];
             // SAFETY: an element holding node i
             let fq = unsafe { l.f_mut(el) };
@@ -187,6 +214,25 @@ pub(super) fn solve_spd3(h: &Matrix3<f64>, f: &Vec3) -> Option<Vec3> {
     // a non-positive pivot's square root is NaN (or zero, dividing to ±∞)
     let d = Vec3::new(d0, d1, d2);
     d.iter().all(|c| c.is_finite()).then_some(d)
+}
+
+/// Moves the patches' means with node `i` (moved by `d`, its elements' `F_q` carried), if the
+/// mesh has patches.
+///
+/// # Safety
+/// [`PatchView::carry`]'s.
+#[inline(always)]
+unsafe fn carry_patches(
+    material: &crate::material::Material,
+    patches: Option<&PatchView<'_>>,
+    i: usize,
+    d: Vec3,
+    lanes: &[LaneView<'_>],
+) {
+    if let Some(p) = patches {
+        // SAFETY: the caller's promise
+        unsafe { p.carry(material, i, &d, lanes) };
+    }
 }
 
 /// Moves the `F_q` of every element holding node `i` by `Δ ⊗ ∇_X N_a(r_q)` (node `i` moved by `d`).

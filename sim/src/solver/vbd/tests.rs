@@ -115,3 +115,110 @@ fn carried_point_gradients_match_recomputed_ones_for_every_element_type() {
         assert!(moved, "{et}: no F_q moved");
     }
 }
+
+/// P1's node patches under the mixed formulation ([`super::patch`]): a node's patch gradient is
+/// the patch energy's gradient at that node, its local energy changes as the whole energy does
+/// when the node moves, and the means carried along node moves are those of the moved positions.
+#[test]
+fn a_node_s_patch_share_is_the_patch_energy_s_and_its_means_follow_the_node() {
+    use super::patch::Patches;
+    use crate::fem::energy::mixed::patch::energy_and_gradient;
+    use crate::material::VolumeMeasure;
+    let mesh = super::super::tests::beam(ElementType::from_name("p1").unwrap(), [3, 2, 2]);
+    let geometry = precompute(&mesh, None).unwrap();
+    let incidence = NodeIncidence::new(&mesh);
+    let material = Material::new(crate::material::MaterialModel::NeoHookean, 1.0e5, 0.49, 1000.0)
+        .unwrap()
+        .with_volume_measure(VolumeMeasure::Element)
+        .unwrap();
+    let mut x: Vec<Vec3> = mesh
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p + Vec3::new(0.01 * (i % 5) as f64, 0.007 * (i % 3) as f64, -0.012 * (i % 4) as f64))
+        .collect();
+    let fused = Fused::detect();
+    let mut lanes = PointLanes::new(&mesh, &geometry);
+    lanes.refresh(&mesh, &x, fused);
+    let mut patches = Patches::new(&mesh, &geometry, &material).expect("P1 mixed has patches");
+    patches.refresh(&mesh, &material, &LaneView::of(&mut lanes, &material));
+    {
+        let means = crate::fem::energy::mixed::patch::NodeMeans::new(&mesh, &geometry, &material, &x);
+        for a in 0..mesh.num_nodes() {
+            let (c, f) = patches.mean(a);
+            assert!((c - means.c_bar[a]).abs() < 1e-12 && (f - means.f_bar[a]).norm() < 1e-12, "node {a}: refreshed");
+        }
+    }
+    let mut moved_any = false;
+    for (k, i) in (0..mesh.num_nodes()).step_by(4).enumerate() {
+        let mut gradient = vec![Vec3::zeros(); x.len()];
+        let before = energy_and_gradient(&mesh, &geometry, &material, &x, Some(&mut gradient));
+        let view_lanes = LaneView::of(&mut lanes, &material);
+        let (view, _) = patches.view();
+        // SAFETY: one thread
+        let (share, block) = unsafe { view.node_share(&material, i, &view_lanes) };
+        let scale = gradient[i].norm().max(1e-3);
+
+        assert!((share - gradient[i]).norm() <= 1e-9 * scale, "node {i}: share {share} vs gradient {}", gradient[i]);
+        assert!(block.symmetric_eigenvalues().min() >= -1e-9 * block.norm(), "node {i}: block {block}");
+        // SAFETY: one thread
+        let local_before = unsafe { view.local_energy(&material, i, &view_lanes) };
+        let d = Vec3::new(0.004 * (k % 3) as f64, -0.003, 0.002 * (k % 2) as f64);
+        x[i] += d;
+        // SAFETY: one thread
+        unsafe {
+            carry_on_this_cpu(fused, &incidence, i, d, &view_lanes);
+            view.carry(&material, i, &d, &view_lanes);
+        }
+        // SAFETY: one thread
+        let local_after = unsafe { view.local_energy(&material, i, &view_lanes) };
+        let after = energy_and_gradient(&mesh, &geometry, &material, &x, None);
+        let (whole, local) = (after - before, local_after - local_before);
+        assert!((whole - local).abs() <= 1e-9 * whole.abs().max(1e-6), "node {i}: ΔU {whole} vs local {local}");
+        moved_any |= whole.abs() > 1e-6;
+    }
+    assert!(moved_any, "no move changed the energy");
+    // the carried means are the means of the moved positions
+    let means = crate::fem::energy::mixed::patch::NodeMeans::new(&mesh, &geometry, &material, &x);
+    let mut fresh = Patches::new(&mesh, &geometry, &material).unwrap();
+    lanes.refresh(&mesh, &x, fused);
+    fresh.refresh(&mesh, &material, &LaneView::of(&mut lanes, &material));
+    for (a, (&c, f)) in means.c_bar.iter().zip(&means.f_bar).enumerate() {
+        let (c_fresh, f_fresh) = fresh.mean(a);
+        let (c_kept, f_kept) = patches.mean(a);
+        assert!((c_fresh - c).abs() < 1e-12 && (f_fresh - f).norm() < 1e-12, "node {a}: refresh vs NodeMeans");
+        assert!((c_kept - c).abs() < 1e-12 && (f_kept - f).norm() < 1e-12, "node {a}: carried vs NodeMeans");
+    }
+}
+
+/// Nodes of one colour of [`super::patch::colour_two_apart`] share no patch: no node lies in an
+/// element with each of two nodes of one colour.
+#[test]
+fn nodes_coloured_two_apart_share_no_patch() {
+    let mesh = super::super::tests::beam(ElementType::from_name("p1").unwrap(), [4, 2, 2]);
+    let incidence = NodeIncidence::new(&mesh);
+    let colours = super::patch::colour_two_apart(&mesh, &incidence);
+    let mut colour_of = vec![usize::MAX; mesh.num_nodes()];
+    for (c, nodes) in colours.iter().enumerate() {
+        for &n in nodes {
+            assert_eq!(colour_of[n as usize], usize::MAX, "node {n} coloured twice");
+            colour_of[n as usize] = c;
+        }
+    }
+    assert!(colour_of.iter().all(|&c| c != usize::MAX), "a node without a colour");
+    for a in 0..mesh.num_nodes() {
+        let mut patch: Vec<u32> = incidence
+            .of(a)
+            .iter()
+            .flat_map(|inc| mesh.blocks[inc.block as usize].element(inc.element as usize).iter().copied())
+            .collect();
+        patch.sort_unstable();
+        patch.dedup();
+        let mut seen = std::collections::HashMap::new();
+        for &n in &patch {
+            if let Some(other) = seen.insert(colour_of[n as usize], n) {
+                panic!("nodes {other} and {n} share colour {} and node {a}'s patch", colour_of[n as usize]);
+            }
+        }
+    }
+}

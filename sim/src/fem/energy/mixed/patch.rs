@@ -34,7 +34,7 @@
 //! displacements instead of `5.5 n`: the ratio that releases the mesh from locking (Bonet &
 //! Burton §2; Zienkiewicz, Taylor & Zhu, *The Finite Element Method*, §11.5 on the count).
 
-use super::{hydrostatic_stiffness_pa, point, point_tangent};
+use super::{hydrostatic_stiffness_pa, point, point_node_block, point_tangent};
 use crate::Vec3;
 use crate::element::ReferenceShape;
 use crate::fem::energy::{PointBlocks, element_grads, gather};
@@ -280,6 +280,66 @@ pub fn hessian_terms(
         }
         add(&patch_nodes, &h);
     }
+}
+
+/// One node `i`'s share of a patch element `e ∋ i` for a vertex block descent node update
+/// (`crate::solver::vbd`): with `p̃_e` the element's pressure, `g = ∇_X N_i`, `V = V_e`,
+/// the gradient of the element's own share `V β P_d(F_e) g` (the pressure's `V p̃_e G_h g` is
+/// the patches' hydrostatic gradient, which [`patch_node_share`] counts), the 3 × 3 block
+/// `V C(β A_d + p̃_e H_h)(g, g)` (not projected) and `V G_h(F_e) g`, the element's part of the
+/// patches' `ḡ_{a,i}` (the module's Hessian, read on node `i`'s diagonal).
+pub fn element_node_share(
+    material: &Material,
+    pressure_pa: f64,
+    f: &Mat3,
+    g: &Vec3,
+    volume_m3: f64,
+) -> (Vec3, nalgebra::Matrix3<f64>, Vec3) {
+    let k_h = hydrostatic_stiffness_pa(material);
+    let beta = ELEMENT_DEVIATORIC_SHARE;
+    let pt = point(material, k_h, f);
+    let gradient = pt.p_d * g * (beta * volume_m3);
+    let block = point_node_block(material, k_h, beta, pressure_pa, f, &pt, g);
+    (gradient, block * volume_m3, pt.g_h * g * volume_m3)
+}
+
+/// Node `a`'s patch term seen from node `i` of its patch (a vertex block descent node update):
+/// the gradient `W_a [(1 − β) P_d(F̄_a) b̄_{a,i} + k_h C̄_a ḡ_{a,i}]` and the positive
+/// semi-definite 3 × 3 block `W_a [(1 − β) Π(C(A_d(F̄_a))(b̄, b̄)) + k_h ḡ ḡᵀ]` (`Π`: the
+/// projection to positive semi-definite of the 3 × 3 block, as the nodes' element blocks are).
+pub fn patch_node_share(
+    material: &Material,
+    weight_m3: f64,
+    f_bar: &Mat3,
+    c_bar: f64,
+    b_bar: &Vec3,
+    g_bar: &Vec3,
+) -> (Vec3, nalgebra::Matrix3<f64>) {
+    let k_h = hydrostatic_stiffness_pa(material);
+    let share = 1.0 - ELEMENT_DEVIATORIC_SHARE;
+    let pt = point(material, k_h, f_bar);
+    let gradient = (pt.p_d * b_bar * share + g_bar * (k_h * c_bar)) * weight_m3;
+    let deviatoric = crate::material::project_psd3(&point_node_block(material, k_h, 1.0, 0.0, f_bar, &pt, b_bar));
+    (gradient, (deviatoric * share + g_bar * g_bar.transpose() * k_h) * weight_m3)
+}
+
+/// A patch element's share of the energy that stays on it, `β V_e ψ_d(F_e)`, and its
+/// hydrostatic term `C_h(F_e)` (what the node means average).
+pub fn element_share_and_hydrostatic(material: &Material, f: &Mat3, volume_m3: f64) -> (f64, f64) {
+    let pt = point(material, hydrostatic_stiffness_pa(material), f);
+    (ELEMENT_DEVIATORIC_SHARE * volume_m3 * pt.psi_d, pt.c_h)
+}
+
+/// Node `a`'s patch energy `W_a [(1 − β) ψ_d(F̄_a) + k_h/2 C̄_a²]`.
+pub fn patch_energy(material: &Material, weight_m3: f64, f_bar: &Mat3, c_bar: f64) -> f64 {
+    let k_h = hydrostatic_stiffness_pa(material);
+    let pt = point(material, k_h, f_bar);
+    weight_m3 * ((1.0 - ELEMENT_DEVIATORIC_SHARE) * pt.psi_d + 0.5 * k_h * c_bar * c_bar)
+}
+
+/// `k_h` (Pa), for [`NodeMeans::element_pressure_pa`].
+pub fn hydrostatic_stiffness(material: &Material) -> f64 {
+    hydrostatic_stiffness_pa(material)
 }
 
 /// Per node, the patch elements around it as indices into the patch elements in mesh order

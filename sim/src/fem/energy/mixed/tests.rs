@@ -224,3 +224,23 @@ fn the_patch_gradient_and_hessian_match_finite_differences_over_the_mesh() {
         assert!(coupled(&hess) > coupled(&plain_k), "{} vs {}", coupled(&hess), coupled(&plain_k));
     }
 }
+
+/// The node block from the models' node blocks ([`point_node_block`], P1's VBD visit) is the
+/// 9 × 9 tangent contracted ([`point_tangent`]), for StVK and Neo-Hookean, with and without a
+/// pressure and a deviatoric share, at a deformed `F`.
+#[test]
+fn a_node_block_is_the_contracted_point_tangent() {
+    let f = Mat3::new(1.1, 0.05, -0.02, 0.03, 0.93, 0.04, -0.01, 0.06, 1.04);
+    let g = Vec3::new(0.7, -1.3, 0.4);
+    for model in [MaterialModel::StVenantKirchhoff, MaterialModel::NeoHookean] {
+        let material = Material::new(model, 1.0e5, 0.45, 1000.0).unwrap();
+        let k_h = hydrostatic_stiffness_pa(&material);
+        let pt = point(&material, k_h, &f);
+        for (share, pressure) in [(1.0, 0.0), (0.1, 2.0e4), (0.1, -3.0e4)] {
+            let want =
+                crate::material::contract(&point_tangent(&material, k_h, share, pressure, &f, &pt, false), &g, &g);
+            let got = point_node_block(&material, k_h, share, pressure, &f, &pt, &g);
+            assert!((got - want).norm() <= 1e-9 * want.norm(), "{model:?} β {share} p {pressure}: {got} vs {want}");
+        }
+    }
+}
