@@ -382,6 +382,30 @@ fn an_implicit_blow_up_names_the_solver_and_keeps_the_last_finite_state() {
     }
 }
 
+/// The symptom of P3 mixed under VBD at ν = 0.4999 (the robustness family's cantilever blew up at
+/// frame 13): a node update that comes out non-finite from finite positions is the sweeps
+/// diverging, not bad input. VBD reports the step failed with its state restored, the step watch
+/// takes it again in halves and, when every halving diverges too (here a node thrown 10¹⁵⁰ m
+/// away, whose element's energy overflows), stops naming VBD's node; the positions stay finite.
+#[test]
+fn a_vbd_node_update_that_diverges_is_taken_again_in_halves_then_named() {
+    let mesh = beam(ElementType::from_name("p1").unwrap(), [2, 1, 1]);
+    let material = Material::new(MaterialModel::StVenantKirchhoff, 1.0e5, 0.3, 1000.0).unwrap();
+    let clamped = clamped_at_x0(&mesh);
+    let mut sim =
+        Simulation::new(mesh.clone(), material, implicit(Method::Vbd, 60.0), cantilever_effects(&clamped, 0.0))
+            .unwrap();
+    sim.step_frame().unwrap();
+    let node = mesh.num_nodes() - 1;
+    sim.positions[node].x = 1.0e150;
+    let err = sim.step_frame().unwrap_err().to_string();
+    assert!(err.contains("the vertex block update of node"), "{err}");
+    assert!(err.contains("halvings"), "{err}");
+    // the step and its first half at each of the six halvings
+    assert_eq!(sim.counters().rejected_steps, 7, "{err}");
+    assert!(sim.positions.iter().all(|p| p.iter().all(|c| c.is_finite())));
+}
+
 /// VBD's two-level correction (`vbd_coarse`) solves the slow bending its sweeps barely move: on
 /// a stiff P2 beam at 60 frames per second it settles in a fraction of the frames the paper's
 /// VBD alone needs (each with its fastest settle damping), on the same static solution.

@@ -120,6 +120,11 @@ pub(crate) trait StepSolver: Send {
     fn last_step_failed(&self) -> bool {
         false
     }
+    /// Why the last step failed, when the solver knows more than that it ended far from solved
+    /// (VBD: the node whose update diverged).
+    fn last_failure_why(&self) -> Option<String> {
+        None
+    }
     /// The step watch rejected the step that started at `time_secs` (it is taken again in halves).
     fn step_rejected(&mut self, _time_secs: f64) {}
     /// The policy a Newton-type solver's last step ran and why.

@@ -84,12 +84,13 @@ impl Simulation {
                     solver: self.settings.method.name(),
                     frame: self.frames + 1,
                     time_secs: self.time_secs + h,
-                    why: match gained {
-                        Some(growth) => format!(
+                    why: match (gained, self.solver.last_failure_why()) {
+                        (Some(growth), _) => format!(
                             "the step raised the energy of a body no effect does work on by {:.1} % of its scale",
                             100.0 * growth
                         ),
-                        None => "the unbalanced force stayed above a tenth of the load".into(),
+                        (None, Some(why)) => why,
+                        (None, None) => "the unbalanced force stayed above a tenth of the load".into(),
                     },
                     halvings,
                     h_secs: h,

@@ -102,6 +102,8 @@ pub(crate) struct Vbd {
     /// P1's node patches under the mixed formulation ([`patch`]), built at the first step that
     /// needs them.
     patches: Option<Patches>,
+    /// The node whose update diverged in the last step, if one did.
+    diverged_at: Option<u32>,
 }
 
 impl Vbd {
@@ -123,6 +125,7 @@ impl Vbd {
             coarse: CoarseSpace::for_settings(mesh, settings),
             failed: false,
             patches: None,
+            diverged_at: None,
         }
     }
 }
@@ -140,6 +143,11 @@ impl StepSolver for Vbd {
 
     fn last_step_failed(&self) -> bool {
         self.failed
+    }
+
+    fn last_failure_why(&self) -> Option<String> {
+        let node = self.diverged_at.filter(|_| self.failed)?;
+        Some(format!("the vertex block update of node {node} lost its positive-definite block or came out non-finite"))
     }
 
     fn begin_step(&mut self, velocities: &[Vec3]) {
@@ -178,6 +186,7 @@ impl StepSolver for Vbd {
     ) -> Result<(), BadElement> {
         let h = s.h;
         super::nan_guard::check_input(s.mesh, positions)?;
+        self.diverged_at = None;
         // the patches follow the material's formulation (a live switch to or from mixed)
         let wants_patches = crate::fem::energy::mixed::patch::has_patches(s.mesh, s.material);
         if !wants_patches || !self.patches.as_ref().is_some_and(|p| p.fits(s.mesh)) {
@@ -273,16 +282,32 @@ impl StepSolver for Vbd {
                 }
                 let lanes = LaneView::of(&mut self.lanes, s.material);
                 let parallel = s.settings.sweep.is_colour();
-                if let Some(p) = &mut self.patches {
-                    p.refresh(s.mesh, s.material, &lanes);
-                    let (view, colours) = p.view();
-                    for colour in colours {
-                        counters.node_updates +=
-                            sweep_colour(&update, colour, positions, &lanes, Some(&view), parallel)?;
+                let swept = match &mut self.patches {
+                    Some(p) => {
+                        p.refresh(s.mesh, s.material, &lanes);
+                        let (view, colours) = p.view();
+                        colours.iter().try_fold(0, |n, colour| {
+                            Ok::<_, BadElement>(
+                                n + sweep_colour(&update, colour, positions, &lanes, Some(&view), parallel)?,
+                            )
+                        })
                     }
-                } else {
-                    for colour in &self.colours {
-                        counters.node_updates += sweep_colour(&update, colour, positions, &lanes, None, parallel)?;
+                    None => self.colours.iter().try_fold(0, |n, colour| {
+                        Ok::<_, BadElement>(n + sweep_colour(&update, colour, positions, &lanes, None, parallel)?)
+                    }),
+                };
+                match swept {
+                    Ok(n) => counters.node_updates += n,
+                    Err(bad) => {
+                        // a node's block lost positive definiteness or its step came out
+                        // non-finite from finite input: the sweeps diverged (P3 mixed at
+                        // ν = 0.4999 under full node steps), which a shorter step cures, so the
+                        // step goes back to its start and is reported failed — the step watch
+                        // takes it again in halves and, failing that, stops naming the node
+                        positions.copy_from_slice(&self.y);
+                        self.failed = true;
+                        self.diverged_at = Some(bad.node);
+                        return Ok(());
                     }
                 }
                 if rho > 0.0 {
