@@ -382,16 +382,34 @@ pub fn driven_until_secs(effects: &[EffectSpec]) -> f64 {
 /// the hook and the bracket of issue #61 under 20 %.
 pub const VBD_LEAST_BOX_FILL: f64 = 0.5;
 
+/// The Poisson ratio from which VBD is said not to be the solver ([`solver_advice`]): on the
+/// robustness family's mixed cantilevers (release, AMD EPYC, session 37) VBD took 5.9 s on P2 and
+/// 37.1 s on P3 at ν = 0.499 against Newton's 0.2 s and 1.2 s, and 540 s and 479 s at 0.4999
+/// against 0.4 s and 2.9 s.
+pub const VBD_MOST_POISSON_RATIO: f64 = 0.499;
+
 /// What the app and `hox simulate` say when the solver chosen is not the one for this body (issue
 /// #61, item 3): VBD on a part from a mesh file that fills less than [`VBD_LEAST_BOX_FILL`] of its
 /// bounding box — a curved or hollow part — where its node-by-node sweeps settle far slower than
 /// Newton (the P2 tube: 208 frames and 9.6 s against Newton's 3.4 s in the same hour, session
 /// 23; issue #61's P2 bracket of 4,982 nodes: 219 frames and 8.3 s against 90 frames and 0.9 s,
 /// session 31 of docs/journal/performance.md); None otherwise.
+///
+/// And VBD on any body from [`VBD_MOST_POISSON_RATIO`] up: near incompressibility its node
+/// updates meet a volume that couples the nodes of each element (or patch), and its sweeps crawl.
 pub fn solver_advice(instance: &Instance) -> Option<String> {
     use crate::params::MeshKind;
     let sim = &instance.sim;
-    if sim.method() != hox_sim::solver::Method::Vbd || instance.scene.mesh_kind() == MeshKind::Box {
+    if sim.method() != hox_sim::solver::Method::Vbd {
+        return None;
+    }
+    let nu = sim.material().poisson_ratio;
+    if nu >= VBD_MOST_POISSON_RATIO {
+        return Some(format!(
+            "vbd is not the solver near incompressibility (ν = {nu}): its node-by-node sweeps crawl where the volume couples the nodes of each element (the robustness family's mixed P2 cantilever at ν = 0.4999: 540 s against Newton's 0.4 s on one thread); newton is (--solver newton)"
+        ));
+    }
+    if instance.scene.mesh_kind() == MeshKind::Box {
         return None;
     }
     let (lo, hi) = sim.mesh().bounding_box();

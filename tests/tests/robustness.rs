@@ -1423,7 +1423,6 @@ fn every_implicit_solver_on_inverted_starts() {
         &[
             "p1 vbd newmark",
             "p1 newton newmark",
-            "p2 vbd euler",
             "p2 vbd newmark",
             "p2 newton newmark",
             "p3 vbd newmark",
