@@ -68,7 +68,7 @@ struct Point {
 }
 
 /// The hydrostatic stiffness `k_h` (Pa).
-fn hydrostatic_stiffness_pa(material: &Material) -> f64 {
+pub fn hydrostatic_stiffness_pa(material: &Material) -> f64 {
     material.split_stiffness_pa()[1]
 }
 

@@ -190,7 +190,8 @@ impl StepSolver for Vbd {
         // the patches follow the material's formulation (a live switch to or from mixed)
         let wants_patches = crate::fem::energy::mixed::patch::has_patches(s.mesh, s.material);
         if !wants_patches || !self.patches.as_ref().is_some_and(|p| p.fits(s.mesh)) {
-            self.patches = if wants_patches { Patches::new(s.mesh, s.geometry, s.material) } else { None };
+            self.patches =
+                if wants_patches { Patches::new(s.mesh, s.geometry, s.material, &self.incidence) } else { None };
         }
         self.y.clear();
         self.y.extend_from_slice(positions);

@@ -23,7 +23,7 @@ use super::lanes::LaneView;
 use crate::Vec3;
 use crate::fem::energy::element_grads;
 use crate::fem::energy::mixed::patch::{
-    element_node_share, element_share_and_hydrostatic, hydrostatic_stiffness, is_patch_block, patch_energy,
+    element_node_share, element_share_and_hydrostatic, hydrostatic_stiffness_pa, is_patch_block, patch_energy,
     patch_node_share,
 };
 use crate::fem::geometry::BlockGeometry;
@@ -85,7 +85,12 @@ thread_local! {
 
 impl Patches {
     /// The patches of `mesh` under `material`, None when it has none.
-    pub(super) fn new(mesh: &Mesh, geometry: &[BlockGeometry], material: &Material) -> Option<Self> {
+    pub(super) fn new(
+        mesh: &Mesh,
+        geometry: &[BlockGeometry],
+        material: &Material,
+        incidence: &NodeIncidence,
+    ) -> Option<Self> {
         let patch_block: Vec<bool> = mesh.blocks.iter().map(|b| is_patch_block(b, material)).collect();
         if !patch_block.iter().any(|&p| p) {
             return None;
@@ -99,7 +104,6 @@ impl Patches {
                 count += block.len();
             }
         }
-        let incidence = NodeIncidence::new(mesh);
         let mut weight_m3 = vec![0.0; n];
         for (b, block) in mesh.blocks.iter().enumerate().filter(|(b, _)| patch_block[*b]) {
             for (e, nodes) in block.elements().enumerate() {
@@ -140,7 +144,7 @@ impl Patches {
             neighbour_start.push(neighbours.len() as u32);
             holding_start.push(holding.len() as u32);
         }
-        let colours = colour_two_apart(mesh, &incidence);
+        let colours = colour_two_apart(mesh, incidence);
         let fixed = Fixed {
             patch_block,
             offset,
@@ -250,7 +254,7 @@ impl PatchView<'_> {
     /// No other thread may access the elements holding node `i` or the means of its neighbours
     /// meanwhile (nodes of one colour lie more than two edges apart).
     pub(super) unsafe fn node_share(&self, material: &Material, i: usize, lanes: &[LaneView<'_>]) -> (Vec3, Mat3) {
-        let k_h = hydrostatic_stiffness(material);
+        let k_h = hydrostatic_stiffness_pa(material);
         let (neighbours, b_bar) = self.neighbours(i);
         let w = &self.patches.weight_m3;
         let (mut gradient, mut block) = (Vec3::zeros(), Mat3::zeros());

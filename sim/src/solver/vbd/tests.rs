@@ -140,7 +140,7 @@ fn a_node_s_patch_share_is_the_patch_energy_s_and_its_means_follow_the_node() {
     let fused = Fused::detect();
     let mut lanes = PointLanes::new(&mesh, &geometry);
     lanes.refresh(&mesh, &x, fused);
-    let mut patches = Patches::new(&mesh, &geometry, &material).expect("P1 mixed has patches");
+    let mut patches = Patches::new(&mesh, &geometry, &material, &incidence).expect("P1 mixed has patches");
     patches.refresh(&mesh, &material, &LaneView::of(&mut lanes, &material));
     {
         let means = crate::fem::energy::mixed::patch::NodeMeans::new(&mesh, &geometry, &material, &x);
@@ -180,7 +180,7 @@ fn a_node_s_patch_share_is_the_patch_energy_s_and_its_means_follow_the_node() {
     assert!(moved_any, "no move changed the energy");
     // the carried means are the means of the moved positions
     let means = crate::fem::energy::mixed::patch::NodeMeans::new(&mesh, &geometry, &material, &x);
-    let mut fresh = Patches::new(&mesh, &geometry, &material).unwrap();
+    let mut fresh = Patches::new(&mesh, &geometry, &material, &incidence).unwrap();
     lanes.refresh(&mesh, &x, fused);
     fresh.refresh(&mesh, &material, &LaneView::of(&mut lanes, &material));
     for (a, (&c, f)) in means.c_bar.iter().zip(&means.f_bar).enumerate() {

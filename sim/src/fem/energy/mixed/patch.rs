@@ -34,7 +34,8 @@
 //! displacements instead of `5.5 n`: the ratio that releases the mesh from locking (Bonet &
 //! Burton §2; Zienkiewicz, Taylor & Zhu, *The Finite Element Method*, §11.5 on the count).
 
-use super::{hydrostatic_stiffness_pa, point, point_node_block, point_tangent};
+pub use super::hydrostatic_stiffness_pa;
+use super::{point, point_node_block, point_tangent};
 use crate::Vec3;
 use crate::element::ReferenceShape;
 use crate::fem::energy::{PointBlocks, element_grads, gather};
@@ -335,11 +336,6 @@ pub fn patch_energy(material: &Material, weight_m3: f64, f_bar: &Mat3, c_bar: f6
     let k_h = hydrostatic_stiffness_pa(material);
     let pt = point(material, k_h, f_bar);
     weight_m3 * ((1.0 - ELEMENT_DEVIATORIC_SHARE) * pt.psi_d + 0.5 * k_h * c_bar * c_bar)
-}
-
-/// `k_h` (Pa), for [`NodeMeans::element_pressure_pa`].
-pub fn hydrostatic_stiffness(material: &Material) -> f64 {
-    hydrostatic_stiffness_pa(material)
 }
 
 /// Per node, the patch elements around it as indices into the patch elements in mesh order
